@@ -1,0 +1,250 @@
+"""Collision checking with python-fcl: the only module that imports ``fcl``.
+
+The robot's links are capsules (see :class:`plannerlab.robots.base.Robot`); obstacles are
+FCL boxes, cylinders and spheres. FCL objects are built once; each query only updates the
+link transforms. A vectorised pre-test (world-aligned bounding boxes of every link against
+every obstacle and every other link, over a whole batch of states) settles most pairs, so
+FCL is asked only about pairs whose boxes overlap.
+
+Pairs that are never checked: a fixed link against the scene (the base stands on its
+pedestal by design) and the robot's ``excluded_pairs`` (neighbours that always touch).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import fcl
+import numpy as np
+
+from plannerlab.paths import densify
+from plannerlab.robots.base import Array, Robot
+from plannerlab.scene import Box, Cylinder, Scene, Sphere
+
+
+@dataclass(frozen=True)
+class PathCheck:
+    """Outcome of checking a densified path.
+
+    Attributes:
+        valid: every checked state is collision-free.
+        states_checked: how many interpolated states were checked.
+        first_invalid_edge: index of the first waypoint edge with a collision (or None).
+        first_invalid_state: the first colliding interpolated state (or None).
+        pairs: the colliding pairs at that state (names).
+    """
+
+    valid: bool
+    states_checked: int
+    first_invalid_edge: int | None = None
+    first_invalid_state: Array | None = None
+    pairs: tuple[tuple[str, str], ...] = ()
+
+
+def _rotations_z_to(d: Array) -> Array:
+    """Rotation matrices (..., 3, 3) whose z axis is the unit vector d (..., 3)."""
+    helper = np.where(np.abs(d[..., :1]) < 0.9, [[1.0, 0.0, 0.0]], [[0.0, 1.0, 0.0]])
+    x = np.cross(helper, d)
+    x /= np.linalg.norm(x, axis=-1, keepdims=True)
+    y = np.cross(d, x)
+    return np.stack([x, y, d], axis=-1)
+
+
+class CollisionChecker:
+    """Validity, colliding pairs and distances for one robot in one scene.
+
+    Holds its own FCL objects and a count of the states it has checked
+    (``checks``); it is not thread-safe and not shared between trials.
+    """
+
+    def __init__(self, robot: Robot, scene: Scene) -> None:
+        self.robot = robot
+        self.scene = scene
+        self.checks = 0
+        self._radii = np.asarray(robot.link_radii_m, dtype=float)
+        L = len(self._radii)
+        self._n_links = L
+        self._link_names = tuple(robot.link_names)
+        # Reference lengths: capsules are rebuilt only if a link's length changes.
+        seg0 = robot.link_segments(np.clip(np.zeros(robot.dof), robot.lower, robot.upper))
+        self._lengths = np.linalg.norm(seg0[:, 1] - seg0[:, 0], axis=-1)
+        self._links = [
+            fcl.CollisionObject(fcl.Capsule(float(r), float(max(ln, 1e-9))), fcl.Transform())
+            for r, ln in zip(self._radii, self._lengths, strict=True)
+        ]
+        self._obstacles = [self._make_obstacle(o) for o in scene.obstacles]
+        self._obs_lo, self._obs_hi = scene.aabbs()
+        moving = np.array([i not in robot.fixed_links for i in range(L)])
+        self._scene_mask = moving[:, None] & np.ones((1, len(self._obstacles)), dtype=bool)
+        excluded = robot.excluded_pairs
+        pairs = [
+            (i, j)
+            for i in range(L)
+            for j in range(i + 1, L)
+            if (i, j) not in excluded and not (i in robot.fixed_links and j in robot.fixed_links)
+        ]
+        self._self_pairs = np.array(pairs, dtype=int).reshape(-1, 2)
+        self._request = fcl.CollisionRequest()
+        self._contact_request = fcl.CollisionRequest(num_max_contacts=1, enable_contact=True)
+        self._distance_request = fcl.DistanceRequest(enable_signed_distance=True)
+
+    # ------------------------------------------------------------------ building
+    @staticmethod
+    def _make_obstacle(o: Box | Cylinder | Sphere) -> fcl.CollisionObject:
+        if isinstance(o, Box):
+            geom = fcl.Box(*(float(s) for s in o.size_m))
+        elif isinstance(o, Cylinder):
+            geom = fcl.Cylinder(float(o.radius_m), float(o.length_m))
+        else:
+            geom = fcl.Sphere(float(o.radius_m))
+        T = o.T_world_obstacle
+        return fcl.CollisionObject(geom, fcl.Transform(T[:3, :3].copy(), T[:3, 3].copy()))
+
+    def _place(self, seg: Array) -> None:
+        """Move the FCL link capsules to the segments (L, 2, 3) of one state."""
+        a, b = seg[:, 0], seg[:, 1]
+        axis = b - a
+        lengths = np.linalg.norm(axis, axis=-1)
+        safe = np.where(lengths > 1e-12, lengths, 1.0)[:, None]
+        d = np.where(lengths[:, None] > 1e-12, axis / safe, [[0.0, 0.0, 1.0]])
+        R = _rotations_z_to(d)
+        centres = (a + b) / 2.0
+        changed = np.flatnonzero(np.abs(lengths - self._lengths) > 1e-9)
+        for i in changed:
+            self._lengths[i] = lengths[i]
+            self._links[i] = fcl.CollisionObject(
+                fcl.Capsule(float(self._radii[i]), float(max(lengths[i], 1e-9))), fcl.Transform()
+            )
+        for i, obj in enumerate(self._links):
+            obj.setTransform(fcl.Transform(R[i], centres[i]))
+
+    # ------------------------------------------------------------------ pre-test
+    def _candidates(self, segs: Array) -> tuple[Array, Array]:
+        """Pairs whose bounding boxes overlap, for a batch of segments (k, L, 2, 3).
+
+        Returns:
+            scene (k, L, n_obstacles) and self (k, n_self_pairs) boolean masks.
+        """
+        r = self._radii[None, :, None]
+        lo = np.minimum(segs[:, :, 0], segs[:, :, 1]) - r  # (k, L, 3)
+        hi = np.maximum(segs[:, :, 0], segs[:, :, 1]) + r
+        if len(self._obstacles):
+            scene = np.all(
+                (lo[:, :, None, :] <= self._obs_hi[None, None])
+                & (hi[:, :, None, :] >= self._obs_lo[None, None]),
+                axis=-1,
+            ) & self._scene_mask[None]
+        else:
+            scene = np.zeros(segs.shape[:2] + (0,), dtype=bool)
+        if len(self._self_pairs):
+            i, j = self._self_pairs[:, 0], self._self_pairs[:, 1]
+            selfc = np.all((lo[:, i] <= hi[:, j]) & (hi[:, i] >= lo[:, j]), axis=-1)
+        else:
+            selfc = np.zeros((segs.shape[0], 0), dtype=bool)
+        return scene, selfc
+
+    def _collide(self, o1: fcl.CollisionObject, o2: fcl.CollisionObject) -> bool:
+        return fcl.collide(o1, o2, self._request, fcl.CollisionResult()) > 0
+
+    def _state_pairs(self, seg: Array, scene: Array, selfc: Array,
+                     first_only: bool) -> list[tuple[int, int, bool]]:
+        """Colliding pairs of one state among the candidates: (link, other, other_is_link)."""
+        self._place(seg)
+        hits: list[tuple[int, int, bool]] = []
+        for li, oi in zip(*np.nonzero(scene), strict=True):
+            if self._collide(self._links[li], self._obstacles[oi]):
+                hits.append((int(li), int(oi), False))
+                if first_only:
+                    return hits
+        for p in np.flatnonzero(selfc):
+            i, j = self._self_pairs[p]
+            if self._collide(self._links[i], self._links[j]):
+                hits.append((int(i), int(j), True))
+                if first_only:
+                    return hits
+        return hits
+
+    # ------------------------------------------------------------------ queries
+    def valid_batch(self, Q: Array) -> np.ndarray:
+        """Validity of every state in Q (k, dof) -> (k,) bool. Counts k checks."""
+        Q = np.atleast_2d(np.asarray(Q, dtype=float))
+        segs = self.robot.link_segments(Q)
+        scene, selfc = self._candidates(segs)
+        valid = np.ones(len(Q), dtype=bool)
+        undecided = np.flatnonzero(scene.any(axis=(1, 2)) | selfc.any(axis=1))
+        for s in undecided:
+            valid[s] = not self._state_pairs(segs[s], scene[s], selfc[s], first_only=True)
+        self.checks += len(Q)
+        return valid
+
+    def is_valid(self, q: Array) -> bool:
+        """True when q (dof,) collides neither with the scene nor with itself."""
+        return bool(self.valid_batch(np.asarray(q, dtype=float)[None, :])[0])
+
+    def first_invalid(self, Q: Array) -> int | None:
+        """Index of the first invalid state of Q (k, dof), checking in order; None if all valid.
+
+        Counts only the states it had to look at.
+        """
+        Q = np.atleast_2d(np.asarray(Q, dtype=float))
+        segs = self.robot.link_segments(Q)
+        scene, selfc = self._candidates(segs)
+        undecided = np.flatnonzero(scene.any(axis=(1, 2)) | selfc.any(axis=1))
+        for s in undecided:
+            if self._state_pairs(segs[s], scene[s], selfc[s], first_only=True):
+                self.checks += int(s) + 1
+                return int(s)
+        self.checks += len(Q)
+        return None
+
+    def colliding_pairs(self, q: Array) -> tuple[tuple[str, str], ...]:
+        """Every colliding pair at q: (link name, obstacle name) or (link name, link name)."""
+        seg = self.robot.link_segments(np.asarray(q, dtype=float))
+        scene, selfc = self._candidates(seg[None])
+        hits = self._state_pairs(seg, scene[0], selfc[0], first_only=False)
+        self.checks += 1
+        names = self.scene.names
+        return tuple(
+            (self._link_names[a], self._link_names[b] if is_link else names[b])
+            for a, b, is_link in hits
+        )
+
+    def clearance(self, q: Array, include_self: bool = True) -> float:
+        """Smallest signed distance [m] over every checked pair; negative = penetration.
+
+        Exact for every pair (no pre-test), so slower than :meth:`is_valid`.
+        """
+        seg = self.robot.link_segments(np.asarray(q, dtype=float))
+        self._place(seg)
+        best = np.inf
+        for li in range(self._n_links):
+            if li in self.robot.fixed_links:
+                continue
+            for obj in self._obstacles:
+                best = min(best, self._signed_distance(self._links[li], obj))
+        if include_self:
+            for i, j in self._self_pairs:
+                best = min(best, self._signed_distance(self._links[i], self._links[j]))
+        self.checks += 1
+        return float(best)
+
+    def _signed_distance(self, o1: fcl.CollisionObject, o2: fcl.CollisionObject) -> float:
+        res = fcl.CollisionResult()
+        if fcl.collide(o1, o2, self._contact_request, res) > 0:
+            return -max((c.penetration_depth for c in res.contacts), default=0.0)
+        return float(fcl.distance(o1, o2, self._distance_request, fcl.DistanceResult()))
+
+    def check_path(self, path: Array, joint_step: float) -> PathCheck:
+        """Check every state of a path densified to at most ``joint_step`` per joint."""
+        states, owners = densify(path, joint_step, self.robot.continuous)
+        bad = self.first_invalid(states)
+        if bad is None:
+            return PathCheck(valid=True, states_checked=len(states))
+        q_bad = states[bad]
+        return PathCheck(
+            valid=False,
+            states_checked=bad + 1,
+            first_invalid_edge=int(owners[bad]),
+            first_invalid_state=q_bad,
+            pairs=self.colliding_pairs(q_bad),
+        )

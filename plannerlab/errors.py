@@ -1,0 +1,44 @@
+"""The project's exceptions. Every error a user can cause is a `PlannerlabError`."""
+
+from __future__ import annotations
+
+import difflib
+from collections.abc import Iterable
+
+
+class PlannerlabError(Exception):
+    """Base class of every error plannerlab raises on purpose."""
+
+
+class ProblemError(PlannerlabError):
+    """A problem file or problem definition is invalid.
+
+    The message names the file, the key and what was expected.
+    """
+
+    def __init__(self, source: str, key: str, expected: str) -> None:
+        self.source = source
+        self.key = key
+        self.expected = expected
+        super().__init__(f"{source}: [{key}] {expected}")
+
+
+class UnknownNameError(PlannerlabError, KeyError):
+    """A name (planner, problem, robot type, obstacle type) that does not exist."""
+
+    def __init__(self, kind: str, name: str, known: Iterable[str]) -> None:
+        self.kind = kind
+        self.name = name
+        self.known = sorted(known)
+        close = difflib.get_close_matches(name, self.known, n=3, cutoff=0.5)
+        hint = f" did you mean {', '.join(repr(c) for c in close)}?" if close else ""
+        listing = ", ".join(self.known)
+        msg = f"unknown {kind} {name!r};{hint} known: {listing}"
+        super().__init__(msg)
+
+    def __str__(self) -> str:  # KeyError would quote the message
+        return str(self.args[0])
+
+
+class PlanFileError(PlannerlabError):
+    """A saved plan (JSON) cannot be read back."""

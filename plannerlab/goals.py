@@ -1,0 +1,77 @@
+"""Goal regions: a target position and surface normal, each with a tolerance.
+
+A state q is in the region when the robot's tip is within ``pos_tol_m`` of ``p_world_m``
+and the tip normal is within ``angle_tol_deg`` of ``n_world``. The normalised goal
+distance (position error / pos_tol + angle error / angle_tol) is what sampling planners
+steer by: below 1 in both terms means inside.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from plannerlab.robots.base import Array, Robot
+
+
+@dataclass(frozen=True, eq=False)
+class GoalRegion:
+    """A target position + normal with tolerances.
+
+    Args:
+        name: label of the leg's goal ("A", "enter", …).
+        p_world_m: (3,) target tip position [m].
+        n_world: (3,) target tip normal, unit length.
+        pos_tol_m: position tolerance [m], > 0.
+        angle_tol_deg: angle tolerance between tip normal and target normal [deg], > 0.
+    """
+
+    name: str
+    p_world_m: Array
+    n_world: Array
+    pos_tol_m: float
+    angle_tol_deg: float
+
+    def __post_init__(self) -> None:
+        p = np.array(self.p_world_m, dtype=float).reshape(3)
+        n = np.array(self.n_world, dtype=float).reshape(3)
+        if not (np.all(np.isfinite(p)) and np.all(np.isfinite(n))):
+            raise ValueError("goal position and normal must be finite")
+        norm = float(np.linalg.norm(n))
+        if norm < 1e-9:
+            raise ValueError("goal normal must not be zero")
+        n = n / norm
+        p.setflags(write=False)
+        n.setflags(write=False)
+        object.__setattr__(self, "p_world_m", p)
+        object.__setattr__(self, "n_world", n)
+        if not (self.pos_tol_m > 0 and np.isfinite(self.pos_tol_m)):
+            raise ValueError("pos_tol_m must be a positive number")
+        if not (self.angle_tol_deg > 0 and np.isfinite(self.angle_tol_deg)):
+            raise ValueError("angle_tol_deg must be a positive number")
+
+    def errors(self, robot: Robot, q: Array) -> tuple[Array, Array]:
+        """Position error [m] and angle error [deg] of q (dof,) or (k, dof)."""
+        p, n = robot.tip(q)
+        return self.errors_from_tip(p, n)
+
+    def errors_from_tip(self, p_world_m: Array, n_world: Array) -> tuple[Array, Array]:
+        """Position error [m] and angle error [deg] of a tip pose (3,) or (k, 3)."""
+        pos_err = np.linalg.norm(np.asarray(p_world_m) - self.p_world_m, axis=-1)
+        cosang = np.clip(np.asarray(n_world) @ self.n_world, -1.0, 1.0)
+        return pos_err, np.degrees(np.arccos(cosang))
+
+    def contains(self, robot: Robot, q: Array) -> Array:
+        """True where q is inside both tolerances (scalar bool for one q)."""
+        pos_err, ang_err = self.errors(robot, q)
+        return (pos_err <= self.pos_tol_m) & (ang_err <= self.angle_tol_deg)
+
+    def distance(self, robot: Robot, q: Array) -> Array:
+        """Normalised goal distance: max(pos_err/pos_tol, angle_err/angle_tol) - 1 clipped at 0.
+
+        Zero exactly inside the region; grows with the larger of the two scaled errors.
+        """
+        pos_err, ang_err = self.errors(robot, q)
+        scaled = np.maximum(pos_err / self.pos_tol_m, ang_err / self.angle_tol_deg)
+        return np.maximum(scaled - 1.0, 0.0)

@@ -1,0 +1,51 @@
+"""Joint-space path utilities shared by planners, the checker and execution."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from plannerlab.robots.base import Array, joint_difference
+
+
+def edge_steps(q_a: Array, q_b: Array, joint_step: float, continuous: np.ndarray) -> int:
+    """Number of intervals so that no joint moves more than ``joint_step`` per interval."""
+    d = np.abs(joint_difference(q_b, q_a, continuous))
+    return max(1, int(np.ceil(float(np.max(d, initial=0.0)) / joint_step - 1e-12)))
+
+
+def interpolate_edge(q_a: Array, q_b: Array, joint_step: float, continuous: np.ndarray) -> Array:
+    """States from q_a to q_b inclusive, at most ``joint_step`` apart per joint: (m, dof).
+
+    Continuous joints go the short way round and are not wrapped here (callers that
+    need [-pi, pi) wrap themselves; kinematics do not care).
+    """
+    n = edge_steps(q_a, q_b, joint_step, continuous)
+    d = joint_difference(q_b, q_a, continuous)
+    t = np.linspace(0.0, 1.0, n + 1)[:, None]
+    return np.asarray(q_a, dtype=float)[None, :] + t * d[None, :]
+
+
+def densify(path: Array, joint_step: float, continuous: np.ndarray) -> tuple[Array, Array]:
+    """A path (m, dof) densified edge by edge.
+
+    Returns:
+        states (M, dof) and, for each, the index of the waypoint edge it belongs to.
+    """
+    path = np.atleast_2d(np.asarray(path, dtype=float))
+    if len(path) == 1:
+        return path.copy(), np.zeros(1, dtype=int)
+    chunks, owners = [path[:1]], [np.zeros(1, dtype=int)]
+    for i in range(len(path) - 1):
+        pts = interpolate_edge(path[i], path[i + 1], joint_step, continuous)[1:]
+        chunks.append(pts)
+        owners.append(np.full(len(pts), i, dtype=int))
+    return np.concatenate(chunks), np.concatenate(owners)
+
+
+def path_length(path: Array, continuous: np.ndarray) -> float:
+    """Sum of joint-space Euclidean edge lengths (wrapping continuous joints)."""
+    path = np.atleast_2d(np.asarray(path, dtype=float))
+    if len(path) < 2:
+        return 0.0
+    d = joint_difference(path[1:], path[:-1], continuous)
+    return float(np.sum(np.linalg.norm(d, axis=1)))

@@ -1,0 +1,110 @@
+"""The planner registry: planners are looked up by name and imported on first use.
+
+An entry maps a name to ``"module:factory"``; the factory is called as
+``factory(name, overrides)`` and returns a planner with frozen settings. OMPL planners
+are all served by :mod:`plannerlab.planners.ompl` (the only module importing ``ompl``).
+"""
+
+from __future__ import annotations
+
+import importlib
+from collections.abc import Mapping
+from dataclasses import dataclass
+from types import MappingProxyType
+from typing import Any
+
+from plannerlab.errors import UnknownNameError
+from plannerlab.planners.base import Planner, PlanResult, Status, Stepper
+
+
+@dataclass(frozen=True)
+class PlannerEntry:
+    """One registered planner.
+
+    Attributes:
+        name: registry name (``gradient``, ``ompl.rrtconnect``, …).
+        target: ``"module:factory"``, imported lazily.
+        summary: one line for ``plannerlab planners``.
+        needs_stepper: the planner runs a simulator in its loop (closed-loop modes).
+        robots: robot kinds it applies to (None: every joint-vector robot).
+    """
+
+    name: str
+    target: str
+    summary: str
+    needs_stepper: bool = False
+    robots: tuple[str, ...] | None = None
+
+
+#: OMPL geometric planners shipped in the ``ompl`` wheel: registry suffix -> OMPL class
+OMPL_PLANNERS: Mapping[str, str] = MappingProxyType({
+    "rrtconnect": "RRTConnect",
+    "rrt": "RRT",
+    "rrtstar": "RRTstar",
+    "informedrrtstar": "InformedRRTstar",
+    "sorrtstar": "SORRTstar",
+    "kpiece1": "KPIECE1",
+    "bkpiece1": "BKPIECE1",
+    "lbkpiece1": "LBKPIECE1",
+    "prm": "PRM",
+    "prmstar": "PRMstar",
+    "bitstar": "BITstar",
+    "fmt": "FMT",
+    "bfmt": "BFMT",
+    "aorrtc": "AORRTC",
+})
+
+
+def _entries() -> dict[str, PlannerEntry]:
+    entries = [
+        PlannerEntry("gradient", "plannerlab.planners.gradient:make",
+                     "the Arm-Z paper's gradient method, faithful (finite differences, "
+                     "kinematic steps)"),
+        PlannerEntry("gradient.closed_loop", "plannerlab.planners.gradient:make",
+                     "the paper's gradient method with PyBullet in the loop (100 steps of "
+                     "1/240 s per iteration)", needs_stepper=True),
+        PlannerEntry("gradient.analytic", "plannerlab.planners.gradient:make",
+                     "faster variant: analytic Jacobian gradient, penalty by clearance, "
+                     "step rejected on collision"),
+    ]
+    for suffix, cls in OMPL_PLANNERS.items():
+        entries.append(PlannerEntry(f"ompl.{suffix}", "plannerlab.planners.ompl:make",
+                                    f"OMPL {cls} (geometric)"))
+    return {e.name: e for e in entries}
+
+
+#: every planner by name (read-only)
+REGISTRY: Mapping[str, PlannerEntry] = MappingProxyType(_entries())
+
+
+def planner_names() -> tuple[str, ...]:
+    return tuple(REGISTRY)
+
+
+def get_entry(name: str) -> PlannerEntry:
+    """The registry entry for ``name``; an unknown name lists the close matches."""
+    try:
+        return REGISTRY[name]
+    except KeyError:
+        raise UnknownNameError("planner", name, REGISTRY) from None
+
+
+def make_planner(name: str, overrides: Mapping[str, Any] | None = None) -> Planner:
+    """A planner by registry name, with some settings overridden."""
+    entry = get_entry(name)
+    module_name, factory = entry.target.split(":")
+    return getattr(importlib.import_module(module_name), factory)(name, dict(overrides or {}))
+
+
+__all__ = [
+    "OMPL_PLANNERS",
+    "REGISTRY",
+    "PlanResult",
+    "Planner",
+    "PlannerEntry",
+    "Status",
+    "Stepper",
+    "get_entry",
+    "make_planner",
+    "planner_names",
+]

@@ -1,0 +1,229 @@
+"""The Arm-Z paper's gradient method (``000_a8ed938e94518caf.txt``, §3.1).
+
+    S ← S_0
+    while f(S) ≥ ε:
+        S_{t+1} ← S_t − γ ∇f(S_t)
+        posctrltowards(S_{t+1})        # 100 PyBullet steps of 1/240 s
+
+with γ = 0.05, ε = 0.5, r1 = r2 = 1 and ∇f by finite differences
+(``scipy.optimize.approx_fprime``). Three registered variants:
+
+``gradient`` (kinematic, faithful objective and gradient)
+    The next state is S − γ∇f. Without a simulator nothing stops the arm from stepping
+    into an obstacle, and A(S) is invisible to a finite-difference gradient (every
+    perturbed state collides too, so the penalty cancels). The kinematic mode therefore
+    does what the simulator's contacts do: the arm moves along the straight joint-space
+    segment towards S − γ∇f and stops at the last collision-free state (checked every
+    ``problem.joint_step``). Blocked steps make f flat, which the stall detector sees.
+``gradient.closed_loop`` (faithful, the paper's loop)
+    ``posctrltowards`` is a :class:`~plannerlab.planners.base.Stepper` (PyBullet through
+    :mod:`plannerlab.sim`): 100 steps of position control towards S − γ∇f, and the next
+    iteration starts from the state the simulator actually reached.
+``gradient.analytic`` (faster)
+    As ``gradient`` but ∇f from the analytic tip Jacobians: one kinematics call instead of
+    dof + 1 objective evaluations (each with a collision check) per iteration. Away from
+    obstacle boundaries it is the gradient approx_fprime estimates.
+
+Stopping: the common goal region of the problem (position and angle tolerances) decides
+success for every planner, so results compare. With ``stop_at_epsilon = True`` the loop
+also stops as in the paper when f < ε (status ``approximate`` if that is outside the
+region). A **stall** is declared when the best f has not improved by more than
+``stall_min_decrease`` over ``stall_window`` iterations while f ≥ ε: status
+``local_minimum`` with the state and iteration.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.optimize import approx_fprime
+
+from plannerlab.collision import CollisionChecker
+from plannerlab.errors import PlannerlabError
+from plannerlab.objective import Objective
+from plannerlab.paths import interpolate_edge
+from plannerlab.planners.base import (
+    Deadline,
+    PlanResult,
+    Status,
+    Stepper,
+    settings_dict,
+    with_overrides,
+)
+from plannerlab.robots.base import Array, wrap_to_pi
+
+
+@dataclass(frozen=True)
+class GradientSettings:
+    """Settings of the gradient method (defaults: the paper's).
+
+    Attributes:
+        gamma: step factor γ (paper: 0.05).
+        epsilon: the paper's goal threshold ε on f (0.5); also the level above which a
+            flat f counts as a stall.
+        r1, r2: weights of position and normal terms (1, 1).
+        penalty: A(S) for a colliding S (1e5).
+        gradient: "finite_difference" (approx_fprime) or "analytic".
+        fd_step: approx_fprime's epsilon [rad] (scipy's default, sqrt of machine epsilon).
+        mode: "kinematic" or "closed_loop" (needs a stepper).
+        sim_steps: simulator steps per iteration in closed loop (100 of 1/240 s).
+        stall_window: iterations without improvement that make a stall.
+        stall_min_decrease: improvement of the best f that resets the stall window.
+        stop_at_epsilon: also stop when f < ε, as the paper's loop does.
+        max_step_rad: 0 = no limit (faithful); else each joint's step is clipped to it.
+    """
+
+    gamma: float = 0.05
+    epsilon: float = 0.5
+    r1: float = 1.0
+    r2: float = 1.0
+    penalty: float = 1e5
+    gradient: str = "finite_difference"
+    fd_step: float = float(np.sqrt(np.finfo(float).eps))
+    mode: str = "kinematic"
+    sim_steps: int = 100
+    stall_window: int = 60
+    stall_min_decrease: float = 1e-3
+    stop_at_epsilon: bool = False
+    max_step_rad: float = 0.0
+
+    def __post_init__(self) -> None:
+        if self.gradient not in ("finite_difference", "analytic"):
+            raise PlannerlabError(
+                f"gradient setting: 'finite_difference' or 'analytic', got {self.gradient!r}")
+        if self.mode not in ("kinematic", "closed_loop"):
+            raise PlannerlabError(f"mode setting: 'kinematic' or 'closed_loop', got {self.mode!r}")
+        if not self.gamma > 0:
+            raise PlannerlabError(f"gamma must be > 0, got {self.gamma}")
+        if self.stall_window < 2:
+            raise PlannerlabError(f"stall_window must be >= 2, got {self.stall_window}")
+
+
+VARIANTS: dict[str, dict[str, object]] = {
+    "gradient": {},
+    "gradient.closed_loop": {"mode": "closed_loop"},
+    "gradient.analytic": {"gradient": "analytic"},
+}
+
+
+class GradientPlanner:
+    """The gradient method as a plannerlab planner (see the module docstring)."""
+
+    def __init__(self, name: str, settings: GradientSettings) -> None:
+        self.name = name
+        self.settings = settings
+
+    # ------------------------------------------------------------------ pieces
+    def objective(self, problem, leg: int, checker: CollisionChecker | None) -> Objective:
+        """The objective f for one leg (build, then solve)."""
+        s = self.settings
+        return Objective(problem.robot, problem.goal(leg), checker, s.r1, s.r2, s.penalty)
+
+    def gradient(self, f: Objective, q: Array) -> Array:
+        if self.settings.gradient == "analytic":
+            return f.smooth_gradient(q)
+        return approx_fprime(q, f, self.settings.fd_step)
+
+    def _advance_kinematic(self, problem, checker: CollisionChecker, q: Array,
+                           q_target: Array) -> tuple[Array, bool]:
+        """Move along q → q_target up to the last collision-free state (blocked by contact)."""
+        states = interpolate_edge(q, q_target, problem.joint_step, problem.robot.continuous)[1:]
+        bad = checker.first_invalid(states)
+        if bad is None:
+            return states[-1], False
+        return (states[bad - 1] if bad > 0 else q), True
+
+    # ------------------------------------------------------------------ solve
+    def solve(self, problem, leg: int, budget, rng: np.random.Generator,
+              q_start: Array | None = None, stepper: Stepper | None = None) -> PlanResult:
+        """Descend f from q_start (default: the problem's start) towards leg's goal.
+
+        ``rng`` is unused: the method is deterministic (kept for the common signature).
+        """
+        del rng
+        s = self.settings
+        t0 = time.perf_counter()
+        robot = problem.robot
+        goal = problem.goal(leg)
+        checker = CollisionChecker(robot, problem.scene)
+        q = np.array(problem.q_start if q_start is None else q_start, dtype=float)
+        f = self.objective(problem, leg, checker)
+        deadline = Deadline(budget, checker)
+        closed = s.mode == "closed_loop"
+        if closed:
+            if stepper is None:
+                raise PlannerlabError(
+                    f"{self.name} runs PyBullet in its loop: pass a stepper (plannerlab.sim)")
+            stepper.reset(q)
+
+        def result(status: Status, reason: str, path: list[Array], trace: list[float],
+                   iterations: int, minima: int = 0, extra: dict | None = None) -> PlanResult:
+            pos_err, ang_err = goal.errors(robot, path[-1])
+            return PlanResult(
+                planner=self.name, problem=problem.name, leg=leg, goal=goal.name,
+                status=status, reason=reason, path=np.array(path),
+                time_s=time.perf_counter() - t0, iterations=iterations,
+                collision_checks=checker.checks, fk_calls=f.evaluations,
+                pos_err_m=float(pos_err), angle_err_deg=float(ang_err),
+                trace=np.array(trace), local_minima=minima, escapes=0,
+                settings=settings_dict(s), extra=extra or {},
+            )
+
+        if not checker.is_valid(q):
+            pairs = ", ".join(f"{a} x {b}" for a, b in checker.colliding_pairs(q))
+            return result(Status.INVALID_START, f"start in collision: {pairs}", [q], [], 0)
+
+        path = [q.copy()]
+        value = f(q)
+        trace = [value]
+        best, best_iter = value, 0
+        blocked_steps = 0
+        iteration = 0
+        while True:
+            if goal.contains(robot, q):
+                return result(Status.SOLVED, f"in the goal region after {iteration} iterations",
+                              path, trace, iteration)
+            if s.stop_at_epsilon and value < s.epsilon:
+                return result(Status.APPROXIMATE,
+                              f"f = {value:.3g} < epsilon = {s.epsilon} but outside the goal "
+                              f"region", path, trace, iteration)
+            if value >= s.epsilon and iteration - best_iter >= s.stall_window:
+                return result(
+                    Status.LOCAL_MINIMUM,
+                    f"stalled at iteration {iteration}: best f = {best:.4g} has not improved by "
+                    f"{s.stall_min_decrease} in {s.stall_window} iterations "
+                    f"({blocked_steps} steps blocked by contact)",
+                    path, trace, iteration, minima=1,
+                    extra={"stall_iteration": iteration, "q_stall": q.tolist(),
+                           "blocked_steps": blocked_steps})
+            exhausted = deadline.exhausted(iteration)
+            if exhausted:
+                return result(Status.BUDGET_EXHAUSTED, exhausted, path, trace, iteration)
+
+            step = s.gamma * self.gradient(f, q)
+            if s.max_step_rad > 0:
+                step = np.clip(step, -s.max_step_rad, s.max_step_rad)
+            q_target = q - step
+            if closed:
+                q_next = wrap_to_pi(stepper.move_towards(q_target, s.sim_steps), robot.continuous)
+            else:
+                q_next, blocked = self._advance_kinematic(problem, checker, q, q_target)
+                blocked_steps += int(blocked)
+                q_next = wrap_to_pi(q_next, robot.continuous)
+            iteration += 1
+            q = q_next
+            value = f(q)
+            path.append(q.copy())
+            trace.append(value)
+            if value < best - s.stall_min_decrease:
+                best, best_iter = value, iteration
+
+
+def make(name: str, overrides: dict) -> GradientPlanner:
+    """Registry factory for ``gradient``, ``gradient.closed_loop``, ``gradient.analytic``."""
+    if name not in VARIANTS:
+        raise PlannerlabError(f"{name} is not a gradient variant ({', '.join(VARIANTS)})")
+    base = GradientSettings(**VARIANTS[name])  # type: ignore[arg-type]
+    return GradientPlanner(name, with_overrides(base, overrides, name))
