@@ -15,6 +15,7 @@ File layout (every key is documented in ``docs/problem-format.md``)::
     [[goals]]   name, p_m, n, pos_tol_m, angle_tol_deg     (one per leg, in order)
     [budget]    max_iterations, max_collision_checks, time_limit_s
     [checking]  joint_step       (largest joint step between checked states on an edge)
+    [simulation] gravity_mps2
     any other table (e.g. [witness], [continuum]) is kept in ``Problem.extras``.
 """
 
@@ -35,7 +36,8 @@ from plannerlab.robots import build_robot
 from plannerlab.robots.base import Array, Robot, pose_matrix
 from plannerlab.scene import OBSTACLE_TYPES, Box, Cylinder, Obstacle, Scene, Sphere
 
-KNOWN_TABLES = ("problem", "robot", "start", "obstacles", "goals", "budget", "checking")
+KNOWN_TABLES = ("problem", "robot", "start", "obstacles", "goals", "budget", "checking",
+                "simulation")
 
 
 @dataclass(frozen=True, eq=False)
@@ -66,6 +68,17 @@ class Budget:
         }
 
 
+@dataclass(frozen=True)
+class SimSettings:
+    """How the problem is simulated when paths are executed (PyBullet).
+
+    Attributes:
+        gravity_mps2: gravity in the world frame [m/s²].
+    """
+
+    gravity_mps2: tuple[float, float, float] = (0.0, 0.0, -9.81)
+
+
 @dataclass(frozen=True, eq=False)
 class Problem:
     """A planning problem. Leg ``i`` goes from the end of leg ``i - 1`` (or the start) to
@@ -79,6 +92,7 @@ class Problem:
     budget: Budget = field(default_factory=Budget)
     joint_step: float = 0.05
     description: str = ""
+    simulation: SimSettings = field(default_factory=SimSettings)
     source: str = "<memory>"
     extras: Mapping[str, Any] = field(default_factory=dict)
 
@@ -295,6 +309,12 @@ def problem_from_dict(data: Mapping[str, Any], source: str) -> Problem:
     c.unknown_keys(("joint_step",))
     joint_step = c.number("joint_step", 0.05, positive=True)
 
+    sim = TableReader(source, "simulation", top.raw("simulation", {}))
+    sim.unknown_keys(("gravity_mps2", "note"))
+    simulation = SimSettings(
+        gravity_mps2=tuple(float(v) for v in sim.vector("gravity_mps2", 3, (0.0, 0.0, -9.81)))
+    )
+
     extras = {k: v for k, v in data.items() if k not in KNOWN_TABLES}
     return Problem(
         name=name,
@@ -305,6 +325,7 @@ def problem_from_dict(data: Mapping[str, Any], source: str) -> Problem:
         budget=budget,
         joint_step=joint_step,
         description=description,
+        simulation=simulation,
         source=source,
         extras=extras,
     )

@@ -129,7 +129,9 @@ def solve_legs(
         if entry.needs_stepper:
             from plannerlab.sim import SimWorld
 
-            stepper = stack.enter_context(SimWorld(problem, gui=gui))
+            stepper = stack.enter_context(
+                SimWorld(problem.robot, problem.scene, gui=gui,
+                         gravity_mps2=problem.simulation.gravity_mps2))
         q = None  # the first leg starts at the problem's start state
         for leg in legs:
             r = planner.solve(problem, leg, budget, leg_rng(seed, leg), q_start=q,

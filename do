@@ -1,0 +1,32 @@
+#!/usr/bin/env bash
+# One entry point for set-up and the two jobs. Creates .venv (Python 3.11+) if it is
+# missing or if pyproject.toml changed since it was made, then runs the job.
+#   ./do main    the main job: planners compared on the Arm-Z paper's problem
+#   ./do test    the test suite (what CI runs)
+#   ./do bench   the speed benchmarks (bench/)
+set -euo pipefail
+cd "$(dirname "$0")"
+PY=${PYTHON:-python3}
+VENV=.venv
+stamp="$VENV/.installed-$(sha1sum pyproject.toml | cut -c1-12)"
+if [ ! -x "$VENV/bin/python" ] || [ ! -f "$stamp" ]; then
+  echo "setting up $VENV (once; a few minutes on a fresh machine)" >&2
+  "$PY" -m venv "$VENV"
+  "$VENV/bin/python" -m pip install --quiet --upgrade pip
+  "$VENV/bin/python" -m pip install --quiet -e ".[test]"
+  rm -f "$VENV"/.installed-*
+  touch "$stamp"
+fi
+export MPLBACKEND=Agg
+job=${1:-main}
+shift || true
+case "$job" in
+  main)
+    exec "$VENV/bin/plannerlab" execute armz_inspection --planner gradient --seed 0 "$@" ;;
+  test)
+    exec "$VENV/bin/python" -m pytest -q "$@" ;;
+  bench)
+    for b in bench/*.py; do "$VENV/bin/python" "$b" "$@"; done ;;
+  *)
+    echo "usage: ./do main|test|bench [args]" >&2; exit 2 ;;
+esac

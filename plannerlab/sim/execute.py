@@ -1,0 +1,561 @@
+"""Executing planned paths in PyBullet and reporting what really happened.
+
+:func:`execute` takes a problem and a joint path (m, dof) and
+
+1. re-checks the path with the FCL :class:`~plannerlab.collision.CollisionChecker` at a
+   finer resolution than planners use (``problem.joint_step / 4`` by default), before any
+   simulation, and records the verdict and the colliding pairs;
+2. drives the simulated robot along it by position control with the Arm-Z paper's
+   parameters (``000_a8ed938e94518caf.txt``: 1/240 s steps, 100 N·m motors, gravity on;
+   see :mod:`plannerlab.sim.world`), logging the state reached at every waypoint, the
+   tracking error and every contact;
+3. measures the final tip error against the leg's goal.
+
+Decisions:
+
+* **Steps per waypoint.** The path is densified to ``problem.joint_step`` per joint and
+  every densified waypoint is commanded for ``steps_per_waypoint`` steps (default
+  :data:`STEPS_PER_WAYPOINT` = 24, i.e. 0.1 s: Arm-Z's 0.02 rad waypoints at 0.2 rad/s),
+  then the last waypoint is held for ``settle_steps`` (default :data:`SETTLE_STEPS` = 240,
+  1 s). The paper's 100 steps per command belong to its gradient loop, whose commands are
+  whole gradient steps. Fewer steps are not safe with the paper's 100 N·m motors: on a
+  straight-segment path moving all 23 joints of the 24-module arm at once, 10 steps per
+  waypoint (0.48 rad/s) left the arm 0.9 rad behind and still 0.46 rad off after settling;
+  20 steps gave 0.036 rad, 24 steps 0.024 rad. The base joints carry the whole arm and
+  saturate first.
+* **Contacts.** Contacts are read after every physics step. A point counts when its
+  penetration depth exceeds ``contact_tol_m`` (default :data:`CONTACT_TOL_M` = 0, i.e.
+  PyBullet's contact distance < 0: real penetration; the points PyBullet reports up to its
+  contact-breaking threshold apart are ignored). No larger tolerance is used because
+  PyBullet resolves contacts stiffly: an 8-module arm driven into a wall at 100 N·m
+  penetrates it by only about 1e-5 m, so a 1 mm threshold would miss a real collision.
+  Contacts are aggregated per (link, other) pair: the largest depth, where it was, and the
+  simulated time the pair was first seen.
+* **Errors.** Tracking error per waypoint = max over joints of the wrapped
+  |q_cmd − q_actual| [rad]; tip tracking error = distance between the tips of the
+  commanded and actual states [m] (forward kinematics of the robot model).
+* **Gravity and torque limits.** A path the FCL re-check passes can still fail here: the
+  paper's 100 N·m motors cannot hold poses whose static gravity torque is larger (a
+  200-waypoint 24-module path through poses needing up to 285 N·m sagged by 3 rad onto
+  the room floor). ``gravity_mps2=(0, 0, 0)`` separates such failures from kinematic ones.
+* **Success** = the path passed the re-check, no contact was recorded and, when a leg was
+  given, the final state lies inside that leg's goal region.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+import time
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from plannerlab.collision import CollisionChecker
+from plannerlab.errors import PlannerlabError
+from plannerlab.paths import densify
+from plannerlab.problem import Problem
+from plannerlab.robots.base import Array, joint_difference
+from plannerlab.sim.world import SimWorld
+
+#: physics steps per densified waypoint (0.1 s)
+STEPS_PER_WAYPOINT: int = 24
+#: physics steps holding the last waypoint at the end (1 s)
+SETTLE_STEPS: int = 240
+#: penetration depth above which a contact point counts [m]
+CONTACT_TOL_M: float = 0.0
+
+
+@dataclass(frozen=True)
+class ContactRecord:
+    """One (robot link, other) pair that was in contact during an execution.
+
+    Attributes:
+        link_name: robot link.
+        other_name: obstacle name, or the other robot link when ``other_is_link``.
+        other_is_link: True for self-contact.
+        max_depth_m: largest penetration depth seen [m].
+        first_time_s: simulated time the pair was first seen, from the leg's start [s].
+        p_world_m: (3,) contact point at the largest depth, world frame [m].
+    """
+
+    link_name: str
+    other_name: str
+    other_is_link: bool
+    max_depth_m: float
+    first_time_s: float
+    p_world_m: tuple[float, float, float]
+
+    def to_dict(self) -> dict[str, Any]:
+        return {
+            "link_name": self.link_name,
+            "other_name": self.other_name,
+            "other_is_link": self.other_is_link,
+            "max_depth_m": self.max_depth_m,
+            "first_time_s": self.first_time_s,
+            "p_world_m": list(self.p_world_m),
+        }
+
+    @classmethod
+    def from_dict(cls, data: Mapping[str, Any]) -> ContactRecord:
+        return cls(
+            link_name=str(data["link_name"]),
+            other_name=str(data["other_name"]),
+            other_is_link=bool(data["other_is_link"]),
+            max_depth_m=float(data["max_depth_m"]),
+            first_time_s=float(data["first_time_s"]),
+            p_world_m=tuple(float(v) for v in data["p_world_m"]),
+        )
+
+
+_ARRAY_FIELDS = (
+    "t_s",
+    "q_cmd_rad",
+    "q_actual_rad",
+    "track_err_rad",
+    "tip_track_err_m",
+    "q_start_rad",
+    "q_final_rad",
+)
+_FLOAT_FIELDS = (
+    "final_pos_err_m",
+    "final_angle_err_deg",
+    "start_offset_rad",
+    "final_track_err_rad",
+    "final_tip_track_err_m",
+)
+
+
+def _json_float(v: float) -> float | str | None:
+    v = float(v)
+    if math.isnan(v):
+        return None
+    if math.isinf(v):
+        return "inf" if v > 0 else "-inf"
+    return v
+
+
+@dataclass(frozen=True, eq=False)
+class Execution:
+    """What happened when a path was executed in the simulator.
+
+    Attributes:
+        problem: problem name.
+        leg: leg index, or None when the path was run without a goal.
+        goal: the leg's goal name (or None).
+        path_valid: the FCL re-check found no collision.
+        recheck_joint_step: re-check resolution [rad per joint].
+        recheck_states: interpolated states the re-check looked at.
+        recheck_first_invalid_edge: first path edge with a collision (or None).
+        recheck_pairs: colliding (link, other) names at the first invalid state.
+        waypoint_step: densification of the commanded path [rad per joint].
+        steps_per_waypoint: physics steps per commanded waypoint.
+        settle_steps: physics steps holding the last waypoint.
+        dt_s: physics step [s].
+        contact_tol_m: penetration depth above which a contact counted [m].
+        gravity_mps2: gravity of the world, world frame [m/s²].
+        t_s: (M,) simulated time at which each waypoint's state was logged, from the
+            leg's start [s].
+        q_cmd_rad: (M, dof) commanded (densified) waypoints.
+        q_actual_rad: (M, dof) state reached at the end of each waypoint's steps
+            (PyBullet's raw, unwrapped joint values).
+        track_err_rad: (M,) max over joints of the wrapped |q_cmd − q_actual| [rad].
+        tip_track_err_m: (M,) distance between commanded and actual tip [m].
+        contacts: every (link, other) pair in contact, see :class:`ContactRecord`.
+        q_start_rad: (dof,) the state the execution started from.
+        carried_over: True when the start state was where the previous leg really
+            ended (:func:`execute_legs`), not a reset to the path's first waypoint.
+        start_offset_rad: max wrapped |q_start − path[0]| over joints [rad].
+        q_final_rad: (dof,) state after settling.
+        final_track_err_rad, final_tip_track_err_m: tracking errors after settling.
+        final_pos_err_m, final_angle_err_deg: final tip errors against the leg's goal
+            [m, deg] (NaN without a leg).
+        goal_reached: final state inside the goal region (None without a leg).
+        sim_time_s: simulated time of this execution (physics steps × dt) [s].
+        wall_time_s: wall-clock time of this execution, re-check included [s].
+        reason: why it succeeded or failed, in words.
+    """
+
+    problem: str
+    leg: int | None
+    goal: str | None
+    path_valid: bool
+    recheck_joint_step: float
+    recheck_states: int
+    recheck_first_invalid_edge: int | None
+    recheck_pairs: tuple[tuple[str, str], ...]
+    waypoint_step: float
+    steps_per_waypoint: int
+    settle_steps: int
+    dt_s: float
+    contact_tol_m: float
+    gravity_mps2: tuple[float, float, float]
+    t_s: Array
+    q_cmd_rad: Array
+    q_actual_rad: Array
+    track_err_rad: Array
+    tip_track_err_m: Array
+    contacts: tuple[ContactRecord, ...]
+    q_start_rad: Array
+    carried_over: bool
+    start_offset_rad: float
+    q_final_rad: Array
+    final_track_err_rad: float
+    final_tip_track_err_m: float
+    final_pos_err_m: float
+    final_angle_err_deg: float
+    goal_reached: bool | None
+    sim_time_s: float
+    wall_time_s: float
+    reason: str
+
+    def __post_init__(self) -> None:
+        for name in _ARRAY_FIELDS:
+            a = np.array(getattr(self, name), dtype=float)
+            if name in ("q_cmd_rad", "q_actual_rad"):
+                a = a.reshape(len(a), -1) if a.size else a.reshape(0, len(self.q_final_rad))
+            a.setflags(write=False)
+            object.__setattr__(self, name, a)
+        for name in _FLOAT_FIELDS:
+            v = getattr(self, name)
+            object.__setattr__(self, name, math.nan if v is None else float(v))
+        object.__setattr__(self, "gravity_mps2", tuple(float(g) for g in self.gravity_mps2))
+        object.__setattr__(
+            self, "recheck_pairs", tuple((str(a), str(b)) for a, b in self.recheck_pairs)
+        )
+        object.__setattr__(
+            self,
+            "contacts",
+            tuple(
+                c if isinstance(c, ContactRecord) else ContactRecord.from_dict(c)
+                for c in self.contacts
+            ),
+        )
+
+    @property
+    def success(self) -> bool:
+        """Re-check valid, no contact, and (with a leg) the final state in the goal."""
+        return self.path_valid and not self.contacts and self.goal_reached is not False
+
+    @property
+    def max_track_err_rad(self) -> float:
+        """Largest per-waypoint tracking error [rad] (0 for an empty log)."""
+        return float(np.max(self.track_err_rad, initial=0.0))
+
+    @property
+    def max_tip_track_err_m(self) -> float:
+        """Largest per-waypoint tip tracking error [m] (0 for an empty log)."""
+        return float(np.max(self.tip_track_err_m, initial=0.0))
+
+    @property
+    def max_contact_depth_m(self) -> float:
+        """Deepest contact of the execution [m] (0 without contacts)."""
+        return max((c.max_depth_m for c in self.contacts), default=0.0)
+
+    def to_dict(self) -> dict[str, Any]:
+        """Plain JSON-able data (NaN becomes None); :meth:`from_dict` reads it back."""
+        out: dict[str, Any] = {}
+        for f in dataclasses.fields(self):
+            v = getattr(self, f.name)
+            if isinstance(v, np.ndarray):
+                v = v.tolist()
+            elif f.name == "contacts":
+                v = [c.to_dict() for c in v]
+            elif f.name == "recheck_pairs":
+                v = [list(p) for p in v]
+            elif f.name == "gravity_mps2":
+                v = list(v)
+            elif isinstance(v, float):
+                v = _json_float(v)
+            out[f.name] = v
+        return out
+
+    @classmethod
+    def from_dict(cls, data: Mapping[str, Any]) -> Execution:
+        """Rebuild an execution from :meth:`to_dict` output.
+
+        Raises:
+            PlannerlabError: ``data`` is not an execution record.
+        """
+        names = {f.name for f in dataclasses.fields(cls)}
+        try:
+            values = {k: data[k] for k in names}
+            for k in ("sim_time_s", "wall_time_s", "dt_s", "contact_tol_m"):
+                values[k] = float(values[k])
+            return cls(**values)
+        except (KeyError, TypeError, ValueError) as exc:
+            raise PlannerlabError(f"not an execution record: {exc!r}") from None
+
+
+# ---------------------------------------------------------------------- running
+def _check_path(problem: Problem, path: Any) -> Array:
+    path = np.atleast_2d(np.asarray(path, dtype=float))
+    dof = problem.robot.dof
+    if path.ndim != 2 or path.shape[1] != dof or len(path) == 0:
+        raise PlannerlabError(f"a path of shape (m, {dof}) for {problem.name}, got {path.shape}")
+    if not np.all(np.isfinite(path)):
+        raise PlannerlabError("the path holds NaN or infinite joint values")
+    return path
+
+
+def _run(
+    world: SimWorld,
+    checker: CollisionChecker,
+    problem: Problem,
+    path: Array,
+    leg: int | None,
+    carried_over: bool,
+    joint_step: float | None,
+    waypoint_step: float | None,
+    steps_per_waypoint: int,
+    settle_steps: int,
+    contact_tol_m: float,
+) -> Execution:
+    t0 = time.perf_counter()
+    robot = problem.robot
+    cont = np.asarray(robot.continuous, dtype=bool)
+    if steps_per_waypoint < 1 or settle_steps < 0:
+        raise PlannerlabError(
+            f"steps_per_waypoint >= 1 and settle_steps >= 0, got {steps_per_waypoint}, "
+            f"{settle_steps}"
+        )
+    recheck_step = float(joint_step) if joint_step is not None else problem.joint_step / 4.0
+    wp_step = float(waypoint_step) if waypoint_step is not None else problem.joint_step
+    if not (recheck_step > 0 and wp_step > 0):
+        raise PlannerlabError(f"joint steps must be positive, got {recheck_step}, {wp_step}")
+    check = checker.check_path(path, recheck_step)
+
+    q_cmd, _ = densify(path, wp_step, cont)
+    if not carried_over:
+        world.reset(path[0])
+    q_start = world.state()
+    start_offset = float(np.max(np.abs(joint_difference(q_start, path[0], cont)), initial=0.0))
+
+    steps0 = world.steps_taken
+    seen: dict[tuple[str, str, bool], list[Any]] = {}
+
+    def run_steps(n: int) -> None:
+        for _ in range(n):
+            world.step(1)
+            t = (world.steps_taken - steps0) * world.dt_s
+            for c in world.contacts(min_depth_m=contact_tol_m):
+                key = (c.link_name, c.other_name, c.other_is_link)
+                rec = seen.get(key)
+                if rec is None:
+                    seen[key] = [c.depth_m, t, c.p_world_m]
+                elif c.depth_m > rec[0]:
+                    rec[0], rec[2] = c.depth_m, c.p_world_m
+
+    M = len(q_cmd)
+    q_act = np.empty_like(q_cmd)
+    t_s = np.empty(M)
+    for k in range(M):
+        world.command(q_cmd[k])
+        run_steps(steps_per_waypoint)
+        q_act[k] = world.state()
+        t_s[k] = (world.steps_taken - steps0) * world.dt_s
+    world.command(q_cmd[-1])
+    run_steps(settle_steps)
+    q_final = world.state()
+
+    track = np.max(np.abs(joint_difference(q_cmd, q_act, cont)), axis=1)
+    tip_track = np.linalg.norm(robot.tip(q_cmd)[0] - robot.tip(q_act)[0], axis=1)
+    final_track = float(np.max(np.abs(joint_difference(q_cmd[-1], q_final, cont)), initial=0.0))
+    final_tip_track = float(np.linalg.norm(robot.tip(q_cmd[-1])[0] - robot.tip(q_final)[0]))
+
+    goal_name: str | None = None
+    pos_err = ang_err = math.nan
+    reached: bool | None = None
+    if leg is not None:
+        goal = problem.goal(leg)
+        goal_name = goal.name
+        pe, ae = goal.errors(robot, q_final)
+        pos_err, ang_err = float(pe), float(ae)
+        reached = bool(pos_err <= goal.pos_tol_m and ang_err <= goal.angle_tol_deg)
+
+    contacts = tuple(
+        ContactRecord(
+            link, other, is_link, float(rec[0]), float(rec[1]), tuple(float(v) for v in rec[2])
+        )
+        for (link, other, is_link), rec in sorted(seen.items(), key=lambda kv: kv[1][1])
+    )
+
+    problems: list[str] = []
+    if not check.valid:
+        listing = ", ".join(f"{a} x {b}" for a, b in check.pairs)
+        problems.append(
+            f"FCL re-check at {recheck_step:.3g} rad: collision on edge "
+            f"{check.first_invalid_edge} ({listing})"
+        )
+    if contacts:
+        worst = max(contacts, key=lambda c: c.max_depth_m)
+        problems.append(
+            f"{len(contacts)} contact pair(s) in simulation, deepest "
+            f"{worst.link_name} x {worst.other_name} "
+            f"{worst.max_depth_m * 1e3:.1f} mm at t = {worst.first_time_s:.3f} s"
+        )
+    if reached is False:
+        goal = problem.goal(leg)  # type: ignore[arg-type]
+        problems.append(
+            f"final tip {pos_err:.3g} m / {ang_err:.3g} deg from goal "
+            f"{goal.name!r} (tolerance {goal.pos_tol_m:g} m / "
+            f"{goal.angle_tol_deg:g} deg)"
+        )
+    if problems:
+        reason = "; ".join(problems)
+    else:
+        reason = (
+            f"executed {M} waypoints without contact; max tracking error "
+            f"{float(np.max(track)):.3g} rad"
+        )
+        if reached:
+            reason += f"; final tip {pos_err:.3g} m / {ang_err:.3g} deg from {goal_name!r}"
+
+    return Execution(
+        problem=problem.name,
+        leg=leg,
+        goal=goal_name,
+        path_valid=check.valid,
+        recheck_joint_step=recheck_step,
+        recheck_states=check.states_checked,
+        recheck_first_invalid_edge=check.first_invalid_edge,
+        recheck_pairs=check.pairs,
+        waypoint_step=wp_step,
+        steps_per_waypoint=int(steps_per_waypoint),
+        settle_steps=int(settle_steps),
+        dt_s=world.dt_s,
+        contact_tol_m=float(contact_tol_m),
+        gravity_mps2=world.gravity_mps2,
+        t_s=t_s,
+        q_cmd_rad=q_cmd,
+        q_actual_rad=q_act,
+        track_err_rad=track,
+        tip_track_err_m=tip_track,
+        contacts=contacts,
+        q_start_rad=q_start,
+        carried_over=carried_over,
+        start_offset_rad=start_offset,
+        q_final_rad=q_final,
+        final_track_err_rad=final_track,
+        final_tip_track_err_m=final_tip_track,
+        final_pos_err_m=pos_err,
+        final_angle_err_deg=ang_err,
+        goal_reached=reached,
+        sim_time_s=(world.steps_taken - steps0) * world.dt_s,
+        wall_time_s=time.perf_counter() - t0,
+        reason=reason,
+    )
+
+
+def execute(
+    problem: Problem,
+    path: Array,
+    *,
+    joint_step: float | None = None,
+    waypoint_step: float | None = None,
+    steps_per_waypoint: int = STEPS_PER_WAYPOINT,
+    settle_steps: int = SETTLE_STEPS,
+    contact_tol_m: float = CONTACT_TOL_M,
+    gravity_mps2: tuple[float, float, float] | None = None,
+    gui: bool = False,
+    leg: int | str | None = None,
+) -> Execution:
+    """Re-check a path with FCL, then execute it in a fresh PyBullet world.
+
+    The robot is reset to ``path[0]`` (at rest) before the first command.
+
+    Args:
+        problem: robot, scene and goals.
+        path: (m, dof) joint path.
+        joint_step: FCL re-check resolution [rad per joint]; default
+            ``problem.joint_step / 4``.
+        waypoint_step: densification of the commanded path [rad per joint]; default
+            ``problem.joint_step``.
+        steps_per_waypoint: physics steps (1/240 s each) per commanded waypoint.
+        settle_steps: physics steps holding the last waypoint at the end.
+        contact_tol_m: penetration depth above which a contact point counts [m].
+        gravity_mps2: gravity in the world frame [m/s²]; default: the problem's
+            ``[simulation] gravity_mps2`` (zero it to separate kinematic from torque-limit
+            failures).
+        gui: show PyBullet's GUI.
+        leg: the leg (index or goal name) whose goal the final state is measured against.
+
+    Returns:
+        the :class:`Execution` record (the re-check verdict is in it; an invalid path is
+        still simulated, to see what it does).
+
+    Raises:
+        PlannerlabError: the path has the wrong shape or holds non-finite values, or a
+            parameter is out of range.
+    """
+    path = _check_path(problem, path)
+    leg_i = problem.resolve_leg(leg) if leg is not None else None
+    checker = CollisionChecker(problem.robot, problem.scene)
+    if gravity_mps2 is None:
+        gravity_mps2 = problem.simulation.gravity_mps2
+    with SimWorld(problem.robot, problem.scene, gui=gui, gravity_mps2=gravity_mps2) as world:
+        return _run(
+            world,
+            checker,
+            problem,
+            path,
+            leg_i,
+            False,
+            joint_step,
+            waypoint_step,
+            steps_per_waypoint,
+            settle_steps,
+            contact_tol_m,
+        )
+
+
+def execute_legs(
+    problem: Problem,
+    leg_paths: Sequence[Array],
+    *,
+    first_leg: int = 0,
+    joint_step: float | None = None,
+    waypoint_step: float | None = None,
+    steps_per_waypoint: int = STEPS_PER_WAYPOINT,
+    settle_steps: int = SETTLE_STEPS,
+    contact_tol_m: float = CONTACT_TOL_M,
+    gravity_mps2: tuple[float, float, float] | None = None,
+    gui: bool = False,
+) -> list[Execution]:
+    """Execute consecutive legs in ONE world, each from where the previous one ended.
+
+    The world is reset to the first path's first waypoint; every later leg starts from
+    the state the simulator actually reached (``carried_over=True`` in its record, with
+    ``start_offset_rad`` saying how far that was from its path's first waypoint).
+    ``leg_paths[i]`` is leg ``first_leg + i``; legs past the problem's last goal are run
+    without a goal. Arguments are those of :func:`execute`.
+
+    Returns:
+        one :class:`Execution` per path, in order.
+    """
+    paths = [_check_path(problem, p) for p in leg_paths]
+    checker = CollisionChecker(problem.robot, problem.scene)
+    out: list[Execution] = []
+    if gravity_mps2 is None:
+        gravity_mps2 = problem.simulation.gravity_mps2
+    with SimWorld(problem.robot, problem.scene, gui=gui, gravity_mps2=gravity_mps2) as world:
+        for i, path in enumerate(paths):
+            leg = first_leg + i
+            out.append(
+                _run(
+                    world,
+                    checker,
+                    problem,
+                    path,
+                    leg if leg < problem.legs else None,
+                    i > 0,
+                    joint_step,
+                    waypoint_step,
+                    steps_per_waypoint,
+                    settle_steps,
+                    contact_tol_m,
+                )
+            )
+    return out

@@ -1,0 +1,106 @@
+"""Problem files: the bundled ones load; each kind of bad file gets an error that names
+the file, the key and what was expected."""
+
+from __future__ import annotations
+
+import re
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from plannerlab.catalog import list_problems, load_problem
+from plannerlab.collision import CollisionChecker
+from plannerlab.errors import ProblemError, UnknownNameError
+
+GOOD = """
+[problem]
+name = "tiny"
+[robot]
+type = "armz"
+n_modules = 6
+[start]
+fill_deg = 180.0
+[[obstacles]]
+name = "wall"
+type = "box"
+center_m = [3.0, 0.0, 2.0]
+size_m = [0.4, 4.0, 4.0]
+[[goals]]
+name = "g"
+p_m = [1.0, 0.0, 3.0]
+n = [0.0, 0.0, 1.0]
+pos_tol_m = 0.1
+angle_tol_deg = 10.0
+"""
+
+
+def write(tmp_path: Path, text: str) -> Path:
+    path = tmp_path / "bad.toml"
+    path.write_text(text)
+    return path
+
+
+def test_the_good_file_loads(tmp_path):
+    p = load_problem(write(tmp_path, GOOD))
+    assert p.robot.dof == 5 and p.scene.names == ("wall",) and p.goals[0].name == "g"
+
+
+@pytest.mark.parametrize("path", list_problems(), ids=lambda p: p.stem)
+def test_every_bundled_problem_loads_with_a_free_start(path):
+    p = load_problem(path)
+    assert CollisionChecker(p.robot, p.scene).is_valid(p.q_start)
+    assert p.legs >= 1
+
+
+BAD = {
+    "missing_key": (GOOD.replace('name = "g"\n', ""), "goals[0].name", "missing"),
+    "zero_normal": (GOOD.replace("n = [0.0, 0.0, 1.0]", "n = [0.0, 0.0, 0.0]"), "goals[0].n",
+                    "non-zero"),
+    "nan": (GOOD.replace("p_m = [1.0, 0.0, 3.0]", "p_m = [1.0, nan, 3.0]"), "goals[0].p_m",
+            "finite"),
+    "wrong_joint_count": (GOOD.replace("fill_deg = 180.0", "q = [0.0, 1.0]"), "start.q",
+                          "5 joint values"),
+    "unknown_obstacle_type": (GOOD.replace('type = "box"', 'type = "cone"'),
+                              "obstacles[0].type", "one of box, cylinder, sphere"),
+    "unknown_robot_type": (GOOD.replace('type = "armz"', 'type = "armzz"'), "robot.type",
+                           "did you mean 'armz'"),
+    "negative_tolerance": (GOOD.replace("pos_tol_m = 0.1", "pos_tol_m = -0.1"),
+                           "goals[0].pos_tol_m", "positive"),
+    "string_for_number": (GOOD.replace("angle_tol_deg = 10.0", 'angle_tol_deg = "ten"'),
+                          "goals[0].angle_tol_deg", "a number"),
+    "misspelt_key": (GOOD.replace("size_m", "sizes_m"), "obstacles[0].sizes_m",
+                     "not a known key"),
+    "no_goals": (GOOD[: GOOD.index("[[goals]]")], "goals", "missing"),
+    "syntax": (GOOD.replace("[robot]", "[robot"), "<syntax>", "valid TOML"),
+    "start_in_collision": (GOOD.replace("center_m = [3.0, 0.0, 2.0]", "center_m = [0.5, 0.0, 2.0]"),
+                           "start", "module_1 x wall"),
+}
+
+
+@pytest.mark.parametrize("case", BAD, ids=list(BAD))
+def test_bad_file_names_file_key_and_expectation(tmp_path, case):
+    text, key, expected = BAD[case]
+    path = write(tmp_path, text)
+    with pytest.raises(ProblemError) as err:
+        load_problem(path)
+    msg = str(err.value)
+    assert str(path) in msg
+    assert f"[{key}]" in msg
+    assert expected in msg
+    assert err.value.key == key
+
+
+def test_missing_file_and_unknown_problem_name(tmp_path):
+    with pytest.raises(ProblemError, match="existing problem file"):
+        load_problem(tmp_path / "nope.toml")
+    with pytest.raises(UnknownNameError, match="did you mean 'armz_pocket'"):
+        load_problem("armz_pockt")
+
+
+def test_loaded_problem_is_read_only(tmp_path):
+    p = load_problem(write(tmp_path, GOOD))
+    with pytest.raises(ValueError):
+        p.q_start[0] = 0.0
+    assert np.all(p.q_start == np.pi)
+    assert re.match(r"^tiny$", p.name)

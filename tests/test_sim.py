@@ -1,0 +1,226 @@
+"""PyBullet execution: URDF kinematics, position control under gravity, contacts, records.
+
+Every test runs the real PyBullet (DIRECT mode); nothing is mocked. Small arms
+(8-18 modules) unless the full 24-module arm is the point.
+"""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+
+from plannerlab.collision import CollisionChecker
+from plannerlab.goals import GoalRegion
+from plannerlab.problem import Problem
+from plannerlab.robots.armz import ArmZ
+from plannerlab.robots.base import pose_matrix, trans
+from plannerlab.scene import Box, Scene
+from plannerlab.sim import Execution, SimWorld, execute, execute_legs
+
+
+def static_gravity_torques_nm(robot: ArmZ, q: np.ndarray) -> np.ndarray:
+    """Gravity torque about each joint axis at rest (dof,) [N·m]: module masses at the
+    chord midpoints (the URDF's inertial origins)."""
+    F = robot.fk(q)
+    origins, axes = F[1:-1, :3, 3], F[1:-1, :3, 2]
+    com = 0.5 * (F[1:-1, :3, 3] + F[2:, :3, 3])  # module i+1 for joint i
+    weight = np.array([0.0, 0.0, -9.81 * robot.module_mass_kg])
+    return np.array(
+        [axes[i] @ np.cross(com[i:] - origins[i], weight).sum(axis=0) for i in range(robot.dof)]
+    )
+
+
+def make_problem(
+    robot: ArmZ, scene: Scene, q_goal: np.ndarray, *, joint_step: float = 0.05
+) -> Problem:
+    p, n = robot.tip(q_goal)
+    goal = GoalRegion("g", p, n, pos_tol_m=0.05, angle_tol_deg=3.0)
+    return Problem(
+        "sim_test", robot, scene, np.full(robot.dof, np.pi), (goal,), joint_step=joint_step
+    )
+
+
+WALL = Scene((Box("wall", trans(0.0, -2.1, 5.0), np.array([6.0, 1.0, 4.0])),))
+
+
+# ---------------------------------------------------------------------- kinematics
+def test_urdf_link_frames_match_fk_24_modules_tilted_base() -> None:
+    T = pose_matrix([1.0, 2.0, 3.0], [0.3, -0.2, 0.5])
+    robot = ArmZ(n_modules=24, T_world_base=T)
+    rng = np.random.default_rng(7)
+    with SimWorld(robot) as world:
+        for _ in range(20):
+            q = rng.uniform(-3 * np.pi, 3 * np.pi, robot.dof)  # unwrapped on purpose
+            world.reset(q)
+            np.testing.assert_array_equal(world.state(), q)
+            F_sim, F_fk = world.link_frames(), robot.fk(q)
+            assert F_sim.shape == F_fk.shape == (robot.dof + 2, 4, 4)
+            assert np.max(np.linalg.norm(F_sim[:, :3, 3] - F_fk[:, :3, 3], axis=1)) <= 1e-6
+            # rotation error angle of R_fk^T R_sim
+            R_rel = np.einsum("fji,fjk->fik", F_fk[:, :3, :3], F_sim[:, :3, :3])
+            cos = np.clip((np.trace(R_rel, axis1=1, axis2=2) - 1.0) / 2.0, -1.0, 1.0)
+            assert np.max(np.arccos(cos)) <= 1e-6
+
+
+def test_self_contacts_match_fcl_pairs_for_a_closed_ring() -> None:
+    """All θ = 0 curls an 18-module arm into a ring that closes on itself: PyBullet reports
+    exactly FCL's colliding pairs (the root URDF link ``base`` named ``module_0``)."""
+    robot = ArmZ(n_modules=18)
+    q = np.zeros(robot.dof)
+    fcl_pairs = set(CollisionChecker(robot, Scene()).colliding_pairs(q))
+    assert fcl_pairs and ("module_0", "module_16") in fcl_pairs
+    with SimWorld(robot) as world:
+        world.reset(q)
+        contacts = world.contacts()
+    assert all(c.other_is_link for c in contacts)
+    assert {(c.link_name, c.other_name) for c in contacts} == fcl_pairs
+
+
+# ---------------------------------------------------------------------- control
+def test_straight_column_holds_exactly_because_gravity_has_no_torque() -> None:
+    """The 24-module straight column (all θ = π) holds under gravity with 100 N·m motors:
+    every joint axis and centre of mass lies in one vertical plane, so gravity has no
+    torque about any joint and the column stays within 1e-2 rad (in fact exactly)."""
+    robot = ArmZ(n_modules=24)
+    q = np.full(robot.dof, np.pi)
+    assert np.max(np.abs(static_gravity_torques_nm(robot, q))) < 1e-9
+    with SimWorld(robot) as world:
+        world.reset(q)
+        q_reached = world.move_towards(q, 240)
+    assert np.max(np.abs(q_reached - q)) <= 1e-2
+
+
+def test_bent_24_module_pose_under_the_torque_limit_holds() -> None:
+    robot = ArmZ(n_modules=24)
+    q = np.pi + np.random.default_rng(0).uniform(-0.5, 0.5, robot.dof)
+    assert np.max(np.abs(static_gravity_torques_nm(robot, q))) < robot.joint_torque_limit_nm
+    with SimWorld(robot) as world:
+        world.reset(q)
+        q_reached = world.move_towards(q, 240)
+    assert np.max(np.abs(q_reached - q)) <= 1e-2
+
+
+def test_pose_needing_more_than_100_nm_sags_under_gravity() -> None:
+    """The honest limit: alternating θ = π, π − 0.6 needs > 100 N·m at some joint, and
+    the paper's motors cannot hold it."""
+    robot = ArmZ(n_modules=24)
+    q = np.where(np.arange(robot.dof) % 2, np.pi, np.pi - 0.6)
+    assert np.max(np.abs(static_gravity_torques_nm(robot, q))) > robot.joint_torque_limit_nm
+    with SimWorld(robot) as world:
+        world.reset(q)
+        q_reached = world.move_towards(q, 240)
+    assert np.max(np.abs(q_reached - q)) > 1e-2
+    with SimWorld(robot, gravity_mps2=(0.0, 0.0, 0.0)) as world:  # the same pose, no gravity
+        world.reset(q)
+        q_reached = world.move_towards(q, 240)
+    assert np.max(np.abs(q_reached - q)) <= 1e-6
+
+
+def test_position_control_reaches_a_nearby_target() -> None:
+    robot = ArmZ(n_modules=8)
+    q0 = np.full(robot.dof, np.pi)
+    q_target = q0 + np.random.default_rng(1).uniform(-0.1, 0.1, robot.dof)
+    with SimWorld(robot) as world:
+        world.reset(q0)
+        q_reached = world.move_towards(q_target, 240)
+        assert world.steps_taken == 240
+        assert world.sim_time_s == pytest.approx(1.0)
+    assert np.max(np.abs(q_reached - q_target)) <= 1e-3
+
+
+def test_continuous_joints_take_the_short_way_round() -> None:
+    """From π − 0.05 to the target −π + 0.05 (0.1 rad away across the wrap): the motor
+    goes up to π + 0.05 (raw, unwrapped), not 6.18 rad the long way down."""
+    robot = ArmZ(n_modules=6)
+    with SimWorld(robot) as world:
+        world.reset(np.full(robot.dof, np.pi - 0.05))
+        q_reached = world.move_towards(np.full(robot.dof, -np.pi + 0.05), 240)
+    np.testing.assert_allclose(q_reached, np.pi + 0.05, atol=1e-3)
+
+
+# ---------------------------------------------------------------------- execution
+def test_running_into_a_wall_is_reported_by_the_recheck_and_the_simulator() -> None:
+    robot = ArmZ(n_modules=8)
+    q0 = np.full(robot.dof, np.pi)
+    q1 = q0.copy()
+    q1[0] = 0.0  # swings the arm's top over to y ≈ -2 m, into the wall's face at y = -1.6
+    problem = make_problem(robot, WALL, q1)
+    ex = execute(problem, np.stack([q0, q1]), leg=0)
+    assert not ex.path_valid
+    assert ex.recheck_first_invalid_edge == 0
+    assert ("module_7", "wall") in ex.recheck_pairs
+    assert ex.contacts
+    hit = {(c.link_name, c.other_name, c.other_is_link) for c in ex.contacts}
+    assert ("module_7", "wall", False) in hit
+    wall_hit = next(c for c in ex.contacts if c.other_name == "wall")
+    assert wall_hit.max_depth_m > 0.0
+    assert wall_hit.p_world_m[1] == pytest.approx(-1.6, abs=0.01)  # on the wall's face
+    assert 0.0 < wall_hit.first_time_s < ex.sim_time_s
+    assert ex.goal_reached is False  # the wall stops the arm
+    assert not ex.success
+    assert "module_7 x wall" in ex.reason
+
+
+def test_short_free_path_executes_without_contact_and_tracks() -> None:
+    robot = ArmZ(n_modules=8)
+    q0 = np.full(robot.dof, np.pi)
+    q1 = q0 + np.random.default_rng(2).uniform(-0.3, 0.3, robot.dof)
+    problem = make_problem(robot, WALL, q1)  # the wall is there but out of the way
+    ex = execute(problem, np.stack([q0, q1]), leg="g")
+    assert ex.path_valid and ex.recheck_pairs == ()
+    assert ex.recheck_joint_step == pytest.approx(problem.joint_step / 4)
+    assert ex.contacts == ()
+    assert ex.max_track_err_rad < 0.02
+    assert ex.max_tip_track_err_m < 0.05
+    assert ex.final_track_err_rad < 1e-3
+    assert ex.final_pos_err_m < 1e-3 and ex.final_angle_err_deg < 0.1
+    assert ex.goal_reached and ex.success
+    M = len(ex.q_cmd_rad)
+    assert ex.q_actual_rad.shape == (M, robot.dof) and ex.t_s.shape == (M,)
+    assert ex.sim_time_s == pytest.approx((M * ex.steps_per_waypoint + ex.settle_steps) / 240)
+    assert not ex.carried_over and ex.start_offset_rad == 0.0
+
+
+def test_execute_legs_carries_the_state_over() -> None:
+    robot = ArmZ(n_modules=8)
+    q0 = np.full(robot.dof, np.pi)
+    q1 = q0 + 0.2
+    q2 = q0 - 0.1
+    problem = make_problem(robot, Scene(), q1)
+    first, second = execute_legs(problem, [np.stack([q0, q1]), np.stack([q1, q2])])
+    assert first.leg == 0 and not first.carried_over
+    assert second.leg is None and second.carried_over  # the problem has one goal only
+    np.testing.assert_array_equal(second.q_start_rad, first.q_final_rad)
+    assert second.start_offset_rad == pytest.approx(
+        np.max(np.abs(first.q_final_rad - q1)), abs=1e-12
+    )
+    assert first.success and second.success
+
+
+def test_execution_json_round_trip() -> None:
+    robot = ArmZ(n_modules=6)
+    q0 = np.full(robot.dof, np.pi)
+    q1 = q0.copy()
+    q1[0] = 0.0
+    # This wall overlaps the arm from the start, so the first record has contacts.
+    scene = Scene((Box("wall", trans(0.0, -1.3, 3.0), np.array([4.0, 1.0, 2.0])),))
+    problem = make_problem(robot, scene, q1)
+    with_contacts = execute(problem, np.stack([q0, q1]), settle_steps=24, leg=0)
+    without_leg = execute(
+        problem, np.stack([q0, q0 + 0.1]), settle_steps=24, gravity_mps2=(0.0, 0.0, 0.0)
+    )
+    assert with_contacts.contacts and not with_contacts.path_valid
+    assert without_leg.leg is None and np.isnan(without_leg.final_pos_err_m)
+    for ex in (with_contacts, without_leg):
+        text = json.dumps(ex.to_dict(), allow_nan=False)  # strictly JSON: NaN -> null
+        back = Execution.from_dict(json.loads(text))
+        assert back.to_dict() == ex.to_dict()
+        assert back.contacts == ex.contacts
+        assert back.recheck_pairs == ex.recheck_pairs
+        np.testing.assert_array_equal(back.q_actual_rad, ex.q_actual_rad)
+        assert back.success == ex.success and back.reason == ex.reason
+        assert back.goal_reached == ex.goal_reached
+    assert np.isnan(back.final_pos_err_m) and back.goal_reached is None
+    assert back.gravity_mps2 == (0.0, 0.0, 0.0) and with_contacts.gravity_mps2 == (0, 0, -9.81)
