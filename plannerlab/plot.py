@@ -22,7 +22,7 @@ from scipy.spatial import ConvexHull  # noqa: E402
 
 from plannerlab.problem import Problem  # noqa: E402
 from plannerlab.robots.base import Array  # noqa: E402
-from plannerlab.scene import Box, Cylinder, Obstacle, Sphere  # noqa: E402
+from plannerlab.scene import Box, Cylinder, Obstacle  # noqa: E402
 
 VIEWS = {"front (x-z)": (0, 2), "top (x-y)": (0, 1)}
 

@@ -11,7 +11,8 @@ File layout (every key is documented in ``docs/problem-format.md``)::
     [problem]   name, description
     [robot]     type = "armz" | "irb6" | "continuum_chain", then the type's parameters
     [start]     q | q_deg | fill | fill_deg
-    [[obstacles]] name, type = "box" | "cylinder" | "sphere", center_m, rpy_deg, size_m | radius_m, length_m
+    [[obstacles]] name, type = "box" | "cylinder" | "sphere", center_m, rpy_deg,
+                  size_m | radius_m, length_m
     [[goals]]   name, p_m, n, pos_tol_m, angle_tol_deg     (one per leg, in order)
     [budget]    max_iterations, max_collision_checks, time_limit_s
     [checking]  joint_step       (largest joint step between checked states on an edge)

@@ -197,7 +197,8 @@ class ArmZ:
                 f"    <inertial>\n"
                 f'      <origin xyz="{xyz}" rpy="0 0 0"/>\n'
                 f'      <mass value="{mass_kg!r}"/>\n'
-                f'      <inertia ixx="{ixx!r}" ixy="0" ixz="0" iyy="{iyy!r}" iyz="0" izz="{izz!r}"/>\n'
+                f'      <inertia ixx="{ixx!r}" ixy="0" ixz="0" iyy="{iyy!r}" iyz="0" '
+                f'izz="{izz!r}"/>\n'
                 f"    </inertial>\n"
                 f"    <collision>\n"
                 f'      <origin xyz="{xyz}" rpy="{tilt_rad!r} 0 0"/>\n'
