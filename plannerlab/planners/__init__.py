@@ -67,6 +67,10 @@ def _entries() -> dict[str, PlannerEntry]:
                      "faster variant: analytic Jacobian gradient, penalty by clearance, "
                      "step rejected on collision"),
     ]
+    entries.append(PlannerEntry(
+        "chord_arc", "plannerlab.planners.chord_arc:make",
+        "continuum robot's chord-arc tree search with obstacle wrapping (contact at the "
+        "problem's collision points)", robots=("continuum_chain",)))
     for suffix, cls in OMPL_PLANNERS.items():
         entries.append(PlannerEntry(f"ompl.{suffix}", "plannerlab.planners.ompl:make",
                                     f"OMPL {cls} (geometric)"))

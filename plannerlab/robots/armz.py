@@ -96,7 +96,7 @@ class ArmZ:
 
     @property
     def link_frame_names(self) -> tuple[str, ...]:
-        return ("base",) + tuple(f"face_{i}" for i in range(self.n_modules))
+        return ("module_0",) + tuple(f"face_{i}" for i in range(self.n_modules))
 
     @property
     def lower(self) -> Array:
@@ -178,7 +178,7 @@ class ArmZ:
         """URDF of the chain in its base frame (load it at ``T_world_base``, fixed base).
 
         A module is a link whose frame is its bottom face turned by its joint; a massless
-        link ``face_i`` is fixed at its top face, so the URDF link frames ``base, face_0 …
+        link ``face_i`` is fixed at its top face, so the URDF link frames ``module_0, face_0 …
         face_{n-1}`` are exactly the frames of :meth:`fk`. Collision: one capsule per
         module along its chord, radius ``collision_radius_m``.
         """
@@ -234,9 +234,9 @@ class ArmZ:
         base_tilt = float(np.arctan2(-self.delta_y_m, self.delta_z_m / 2.0))
         base_mid = (0.0, self.delta_y_m / 2.0, self.delta_z_m / 4.0)
         parts = ['<?xml version="1.0"?>\n<robot name="armz">\n']
-        parts.append(module_body("base", base_mid, base_tilt, base_chord, self.module_mass_kg))
+        parts.append(module_body("module_0", base_mid, base_tilt, base_chord, self.module_mass_kg))
         parts.append(frame_link("face_0"))
-        parts.append(fixed("base_to_face_0", "base", "face_0", self._T_base_j1))
+        parts.append(fixed("module_0_to_face_0", "module_0", "face_0", self._T_base_j1))
         for i in range(1, self.n_modules):
             parts.append(module_body(f"module_{i}", mid, tilt, ell, self.module_mass_kg))
             parts.append(

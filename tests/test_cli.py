@@ -1,0 +1,89 @@
+"""The plannerlab command end to end: list, solve, execute, plot, errors."""
+
+from __future__ import annotations
+
+import json
+import shutil
+import subprocess
+import sys
+
+import pytest
+
+from plannerlab.cli import main
+
+
+def run(capsys, *argv: str) -> tuple[int, str, str]:
+    code = main(list(argv))
+    out, err = capsys.readouterr()
+    return code, out, err
+
+
+def test_problems_and_planners_list_as_json(capsys):
+    code, out, _ = run(capsys, "problems", "--json")
+    names = {p["name"] for p in json.loads(out)}
+    assert code == 0 and {"armz_inspection", "armz_pocket"} <= names
+    code, out, _ = run(capsys, "planners", "--json")
+    planners = {p["name"] for p in json.loads(out)}
+    assert {"gradient", "gradient.closed_loop", "gradient.analytic", "ompl.rrtconnect",
+            "ompl.kpiece1"} <= planners
+
+
+def test_solve_execute_plot_round_trip(capsys, tmp_path):
+    plan_path = tmp_path / "plan.json"
+    code, out, _ = run(capsys, "solve", "armz_pocket", "--planner", "gradient.analytic",
+                       "--seed", "3", "--out", str(plan_path), "--json")
+    assert code == 0
+    plan = json.loads(out)
+    assert plan == json.loads(plan_path.read_text())
+    leg = plan["legs"][0]
+    assert leg["status"] == "local_minimum" and leg["seed"] == 3
+    assert plan["versions"]["pybullet"] and plan["versions"]["python-fcl"]
+    # --strict turns the stall into a failing exit code
+    assert run(capsys, "solve", "armz_pocket", "--planner", "gradient.analytic",
+               "--out", str(tmp_path / "p2.json"), "--strict")[0] == 1
+
+    code, out, _ = run(capsys, "execute", str(plan_path), "--json")
+    assert code == 0
+    executed = json.loads(out)
+    ex = executed["executions"][0]
+    assert ex["path_valid"] is True and ex["leg"] == 0
+    assert ex["final_pos_err_m"] == pytest.approx(leg["pos_err_m"], abs=0.05)
+    assert len(ex["q_actual_rad"]) > 1
+
+    code, out, _ = run(capsys, "plot", str(plan_path), "--out", str(tmp_path / "fig"), "--json")
+    files = json.loads(out)
+    assert code == 0 and any(f.endswith("stall.png") for f in files)
+    assert all((tmp_path / "fig" / f.split("/")[-1]).stat().st_size > 10_000 for f in files)
+
+
+def test_table_output_names_every_leg(capsys, tmp_path):
+    code, out, _ = run(capsys, "solve", "armz_inspection", "--planner", "gradient.analytic",
+                       "--legs", "enter", "--max-iterations", "20",
+                       "--out", str(tmp_path / "p.json"))
+    assert code == 0
+    assert "enter" in out and "budget_exhausted" in out and "iteration budget of 20" in out
+
+
+@pytest.mark.parametrize(
+    ("argv", "message"),
+    [
+        (("solve", "armz_pocket", "--planner", "ompl.rrtconect"), "did you mean 'ompl.rrtconnect'"),
+        (("solve", "armz_pockt", "--planner", "gradient"), "did you mean 'armz_pocket'"),
+        (("solve", "armz_pocket", "--planner", "gradient", "--set", "gama=1"),
+         "did you mean 'gamma'"),
+        (("solve", "armz_pocket", "--planner", "gradient", "--legs", "nowhere"),
+         "unknown leg 'nowhere'"),
+        (("execute", "missing_plan.json"), "no such plan file"),
+    ],
+)
+def test_bad_input_exits_2_with_a_clear_message(capsys, argv, message):
+    code, out, err = run(capsys, *argv)
+    assert code == 2
+    assert message in " ".join((out + err).split())
+
+
+def test_console_script_is_installed():
+    exe = shutil.which("plannerlab") or str(__import__("pathlib").Path(sys.executable).parent
+                                             / "plannerlab")
+    done = subprocess.run([exe, "planners"], capture_output=True, text=True, timeout=120)
+    assert done.returncode == 0 and "gradient" in done.stdout
