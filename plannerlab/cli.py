@@ -262,6 +262,8 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--out", help="folder for the PNG files (default: beside the plan)")
     p.add_argument("--json", action="store_true")
     p.set_defaults(func=cmd_plot)
+    from plannerlab.ik_cli import add_ik_parser
+    add_ik_parser(sub)
     return parser
 
 

@@ -117,3 +117,14 @@ def test_inspection_leg_reaches_the_same_final_state_every_run():
     assert a.status == b.status
     np.testing.assert_array_equal(a.path[-1], b.path[-1])
     assert a.iterations == b.iterations <= 150
+
+
+def test_descent_keeps_bounded_joints_inside_their_limits():
+    problem = load_problem("irb6_pick_table")
+    r = make_planner("gradient.analytic").solve(problem, 0, problem.budget.replace(
+        max_iterations=300), np.random.default_rng(0))
+    robot = problem.robot
+    bounded = ~robot.continuous
+    assert len(r.path) > 5
+    assert np.all(r.path[:, bounded] >= robot.lower[bounded] - 1e-12)
+    assert np.all(r.path[:, bounded] <= robot.upper[bounded] + 1e-12)

@@ -68,6 +68,12 @@ def _entries() -> dict[str, PlannerEntry]:
                      "step rejected on collision"),
     ]
     entries.append(PlannerEntry(
+        "gradient+rrtconnect", "plannerlab.planners.hybrid:make",
+        "gradient descent; at a local minimum RRT-Connect plans from the stall to the goal"))
+    entries.append(PlannerEntry(
+        "gradient.multistart", "plannerlab.planners.hybrid:make",
+        "gradient descent restarted from random collision-free states near each stall"))
+    entries.append(PlannerEntry(
         "chord_arc", "plannerlab.planners.chord_arc:make",
         "continuum robot's chord-arc tree search with obstacle wrapping (contact at the "
         "problem's collision points)", robots=("continuum_chain",)))

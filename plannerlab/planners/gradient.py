@@ -205,7 +205,9 @@ class GradientPlanner:
             step = s.gamma * self.gradient(f, q)
             if s.max_step_rad > 0:
                 step = np.clip(step, -s.max_step_rad, s.max_step_rad)
-            q_target = q - step
+            # joints with limits stay inside them (continuous joints wrap)
+            q_target = np.where(robot.continuous, q - step,
+                                np.clip(q - step, robot.lower, robot.upper))
             if closed:
                 q_next = wrap_to_pi(stepper.move_towards(q_target, s.sim_steps), robot.continuous)
             else:

@@ -61,6 +61,9 @@ Collision capsules (``link_names``): the LP-1 rail (fixed), the column, the lowe
 upper arm and the wrist (wrist point → flange). Self-collision is not counted between
 neighbours, nor between the column and the upper arm (the parallelogram links sit side by
 side on the real arm; the capsule model would make them overlap when θ2 < 0 and θ3 < 0).
+
+Problem files build the model with :func:`from_table` (``[robot] type = "irb6"``); goal
+regions are sampled through the analytic IK by :meth:`IRb6.sample_goal_state`.
 """
 
 from __future__ import annotations

@@ -1,0 +1,265 @@
+"""``plannerlab ik``: the IRb-6 analytic inverse kinematics from the command line.
+
+    plannerlab ik irb6 --position X Y Z --approach CX CY CZ [--roll DEG]
+                       [--previous-theta5 DEG] [--problem FILE-or-name] [--frame station|world]
+                       [--json]
+
+Prints the case of the pose (unambiguous, ambiguous 1 or 2, ``docs/papers.md`` §2), the
+paper's R_wew and R_zew, the feasible λ0 intervals and every solution with its
+forward-kinematics check, or the reason the pose is unreachable. Units: the position in
+metres and the approach vector in the station frame (x_s horizontal, y_s up, z_s along
+the track; ``--frame world`` reads them in the world frame of ``--problem``'s robot),
+angles in degrees. Exit status: 0 when a solution exists, 1 when the pose is unreachable,
+2 on bad input (the CLI's main prints the :class:`PlannerlabError`).
+
+Argument parsing and printing only; the solver is :mod:`plannerlab.robots.irb6_ik`.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+from typing import Any
+
+import numpy as np
+from rich.console import Console
+from rich.markup import escape
+from rich.table import Table
+
+from plannerlab.errors import PlannerlabError
+
+#: robots the ``ik`` command knows (those with an analytic IK)
+IK_ROBOTS = ("irb6",)
+
+
+def add_ik_parser(subparsers: Any) -> argparse.ArgumentParser:
+    """Register the ``ik`` subcommand on the ``plannerlab`` parser's subparsers."""
+    p = subparsers.add_parser(
+        "ik",
+        help="analytic inverse kinematics of the IRb-6 on LP-1: case, λ0 intervals, solutions",
+        description=__doc__,
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
+    p.add_argument("robot", choices=IK_ROBOTS, help="robot with an analytic IK")
+    p.add_argument(
+        "--position",
+        nargs=3,
+        type=float,
+        required=True,
+        metavar=("X", "Y", "Z"),
+        help="flange position [m] (station frame unless --frame world)",
+    )
+    p.add_argument(
+        "--approach",
+        nargs=3,
+        type=float,
+        required=True,
+        metavar=("CX", "CY", "CZ"),
+        help="approach vector c (normalised here; station frame unless --frame world)",
+    )
+    p.add_argument(
+        "--roll",
+        type=float,
+        default=0.0,
+        metavar="DEG",
+        help="roll of the flange about c [deg] (θ5 for a non-vertical approach; default 0)",
+    )
+    p.add_argument(
+        "--previous-theta5",
+        type=float,
+        default=None,
+        metavar="DEG",
+        help="θ5 of the previous pose [deg]: at the ends of the θ5 range keep the closer value",
+    )
+    p.add_argument(
+        "--problem",
+        default=None,
+        metavar="FILE",
+        help="take the robot's parameters from this problem's [robot] table (name or .toml)",
+    )
+    p.add_argument(
+        "--frame",
+        choices=("station", "world"),
+        default="station",
+        help="frame of --position/--approach (world = the problem's world; default station)",
+    )
+    p.add_argument("--json", action="store_true", help="machine-readable output on stdout")
+    p.set_defaults(func=cmd_ik)
+    return p
+
+
+# ---------------------------------------------------------------------- helpers
+def _finite3(values: Any, option: str) -> np.ndarray:
+    v = np.asarray(values, dtype=float)
+    if v.shape != (3,) or not np.all(np.isfinite(v)):
+        shown = ", ".join(str(x) for x in values)
+        raise PlannerlabError(f"{option} expects three finite numbers, got ({shown})")
+    return v
+
+
+def _finite(value: float | None, option: str) -> float | None:
+    if value is not None and not math.isfinite(value):
+        raise PlannerlabError(f"{option} expects a finite angle in degrees, got {value}")
+    return value
+
+
+def _robot(args: argparse.Namespace) -> tuple[Any, str | None]:
+    """The IRb-6 model (defaults, or a problem's [robot] table) and the problem's name."""
+    from plannerlab.robots.irb6 import IRb6
+
+    if args.problem is None:
+        if args.frame == "world":
+            raise PlannerlabError("--frame world needs --problem (the world of which problem?)")
+        return IRb6(), None
+    from plannerlab.catalog import resolve_problem_path
+    from plannerlab.problem import parse_problem
+
+    problem = parse_problem(resolve_problem_path(args.problem))
+    if not isinstance(problem.robot, IRb6):
+        raise PlannerlabError(
+            f"--problem {args.problem}: its robot is {problem.robot.kind!r}; "
+            f"'plannerlab ik irb6' needs a problem with [robot] type = \"irb6\""
+        )
+    return problem.robot, problem.name
+
+
+def _rotation_error_rad(R_a: np.ndarray, R_b: np.ndarray) -> float:
+    """Angle of the rotation R_a^T R_b [rad], accurate for small angles too."""
+    R = R_a.T @ R_b
+    skew = 0.5 * np.array([R[2, 1] - R[1, 2], R[0, 2] - R[2, 0], R[1, 0] - R[0, 1]])
+    return float(math.atan2(float(np.linalg.norm(skew)), 0.5 * (float(np.trace(R)) - 1.0)))
+
+
+def ik_report(
+    robot: Any,
+    p_station_m: np.ndarray,
+    c_station: np.ndarray,
+    roll_rad: float,
+    previous_theta5_rad: float | None,
+) -> dict[str, Any]:
+    """Solve one pose and check every solution with the forward kinematics.
+
+    Returns:
+        A JSON-able dict: ``case``, ``lambda0_intervals_m``, ``R_wew_m``, ``R_zew_m``,
+        ``solutions`` (each with ``q``, ``lambda0_m``, ``theta_deg``, ``pos_err_m``,
+        ``rot_err_deg``, ``approach_err_deg``), ``reachable``, ``reason_code``, ``reason``.
+    """
+    from plannerlab.robots.irb6_ik import pose_from_approach, solve_ik
+
+    T_target = pose_from_approach(p_station_m, c_station, roll_rad)
+    answer = solve_ik(robot, T_target, previous_theta5_rad)
+    solutions = []
+    for q in answer.solutions:
+        T_fk = robot.fk_station(q)[5]
+        pos_err = float(np.linalg.norm(T_fk[:3, 3] - T_target[:3, 3]))
+        cos_c = float(np.clip(T_fk[:3, 2] @ T_target[:3, 2], -1.0, 1.0))
+        solutions.append(
+            {
+                "q": [float(v) for v in q],
+                "lambda0_m": float(q[0]),
+                "theta_deg": [math.degrees(float(v)) for v in q[1:]],
+                "pos_err_m": pos_err,
+                "rot_err_deg": math.degrees(_rotation_error_rad(T_target[:3, :3], T_fk[:3, :3])),
+                "approach_err_deg": math.degrees(math.acos(cos_c)),
+            }
+        )
+    return {
+        "case": answer.case,
+        "lambda0_intervals_m": [[float(lo), float(hi)] for lo, hi in answer.lambda0_intervals_m],
+        "R_wew_m": answer.inner_radius_m,
+        "R_zew_m": answer.outer_radius_m,
+        "reachable": answer.ok,
+        "reason_code": answer.reason_code,
+        "reason": answer.reason,
+        "solutions": solutions,
+    }
+
+
+# ---------------------------------------------------------------------- command
+def cmd_ik(args: argparse.Namespace, console: Console) -> int:
+    """Run ``plannerlab ik``: 0 with solutions, 1 when unreachable (bad input raises)."""
+    p_in = _finite3(args.position, "--position")
+    c_in = _finite3(args.approach, "--approach")
+    norm = float(np.linalg.norm(c_in))
+    if norm < 1e-12:
+        raise PlannerlabError(
+            "--approach must be a non-zero direction vector (c = 0, 0, 0 has no direction)"
+        )
+    c_in = c_in / norm
+    roll_deg = _finite(args.roll, "--roll")
+    prev_deg = _finite(args.previous_theta5, "--previous-theta5")
+    robot, problem_name = _robot(args)
+    if args.frame == "world":
+        T_base_world = np.linalg.inv(robot.T_world_base)
+        p_s = T_base_world[:3, :3] @ p_in + T_base_world[:3, 3]
+        c_s = T_base_world[:3, :3] @ c_in
+    else:
+        p_s, c_s = p_in, c_in
+    report = ik_report(
+        robot,
+        p_s,
+        c_s,
+        math.radians(float(roll_deg or 0.0)),
+        None if prev_deg is None else math.radians(prev_deg),
+    )
+    out = {
+        "robot": args.robot,
+        "problem": problem_name,
+        "frame": args.frame,
+        "position_station_m": [float(v) for v in p_s],
+        "approach_station": [float(v) for v in c_s],
+        "roll_deg": float(roll_deg or 0.0),
+        "previous_theta5_deg": prev_deg,
+        **report,
+    }
+    if args.json:
+        print(json.dumps(out, indent=1))
+    else:
+        _print(console, out)
+    return 0 if report["reachable"] else 1
+
+
+def _print(console: Console, out: dict[str, Any]) -> None:
+    def vec(v: list[float]) -> str:
+        return "(" + ", ".join(f"{x:.4f}" for x in v) + ")"
+
+    t = Table(title="IRb-6 on LP-1: analytic IK", show_header=False)
+    t.add_column("", style="bold")
+    t.add_column("")
+
+    def row(label: str, value: str) -> None:
+        t.add_row(escape(label), value)
+
+    source = f"problem {out['problem']}" if out["problem"] else "model defaults"
+    row("robot", f"{out['robot']} ({source})")
+    row("flange position (station) [m]", vec(out["position_station_m"]))
+    row("approach c (station)", vec(out["approach_station"]))
+    row("roll [°]", f"{out['roll_deg']:.3f}")
+    row("case", out["case"])
+    if out["R_wew_m"] is not None and out["R_zew_m"] is not None:
+        row("R_wew, R_zew [m]", f"{out['R_wew_m']:.4f}, {out['R_zew_m']:.4f}")
+    spans = " ∪ ".join(f"[{lo:.4f}, {hi:.4f}]" for lo, hi in out["lambda0_intervals_m"])
+    if out["case"] == "unambiguous" and out["lambda0_intervals_m"]:
+        spans = f"{out['lambda0_intervals_m'][0][0]:.4f} (one value: d_z − d_x·c_z/c_x)"
+    row("λ0 intervals [m]", escape(spans or "none"))
+    if not out["reachable"]:
+        row("unreachable", f"[red]{out['reason_code']}[/red]: {escape(out['reason'] or '')}")
+    console.print(t)
+    if not out["solutions"]:
+        return
+    s = Table(title=f"{len(out['solutions'])} solution(s), checked by forward kinematics")
+    for col in ("#", "λ0 m", "θ1 °", "θ2 °", "θ3 °", "θ4 °", "θ5 °", "pos err m", "rot err °"):
+        s.add_column(col, justify="right")
+    for i, sol in enumerate(out["solutions"], start=1):
+        s.add_row(
+            str(i),
+            f"{sol['lambda0_m']:.4f}",
+            *(f"{v:.3f}" for v in sol["theta_deg"]),
+            f"{sol['pos_err_m']:.2e}",
+            f"{sol['rot_err_deg']:.2e}",
+        )
+    console.print(s)
+
+
+__all__ = ["IK_ROBOTS", "add_ik_parser", "cmd_ik", "ik_report"]

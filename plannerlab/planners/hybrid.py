@@ -1,0 +1,238 @@
+"""Planners that extend the gradient method against local minima.
+
+``gradient+rrtconnect``
+    Gradient descent (the paper's objective); when it stalls in a local minimum,
+    RRT-Connect plans from the stalled state into the goal region (goal states from IK).
+    If RRT-Connect fails within its slice of the budget, descent resumes from the stalled
+    state's neighbourhood and the next stall gets another attempt, up to
+    ``max_escapes``. The path is descent, then the RRT-Connect path.
+``gradient.multistart``
+    Random-restart descent along the path, the remedy TRAC-IK and cuRobo use against
+    local minima: at a stall, the arm moves to a random collision-free state near the
+    stall (a straight joint-space edge, checked; Gaussian noise growing with every failed
+    restart) and descends again. Each restart is part of the path, so the result is an
+    executable path, not only a goal state.
+
+A local minimum is *escaped* when, after it, the planner reaches the goal region or a
+state whose objective is lower than the stall's by more than ``stall_min_decrease``.
+Both planners report ``local_minima`` (stalls met) and ``escapes``.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, replace
+from typing import Any
+
+import numpy as np
+
+from plannerlab.collision import CollisionChecker
+from plannerlab.errors import PlannerlabError
+from plannerlab.objective import Objective
+from plannerlab.paths import interpolate_edge
+from plannerlab.planners.base import PlanResult, Status, settings_dict, with_overrides
+from plannerlab.planners.gradient import GradientPlanner, GradientSettings
+from plannerlab.problem import Budget
+from plannerlab.robots.base import Array, wrap_to_pi
+
+
+@dataclass(frozen=True)
+class HybridSettings:
+    """Settings of the hybrid planners.
+
+    Attributes:
+        gamma, epsilon, stall_window, stall_min_decrease: the descent's (paper: 0.05, 0.5;
+            plannerlab's stall rule).
+        gradient: "analytic" (default: the same descent as approx_fprime's, faster) or
+            "finite_difference".
+        max_escapes: stalls the planner tries to leave before it gives up.
+        escape_checks: collision checks one escape attempt may use (RRT-Connect's slice,
+            or the restart sampling's).
+        rrt_range: RRT-Connect's range (0: OMPL's default).
+        restart_noise_rad: first restart's noise (std. dev. per joint) [rad].
+        restart_noise_growth: factor on the noise after every failed restart.
+        restart_tries: samples per restart before the noise grows.
+    """
+
+    gamma: float = 0.05
+    epsilon: float = 0.5
+    stall_window: int = 60
+    stall_min_decrease: float = 1e-3
+    gradient: str = "analytic"
+    max_escapes: int = 10
+    escape_checks: int = 20000
+    rrt_range: float = 0.0
+    restart_noise_rad: float = 0.3
+    restart_noise_growth: float = 1.5
+    restart_tries: int = 20
+
+    def descent(self) -> GradientSettings:
+        return GradientSettings(gamma=self.gamma, epsilon=self.epsilon,
+                                stall_window=self.stall_window,
+                                stall_min_decrease=self.stall_min_decrease,
+                                gradient=self.gradient)
+
+
+class _Ledger:
+    """What the sub-solves have used so far, against the overall budget."""
+
+    def __init__(self, budget: Budget) -> None:
+        self.budget = budget
+        self.iterations = 0
+        self.checks = 0
+        self.fk_calls = 0
+        self.t0 = time.perf_counter()
+
+    def add(self, r: PlanResult) -> None:
+        self.iterations += r.iterations
+        self.checks += r.collision_checks
+        self.fk_calls += r.fk_calls
+
+    def remaining(self, checks_cap: int | None = None) -> Budget | None:
+        """The budget left (None when a limit is used up), checks capped at ``checks_cap``."""
+        b = self.budget
+        it = None if b.max_iterations is None else b.max_iterations - self.iterations
+        ch = None if b.max_collision_checks is None else b.max_collision_checks - self.checks
+        tl = None if b.time_limit_s is None else b.time_limit_s - (time.perf_counter() - self.t0)
+        if (it is not None and it <= 0) or (ch is not None and ch <= 0) or (
+                tl is not None and tl <= 0):
+            return None
+        if checks_cap is not None:
+            ch = checks_cap if ch is None else min(ch, checks_cap)
+        return Budget(max_iterations=it, max_collision_checks=ch, time_limit_s=tl)
+
+    def exhausted_reason(self) -> str:
+        b = self.budget
+        if b.max_iterations is not None and self.iterations >= b.max_iterations:
+            return f"iteration budget of {b.max_iterations} used up"
+        if b.max_collision_checks is not None and self.checks >= b.max_collision_checks:
+            return f"collision-check budget of {b.max_collision_checks} used up"
+        return f"time limit of {b.time_limit_s:g} s reached"
+
+
+class HybridPlanner:
+    """``gradient+rrtconnect`` and ``gradient.multistart`` (see the module docstring)."""
+
+    def __init__(self, name: str, settings: HybridSettings) -> None:
+        self.name = name
+        self.settings = settings
+        self._descent = GradientPlanner(f"{name}/descent", settings.descent())
+
+    def solve(self, problem: Any, leg: int, budget: Budget, rng: np.random.Generator,
+              q_start: Array | None = None, stepper: Any = None) -> PlanResult:
+        del stepper
+        s = self.settings
+        t0 = time.perf_counter()
+        robot = problem.robot
+        goal = problem.goal(leg)
+        ledger = _Ledger(budget)
+        q = np.array(problem.q_start if q_start is None else q_start, dtype=float)
+        path: list[Array] = [q]
+        trace: list[float] = []
+        minima = escapes = 0
+        notes: list[str] = []
+        stall_f: float | None = None
+        noise = s.restart_noise_rad
+        objective = Objective(robot, goal, None)
+
+        def done(status: Status, reason: str) -> PlanResult:
+            p = np.array(path)
+            pos_err, ang_err = goal.errors(robot, p[-1])
+            return PlanResult(
+                planner=self.name, problem=problem.name, leg=leg, goal=goal.name,
+                status=status, reason=reason, path=p, time_s=time.perf_counter() - t0,
+                iterations=ledger.iterations, collision_checks=ledger.checks,
+                fk_calls=ledger.fk_calls, pos_err_m=float(pos_err),
+                angle_err_deg=float(ang_err), trace=np.array(trace), local_minima=minima,
+                escapes=escapes, settings=settings_dict(s), extra={"steps": notes})
+
+        while True:
+            sub = ledger.remaining()
+            if sub is None:
+                return done(Status.BUDGET_EXHAUSTED, ledger.exhausted_reason())
+            r = self._descent.solve(problem, leg, sub, rng, q_start=q)
+            ledger.add(r)
+            path.extend(r.path[1:])
+            trace.extend(r.trace.tolist())
+            q = r.path[-1]
+            if stall_f is not None and (r.solved or r.trace.min() < stall_f
+                                        - s.stall_min_decrease):
+                escapes += 1
+                stall_f = None
+            notes.append(f"descent: {r.status.value} after {r.iterations} iterations")
+            if r.status in (Status.SOLVED, Status.INVALID_START):
+                return done(r.status, f"{r.reason}; {minima} local minima met, "
+                                      f"{escapes} escaped")
+            if r.status is not Status.LOCAL_MINIMUM:
+                return done(r.status, r.reason)
+            minima += 1
+            stall_f = float(objective(q))
+            if minima > s.max_escapes:
+                return done(Status.LOCAL_MINIMUM,
+                            f"{minima} local minima met, {escapes} escaped; gave up after "
+                            f"{s.max_escapes} escape attempts")
+            if self.name == "gradient+rrtconnect":
+                rrt = self._rrt_escape(problem, leg, ledger, rng, q)
+                if rrt is None:
+                    return done(Status.BUDGET_EXHAUSTED, ledger.exhausted_reason())
+                notes.append(f"rrtconnect from stall {minima}: {rrt.status.value}")
+                if rrt.solved:
+                    path.extend(rrt.path[1:])
+                    escapes += 1
+                    return done(Status.SOLVED,
+                                f"descent stalled; RRT-Connect reached the goal region from "
+                                f"stall {minima}; {minima} local minima met, {escapes} escaped")
+            # restart near the stall (multistart always; rrtconnect after a failed slice)
+            q_new = self._restart(problem, ledger, rng, q, noise)
+            noise *= s.restart_noise_growth
+            if q_new is None:
+                notes.append(f"no collision-free restart near stall {minima}")
+                continue
+            path.extend(q_new[1:])
+            q = q_new[-1]
+
+    # ------------------------------------------------------------------ escapes
+    def _rrt_escape(self, problem: Any, leg: int, ledger: _Ledger, rng: np.random.Generator,
+                    q: Array) -> PlanResult | None:
+        from plannerlab.planners import make_planner
+
+        sub = ledger.remaining(checks_cap=self.settings.escape_checks)
+        if sub is None:
+            return None
+        overrides = {"range": self.settings.rrt_range} if self.settings.rrt_range > 0 else {}
+        rrt = make_planner("ompl.rrtconnect", overrides)
+        r = rrt.solve(problem, leg, sub, rng, q_start=q)
+        ledger.add(r)
+        return r
+
+    def _restart(self, problem: Any, ledger: _Ledger, rng: np.random.Generator, q: Array,
+                 noise_rad: float) -> Array | None:
+        """A straight, collision-free edge from q to a random state near it: (m, dof)."""
+        robot = problem.robot
+        checker = CollisionChecker(robot, problem.scene)
+        for _ in range(self.settings.restart_tries):
+            if ledger.remaining() is None:
+                break
+            q_try = wrap_to_pi(q + rng.normal(0.0, noise_rad, robot.dof), robot.continuous)
+            q_try = np.clip(q_try, robot.lower, robot.upper)
+            edge = interpolate_edge(q, q_try, problem.joint_step, robot.continuous)
+            before = checker.checks
+            ok = checker.first_invalid(edge) is None
+            ledger.checks += checker.checks - before
+            if ok:
+                return wrap_to_pi(edge, robot.continuous)
+        return None
+
+
+VARIANTS = ("gradient+rrtconnect", "gradient.multistart")
+
+
+def make(name: str, overrides: dict) -> HybridPlanner:
+    """Registry factory for ``gradient+rrtconnect`` and ``gradient.multistart``."""
+    if name not in VARIANTS:
+        raise PlannerlabError(f"{name} is not a hybrid planner ({', '.join(VARIANTS)})")
+    settings = with_overrides(HybridSettings(), overrides, name)
+    if settings.gradient not in ("analytic", "finite_difference"):
+        raise PlannerlabError(f"gradient setting: 'analytic' or 'finite_difference', got "
+                              f"{settings.gradient!r}")
+    return HybridPlanner(name, replace(settings))
