@@ -264,6 +264,8 @@ def build_parser() -> argparse.ArgumentParser:
     p.set_defaults(func=cmd_plot)
     from plannerlab.ik_cli import add_ik_parser
     add_ik_parser(sub)
+    from plannerlab.compare_cli import add_compare_parser
+    add_compare_parser(sub)
     return parser
 
 

@@ -1,0 +1,796 @@
+"""Grids of trials (problems × planners × seeds), each trial in its own process.
+
+A :class:`Trial` is (problem, planner, seed, budget overrides, settings overrides, legs,
+execute). :func:`run_trial` runs one and returns a JSON-able record; it is meant to run in
+a *fresh* process, because OMPL's random generator is process-global and its seed only
+takes effect before OMPL's first generator exists (see :mod:`plannerlab.planners.ompl`).
+:func:`run_comparison` runs many, ``jobs`` at a time, one spawned process per trial, and
+appends every finished record to a :class:`TrialStore` (JSON lines, flushed and fsynced
+line by line), so that rerunning the same comparison skips the trials already finished
+and an interrupted run loses only the trials that were still running.
+:func:`summarise` turns records into one row per (problem, planner).
+
+Decisions:
+
+* **One spawned process per trial** (``multiprocessing`` "spawn" context, at most ``jobs``
+  alive). This is what ``ProcessPoolExecutor(mp_context=spawn, max_tasks_per_child=1)``
+  gives, managed by hand so that (a) a trial whose process dies (a segfault in a native
+  library) is recorded as an ``error`` for *that* trial instead of breaking a whole pool
+  and every trial running beside it, and (b) on Ctrl-C the running trials are terminated
+  at once. Children ignore SIGINT: the parent decides. A record is appended by the parent
+  only, when a child has sent it, so there is a single writer.
+* **Seeding.** The child seeds OMPL (``seed_ompl(seed)``) before anything else whenever
+  :mod:`plannerlab.planners.ompl` imports, whatever the planner (a planner may use OMPL
+  inside); numpy generators come from :func:`plannerlab.runner.leg_rng`.
+* **Trial key.** ``problem/planner/s<seed>/<hash>`` where the hash (sha256, 10 hex) covers
+  the budget and settings overrides, the legs and the execute flag, so one store can hold
+  runs of the same grid under different budgets without mixing them.
+* **Errors.** A trial that raises is recorded with status ``error`` and the exception's
+  last line (never kills the run); it is "finished" for resuming unless ``retry_errors``.
+* **Statistics** (:func:`summarise`): success = every leg SOLVED; a trial with status
+  ``error`` counts in ``n`` as a failure. Times (sum over legs of ``time_s``) and final
+  tip errors are over every trial that did not error; path length over successful trials
+  only; 95 % Wilson score interval for the success rate.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import hashlib
+import json
+import logging
+import math
+import multiprocessing
+import os
+import signal
+import time
+import traceback
+from collections.abc import Callable, Iterable, Iterator, Mapping, Sequence
+from dataclasses import dataclass, field
+from datetime import UTC, datetime
+from multiprocessing.connection import Connection, wait
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from plannerlab.errors import PlannerlabError
+
+LOGGER = logging.getLogger(__name__)
+
+RECORD_FORMAT = "plannerlab.trial/1"
+#: two-sided 95 % normal quantile
+Z95 = 1.959963984540054
+#: statuses of a trial record: the planner statuses plus "error" (the trial raised)
+ERROR_STATUS = "error"
+
+Scalar = int | float | str | bool | None
+
+
+# ---------------------------------------------------------------------- trials
+def _frozen_items(d: Mapping[str, Any] | Iterable[tuple[str, Any]] | None) -> tuple:
+    items = dict(d or {}).items()
+    return tuple(sorted((str(k), v) for k, v in items if v is not None))
+
+
+@dataclass(frozen=True)
+class Trial:
+    """One run of one planner on one problem with one seed.
+
+    Build with :meth:`make` (it normalises the mappings into sorted tuples, so trials are
+    hashable and picklable).
+
+    Attributes:
+        problem: problem name (as reported by the problem file).
+        problem_file: path of the problem file the child process loads.
+        planner: registry name.
+        seed: the trial's seed (numpy streams per leg, and OMPL's global seed).
+        budget: overrides of the problem's budget, sorted ``(key, value)`` pairs with keys
+            of :class:`~plannerlab.problem.Budget` (``max_iterations``,
+            ``max_collision_checks``, ``time_limit_s``).
+        settings: planner settings overrides, sorted ``(key, value)`` pairs.
+        legs: leg indices to solve, in order (None: every leg).
+        execute: also execute the planned legs in PyBullet.
+    """
+
+    problem: str
+    problem_file: str
+    planner: str
+    seed: int
+    budget: tuple[tuple[str, Scalar], ...] = ()
+    settings: tuple[tuple[str, Scalar], ...] = ()
+    legs: tuple[int, ...] | None = None
+    execute: bool = False
+
+    @classmethod
+    def make(
+        cls,
+        problem: str,
+        problem_file: str | Path,
+        planner: str,
+        seed: int,
+        *,
+        budget: Mapping[str, Scalar] | None = None,
+        settings: Mapping[str, Scalar] | None = None,
+        legs: Sequence[int] | None = None,
+        execute: bool = False,
+    ) -> Trial:
+        return cls(
+            problem=str(problem),
+            problem_file=str(problem_file),
+            planner=str(planner),
+            seed=int(seed),
+            budget=_frozen_items(budget),
+            settings=_frozen_items(settings),
+            legs=None if legs is None else tuple(int(i) for i in legs),
+            execute=bool(execute),
+        )
+
+    @property
+    def config(self) -> dict[str, Any]:
+        """Everything but problem, planner and seed, as plain data."""
+        return {
+            "budget": dict(self.budget),
+            "settings": dict(self.settings),
+            "legs": None if self.legs is None else list(self.legs),
+            "execute": self.execute,
+        }
+
+    @property
+    def key(self) -> str:
+        """Stable identifier: ``problem/planner/s<seed>/<10 hex of the config>``."""
+        blob = json.dumps(self.config, sort_keys=True, separators=(",", ":"))
+        h = hashlib.sha256(blob.encode()).hexdigest()[:10]
+        return f"{self.problem}/{self.planner}/s{self.seed}/{h}"
+
+    def to_dict(self) -> dict[str, Any]:
+        return {
+            "problem": self.problem,
+            "problem_file": self.problem_file,
+            "planner": self.planner,
+            "seed": self.seed,
+            **self.config,
+        }
+
+
+def parse_seeds(spec: str) -> list[int]:
+    """``"0-19"``, ``"0,3,5-7"`` or ``"4"`` -> sorted unique seeds.
+
+    Raises:
+        PlannerlabError: malformed spec or a negative/empty range.
+    """
+    seeds: set[int] = set()
+    for part in str(spec).split(","):
+        part = part.strip()
+        if not part:
+            continue
+        try:
+            if "-" in part:
+                a, b = part.split("-", 1)
+                lo, hi = int(a), int(b)
+                if hi < lo:
+                    raise ValueError
+                seeds.update(range(lo, hi + 1))
+            else:
+                seeds.add(int(part))
+        except ValueError:
+            raise PlannerlabError(
+                f"seeds: expected integers and ranges like 0-19 or 0,3,5-7, got {part!r}"
+            ) from None
+    if not seeds:
+        raise PlannerlabError(f"seeds: no seed in {spec!r}")
+    if min(seeds) < 0:
+        raise PlannerlabError(f"seeds: must be >= 0, got {min(seeds)}")
+    return sorted(seeds)
+
+
+# ---------------------------------------------------------------------- one trial
+def _num(x: Any) -> Any:
+    """A JSON-safe number: NaN -> None, ±inf -> None (tables show them as "-")."""
+    if isinstance(x, np.generic):
+        x = x.item()
+    if isinstance(x, float) and not math.isfinite(x):
+        return None
+    return x
+
+
+def _seed_ompl(seed: int) -> bool:
+    """Seed OMPL's process-global RNG if the OMPL adapter imports; False when it cannot."""
+    try:
+        from plannerlab.planners import ompl as ompl_adapter
+    except ImportError as exc:
+        LOGGER.debug("OMPL adapter not importable (%s): OMPL not seeded", exc)
+        return False
+    seed_fn = getattr(ompl_adapter, "seed_ompl", None)
+    if seed_fn is None:
+        LOGGER.warning("plannerlab.planners.ompl has no seed_ompl(): OMPL not seeded")
+        return False
+    seed_fn(int(seed))
+    return True
+
+
+def _leg_record(r: Any, continuous: np.ndarray) -> dict[str, Any]:
+    from plannerlab.paths import path_length
+
+    path = np.ascontiguousarray(r.path, dtype=float)
+    extra_lengths = {
+        str(k): _num(float(v))
+        for k, v in dict(r.extra).items()
+        if "length" in str(k) and isinstance(v, int | float | np.number) and not isinstance(v, bool)
+    }
+    return {
+        "leg": int(r.leg),
+        "goal": r.goal,
+        "status": r.status.value,
+        "reason": r.reason,
+        "time_s": _num(float(r.time_s)),
+        "iterations": int(r.iterations),
+        "collision_checks": int(r.collision_checks),
+        "fk_calls": int(r.fk_calls),
+        "pos_err_m": _num(float(r.pos_err_m)),
+        "angle_err_deg": _num(float(r.angle_err_deg)),
+        "local_minima": int(r.local_minima),
+        "escapes": int(r.escapes),
+        "path_length": _num(path_length(path, continuous)),
+        "path_points": int(len(path)),
+        "path_sha256": hashlib.sha256(path.tobytes()).hexdigest()[:16],
+        "extra_lengths": extra_lengths,
+    }
+
+
+def _execution_record(executions: Sequence[Any]) -> dict[str, Any]:
+    legs = [
+        {
+            "leg": e.leg,
+            "success": bool(e.success),
+            "path_valid": bool(e.path_valid),
+            "max_track_err_rad": _num(e.max_track_err_rad),
+            "max_tip_track_err_m": _num(e.max_tip_track_err_m),
+            "contacts": len(e.contacts),
+            "final_pos_err_m": _num(e.final_pos_err_m),
+            "final_angle_err_deg": _num(e.final_angle_err_deg),
+            "sim_time_s": _num(e.sim_time_s),
+            "wall_time_s": _num(e.wall_time_s),
+            "reason": e.reason,
+        }
+        for e in executions
+    ]
+    last = executions[-1] if executions else None
+    return {
+        "success": bool(executions) and all(x["success"] for x in legs),
+        "path_valid": all(x["path_valid"] for x in legs),
+        "max_track_err_rad": _num(max((e.max_track_err_rad for e in executions), default=0.0)),
+        "contacts": sum(x["contacts"] for x in legs),
+        "final_pos_err_m": _num(last.final_pos_err_m) if last else None,
+        "final_angle_err_deg": _num(last.final_angle_err_deg) if last else None,
+        "legs": legs,
+    }
+
+
+def _trial_status(legs: Sequence[Mapping[str, Any]]) -> str:
+    for leg in legs:
+        if leg["status"] != "solved":
+            return str(leg["status"])
+    return "solved" if legs else "failed"
+
+
+def run_trial(trial: Trial) -> dict[str, Any]:
+    """Run one trial and return its record (plain JSON-able data). Never raises
+    (except KeyboardInterrupt/SystemExit): an exception becomes status ``error``.
+
+    Meant to run in a fresh process: OMPL is seeded first, before any OMPL object exists.
+    """
+    t0 = time.perf_counter()
+    ompl_seeded = _seed_ompl(trial.seed)  # first: before any OMPL object exists
+    from plannerlab.io import versions
+
+    rec: dict[str, Any] = {
+        "format": RECORD_FORMAT,
+        "key": trial.key,
+        **trial.to_dict(),
+        "ompl_seeded": ompl_seeded,
+    }
+    try:
+        from plannerlab.catalog import load_problem
+        from plannerlab.runner import solve_legs
+
+        problem = load_problem(trial.problem_file)
+        budget = problem.budget.replace(**dict(trial.budget))
+        plan = solve_legs(
+            problem,
+            trial.planner,
+            trial.seed,
+            legs=trial.legs,
+            budget=budget,
+            overrides=dict(trial.settings),
+        )
+        legs = [_leg_record(r, problem.robot.continuous) for r in plan.legs]
+        rec["budget_used"] = budget.to_dict()
+        rec["settings_used"] = dict(plan.legs[0].settings) if plan.legs else {}
+        rec["legs_run"] = legs
+        rec["status"] = _trial_status(legs)
+        rec["success"] = bool(legs) and all(x["status"] == "solved" for x in legs)
+        rec["error"] = None
+        rec["totals"] = {
+            k: _num(sum((x[k] or 0) for x in legs))
+            for k in (
+                "time_s",
+                "iterations",
+                "collision_checks",
+                "fk_calls",
+                "path_length",
+                "local_minima",
+                "escapes",
+            )
+        }
+        rec["final_pos_err_m"] = legs[-1]["pos_err_m"] if legs else None
+        rec["final_angle_err_deg"] = legs[-1]["angle_err_deg"] if legs else None
+        rec["execution"] = None
+        if trial.execute and plan.legs:
+            from plannerlab.sim.execute import execute_legs
+
+            executions = execute_legs(
+                problem, [r.path for r in plan.legs], first_leg=plan.legs[0].leg
+            )
+            rec["execution"] = _execution_record(executions)
+    except Exception as exc:  # a crashing trial is a record, never the end of the run
+        last = traceback.format_exception_only(type(exc), exc)[-1].strip()
+        LOGGER.debug("trial %s raised", trial.key, exc_info=True)
+        rec.update(
+            status=ERROR_STATUS,
+            success=False,
+            error=last,
+            legs_run=[],
+            totals={},
+            execution=None,
+            final_pos_err_m=None,
+            final_angle_err_deg=None,
+        )
+    rec["versions"] = versions()
+    rec["pid"] = os.getpid()
+    rec["wall_s"] = time.perf_counter() - t0
+    rec["finished_at"] = datetime.now(UTC).isoformat(timespec="seconds")
+    return rec
+
+
+def _error_record(trial: Trial, error: str) -> dict[str, Any]:
+    return {
+        "format": RECORD_FORMAT,
+        "key": trial.key,
+        **trial.to_dict(),
+        "status": ERROR_STATUS,
+        "success": False,
+        "error": error,
+        "legs_run": [],
+        "totals": {},
+        "execution": None,
+        "final_pos_err_m": None,
+        "final_angle_err_deg": None,
+        "finished_at": datetime.now(UTC).isoformat(timespec="seconds"),
+    }
+
+
+#: characters of a trial process's captured output kept in its record
+OUTPUT_TAIL_CHARS = 2000
+
+
+def _tail(path: Path, chars: int = OUTPUT_TAIL_CHARS) -> str:
+    try:
+        text = path.read_text(encoding="utf-8", errors="replace")
+    except OSError:
+        return ""
+    return text[-chars:]
+
+
+@contextlib.contextmanager
+def _sigint_ignored() -> Iterator[None]:
+    """Ignore SIGINT while starting a child, so that the child starts with SIGINT ignored
+    (a terminal's Ctrl-C goes to the whole process group; the parent stops the children).
+    A no-op outside the main thread, where handlers cannot be changed."""
+    import threading
+
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    previous = signal.signal(signal.SIGINT, signal.SIG_IGN)
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGINT, previous)
+
+
+def _child_main(trial: Trial, conn: Connection, out_path: str) -> None:
+    """Entry point of a trial's process: run it and send the record to the parent.
+
+    The process's stdout and stderr (file descriptors 1 and 2: Python warnings, log
+    records without a handler, native libraries' own prints) go to ``out_path``, so they
+    cannot garble the parent's progress display; their tail is kept in the record.
+    """
+    import sys
+
+    signal.signal(signal.SIGINT, signal.SIG_IGN)  # the parent handles Ctrl-C
+    fd = os.open(out_path, os.O_WRONLY | os.O_CREAT | os.O_TRUNC, 0o644)
+    os.dup2(fd, 1)
+    os.dup2(fd, 2)
+    os.close(fd)
+    try:
+        rec = run_trial(trial)
+        sys.stdout.flush()
+        sys.stderr.flush()
+        output = _tail(Path(out_path))
+        if output:
+            rec["output"] = output
+        conn.send(rec)
+    finally:
+        conn.close()
+
+
+# ---------------------------------------------------------------------- the store
+class TrialStore:
+    """Append-only JSON-lines file of finished trial records (one line per trial).
+
+    Every line is flushed and fsynced when written. On reading, a line that is not valid
+    JSON is ignored: the last one may be half-written by a kill (it is cut off before the
+    next append, so new lines never glue onto it); any other is logged. A key that occurs
+    twice keeps its last record.
+    """
+
+    def __init__(self, path: str | Path) -> None:
+        self.path = Path(path)
+
+    def load(self) -> dict[str, dict[str, Any]]:
+        """Records by trial key."""
+        out: dict[str, dict[str, Any]] = {}
+        if not self.path.exists():
+            return out
+        lines = self.path.read_bytes().split(b"\n")
+        for i, line in enumerate(lines):
+            if not line.strip():
+                continue
+            try:
+                rec = json.loads(line)
+            except (json.JSONDecodeError, UnicodeDecodeError):
+                if i < len(lines) - 1:
+                    LOGGER.warning("%s: line %d is not JSON; ignored", self.path, i + 1)
+                continue
+            if isinstance(rec, dict) and "key" in rec:
+                out[str(rec["key"])] = rec
+        return out
+
+    def _cut_partial_tail(self) -> None:
+        """Drop a last line without its newline (a write interrupted by a kill)."""
+        if not self.path.exists():
+            return
+        with open(self.path, "r+b") as fh:
+            size = fh.seek(0, os.SEEK_END)
+            if size == 0:
+                return
+            fh.seek(size - 1)
+            if fh.read(1) == b"\n":
+                return
+            data = self.path.read_bytes()
+            cut = data.rfind(b"\n") + 1
+            LOGGER.info("%s: dropping a half-written last line (%d bytes)", self.path, size - cut)
+            fh.truncate(cut)
+            fh.flush()
+            os.fsync(fh.fileno())
+
+    @contextlib.contextmanager
+    def writer(self) -> Iterator[Callable[[Mapping[str, Any]], None]]:
+        """Exclusive appender: ``with store.writer() as append: append(record)``.
+
+        Raises:
+            PlannerlabError: another process holds the store (a comparison already running
+                into the same folder).
+        """
+        import fcntl
+
+        self.path.parent.mkdir(parents=True, exist_ok=True)
+        lock_path = self.path.with_name(self.path.name + ".lock")
+        with open(lock_path, "a") as lock:
+            try:
+                fcntl.flock(lock.fileno(), fcntl.LOCK_EX | fcntl.LOCK_NB)
+            except BlockingIOError:
+                raise PlannerlabError(
+                    f"{self.path} is in use by another comparison (lock {lock_path})"
+                ) from None
+            self._cut_partial_tail()
+            with open(self.path, "a", encoding="utf-8") as fh:
+
+                def append(rec: Mapping[str, Any]) -> None:
+                    fh.write(json.dumps(rec, separators=(",", ":"), allow_nan=False) + "\n")
+                    fh.flush()
+                    os.fsync(fh.fileno())
+
+                yield append
+
+
+def store_path(out_dir: str | Path, name: str) -> Path:
+    """``<out_dir>/<name>/trials.jsonl``."""
+    return Path(out_dir) / name / "trials.jsonl"
+
+
+def default_name(problems: Sequence[str], planners: Sequence[str]) -> str:
+    """A folder name from the problems and planners (filesystem-safe, at most ~80 chars)."""
+    import re
+
+    raw = "__".join(["+".join(problems), "+".join(planners)])
+    safe = re.sub(r"[^A-Za-z0-9._+-]", "_", raw)
+    if len(safe) <= 80:
+        return safe
+    h = hashlib.sha256(raw.encode()).hexdigest()[:8]
+    return f"{safe[:70]}-{h}"
+
+
+# ---------------------------------------------------------------------- comparisons
+@dataclass
+class ComparisonRun:
+    """What :func:`run_comparison` did.
+
+    Attributes:
+        records: one record per requested trial that is finished (in the trials' order).
+        ran: trials run by this call; skipped: trials already in the store.
+        missing: trials without a record (only after an interruption).
+    """
+
+    records: list[dict[str, Any]]
+    ran: int
+    skipped: int
+    missing: list[Trial] = field(default_factory=list)
+
+
+def run_comparison(
+    trials: Sequence[Trial],
+    store: TrialStore | str | Path,
+    jobs: int = 1,
+    on_done: Callable[[dict[str, Any], bool], None] | None = None,
+    *,
+    retry_errors: bool = False,
+    poll_s: float = 0.5,
+) -> ComparisonRun:
+    """Run the trials not yet in ``store``, ``jobs`` at a time, each in its own process.
+
+    Args:
+        trials: the grid; duplicates (same key) run once.
+        store: where finished records are appended (a :class:`TrialStore` or its path).
+        jobs: processes alive at once (>= 1).
+        on_done: called in this process as ``on_done(record, skipped)`` for every trial
+            already in the store (``skipped=True``, first) and every trial as it finishes.
+        retry_errors: rerun trials whose stored record has status ``error``.
+        poll_s: how often to look at the children [s] (only matters for responsiveness).
+
+    Returns:
+        the records of every requested trial (see :class:`ComparisonRun`).
+
+    Raises:
+        KeyboardInterrupt: after terminating the running trials; every trial finished
+            before is in the store, so rerunning resumes.
+    """
+    if jobs < 1:
+        raise PlannerlabError(f"jobs: expected >= 1, got {jobs}")
+    store = store if isinstance(store, TrialStore) else TrialStore(store)
+    unique: dict[str, Trial] = {}
+    for t in trials:
+        unique.setdefault(t.key, t)
+    stored = store.load()
+    results: dict[str, dict[str, Any]] = {}
+    todo: list[Trial] = []
+    for key, t in unique.items():
+        rec = stored.get(key)
+        if rec is not None and not (retry_errors and rec.get("status") == ERROR_STATUS):
+            results[key] = rec
+        else:
+            todo.append(t)
+    skipped = len(results)
+    if on_done is not None:
+        for key in unique:
+            if key in results:
+                on_done(results[key], True)
+    ran = 0
+    if todo:
+        ctx = multiprocessing.get_context("spawn")
+        queue = list(reversed(todo))
+        running: dict[Connection, tuple[Trial, Any, Path]] = {}  # pipe -> trial, proc, output
+        out_dir = store.path.parent / ".running"
+        with store.writer() as append:
+            out_dir.mkdir(parents=True, exist_ok=True)
+            for stale in out_dir.glob("*.out"):  # left by a run that was killed
+                stale.unlink(missing_ok=True)
+
+            def finish(rec: dict[str, Any]) -> None:
+                nonlocal ran
+                append(rec)
+                results[rec["key"]] = rec
+                ran += 1
+                if on_done is not None:
+                    on_done(rec, False)
+
+            try:
+                while queue or running:
+                    while queue and len(running) < jobs:
+                        trial = queue.pop()
+                        recv, send = ctx.Pipe(duplex=False)
+                        out = out_dir / (
+                            hashlib.sha256(trial.key.encode()).hexdigest()[:16] + ".out"
+                        )
+                        proc = ctx.Process(
+                            target=_child_main,
+                            args=(trial, send, str(out)),
+                            name=f"trial {trial.key}",
+                            daemon=True,
+                        )
+                        running[recv] = (trial, proc, out)  # before start: see the cleanup
+                        with _sigint_ignored():  # inherited: Ctrl-C is the parent's to handle
+                            proc.start()
+                        send.close()  # the child holds the only write end now
+                    for conn in wait(list(running), timeout=poll_s):
+                        # stays in `running` until handled, so an interrupt cleans it up
+                        trial, proc, out = running[conn]  # type: ignore[index]
+                        try:
+                            rec = conn.recv()  # type: ignore[union-attr]
+                        except (EOFError, OSError):
+                            rec = None
+                        conn.close()  # type: ignore[union-attr]
+                        if rec is not None:
+                            finish(rec)  # stored first: nothing below can lose it
+                            proc.join(timeout=30)
+                        else:
+                            proc.join(timeout=30)
+                            rec = _error_record(
+                                trial,
+                                f"trial process died (exit code {proc.exitcode}) "
+                                "before reporting a result",
+                            )
+                            output = _tail(out)
+                            if output:
+                                rec["output"] = output
+                            finish(rec)
+                        out.unlink(missing_ok=True)
+                        del running[conn]  # type: ignore[arg-type]
+            except BaseException as exc:
+                started = [(c, p, o) for c, (_t, p, o) in running.items() if p.pid is not None]
+                for _conn, proc, _out in started:
+                    proc.terminate()
+                for _conn, proc, _out in started:
+                    proc.join(timeout=10)
+                    if proc.is_alive():
+                        proc.kill()
+                        proc.join(timeout=5)
+                if isinstance(exc, KeyboardInterrupt):
+                    # keep the results that were sent but not yet read
+                    for conn, _proc, _out in started:
+                        with contextlib.suppress(Exception):
+                            if conn.poll(0):
+                                rec = conn.recv()
+                                if isinstance(rec, dict) and "key" in rec:
+                                    finish(rec)
+                for conn, (_trial, _proc, out) in running.items():
+                    conn.close()
+                    out.unlink(missing_ok=True)
+                raise
+            finally:
+                with contextlib.suppress(OSError):
+                    out_dir.rmdir()  # only when empty
+    records = [results[k] for k in unique if k in results]
+    missing = [t for k, t in unique.items() if k not in results]
+    return ComparisonRun(records=records, ran=ran, skipped=skipped, missing=missing)
+
+
+# ---------------------------------------------------------------------- statistics
+def wilson_interval(successes: int, n: int, z: float = Z95) -> tuple[float, float]:
+    """Wilson score interval of a binomial proportion (95 % by default).
+
+    ``(nan, nan)`` for ``n == 0``. 0/20 gives (0, 0.161); 20/20 gives (0.839, 1).
+    """
+    if n <= 0:
+        return (math.nan, math.nan)
+    if not 0 <= successes <= n:
+        raise ValueError(f"successes must be in [0, {n}], got {successes}")
+    p = successes / n
+    z2 = z * z
+    denom = 1.0 + z2 / n
+    center = (p + z2 / (2 * n)) / denom
+    half = z * math.sqrt(p * (1 - p) / n + z2 / (4 * n * n)) / denom
+    lo = 0.0 if successes == 0 else max(0.0, center - half)
+    hi = 1.0 if successes == n else min(1.0, center + half)
+    return (lo, hi)
+
+
+def _vals(xs: Iterable[Any]) -> np.ndarray:
+    return np.array([float(x) for x in xs if x is not None and math.isfinite(float(x))])
+
+
+def _pct(xs: np.ndarray, q: float) -> float:
+    return float(np.percentile(xs, q)) if xs.size else math.nan
+
+
+#: the columns of a summary row, in order
+SUMMARY_COLUMNS = (
+    "problem",
+    "planner",
+    "n",
+    "successes",
+    "errors",
+    "success_rate",
+    "ci95_low",
+    "ci95_high",
+    "time_median_s",
+    "time_p75_s",
+    "time_p95_s",
+    "path_length_median",
+    "pos_err_median_m",
+    "angle_err_median_deg",
+    "checks_median",
+    "iterations_median",
+    "local_minima",
+    "escapes",
+    "executed",
+    "exec_successes",
+    "exec_success_rate",
+    "exec_track_err_median_rad",
+    "exec_contacts",
+)
+
+
+def summarise(records: Iterable[Mapping[str, Any]]) -> list[dict[str, Any]]:
+    """One row per (problem, planner), in order of first appearance; keys
+    :data:`SUMMARY_COLUMNS` (NaN where there is nothing to measure)."""
+    groups: dict[tuple[str, str], list[Mapping[str, Any]]] = {}
+    for r in records:
+        groups.setdefault((str(r["problem"]), str(r["planner"])), []).append(r)
+    rows = []
+    for (problem, planner), recs in groups.items():
+        n = len(recs)
+        ok = [r for r in recs if r.get("success")]
+        ran = [r for r in recs if r.get("status") != ERROR_STATUS]
+        lo, hi = wilson_interval(len(ok), n)
+        t = _vals(r["totals"].get("time_s") for r in ran)
+        ex = [r["execution"] for r in recs if r.get("execution")]
+        rows.append(
+            {
+                "problem": problem,
+                "planner": planner,
+                "n": n,
+                "successes": len(ok),
+                "errors": n - len(ran),
+                "success_rate": len(ok) / n if n else math.nan,
+                "ci95_low": lo,
+                "ci95_high": hi,
+                "time_median_s": _pct(t, 50),
+                "time_p75_s": _pct(t, 75),
+                "time_p95_s": _pct(t, 95),
+                "path_length_median": _pct(_vals(r["totals"].get("path_length") for r in ok), 50),
+                "pos_err_median_m": _pct(_vals(r.get("final_pos_err_m") for r in ran), 50),
+                "angle_err_median_deg": _pct(_vals(r.get("final_angle_err_deg") for r in ran), 50),
+                "checks_median": _pct(_vals(r["totals"].get("collision_checks") for r in ran), 50),
+                "iterations_median": _pct(_vals(r["totals"].get("iterations") for r in ran), 50),
+                "local_minima": int(sum(r["totals"].get("local_minima") or 0 for r in ran)),
+                "escapes": int(sum(r["totals"].get("escapes") or 0 for r in ran)),
+                "executed": len(ex),
+                "exec_successes": sum(1 for e in ex if e.get("success")),
+                "exec_success_rate": (
+                    sum(1 for e in ex if e.get("success")) / len(ex) if ex else math.nan
+                ),
+                "exec_track_err_median_rad": _pct(
+                    _vals(e.get("max_track_err_rad") for e in ex), 50
+                ),
+                "exec_contacts": int(sum(e.get("contacts") or 0 for e in ex)),
+            }
+        )
+    return rows
+
+
+__all__ = [
+    "ERROR_STATUS",
+    "SUMMARY_COLUMNS",
+    "ComparisonRun",
+    "Trial",
+    "TrialStore",
+    "default_name",
+    "parse_seeds",
+    "run_comparison",
+    "run_trial",
+    "store_path",
+    "summarise",
+    "wilson_interval",
+]

@@ -1,0 +1,387 @@
+"""``plannerlab compare``: planners × problems × seeds, each trial in its own process.
+
+    plannerlab compare PROBLEM... --planners a,b,c --seeds 0-19
+                       [--time-limit S | --max-checks N | --max-iterations N]
+                       [--legs L1,L2] [--set PLANNER:KEY=VALUE ...] [--execute]
+                       [--jobs J] [--name NAME] [--out DIR] [--retry-errors] [--json]
+
+Every (problem, planner, seed) is a trial run in a fresh process (OMPL's generator is
+process-global and must be seeded before any OMPL object exists). Finished trials are
+appended to ``DIR/NAME/trials.jsonl`` as they finish, so rerunning the same command skips
+them and an interrupted comparison resumes where it stopped. At the end: a table per
+problem (success rate with a 95 % Wilson interval, time median/p75/p95, path length,
+final tip errors, collision checks, local minima met/escaped, PyBullet execution), and
+CSV, Markdown and OMPL benchmark logs in ``DIR/NAME/`` (load a log with
+``ompl_benchmark_statistics LOG -d results.db``).
+
+Budgets are per leg; use ``--max-checks`` or ``--max-iterations`` for reproducible
+numbers, ``--time-limit`` for benchmarks. Argument parsing and printing only: the work
+is :mod:`plannerlab.bench` and :mod:`plannerlab.report`.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import re
+import shlex
+import time
+from datetime import UTC, datetime
+from pathlib import Path
+from typing import Any
+
+from rich.console import Console
+from rich.markup import escape
+from rich.progress import (
+    BarColumn,
+    MofNCompleteColumn,
+    Progress,
+    SpinnerColumn,
+    TextColumn,
+    TimeElapsedColumn,
+    TimeRemainingColumn,
+)
+from rich.table import Table
+
+from plannerlab.errors import PlannerlabError
+
+DEFAULT_OUT = Path("results") / "compare"
+
+
+def add_compare_parser(subparsers: Any) -> argparse.ArgumentParser:
+    """Register the ``compare`` subcommand on the ``plannerlab`` parser's subparsers."""
+    p = subparsers.add_parser(
+        "compare",
+        help="run planners × problems × seeds (one process per trial), tables + CSV/MD/OMPL log",
+        description=__doc__,
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
+    p.add_argument("problems", nargs="+", metavar="PROBLEM", help="problem names or .toml paths")
+    p.add_argument(
+        "--planners", required=True, help="comma-separated registry names (plannerlab planners)"
+    )
+    p.add_argument(
+        "--seeds", default="0-19", help="seeds: a range 0-19, a list 0,3,5-7 (default 0-19)"
+    )
+    p.add_argument("--time-limit", type=float, metavar="S", help="time limit per leg [s]")
+    p.add_argument("--max-checks", type=int, metavar="N", help="collision-check budget per leg")
+    p.add_argument("--max-iterations", type=int, metavar="N", help="iteration budget per leg")
+    p.add_argument("--legs", help="comma-separated leg names or indices (default: all)")
+    p.add_argument(
+        "--set",
+        action="append",
+        metavar="PLANNER:KEY=VALUE",
+        help="override a setting of one planner (repeatable)",
+    )
+    p.add_argument(
+        "--execute",
+        action="store_true",
+        help="also execute every plan in PyBullet (success, tracking error)",
+    )
+    p.add_argument("--jobs", type=int, default=1, help="trials run at once (default 1)")
+    p.add_argument("--name", help="comparison name (default: from problems and planners)")
+    p.add_argument(
+        "--out",
+        default=str(DEFAULT_OUT),
+        help=f"parent folder of the comparison's folder (default {DEFAULT_OUT})",
+    )
+    p.add_argument(
+        "--retry-errors", action="store_true", help="rerun trials whose stored record is an error"
+    )
+    p.add_argument(
+        "--json", action="store_true", help="print the summary rows and file paths as JSON"
+    )
+    p.set_defaults(func=cmd_compare)
+    return p
+
+
+# ---------------------------------------------------------------------- arguments
+def _split(spec: str) -> list[str]:
+    return [x.strip() for x in spec.split(",") if x.strip()]
+
+
+def parse_settings(items: list[str] | None, planners: list[str]) -> dict[str, dict[str, str]]:
+    """``["ompl.rrt:range=0.5", ...]`` -> ``{"ompl.rrt": {"range": "0.5"}}``."""
+    out: dict[str, dict[str, str]] = {}
+    for item in items or []:
+        lhs, eq, value = item.partition("=")
+        planner, colon, key = lhs.rpartition(":")
+        if not eq or not colon or not planner.strip() or not key.strip():
+            raise PlannerlabError(f"--set expects PLANNER:KEY=VALUE, got {item!r}")
+        planner = planner.strip()
+        if planner not in planners:
+            from plannerlab.errors import UnknownNameError
+
+            raise UnknownNameError("planner in --set (not in --planners)", planner, planners)
+        out.setdefault(planner, {})[key.strip()] = value.strip()
+    return out
+
+
+def _command(args: argparse.Namespace) -> str:
+    """The command that reproduces (and resumes) this comparison, canonically spelled."""
+    parts = [
+        "plannerlab",
+        "compare",
+        *args.problems,
+        "--planners",
+        args.planners,
+        "--seeds",
+        args.seeds,
+    ]
+    for flag, value in (
+        ("--time-limit", args.time_limit),
+        ("--max-checks", args.max_checks),
+        ("--max-iterations", args.max_iterations),
+        ("--legs", args.legs),
+    ):
+        if value is not None:
+            parts += [flag, str(value)]
+    for item in args.set or []:
+        parts += ["--set", item]
+    if args.execute:
+        parts.append("--execute")
+    parts += ["--jobs", str(args.jobs)]
+    if args.name:
+        parts += ["--name", args.name]
+    if Path(args.out) != DEFAULT_OUT:
+        parts += ["--out", args.out]
+    return shlex.join(parts)
+
+
+def _json_safe(x: Any) -> Any:
+    if isinstance(x, float) and not math.isfinite(x):
+        return None
+    if isinstance(x, dict):
+        return {k: _json_safe(v) for k, v in x.items()}
+    if isinstance(x, list | tuple):
+        return [_json_safe(v) for v in x]
+    return x
+
+
+# ---------------------------------------------------------------------- command
+def cmd_compare(args: argparse.Namespace, console: Console) -> int:
+    from plannerlab.bench import (
+        ERROR_STATUS,
+        Trial,
+        TrialStore,
+        default_name,
+        parse_seeds,
+        run_comparison,
+        store_path,
+        summarise,
+    )
+    from plannerlab.catalog import load_problem, resolve_problem_path
+    from plannerlab.io import versions
+    from plannerlab.planners import get_entry, make_planner
+    from plannerlab.report import machine_info, write_reports
+
+    # -- validate everything before the first process starts
+    if args.jobs < 1:
+        raise PlannerlabError(f"--jobs: expected >= 1, got {args.jobs}")
+    for flag, v in (
+        ("--max-checks", args.max_checks),
+        ("--max-iterations", args.max_iterations),
+        ("--time-limit", args.time_limit),
+    ):
+        if v is not None and v <= 0:
+            raise PlannerlabError(f"{flag}: expected > 0, got {v}")
+    seeds = parse_seeds(args.seeds)
+    planners = list(dict.fromkeys(_split(args.planners)))
+    if not planners:
+        raise PlannerlabError("--planners: give at least one planner name")
+    entries = {name: get_entry(name) for name in planners}  # unknown: "did you mean"
+    settings = parse_settings(args.set, planners)
+    for name in planners:
+        make_planner(name, settings.get(name))  # unknown setting or bad value: raises now
+    problems = []
+    for spec in dict.fromkeys(args.problems):
+        problems.append((load_problem(spec), resolve_problem_path(spec).resolve()))
+    names = [p.name for p, _ in problems]
+    if len(set(names)) != len(names):
+        raise PlannerlabError(f"two problem files have the same problem name: {names}")
+    for problem, _ in problems:
+        for name, entry in entries.items():
+            if entry.robots is not None and problem.robot.kind not in entry.robots:
+                raise PlannerlabError(
+                    f"planner {name} works on {', '.join(entry.robots)} robots; "
+                    f"{problem.name} has a {problem.robot.kind}"
+                )
+    legs_by_problem: dict[str, list[int] | None] = {}
+    for problem, _ in problems:
+        legs_by_problem[problem.name] = (
+            [problem.resolve_leg(x) for x in _split(args.legs)] if args.legs else None
+        )
+    budget = {
+        "max_iterations": args.max_iterations,
+        "max_collision_checks": args.max_checks,
+        "time_limit_s": args.time_limit,
+    }
+    budget = {k: v for k, v in budget.items() if v is not None}
+    name = args.name or default_name(names, planners)
+    if not re.fullmatch(r"[A-Za-z0-9._+-]+", name) or name in (".", ".."):
+        raise PlannerlabError(f"--name: letters, digits and . _ + - only, got {name!r}")
+    folder = Path(args.out) / name
+    store = TrialStore(store_path(args.out, name))
+    command = _command(args)
+
+    # seeds outermost within a problem: an interrupted run stays balanced over planners
+    trials = [
+        Trial.make(
+            problem.name,
+            path,
+            planner,
+            seed,
+            budget=budget,
+            settings=settings.get(planner),
+            legs=legs_by_problem[problem.name],
+            execute=args.execute,
+        )
+        for problem, path in problems
+        for seed in seeds
+        for planner in planners
+    ]
+
+    # -- run, with a progress bar
+    started = datetime.now(UTC)
+    t0 = time.perf_counter()
+    counts = {"ran": 0, "skipped": 0, "errors": 0}
+    progress = Progress(
+        SpinnerColumn(),
+        TextColumn("[bold]{task.description}"),
+        BarColumn(),
+        MofNCompleteColumn(),
+        TextColumn("{task.fields[detail]}"),
+        TimeElapsedColumn(),
+        TimeRemainingColumn(),
+        console=console,
+    )
+
+    def detail() -> str:
+        s = f"{counts['ran']} run, {counts['skipped']} skipped"
+        return s + (f", [red]{counts['errors']} errors[/red]" if counts["errors"] else "")
+
+    task = progress.add_task(f"compare {name}", total=len(trials), detail="")
+
+    def on_done(rec: dict[str, Any], skipped: bool) -> None:
+        counts["skipped" if skipped else "ran"] += 1
+        if rec.get("status") == ERROR_STATUS:
+            counts["errors"] += 1
+        last = (
+            ""
+            if skipped
+            else (f" · last: {escape(rec['planner'])} s{rec['seed']} {rec.get('status')}")
+        )
+        progress.update(task, advance=1, detail=detail() + last)
+
+    try:
+        with progress:
+            run = run_comparison(
+                trials, store, jobs=args.jobs, on_done=on_done, retry_errors=args.retry_errors
+            )
+    except KeyboardInterrupt:
+        done = counts["ran"] + counts["skipped"]
+        console.print(
+            f"[yellow]interrupted[/yellow]: {done} of {len(trials)} trials are finished and "
+            f"safe in {store.path} (the running ones were stopped). Rerun the same command "
+            f"to resume:\n  {escape(command)}",
+            highlight=False,
+        )
+        return 130
+    wall_s = time.perf_counter() - t0
+
+    # -- report
+    order_p = {n: i for i, n in enumerate(names)}
+    order_pl = {n: i for i, n in enumerate(planners)}
+    records = sorted(
+        run.records,
+        key=lambda r: (
+            order_p.get(r["problem"], 1 << 30),
+            order_pl.get(r["planner"], 1 << 30),
+            int(r["seed"]),
+        ),
+    )
+    rows = summarise(records)
+    meta = {
+        "command": command,
+        "problems": names,
+        "problem_files": [str(path) for _, path in problems],
+        "planners": planners,
+        "seeds": seeds,
+        "seeds_spec": args.seeds,
+        "budget": budget,
+        "budgets_used": {p.name: p.budget.replace(**budget).to_dict() for p, _ in problems},
+        "settings": settings,
+        "legs": args.legs,
+        "execute": bool(args.execute),
+        "jobs": args.jobs,
+        "trials": len(trials),
+        "ran": run.ran,
+        "skipped": run.skipped,
+        "errors": sum(1 for r in records if r.get("status") == ERROR_STATUS),
+        "started_at": started.isoformat(timespec="seconds"),
+        "wall_s": wall_s,
+        "store": str(store.path),
+        "versions": versions(),
+        "machine": machine_info(),
+    }
+    files = write_reports(folder, name, records, rows, meta)
+
+    if args.json:
+        print(
+            json.dumps(
+                _json_safe(
+                    {
+                        "name": name,
+                        "store": str(store.path),
+                        "files": [str(f) for f in files],
+                        "trials": len(trials),
+                        "ran": run.ran,
+                        "skipped": run.skipped,
+                        "errors": meta["errors"],
+                        "wall_s": wall_s,
+                        "summary": rows,
+                    }
+                )
+            )
+        )
+        return 0
+    _print_tables(console, rows, args.execute)
+    errors = [r for r in records if r.get("status") == ERROR_STATUS]
+    if errors:
+        console.print(
+            f"[red]{len(errors)} trial(s) raised[/red] (rerun them with "
+            f"--retry-errors), e.g. {escape(errors[0]['key'])}: "
+            f"{escape(str(errors[0].get('error')))}",
+            highlight=False,
+        )
+    console.print(
+        f"{len(trials)} trials: {run.ran} run now, {run.skipped} already in the "
+        f"store; {wall_s:.1f} s",
+        highlight=False,
+    )
+    console.print(f"trial store: {store.path}", highlight=False)
+    for f in files:
+        console.print(f"wrote {f}", highlight=False)
+    return 0
+
+
+def _print_tables(console: Console, rows: list[dict[str, Any]], executed: bool) -> None:
+    from plannerlab.report import EXEC_HEADERS, TABLE_HEADERS, TABLE_NOTES, summary_cells
+
+    headers = TABLE_HEADERS + (EXEC_HEADERS if executed else ())
+    for problem in dict.fromkeys(r["problem"] for r in rows):
+        t = Table(title=f"{problem}", title_justify="left")
+        for h in headers:
+            t.add_column(h, overflow="fold", no_wrap=(h == "planner"))
+        for r in rows:
+            if r["problem"] != problem:
+                continue
+            cells = [escape(c) for c in summary_cells(r, executed)]
+            style = (
+                "green" if r["success_rate"] >= 0.95 else "red" if r["successes"] == 0 else "yellow"
+            )
+            cells[1] = f"[{style}]{cells[1]}[/{style}]"
+            t.add_row(*cells)
+        console.print(t)
+    console.print(f"[dim]{TABLE_NOTES}[/dim]", highlight=False)

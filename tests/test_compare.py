@@ -1,0 +1,395 @@
+"""``plannerlab compare``: one process per trial, resumable store, reports, OMPL log.
+
+Budgets are collision-check budgets (never clocks). One comparison is run once per module
+(``armz_pocket``, gradient planners and OMPL RRT-Connect when the adapter imports, seeds
+0-2, two jobs); the resume tests work on copies of its store.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import os
+import shutil
+import signal
+import sqlite3
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import pytest
+
+from plannerlab.bench import (
+    ERROR_STATUS,
+    Trial,
+    TrialStore,
+    parse_seeds,
+    run_comparison,
+    summarise,
+    wilson_interval,
+)
+from plannerlab.catalog import resolve_problem_path
+from plannerlab.cli import main
+from plannerlab.errors import PlannerlabError
+
+try:
+    import plannerlab.planners.ompl  # noqa: F401
+
+    HAVE_OMPL = True
+except ImportError:  # pragma: no cover - the adapter is optional while being written
+    HAVE_OMPL = False
+
+PROBLEM = "armz_pocket"
+PLANNERS = ["gradient", "gradient.analytic"] + (["ompl.rrtconnect"] if HAVE_OMPL else [])
+SEEDS = [0, 1, 2]
+MAX_CHECKS = 300
+NAME = "t"
+BIN = Path(sys.executable).parent
+
+
+def _trials() -> list[Trial]:
+    """The module comparison's trials, as the CLI builds them (same keys)."""
+    path = resolve_problem_path(PROBLEM).resolve()
+    return [
+        Trial.make(PROBLEM, path, pl, s, budget={"max_collision_checks": MAX_CHECKS})
+        for s in SEEDS
+        for pl in PLANNERS
+    ]
+
+
+def _lines(path: Path) -> list[dict]:
+    return [json.loads(x) for x in path.read_text().splitlines() if x.strip()]
+
+
+def _deterministic(rec: dict) -> list[dict]:
+    """A record's per-leg results without the clocks."""
+    return [{k: v for k, v in leg.items() if k != "time_s"} for leg in rec["legs_run"]]
+
+
+@pytest.fixture(scope="module")
+def comparison(tmp_path_factory: pytest.TempPathFactory) -> dict:
+    out = tmp_path_factory.mktemp("compare")
+    argv = [
+        "compare",
+        PROBLEM,
+        "--planners",
+        ",".join(PLANNERS),
+        "--seeds",
+        "0-2",
+        "--max-checks",
+        str(MAX_CHECKS),
+        "--jobs",
+        "2",
+        "--out",
+        str(out),
+        "--name",
+        NAME,
+        "--json",
+    ]
+    import contextlib
+    import io
+
+    buf = io.StringIO()
+    with contextlib.redirect_stdout(buf):
+        code = main(argv)
+    assert code == 0
+    summary = json.loads(buf.getvalue())
+    return {
+        "argv": argv,
+        "out": out,
+        "folder": out / NAME,
+        "summary": summary,
+        "store": out / NAME / "trials.jsonl",
+    }
+
+
+def _copy_store(comparison: dict, tmp_path: Path) -> Path:
+    dst = tmp_path / "trials.jsonl"
+    shutil.copy(comparison["store"], dst)
+    return dst
+
+
+# ---------------------------------------------------------------------- the store
+def test_store_has_one_record_per_trial(comparison: dict) -> None:
+    s = comparison["summary"]
+    n = len(PLANNERS) * len(SEEDS)
+    assert (s["trials"], s["ran"], s["skipped"], s["errors"]) == (n, n, 0, 0)
+    recs = _lines(comparison["store"])
+    assert len(recs) == n
+    assert {r["key"] for r in recs} == {t.key for t in _trials()}
+    assert len({r["pid"] for r in recs}) == n  # every trial had its own process
+    for r in recs:
+        assert r["status"] != ERROR_STATUS, r.get("error")
+        assert r["budget_used"]["max_collision_checks"] == MAX_CHECKS
+        assert r["legs_run"] and r["legs_run"][0]["path_length"] is not None
+
+
+def test_rerun_skips_every_finished_trial(comparison: dict, capsys) -> None:
+    before = comparison["store"].read_bytes()
+    assert main(comparison["argv"]) == 0
+    s = json.loads(capsys.readouterr().out)
+    assert (s["ran"], s["skipped"]) == (0, len(PLANNERS) * len(SEEDS))
+    assert comparison["store"].read_bytes() == before  # no new record, no new process
+
+
+def test_deleted_line_reruns_only_that_trial(comparison: dict, tmp_path: Path) -> None:
+    store = _copy_store(comparison, tmp_path)
+    lines = store.read_text().splitlines(keepends=True)
+    gone = json.loads(lines.pop(1))
+    store.write_text("".join(lines))
+    fresh: list[str] = []
+    run = run_comparison(
+        _trials(),
+        store,
+        jobs=2,
+        on_done=lambda r, skipped: None if skipped else fresh.append(r["key"]),
+    )
+    assert (run.ran, run.skipped) == (1, len(_trials()) - 1)
+    assert fresh == [gone["key"]]
+    recs = _lines(store)
+    assert len(recs) == len(_trials())
+    again = next(r for r in recs if r["key"] == gone["key"])
+    assert again["pid"] != gone["pid"]
+    assert _deterministic(again) == _deterministic(gone)
+
+
+def test_truncated_last_line_is_ignored_and_rerun(comparison: dict, tmp_path: Path) -> None:
+    store = _copy_store(comparison, tmp_path)
+    data = store.read_bytes()
+    last_start = data.rstrip(b"\n").rfind(b"\n") + 1
+    cut = json.loads(data[last_start:])
+    store.write_bytes(data[: last_start + (len(data) - last_start) // 2])  # killed mid-write
+    assert cut["key"] not in TrialStore(store).load()
+    assert len(TrialStore(store).load()) == len(_trials()) - 1
+    run = run_comparison(_trials(), store, jobs=1)
+    assert (run.ran, run.skipped) == (1, len(_trials()) - 1)
+    recs = _lines(store)  # every line parses: the half line was cut, not glued onto
+    assert len(recs) == len(_trials())
+    assert {r["key"] for r in recs} == {t.key for t in _trials()}
+
+
+# ---------------------------------------------------------------------- reports
+def test_csv_and_markdown_name_every_planner(comparison: dict) -> None:
+    folder = comparison["folder"]
+    for f in ("summary.csv", "trials.csv", "legs.csv", "report.md", "meta.json"):
+        assert (folder / f).is_file(), f
+    summary = (folder / "summary.csv").read_text().splitlines()
+    assert len(summary) == 1 + len(PLANNERS)
+    assert len((folder / "trials.csv").read_text().splitlines()) == 1 + len(_trials())
+    md = (folder / "report.md").read_text()
+    for pl in PLANNERS:
+        assert any(line.startswith(f"{PROBLEM},{pl},") for line in summary[1:])
+        assert f"| {pl} |" in md
+    assert "plannerlab compare armz_pocket" in md and "--max-checks 300" in md
+    assert "ompl" in md and "## Machine" in md
+    meta = json.loads((folder / "meta.json").read_text())
+    assert meta["seeds"] == SEEDS and meta["budget"] == {"max_collision_checks": MAX_CHECKS}
+
+
+def test_ompl_log_loads_into_sqlite(comparison: dict, tmp_path: Path) -> None:
+    log = comparison["folder"] / f"{NAME}.log"
+    db = tmp_path / "bench.db"
+    script = BIN / "ompl_benchmark_statistics"
+    if not script.exists():
+        found = shutil.which("ompl_benchmark_statistics")
+        if found is None:
+            pytest.skip("ompl_benchmark_statistics is not installed")
+        script = Path(found)
+    proc = subprocess.run(
+        [str(script), str(log), "-d", str(db)], capture_output=True, text=True, timeout=120
+    )
+    assert proc.returncode == 0, proc.stderr
+    con = sqlite3.connect(db)
+    try:
+        rows = dict(
+            (name, (n, solved))
+            for name, n, solved in con.execute(
+                "SELECT p.name, COUNT(*), SUM(r.solved) FROM runs r "
+                "JOIN plannerConfigs p ON p.id = r.plannerid GROUP BY p.name"
+            )
+        )
+        exps = con.execute("SELECT name, runcount FROM experiments").fetchall()
+        seeds = sorted(s for (s,) in con.execute("SELECT DISTINCT seed FROM runs"))
+        enum = dict(con.execute("SELECT description, value FROM enums WHERE name='status'"))
+        statuses = con.execute(
+            "SELECT COUNT(*) FROM runs WHERE status = ?", (enum["solved"],)
+        ).fetchone()[0]
+    finally:
+        con.close()
+    expected = {r["planner"]: r["successes"] for r in comparison["summary"]["summary"]}
+    assert exps == [(PROBLEM, len(SEEDS))]
+    assert seeds == SEEDS
+    assert rows == {pl: (len(SEEDS), expected[pl]) for pl in PLANNERS}
+    assert statuses == sum(expected.values())
+
+
+# ---------------------------------------------------------------------- determinism
+def test_same_seed_same_results_in_fresh_processes(comparison: dict, tmp_path: Path) -> None:
+    first = {r["key"]: r for r in _lines(comparison["store"])}
+    pick = [t for t in _trials() if t.seed == 1]
+    run = run_comparison(pick, tmp_path / "again.jsonl", jobs=2)
+    assert run.ran == len(pick)
+    for rec in run.records:
+        old = first[rec["key"]]
+        assert rec["pid"] != old["pid"]
+        assert _deterministic(rec) == _deterministic(old), rec["key"]
+
+
+# ---------------------------------------------------------------------- failures
+def test_a_raising_trial_is_recorded_and_execution_summarised(tmp_path: Path) -> None:
+    path = resolve_problem_path(PROBLEM).resolve()
+    bad = Trial.make(PROBLEM, tmp_path / "missing.toml", "gradient", 0)
+    ok = Trial.make(
+        PROBLEM, path, "gradient.analytic", 0, budget={"max_collision_checks": 100}, execute=True
+    )
+    run = run_comparison([bad, ok], tmp_path / "s.jsonl", jobs=2)
+    recs = {r["key"]: r for r in run.records}
+    assert recs[bad.key]["status"] == ERROR_STATUS
+    assert "missing.toml" in recs[bad.key]["error"]
+    ex = recs[ok.key]["execution"]
+    assert ex is not None and set(ex) >= {"success", "max_track_err_rad", "contacts"}
+    assert len(ex["legs"]) == len(recs[ok.key]["legs_run"])
+    rows = summarise(run.records)
+    assert [r["errors"] for r in rows] == [1, 0]
+    assert rows[1]["executed"] == 1 and math.isfinite(rows[1]["exec_track_err_median_rad"])
+
+
+def test_a_trial_whose_process_dies_is_recorded(tmp_path: Path) -> None:
+    """A hard crash (here SIGKILL) of one trial's process is that trial's error record;
+    the trial beside it is unaffected."""
+    import multiprocessing
+    import threading
+
+    path = resolve_problem_path(PROBLEM).resolve()
+    victim = Trial.make(PROBLEM, path, "gradient", 0)  # default budget: a few seconds
+    other = Trial.make(PROBLEM, path, "gradient.analytic", 0, budget={"max_collision_checks": 100})
+    killed: list[int] = []
+
+    def killer() -> None:
+        deadline = time.monotonic() + 60
+        while time.monotonic() < deadline and not killed:
+            for child in multiprocessing.active_children():
+                if child.name == f"trial {victim.key}" and child.pid:
+                    time.sleep(0.5)
+                    os.kill(child.pid, signal.SIGKILL)
+                    killed.append(child.pid)
+                    break
+            time.sleep(0.02)
+
+    th = threading.Thread(target=killer, daemon=True)
+    th.start()
+    run = run_comparison([victim, other], tmp_path / "s.jsonl", jobs=2)
+    th.join(timeout=5)
+    recs = {r["key"]: r for r in run.records}
+    assert killed
+    assert recs[victim.key]["status"] == ERROR_STATUS
+    assert "died" in recs[victim.key]["error"]
+    assert recs[other.key]["status"] != ERROR_STATUS
+
+
+def test_interrupted_compare_resumes(tmp_path: Path) -> None:
+    argv = [
+        str(BIN / "plannerlab"),
+        "compare",
+        PROBLEM,
+        "--planners",
+        "gradient.analytic",
+        "--seeds",
+        "0-3",
+        "--max-checks",
+        "100",
+        "--jobs",
+        "1",
+        "--out",
+        str(tmp_path),
+        "--name",
+        "irq",
+    ]
+    store = tmp_path / "irq" / "trials.jsonl"
+    proc = subprocess.Popen(argv, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+    deadline = time.monotonic() + 90
+    while time.monotonic() < deadline and not (store.exists() and store.read_text().strip()):
+        time.sleep(0.05)
+    proc.send_signal(signal.SIGINT)
+    out, _ = proc.communicate(timeout=60)
+    done = _lines(store)
+    if proc.returncode == 0:  # finished before the signal landed: nothing to resume
+        assert len(done) == 4
+        return
+    assert proc.returncode == 130, out
+    assert "resume" in out
+    assert 1 <= len(done) < 4
+    res = subprocess.run([*argv, "--json"], capture_output=True, text=True, timeout=120)
+    assert res.returncode == 0, res.stderr
+    s = json.loads(res.stdout)
+    assert (s["skipped"], s["ran"]) == (len(done), 4 - len(done))
+    assert len(_lines(store)) == 4
+    assert not (tmp_path / "irq" / ".running").exists() or not any(
+        (tmp_path / "irq" / ".running").iterdir()
+    )
+
+
+# ---------------------------------------------------------------------- units
+def test_wilson_interval_known_values() -> None:
+    lo, hi = wilson_interval(0, 20)
+    assert lo == 0.0 and hi == pytest.approx(0.1611, abs=5e-4)
+    lo, hi = wilson_interval(20, 20)
+    assert hi == 1.0 and lo == pytest.approx(0.8389, abs=5e-4)
+    lo, hi = wilson_interval(10, 20)
+    assert (lo, hi) == pytest.approx((0.2993, 0.7007), abs=5e-4)
+    assert all(math.isnan(x) for x in wilson_interval(0, 0))
+
+
+def test_parse_seeds() -> None:
+    assert parse_seeds("0-19") == list(range(20))
+    assert parse_seeds("0,3,5-7") == [0, 3, 5, 6, 7]
+    assert parse_seeds("4") == [4]
+    for bad in ("a", "5-2", "-1", ""):
+        with pytest.raises(PlannerlabError):
+            parse_seeds(bad)
+
+
+def test_unknown_planner_and_setting_fail_up_front(tmp_path: Path, capsys) -> None:
+    base = ["compare", PROBLEM, "--seeds", "0", "--out", str(tmp_path)]
+    assert main([*base, "--planners", "gradient,gradiant.analytic"]) == 2
+    err = capsys.readouterr().err
+    assert "did you mean" in err and "gradient.analytic" in err
+    assert main([*base, "--planners", "gradient", "--set", "gradient:no_such_key=1"]) == 2
+    assert "no_such_key" in capsys.readouterr().err
+    assert main([*base, "--planners", "gradient", "--set", "rrt:range=1"]) == 2
+    assert main([*base, "--planners", "gradient", "--seeds", "3-1"]) == 2
+    assert not any(tmp_path.iterdir())  # nothing ran, nothing written
+
+
+def test_cli_parses_the_issue_example() -> None:
+    from plannerlab.cli import build_parser
+
+    a = build_parser().parse_args(
+        [
+            "compare",
+            "p1",
+            "p2",
+            "--planners",
+            "a,b,c",
+            "--seeds",
+            "0-19",
+            "--time-limit",
+            "2",
+            "--execute",
+            "--jobs",
+            "4",
+        ]
+    )
+    assert a.problems == ["p1", "p2"] and a.planners == "a,b,c" and a.jobs == 4
+    assert a.time_limit == 2.0 and a.execute and a.max_checks is None
+
+
+@pytest.mark.skipif(os.name != "posix", reason="the store lock uses fcntl")
+def test_store_is_locked_while_written(tmp_path: Path) -> None:
+    store = TrialStore(tmp_path / "s.jsonl")
+    with store.writer() as append:
+        append({"key": "k", "x": 1})
+        with pytest.raises(PlannerlabError, match="in use"), store.writer():
+            pass
+    assert TrialStore(tmp_path / "s.jsonl").load() == {"k": {"key": "k", "x": 1}}
