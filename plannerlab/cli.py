@@ -266,6 +266,8 @@ def build_parser() -> argparse.ArgumentParser:
     add_ik_parser(sub)
     from plannerlab.compare_cli import add_compare_parser
     add_compare_parser(sub)
+    from plannerlab.continuum_cli import add_continuum_parser
+    add_continuum_parser(sub)
     return parser
 
 

@@ -1,0 +1,642 @@
+"""``chord_arc``: the continuum paper's chord-arc tree search as a plannerlab planner.
+
+Source: ``003_d410ec97f064abf9.txt`` (digest in ``docs/papers.md`` §3). The search itself,
+the contact-type check and the motion sequence live in
+:mod:`plannerlab.planners.chord_arc_search` (pure functions over planar data); this module
+wraps them behind the planner contract ``solve(problem, leg, budget, rng) -> PlanResult``
+for a :class:`~plannerlab.robots.continuum.ContinuumChain` problem.
+
+Build, then solve:
+
+* :meth:`ChordArcPlanner.query` builds the planar query from the problem: the robot's base
+  port (``T_world_base``: origin, insertion direction = base x) and length, the scene's
+  obstacles cut by the robot's plane z = base z (a box standing upright: a rectangle with
+  its yaw; a vertical cylinder: a circle; a sphere: the circle of its cross-section; shapes
+  that miss the plane are left out), the collision points of the problem file's
+  ``[continuum] collision_points_m`` and the leg's goal position as the target.
+* :meth:`ChordArcPlanner.solve` runs :func:`~plannerlab.planners.chord_arc_search.
+  solve_chord_arc` and turns **every** solution that survives into data, then picks one
+  (``choose``) and returns its motion sequence as the joint path.
+
+**Every solution is returned** (``extra["solutions"]``: bend angles, arc lengths,
+curvatures, collision points used, their obstacles and contact types), not only the first.
+Solutions are dropped, with the reason kept (``extra["dropped"]``), when
+
+1. a contact does not behave as its type requires, or the initial push or the re-bend
+   sweeps into an obstacle (the search module's motion check), or
+2. the chain cannot follow the motion: a joint of the rigid-link chain would leave its
+   bounds (the curve is too sharp for ``n_links`` links of ±``max_joint_rad``), or
+3. the robot's thickness (the search treats it as a curve) makes it touch an obstacle
+   away from the solution's collision points somewhere along the motion (FCL, below).
+
+**The path** is the joint path (m, dof) of the chosen solution's motion sequence: each
+:class:`~plannerlab.planners.chord_arc_search.MotionStep` is sampled so that neither the
+robot's inserted length nor the last arc's length changes by more than ``path_step_m``
+between waypoints, and no joint by more than ``path_joint_step_rad`` (resampled finer if
+it would), and every shape is mapped to joints by ``ContinuumChain.q_from_arcs`` (the
+leftover length stays straight behind the port). The path starts at the retracted,
+straight robot (insertion 0, every joint 0): ``q_start`` must be that state.
+
+**Robot thickness.** By default (``inflate_by_radius = False``) the search is the
+paper's: the robot is a curve, the obstacles and collision points are the problem's.
+With ``inflate_by_radius = True`` it plans the chain's *axis* instead: obstacles grown by
+the link radius r (:func:`grow_query`), collision points moved out of their obstacle by
+r, so the capsules touch the corners rather than cut them. Measured in PyBullet
+(:mod:`plannerlab.continuum_exec`): the paper's model deflects the chain at the corners
+(case 2's chosen solution ended 95 mm off with contacts away from the collision points),
+the grown model ended 1.5-7 mm off with contact only at the collision points; but it
+finds fewer solutions (case 2: 1 instead of the paper's 2).
+
+**Contact is allowed by design.** The curve passes *through* each collision point (an
+obstacle corner; with ``inflate_by_radius``, r from it), so the chain's capsules
+(radius r) overlap or touch the obstacle there while the robot bears on it and slides
+past it. The FCL re-check of this path (e.g.
+:func:`plannerlab.sim.execute.execute`'s ``path_valid``, or the shared planner check's
+"every edge collision-free") therefore reports collisions at those points. This planner
+is the one contact-permitting planner: :attr:`ChordArcPlanner.allows_contact` is True.
+During ``solve`` every state of every surviving solution's path is checked with FCL
+(:class:`~plannerlab.collision.CollisionChecker`); a colliding (link, obstacle) pair is
+*expected* when the link's axis passes within ``contact_tolerance_m`` (= 2·r +
+``contact_margin_m``) of one of the solution's collision points on that obstacle;
+``extra["expected_contacts"]`` lists the chosen solution's expected pairs. Any other
+colliding pair drops the solution (3. above). These checks count in
+``collision_checks``.
+
+**Budget.** ``iterations`` = bases expanded by the search; ``budget.max_iterations`` caps
+``max_expansions``. The search (milliseconds) is not interruptible: a ``time_limit_s``
+is compared with the search time afterwards (status ``budget_exhausted`` if it was
+exceeded), and the FCL contact classification stops at ``max_collision_checks`` (status
+``budget_exhausted``). The method is deterministic: ``rng`` is unused.
+
+``trace``: the distance from the tip to the target [m] at each waypoint of the returned
+path (it falls as the robot advances; flat stretches are the pushes and re-bends).
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from collections.abc import Sequence
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from plannerlab.collision import CollisionChecker
+from plannerlab.errors import PlannerlabError, ProblemError
+from plannerlab.planners.base import (
+    Deadline,
+    PlanResult,
+    Status,
+    Stepper,
+    settings_dict,
+    with_overrides,
+)
+from plannerlab.planners.chord_arc_search import (
+    ChordArcInputError,
+    ChordArcPlan,
+    ChordArcQuery,
+    ChordArcResult,
+    ChordArcSolution,
+    Circle,
+    ConvexPolygon,
+    MotionStep,
+    PlanarObstacle,
+    solve_chord_arc,
+)
+from plannerlab.planners.chord_arc_search import ChordArcSettings as SearchSettings
+from plannerlab.planners.chord_arc_search import prepare as prepare_check
+from plannerlab.robots.base import Array
+from plannerlab.robots.continuum import ContinuumChain
+from plannerlab.scene import Box, Cylinder, Scene, Sphere
+
+#: values of :attr:`ChordArcSettings.choose`
+CHOICES: tuple[str, ...] = ("shortest", "fewest_contacts", "first")
+
+
+@dataclass(frozen=True)
+class ChordArcSettings:
+    """Settings of the ``chord_arc`` planner.
+
+    Attributes:
+        max_expansions: most bases the search expands (the port counts as one).
+        max_depth: most arcs in a solution (contacts + 1); 0 = collision points + 1.
+        arc_step_m: largest spacing of the samples along an arc in the search [m].
+        inside_tol_m: an arc sample counts as inside an obstacle only deeper than this [m].
+        boundary_tol_m: how far a collision point may lie from an obstacle boundary [m].
+        max_bend_rad: largest |θ| of one arc [rad].
+        push_length_m: initial push l at each contact [m] (capped at half the next arc).
+        choose: which surviving solution to execute: "shortest" (least arc length),
+            "fewest_contacts" (ties: shorter), "first" (breadth-first order).
+        path_step_m: largest change of inserted length and of the last arc's length
+            between path waypoints [m].
+        path_joint_step_rad: largest change of any bend joint between waypoints [rad].
+        check_contacts: FCL-check every state of every surviving solution's path and drop
+            solutions touching obstacles away from their collision points.
+        contact_margin_m: a contact is expected within 2·link radius + this of one of
+            the solution's collision points [m].
+        inflate_by_radius: plan the robot's axis among obstacles grown by the link
+            radius, through collision points moved out of their obstacle by the radius
+            (the chain then touches the corners instead of cutting them); False: the
+            paper's zero-thickness curve.
+    """
+
+    max_expansions: int = 100_000
+    max_depth: int = 0
+    arc_step_m: float = 1e-3
+    inside_tol_m: float = 1e-6
+    boundary_tol_m: float = 1e-6
+    max_bend_rad: float = math.pi
+    push_length_m: float = 0.005
+    choose: str = "shortest"
+    path_step_m: float = 0.002
+    path_joint_step_rad: float = 0.02
+    check_contacts: bool = True
+    contact_margin_m: float = 0.01
+    inflate_by_radius: bool = False
+
+    def __post_init__(self) -> None:
+        if self.choose not in CHOICES:
+            raise PlannerlabError(f"choose must be one of {', '.join(CHOICES)}, "
+                                  f"got {self.choose!r}")
+        if self.max_expansions < 1:
+            raise PlannerlabError(f"max_expansions must be >= 1, got {self.max_expansions}")
+        if self.max_depth < 0:
+            raise PlannerlabError(f"max_depth must be >= 0 (0: no limit), got {self.max_depth}")
+        for name in ("arc_step_m", "max_bend_rad", "push_length_m", "path_step_m",
+                     "path_joint_step_rad"):
+            if not getattr(self, name) > 0:
+                raise PlannerlabError(f"{name} must be > 0, got {getattr(self, name)}")
+        for name in ("inside_tol_m", "boundary_tol_m", "contact_margin_m"):
+            if not getattr(self, name) >= 0:
+                raise PlannerlabError(f"{name} must be >= 0, got {getattr(self, name)}")
+
+    def search_settings(self, max_iterations: int | None = None) -> SearchSettings:
+        """The search module's settings; ``max_iterations`` (a budget) caps the expansions."""
+        expansions = self.max_expansions
+        if max_iterations is not None:
+            expansions = max(1, min(expansions, int(max_iterations)))
+        return SearchSettings(
+            max_depth=self.max_depth or None, max_expansions=expansions,
+            arc_step_m=self.arc_step_m, inside_tol_m=self.inside_tol_m,
+            boundary_tol_m=self.boundary_tol_m, max_bend_rad=self.max_bend_rad,
+            push_length_m=self.push_length_m,
+        )
+
+
+# --------------------------------------------------------------------------- building
+
+
+def _planar_obstacles(scene: Scene, z_m: float, tol: float = 1e-9) -> tuple[PlanarObstacle, ...]:
+    """The scene cut by the plane z = ``z_m``: rectangles and circles (see module doc).
+
+    Raises:
+        ChordArcInputError: a box or cylinder that is not upright (its cut is not a
+            rectangle or a circle).
+    """
+    out: list[PlanarObstacle] = []
+    for o in scene.obstacles:
+        T = o.T_world_obstacle
+        c = T[:3, 3]
+        dz = abs(float(c[2]) - z_m)
+        if isinstance(o, Sphere):
+            if dz < o.radius_m:
+                out.append(Circle((c[0], c[1]), math.sqrt(o.radius_m**2 - dz**2), o.name))
+            continue
+        if abs(abs(float(T[2, 2])) - 1.0) > tol:
+            raise ChordArcInputError(
+                f"obstacle {o.name!r}: only upright boxes and vertical cylinders can be cut "
+                f"by the robot's plane (local z = {T[:3, 2].round(6).tolist()})")
+        if isinstance(o, Box):
+            if dz < o.size_m[2] / 2.0:
+                yaw = math.atan2(float(T[1, 0]), float(T[0, 0]))
+                out.append(ConvexPolygon.rectangle((c[0], c[1]), (o.size_m[0], o.size_m[1]),
+                                                   yaw, o.name))
+        elif isinstance(o, Cylinder):
+            if dz < o.length_m / 2.0:
+                out.append(Circle((c[0], c[1]), o.radius_m, o.name))
+        else:  # pragma: no cover - Scene only holds the three types
+            raise ChordArcInputError(f"obstacle {o.name!r}: unknown type {type(o).__name__}")
+    return tuple(out)
+
+
+def _grown_polygon(poly: ConvexPolygon, r: float) -> ConvexPolygon:
+    """The polygon grown by ``r``, corners chamfered by the tangent at ``r`` along each
+    corner's bisector (it contains the exact, rounded Minkowski sum)."""
+    v = np.array(poly.vertices_m)  # counter-clockwise
+    d = np.roll(v, -1, axis=0) - v
+    n = np.stack([d[:, 1], -d[:, 0]], axis=1) / np.hypot(d[:, 0], d[:, 1])[:, None]
+    out = []
+    for i in range(len(v)):
+        n_in, n_out = n[i - 1], n[i]  # normals of the edges into and out of vertex i
+        b = (n_in + n_out) / np.linalg.norm(n_in + n_out)
+        for m in (n_in, n_out):
+            out.append(v[i] + r * (m + b) / (1.0 + float(m @ b)))
+    return ConvexPolygon(tuple(map(tuple, out)), poly.name)
+
+
+def grow_query(query: ChordArcQuery, radius_m: float,
+               boundary_tol_m: float = 1e-6) -> ChordArcQuery:
+    """The query for the axis of a robot of radius ``radius_m`` (configuration space).
+
+    Circles grow by the radius; convex polygons grow by it with chamfered corners
+    (:func:`_grown_polygon`); each collision point moves out of its obstacle by the radius,
+    against the direction into the obstacle (a corner's bisector, an edge's normal, a
+    circle's radius), which puts a corner's point on the middle of its chamfer.
+    """
+    prep = prepare_check(query, SearchSettings(boundary_tol_m=boundary_tol_m))
+    obstacles: list[PlanarObstacle] = []
+    for o in query.obstacles:
+        if isinstance(o, Circle):
+            obstacles.append(Circle(o.center_m, o.radius_m + radius_m, o.name))
+        else:
+            obstacles.append(_grown_polygon(o, radius_m))
+    points = tuple(tuple((np.asarray(p) - radius_m * prep.into[i]).tolist())
+                   for i, p in enumerate(query.collision_points_m))
+    return ChordArcQuery(query.base_xy_m, query.base_tangent, query.total_length_m,
+                         tuple(obstacles), points, query.target_xy_m)
+
+
+def collision_points(problem: Any) -> tuple[tuple[float, float], ...]:
+    """``[continuum] collision_points_m`` of a problem: (x, y) or (x, y, z) each [m].
+
+    Raises:
+        ProblemError: the table or key is missing, or a point is not 2 or 3 numbers.
+    """
+    key = "continuum.collision_points_m"
+    table = problem.extras.get("continuum")
+    if not isinstance(table, dict) or "collision_points_m" not in table:
+        raise ProblemError(problem.source, key,
+                           "is missing: the chord_arc planner needs the points where contact "
+                           "is allowed ([continuum] collision_points_m = [[x, y], ...])")
+    raw = table["collision_points_m"]
+    pts: list[tuple[float, float]] = []
+    if not isinstance(raw, list):
+        raise ProblemError(problem.source, key, f"a list of [x, y] points, got {raw!r}")
+    for i, p in enumerate(raw):
+        ok = (isinstance(p, list | tuple) and len(p) in (2, 3)
+              and all(isinstance(v, int | float) and not isinstance(v, bool)
+                      and math.isfinite(v) for v in p))
+        if not ok:
+            raise ProblemError(problem.source, f"{key}[{i}]",
+                               f"two or three finite numbers (x, y[, z]) [m], got {p!r}")
+        pts.append((float(p[0]), float(p[1])))
+    return tuple(pts)
+
+
+def _shape_dict(sol: ChordArcSolution, real: ChordArcQuery) -> dict[str, Any]:
+    """A solution as data; ``contact_points_m`` are the problem's collision points (the
+    obstacle corners), ``axis_points_m`` where the robot's axis passes them."""
+    return {
+        "contact_indices": list(sol.contact_indices),
+        "contact_points_m": [list(real.collision_points_m[i]) for i in sol.contact_indices],
+        "axis_points_m": [list(p) for p in sol.contact_points_m],
+        "bend_angles_rad": [a.theta_rad for a in sol.arcs],
+        "arc_lengths_m": [a.length_m for a in sol.arcs],
+        "curvatures_per_m": [a.curvature_per_m for a in sol.arcs],
+        "total_length_m": sol.total_length_m,
+        "leftover_m": sol.leftover_m,
+    }
+
+
+def _steps(a: float, b: float, step: float) -> int:
+    return max(1, math.ceil(abs(b - a) / step - 1e-12))
+
+
+@dataclass(frozen=True)
+class _Candidate:
+    """A solution that survived the search's motion check, as the chain will move it."""
+
+    plan: ChordArcPlan
+    path: Array  # (m, dof)
+    step_of: Array  # (m,) motion step index of each waypoint (-1: the start)
+    reason: str  # why it is dropped; "" if it holds
+    expected: tuple[dict[str, Any], ...]
+    unexpected: tuple[dict[str, Any], ...]
+
+
+# --------------------------------------------------------------------------- planner
+
+
+class ChordArcPlanner:
+    """The chord-arc search as a planner (see the module docstring)."""
+
+    #: the one contact-permitting planner: its paths touch obstacles at the problem's
+    #: collision points by design, so "every edge collision-free" does not apply.
+    allows_contact: bool = True
+
+    def __init__(self, name: str, settings: ChordArcSettings) -> None:
+        self.name = name
+        self.settings = settings
+
+    # ------------------------------------------------------------------ build
+    def query(self, problem: Any, leg: int) -> ChordArcQuery:
+        """The planar query of one leg (base port, obstacles, collision points, target).
+
+        Raises:
+            PlannerlabError: not a continuum chain; a problem that cannot be cut by the
+                robot's plane; missing or malformed collision points.
+        """
+        robot = problem.robot
+        if not isinstance(robot, ContinuumChain):
+            raise PlannerlabError(f"{self.name} plans for the continuum_chain robot, got "
+                                  f"{getattr(robot, 'kind', type(robot).__name__)!r}")
+        T = robot.T_world_base
+        return ChordArcQuery(
+            base_xy_m=(float(T[0, 3]), float(T[1, 3])),
+            base_tangent=(float(T[0, 0]), float(T[1, 0])),
+            total_length_m=robot.length_m,
+            obstacles=_planar_obstacles(problem.scene, float(T[2, 3])),
+            collision_points_m=collision_points(problem),
+            target_xy_m=tuple(float(v) for v in problem.goal(leg).p_world_m[:2]),
+        )
+
+    def planning_query(self, problem: Any, query: ChordArcQuery) -> ChordArcQuery:
+        """The query the search runs on: :func:`grow_query` by the link radius if
+        ``inflate_by_radius``, else ``query`` itself."""
+        if not self.settings.inflate_by_radius:
+            return query
+        return grow_query(query, problem.robot.link_radius_m, self.settings.boundary_tol_m)
+
+    def search(self, problem: Any, leg: int, max_iterations: int | None = None
+               ) -> tuple[ChordArcQuery, ChordArcResult]:
+        """The problem's query (real obstacles and collision points) and the search
+        module's result (search + motion check) on the planning query, e.g. for figures."""
+        query = self.query(problem, leg)
+        plan_q = self.planning_query(problem, query)
+        return query, solve_chord_arc(plan_q, self.settings.search_settings(max_iterations))
+
+    def motion_path(self, robot: ContinuumChain, motion: Sequence[MotionStep]
+                    ) -> tuple[Array, Array]:
+        """Joint path (m, dof) of a motion sequence and the step index of each waypoint.
+
+        Starts at the retracted straight robot (all zeros); see the module docstring for
+        the spacing.
+        """
+        s = self.settings
+        states = [robot.q_from_arcs([], insertion_m=0.0)]
+        owner = [-1]
+        for k, step in enumerate(motion):
+            l0, l1 = step.start_shape[-1][1], step.end_shape[-1][1]
+            n = _steps(l0, l1, s.path_step_m)
+            for _ in range(4):  # refine until no joint jumps more than path_joint_step_rad
+                Q = np.array([robot.q_from_arcs(step.shape_at(a))
+                              for a in np.linspace(0.0, 1.0, n + 1)])
+                jump = float(np.max(np.abs(np.diff(Q[:, 1:], axis=0)), initial=0.0))
+                if jump <= s.path_joint_step_rad * (1.0 + 1e-9):
+                    break
+                n = math.ceil(n * jump / s.path_joint_step_rad)
+            gap = np.max(np.abs(Q[0] - states[-1]))
+            if gap > 1e-9:  # pragma: no cover - the search's steps are continuous
+                raise PlannerlabError(f"motion step {k} ({step.kind}) does not start where "
+                                      f"the previous one ended ({gap:.3g} apart)")
+            states.extend(Q[1:])
+            owner.extend([k] * (len(Q) - 1))
+        return np.array(states), np.array(owner, dtype=int)
+
+    def _classify(self, robot: ContinuumChain, checker: CollisionChecker,
+                  deadline: Deadline, budget: Any, plan: ChordArcPlan, query: ChordArcQuery,
+                  path: Array, tol: float) -> tuple[list[dict[str, Any]], list[dict[str, Any]],
+                                                    bool]:
+        """FCL contacts along a path, split into expected and unexpected (link, obstacle).
+
+        Returns (expected, unexpected, cut short by the check budget).
+        """
+        limit = budget.max_collision_checks
+        if limit is not None:
+            left = limit - deadline.checks_used
+            if left < len(path):
+                return [], [], True
+        bad = np.flatnonzero(~checker.valid_batch(path))
+        pts = {i: np.asarray(query.collision_points_m[i])
+               for i in plan.solution.contact_indices}
+        owner = {i: c.obstacle for i, c in zip(plan.solution.contact_indices,
+                                                plan.contacts, strict=True)}
+        link_index = {n: i for i, n in enumerate(robot.link_names)}
+        expected: dict[tuple[str, str], dict[str, Any]] = {}
+        unexpected: dict[tuple[str, str], dict[str, Any]] = {}
+        for k in bad:
+            if limit is not None and deadline.checks_used >= limit:
+                return list(expected.values()), list(unexpected.values()), True
+            seg = robot.link_segments(path[k])[:, :, :2]
+            for link, other in checker.colliding_pairs(path[k]):
+                key = (link, other)
+                if key in unexpected:
+                    continue
+                li = link_index.get(link)
+                best: tuple[float, int | None] = (math.inf, None)
+                if li is not None:
+                    a, b = seg[li]
+                    for i, p in pts.items():
+                        if owner[i] != other:
+                            continue
+                        d = b - a
+                        t = float(np.clip(np.dot(p - a, d) / max(np.dot(d, d), 1e-300), 0, 1))
+                        dist = float(np.linalg.norm(a + t * d - p))
+                        if dist < best[0]:
+                            best = (dist, i)
+                rec = {"link": link, "obstacle": other, "first_state": int(k),
+                       "collision_point": best[1],
+                       "distance_m": None if best[1] is None else best[0]}
+                if best[0] > tol:  # once anywhere else: unexpected
+                    expected.pop(key, None)
+                    unexpected[key] = rec
+                elif key not in expected:
+                    expected[key] = rec
+        return list(expected.values()), list(unexpected.values()), False
+
+    # ------------------------------------------------------------------ solve
+    def solve(self, problem: Any, leg: int, budget: Any, rng: np.random.Generator,
+              q_start: Array | None = None, stepper: Stepper | None = None) -> PlanResult:
+        """Search every chord-arc solution to leg ``leg``'s target; return the chosen one.
+
+        Args:
+            problem: a continuum_chain problem with ``[continuum] collision_points_m``.
+            leg: leg index (its goal position is the target).
+            budget: see the module docstring.
+            rng: unused (deterministic).
+            q_start: (dof,) must be the retracted straight robot (default: the problem's
+                start).
+            stepper: unused (open-loop).
+
+        Raises:
+            PlannerlabError: bad input (see :meth:`query`; a collision point off every
+                obstacle boundary).
+        """
+        del rng, stepper
+        t0 = time.perf_counter()
+        s = self.settings
+        robot = problem.robot
+        goal = problem.goal(leg)
+        query_error = ""
+        query: ChordArcQuery | None = None
+        real = self.query(problem, leg)
+        try:
+            query = self.planning_query(problem, real)
+            prepare_check(query, s.search_settings())
+        except ChordArcInputError as exc:  # only the target can be wrong per leg
+            if "target" not in str(exc):
+                raise
+            query_error = str(exc) + (
+                " (obstacles grown by the link radius)" if s.inflate_by_radius else "")
+            query = None
+        checker = CollisionChecker(robot, problem.scene)
+        deadline = Deadline(budget, checker)
+        q0 = np.asarray(problem.q_start if q_start is None else q_start, dtype=float)
+        q0 = q0.reshape(robot.dof)
+        tol = 2.0 * robot.link_radius_m + s.contact_margin_m
+        base_extra: dict[str, Any] = {
+            "collision_points_m": [list(p) for p in real.collision_points_m],
+            "inflated_by_m": robot.link_radius_m if s.inflate_by_radius else 0.0,
+            "contact_tolerance_m": tol, "solutions": [], "dropped": [], "chosen": None,
+            "expected_contacts": [], "allows_contact": True,
+        }
+
+        def result(status: Status, reason: str, path: Array, iterations: int = 0,
+                   trace: Array | None = None, extra: dict[str, Any] | None = None
+                   ) -> PlanResult:
+            pe, ae = goal.errors(robot, path[-1])
+            return PlanResult(
+                planner=self.name, problem=problem.name, leg=leg, goal=goal.name,
+                status=status, reason=reason, path=path, time_s=time.perf_counter() - t0,
+                iterations=iterations, collision_checks=deadline.checks_used,
+                fk_calls=0, pos_err_m=float(pe), angle_err_deg=float(ae),
+                trace=np.zeros(0) if trace is None else trace, settings=settings_dict(s),
+                extra={**base_extra, **(extra or {})},
+            )
+
+        straight = robot.q_from_arcs([], insertion_m=0.0)
+        if not np.allclose(q0, straight, atol=1e-9):
+            return result(Status.INVALID_START,
+                          "chord_arc moves the robot from the retracted straight state "
+                          "(insertion 0, every joint 0); the start differs by "
+                          f"{float(np.max(np.abs(q0 - straight))):.3g}", q0[None])
+        z_base = float(robot.T_world_base[2, 3])
+        if abs(float(goal.p_world_m[2]) - z_base) > goal.pos_tol_m:
+            return result(Status.INVALID_GOAL,
+                          f"target {goal.p_world_m.tolist()} m is {goal.p_world_m[2] - z_base:.3g} "
+                          "m off the robot's plane", q0[None])
+        if query is None:
+            return result(Status.INVALID_GOAL, query_error, q0[None])
+
+        t_search = time.perf_counter()
+        res = solve_chord_arc(query, s.search_settings(budget.max_iterations))
+        search_s = time.perf_counter() - t_search
+        srch = res.search
+        base_extra["search"] = {
+            "time_s": search_s, "expansions": srch.expansions, "arcs_built": srch.arcs_built,
+            "arcs_checked": srch.arcs_checked, "rejected_bend": srch.arcs_rejected_bend,
+            "rejected_length": srch.arcs_rejected_length,
+            "rejected_obstacle": srch.arcs_rejected_obstacle,
+            "depth_reached": srch.depth_reached, "budget_exhausted": srch.budget_exhausted,
+            "geometric_solutions": len(srch.solutions),
+        }
+        dropped: list[dict[str, Any]] = [
+            {"reason": d.reason, "stage": "contact_type", **_shape_dict(d.solution, real)}
+            for d in res.dropped]
+        iters = srch.expansions
+        if budget.time_limit_s is not None and search_s >= budget.time_limit_s:
+            return result(Status.BUDGET_EXHAUSTED,
+                          f"time limit of {budget.time_limit_s:g} s reached: the search took "
+                          f"{search_s:.3g} s", q0[None], iters)
+
+        # the chain's view of each surviving solution: joint bounds, then FCL contacts
+        cands: list[_Candidate] = []
+        cut_short = False
+        for plan in res.plans:
+            path, owner = self.motion_path(robot, plan.motion)
+            reason = ""
+            lo_ok = path >= robot.lower - 1e-12
+            hi_ok = path <= robot.upper + 1e-12
+            if not (lo_ok.all() and hi_ok.all()):
+                k, j = np.argwhere(~(lo_ok & hi_ok))[0]
+                reason = (f"the chain cannot follow it: {robot.joint_names[j]} would reach "
+                          f"{path[k, j]:.3g} (bounds [{robot.lower[j]:.3g}, "
+                          f"{robot.upper[j]:.3g}]) during step {owner[k]} "
+                          f"({plan.motion[owner[k]].kind})")
+            exp: list[dict[str, Any]] = []
+            unexp: list[dict[str, Any]] = []
+            if not reason and s.check_contacts and not cut_short:
+                exp, unexp, cut_short = self._classify(robot, checker, deadline, budget, plan,
+                                                       real, path, tol)
+                if unexp:
+                    u = unexp[0]
+                    reason = (f"the {robot.link_radius_m * 1e3:.3g} mm-radius chain touches "
+                              f"{u['obstacle']!r} with {u['link']} away from the solution's "
+                              f"collision points (waypoint {u['first_state']}; "
+                              f"{len(unexp)} such pair(s))")
+            cands.append(_Candidate(plan, path, owner, reason, tuple(exp), tuple(unexp)))
+        for c in cands:
+            if c.reason:
+                dropped.append({"reason": c.reason, "stage": "chain",
+                                **_shape_dict(c.plan.solution, real),
+                                "unexpected_contacts": list(c.unexpected)})
+        kept = [c for c in cands if not c.reason]
+        solutions = []
+        for c in kept:
+            d = _shape_dict(c.plan.solution, real)
+            d["contact_obstacles"] = [ck.obstacle for ck in c.plan.contacts]
+            d["contact_types"] = [ck.contact_type for ck in c.plan.contacts]
+            d["contact_sides"] = [ck.side for ck in c.plan.contacts]
+            d["motion"] = [{"kind": m.kind, "description": m.description}
+                           for m in c.plan.motion]
+            d["path_waypoints"] = len(c.path)
+            d["expected_contacts"] = list(c.expected)
+            solutions.append(d)
+        base_extra["solutions"] = solutions
+        base_extra["dropped"] = dropped
+        n_pts = len(query.collision_points_m)
+
+        if cut_short:
+            return result(Status.BUDGET_EXHAUSTED,
+                          f"collision-check budget of {budget.max_collision_checks} used up "
+                          "while checking the solutions' contacts", q0[None], iters)
+        if not kept:
+            why = "; ".join(d["reason"] for d in dropped[:3])
+            if not srch.solutions:
+                status = Status.BUDGET_EXHAUSTED if srch.budget_exhausted else Status.FAILED
+                reason = (f"no chord-arc shape reaches the target through the {n_pts} "
+                          f"collision points ({srch.expansions} expansions, depth "
+                          f"{srch.depth_reached}"
+                          + (", expansion budget used up)" if srch.budget_exhausted else ")"))
+            else:
+                status = Status.FAILED
+                reason = (f"all {len(srch.solutions)} geometric solution(s) dropped: {why}"
+                          + (" …" if len(dropped) > 3 else ""))
+            return result(status, reason, q0[None], iters)
+
+        if s.choose == "shortest":
+            chosen = min(range(len(kept)), key=lambda i: kept[i].plan.solution.total_length_m)
+        elif s.choose == "fewest_contacts":
+            chosen = min(range(len(kept)), key=lambda i: (
+                len(kept[i].plan.solution.contact_indices), kept[i].plan.solution.total_length_m))
+        else:
+            chosen = 0
+        c = kept[chosen]
+        tips = robot.tip(c.path)[0]
+        trace = np.linalg.norm(tips - goal.p_world_m, axis=1)
+        extra = {"chosen": chosen, "expected_contacts": list(c.expected),
+                 "motion_step_of_waypoint": c.step_of.tolist()}
+        q_end = c.path[-1]
+        summary = (f"{len(kept)} solution(s) of {len(srch.solutions)} geometric "
+                   f"({len(dropped)} dropped) in {srch.expansions} expansions; chose "
+                   f"{s.choose} #{chosen}: {len(c.plan.solution.contact_indices)} contact(s) "
+                   f"at point(s) {list(c.plan.solution.contact_indices)}, "
+                   f"{c.plan.solution.total_length_m:.4g} m")
+        if not goal.contains(robot, q_end):
+            pe, _ = goal.errors(robot, q_end)
+            return result(Status.APPROXIMATE,
+                          f"{summary}; the chain's tip ends {float(pe):.3g} m from the target "
+                          f"(tolerance {goal.pos_tol_m:g} m)", c.path, iters, trace, extra)
+        return result(Status.SOLVED, summary + "; contact at the collision points by design",
+                      c.path, iters, trace, extra)
+
+
+def make(name: str, overrides: dict[str, Any]) -> ChordArcPlanner:
+    """Registry factory for ``chord_arc``."""
+    if name != "chord_arc":
+        raise PlannerlabError(f"{name} is not served by plannerlab.planners.chord_arc")
+    return ChordArcPlanner(name, with_overrides(ChordArcSettings(), overrides, name))
+
+
+__all__ = ["CHOICES", "ChordArcPlanner", "ChordArcSettings", "collision_points", "make"]

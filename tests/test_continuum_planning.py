@@ -1,0 +1,196 @@
+"""The continuum paper's cases as planning problems (``docs/papers.md`` §3, issue 4).
+
+* ``chord_arc`` through the registry: solved, the paper's solution counts (2, 2, 1),
+  every solution and every dropped one reported, same result every run.
+* "Unsolvable without contact": a single constant-curvature section (the paper's claim)
+  reaches no target; RRT-Connect on the 40-link chain with contact forbidden (what the
+  issue asked to show) does not solve cases 1 and 2, but DOES solve case 3: the chain is
+  not a single section, and the un-inserted part behind the port is free to swing (the
+  port is not modelled in the scene), so it goes round the slab's right end.
+* PyBullet execution of the chosen solution (20-40 s each: two of them, in two worker
+  processes). The paper's zero-thickness model (default) cuts the corners by the link
+  radius; on case 2 its chosen solution ends 9 cm off with contacts away from the
+  collision points. With ``inflate_by_radius`` the chain touches only the collision
+  points and ends within 1 cm on every case.
+"""
+
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+from concurrent.futures import ProcessPoolExecutor
+
+import numpy as np
+import pytest
+
+from plannerlab.catalog import load_problem
+from plannerlab.planners import make_planner
+from plannerlab.planners.base import PlanResult, Status
+from plannerlab.runner import leg_rng
+
+CASES = (1, 2, 3)
+PAPER_SOLUTIONS = {1: 2, 2: 2, 3: 1}
+RRT_CHECKS = 100_000  # collision-check budget of RRT-Connect (generous: a few 100 suffice
+#                       where it succeeds)
+
+
+def _solve(case: int, overrides: dict | None = None, seed: int = 0) -> PlanResult:
+    problem = load_problem(f"continuum_case{case}")
+    planner = make_planner("chord_arc", overrides)
+    return planner.solve(problem, 0, problem.budget, leg_rng(seed, 0))
+
+
+def _execute(case: int, overrides: dict) -> dict:
+    """Worker: plan and execute in PyBullet; plain data back."""
+    from plannerlab.continuum_exec import execute_chord_arc
+
+    problem = load_problem(f"continuum_case{case}")
+    return execute_chord_arc(problem, _solve(case, overrides)).to_dict()
+
+
+_RRT = """
+import json, sys
+from plannerlab.catalog import load_problem
+from plannerlab.planners import make_planner
+from plannerlab.runner import leg_rng
+p = load_problem(sys.argv[1])
+r = make_planner("ompl.rrtconnect").solve(
+    p, 0, p.budget.replace(max_collision_checks=int(sys.argv[2])), leg_rng(0, 0))
+print(json.dumps({"status": r.status.value, "reason": r.reason,
+                  "checks": r.collision_checks}))
+"""
+
+
+@pytest.fixture(scope="module")
+def rrt_runs():
+    """RRT-Connect on each case, one fresh process per case (OMPL's seed is process-global),
+    all started at once."""
+    procs = {c: subprocess.Popen([sys.executable, "-c", _RRT, f"continuum_case{c}",
+                                  str(RRT_CHECKS)], stdout=subprocess.PIPE,
+                                 stderr=subprocess.DEVNULL, text=True) for c in CASES}
+    yield procs
+    for proc in procs.values():
+        if proc.poll() is None:
+            proc.kill()
+
+
+@pytest.fixture(scope="module")
+def executions():
+    """The two PyBullet executions (20-40 s each), in two worker processes."""
+    with ProcessPoolExecutor(max_workers=2) as pool:
+        yield {
+            ("paper", 2): pool.submit(_execute, 2, {}),
+            ("grown", 3): pool.submit(_execute, 3, {"inflate_by_radius": True}),
+        }
+
+
+def _rrt(rrt_runs, case: int) -> dict:
+    proc = rrt_runs[case]
+    out, _ = proc.communicate(timeout=300)
+    assert proc.returncode == 0, f"RRT-Connect process for case {case} failed"
+    return json.loads(out.strip().splitlines()[-1])
+
+
+# --------------------------------------------------------------------------- chord_arc
+
+
+@pytest.mark.parametrize("case", CASES)
+def test_chord_arc_solves_with_the_papers_solution_counts(case: int) -> None:
+    r = _solve(case)
+    assert r.status is Status.SOLVED, r.reason
+    sols = r.extra["solutions"]
+    assert len(sols) == PAPER_SOLUTIONS[case]
+    for s in sols:
+        n = len(s["contact_indices"])
+        assert n >= 1  # unsolvable without contact
+        assert len(s["bend_angles_rad"]) == len(s["arc_lengths_m"]) == n + 1
+        assert len(s["contact_points_m"]) == len(s["contact_types"]) == n
+        assert set(s["contact_types"]) <= {"forward", "backward"}
+        assert s["total_length_m"] <= load_problem(f"continuum_case{case}").robot.length_m
+    assert r.extra["dropped"] and all(d["reason"] for d in r.extra["dropped"])
+    assert 0 <= r.extra["chosen"] < len(sols)
+    # the path: retracted start, tip at the target, contact only at collision points
+    assert np.all(r.path[0] == 0.0)
+    assert r.pos_err_m < 1e-3
+    chosen = sols[r.extra["chosen"]]
+    assert r.extra["expected_contacts"]
+    assert {e["collision_point"] for e in r.extra["expected_contacts"]} <= set(
+        chosen["contact_indices"])
+    assert json.loads(json.dumps(r.to_dict())) == r.to_dict()
+
+
+@pytest.mark.parametrize("case", CASES)
+def test_chord_arc_is_the_same_every_run(case: int) -> None:
+    a, b = _solve(case, seed=0), _solve(case, seed=7)
+    np.testing.assert_array_equal(a.path, b.path)
+    da, db = a.to_dict(), b.to_dict()
+    for d in (da, db):
+        d["extra"].pop("search")  # holds the search's wall time
+        d.pop("time_s")
+        d.pop("seed")
+    assert da == db
+
+
+def test_chord_arc_declares_contact_and_rejects_a_moved_start() -> None:
+    planner = make_planner("chord_arc")
+    assert planner.allows_contact is True
+    problem = load_problem("continuum_case3")
+    q = problem.q_start.copy()
+    q[0] = 0.1
+    r = planner.solve(problem, 0, problem.budget, leg_rng(0, 0), q_start=q)
+    assert r.status is Status.INVALID_START
+
+
+@pytest.mark.parametrize("case", CASES)
+def test_a_single_section_without_contact_reaches_no_target(case: int) -> None:
+    """The paper: "all three cases are unsolvable for a single section without contact"."""
+    r = _solve(case, {"max_depth": 1})
+    assert r.status is Status.FAILED
+    assert r.extra["search"]["geometric_solutions"] == 0
+
+
+# --------------------------------------------------------------------------- RRT-Connect
+
+
+@pytest.mark.parametrize("case", (1, 2))
+def test_rrtconnect_without_contact_does_not_solve(case: int, rrt_runs) -> None:
+    """Seed 0, 100 000 collision checks. Measured: both end INVALID_GOAL (its IK finds no
+    contact-free goal state behind the wall in 40 attempts)."""
+    out = _rrt(rrt_runs, case)
+    assert out["status"] != "solved", out
+
+
+def test_rrtconnect_without_contact_solves_case3_the_chain_is_no_single_section(
+        rrt_runs) -> None:
+    """Not what the issue expected: the 40-link chain with ±90° joints is a snake, not a
+    single constant-curvature section, and nothing holds its un-inserted part behind the
+    port, so RRT-Connect swings it round the slab's right end without touching anything
+    (a few hundred checks, every seed tried)."""
+    out = _rrt(rrt_runs, 3)
+    assert out["status"] == "solved", out
+
+
+# --------------------------------------------------------------------------- PyBullet
+
+
+@pytest.mark.slow
+def test_execution_of_grown_plan_touches_only_collision_points(executions) -> None:
+    """``inflate_by_radius`` on case 3 (the quickest: ~20 s of PyBullet). Cases 1 and 2
+    behave the same (tip 5.1 and 6.8 mm off, no unexpected contact: ``plannerlab
+    continuum 1 2 3 --execute --set inflate_by_radius=true``, results/continuum.md); they
+    are left out to keep this file under two minutes. Measured here: 1.5 mm."""
+    e = executions["grown", 3].result(timeout=300)
+    assert e["unexpected"] == 0, e["reason"]
+    assert e["expected"] > 0
+    assert e["tip_error_m"] < 0.01, e["reason"]
+
+
+@pytest.mark.slow
+def test_execution_of_paper_model_case2_has_unexpected_contacts(executions) -> None:
+    """Known failure, kept visible: the paper's zero-thickness curve passes through the
+    corners, the 2 mm capsules cannot, so the chain is deflected at the wall corner; the
+    tip (measured 95 mm off) catches the post's lower edge away from the collision point."""
+    e = executions["paper", 2].result(timeout=300)
+    assert e["unexpected"] > 0
+    assert e["tip_error_m"] > 0.005
