@@ -1,4 +1,8 @@
-"""Figures with matplotlib (Agg backend, files only).
+"""Figures with matplotlib.
+
+Figures are built as :class:`matplotlib.figure.Figure` objects without pyplot, so nothing
+here touches the global backend or pyplot's figure list: the CLI saves them to PNG files,
+a notebook displays them.
 
 The arm is drawn as its chain of capsule axes; obstacles as wireframes (3D) and filled
 projections (2D). Each snapshot has three panels: 3D, a front view (x–z) and a top view
@@ -12,17 +16,14 @@ from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
-import matplotlib
+import numpy as np
+from matplotlib import colormaps
+from matplotlib.figure import Figure
+from scipy.spatial import ConvexHull
 
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
-import numpy as np  # noqa: E402
-from matplotlib.figure import Figure  # noqa: E402
-from scipy.spatial import ConvexHull  # noqa: E402
-
-from plannerlab.problem import Problem  # noqa: E402
-from plannerlab.robots.base import Array  # noqa: E402
-from plannerlab.scene import Box, Cylinder, Obstacle  # noqa: E402
+from plannerlab.problem import Problem
+from plannerlab.robots.base import Array
+from plannerlab.scene import Box, Cylinder, Obstacle
 
 VIEWS = {"front (x-z)": (0, 2), "top (x-y)": (0, 1)}
 
@@ -104,8 +105,8 @@ def draw_goals(ax: Any, problem: Problem, dims: tuple[int, int] | None) -> None:
 
 def snapshot_figure(problem: Problem, states: Sequence[tuple[str, Array]], title: str) -> Figure:
     """The arm in one or more states: 3D, front and top views."""
-    fig = plt.figure(figsize=(15, 5))
-    colors = plt.cm.viridis(np.linspace(0.0, 0.85, max(len(states), 1)))
+    fig = Figure(figsize=(15, 5))
+    colors = colormaps["viridis"](np.linspace(0.0, 0.85, max(len(states), 1)))
     ax3 = fig.add_subplot(1, 3, 1, projection="3d")
     draw_scene_3d(ax3, problem)
     draw_goals(ax3, problem, None)
@@ -134,7 +135,8 @@ def snapshot_figure(problem: Problem, states: Sequence[tuple[str, Array]], title
 
 def trace_figure(results: Sequence[Any], title: str) -> Figure:
     """Objective (or best goal distance) per iteration, one curve per leg, log scale."""
-    fig, ax = plt.subplots(figsize=(8, 4))
+    fig = Figure(figsize=(8, 4))
+    ax = fig.add_subplot(1, 1, 1)
     offset = 0
     for r in results:
         if len(r.trace) == 0:
@@ -157,7 +159,6 @@ def trace_figure(results: Sequence[Any], title: str) -> Figure:
 def save(fig: Figure, path: Path) -> Path:
     path.parent.mkdir(parents=True, exist_ok=True)
     fig.savefig(path, dpi=110)
-    plt.close(fig)
     return path
 
 
