@@ -279,3 +279,17 @@ def test_gradient_analytic_runs_on_every_irb6_problem(name: str) -> None:
     assert result.path.ndim == 2 and result.path.shape[1] == 6
     assert np.array_equal(result.path[0], problem.q_start)
     assert result.iterations <= 150 and result.reason
+
+
+def test_rrtconnect_reaches_the_goal_through_the_analytic_ik_and_moves_the_track():
+    """OMPL's goal sampling goes through the IRb-6's analytic IK (the robot's hook)."""
+    from plannerlab.planners import make_planner
+    from plannerlab.planners.base import Status
+
+    problem = load_problem("irb6_track_obstacle")
+    r = make_planner("ompl.rrtconnect").solve(
+        problem, 0, problem.budget.replace(max_collision_checks=60000, max_iterations=None),
+        np.random.default_rng(0))
+    assert r.status is Status.SOLVED, r.reason
+    assert problem.goal(0).contains(problem.robot, r.path[-1])
+    assert r.path[-1][0] >= 0.48  # the pillar forces the carriage along the track

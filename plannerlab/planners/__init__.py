@@ -64,8 +64,8 @@ def _entries() -> dict[str, PlannerEntry]:
                      "the paper's gradient method with PyBullet in the loop (100 steps of "
                      "1/240 s per iteration)", needs_stepper=True),
         PlannerEntry("gradient.analytic", "plannerlab.planners.gradient:make",
-                     "faster variant: analytic Jacobian gradient, penalty by clearance, "
-                     "step rejected on collision"),
+                     "faster variant: the same descent with the analytic Jacobian gradient "
+                     "instead of dof + 1 objective evaluations"),
     ]
     entries.append(PlannerEntry(
         "gradient+rrtconnect", "plannerlab.planners.hybrid:make",

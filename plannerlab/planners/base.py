@@ -180,6 +180,13 @@ class Deadline:
     def checks_used(self) -> int:
         return (self.checker.checks - self._checks0) if self.checker is not None else 0
 
+    def checks_left(self) -> int | None:
+        """Collision checks still allowed (None: no such limit)."""
+        b = self.budget
+        if b.max_collision_checks is None:
+            return None
+        return max(b.max_collision_checks - self.checks_used, 0)
+
     def exhausted(self, iterations: int) -> str | None:
         """None while within budget, else which limit was hit, in words."""
         b = self.budget

@@ -127,10 +127,20 @@ class GradientPlanner:
         return approx_fprime(q, f, self.settings.fd_step)
 
     def _advance_kinematic(self, problem, checker: CollisionChecker, q: Array,
-                           q_target: Array) -> tuple[Array, bool]:
-        """Move along q → q_target up to the last collision-free state (blocked by contact)."""
+                           q_target: Array, max_states: int | None) -> tuple[Array, bool]:
+        """Move along q → q_target up to the last collision-free state (blocked by contact).
+
+        At most ``max_states`` states are checked (the rest of the check budget); an edge
+        longer than that ends where checking had to stop, as if blocked.
+        """
         states = interpolate_edge(q, q_target, problem.joint_step, problem.robot.continuous)[1:]
-        bad = checker.first_invalid(states)
+        if max_states is not None and len(states) > max_states:
+            states = states[:max_states]
+            bad = checker.first_invalid(states)
+            if bad is None:
+                return states[-1], True
+        else:
+            bad = checker.first_invalid(states)
         if bad is None:
             return states[-1], False
         return (states[bad - 1] if bad > 0 else q), True
@@ -199,6 +209,14 @@ class GradientPlanner:
                     extra={"stall_iteration": iteration, "q_stall": q.tolist(),
                            "blocked_steps": blocked_steps})
             exhausted = deadline.exhausted(iteration)
+            # An iteration costs the gradient's checks (dof + 1 with finite differences),
+            # at least one state of the step and, in closed loop, one check of the state
+            # reached: never start one the check budget cannot pay for.
+            grad_cost = robot.dof + 1 if s.gradient == "finite_difference" else 0
+            left = deadline.checks_left()
+            if exhausted is None and left is not None and left < grad_cost + 1 + int(closed):
+                exhausted = (f"collision-check budget of {budget.max_collision_checks} used up "
+                             f"(an iteration needs {grad_cost + 1 + int(closed)})")
             if exhausted:
                 return result(Status.BUDGET_EXHAUSTED, exhausted, path, trace, iteration)
 
@@ -211,12 +229,14 @@ class GradientPlanner:
             if closed:
                 q_next = wrap_to_pi(stepper.move_towards(q_target, s.sim_steps), robot.continuous)
             else:
-                q_next, blocked = self._advance_kinematic(problem, checker, q, q_target)
+                left = deadline.checks_left()
+                q_next, blocked = self._advance_kinematic(problem, checker, q, q_target, left)
                 blocked_steps += int(blocked)
                 q_next = wrap_to_pi(q_next, robot.continuous)
             iteration += 1
             q = q_next
-            value = f(q)
+            # a kinematic step ends on a checked, collision-free state: A(S) = 0 there
+            value = f(q) if closed else float(f.smooth(q))
             path.append(q.copy())
             trace.append(value)
             if value < best - s.stall_min_decrease:

@@ -1,0 +1,858 @@
+"""OMPL geometric planners behind plannerlab's planner contract.
+
+This is the only module that imports ``ompl`` (the ``ompl`` 2.0.1 nanobind wheel). Every
+planner in :data:`plannerlab.planners.OMPL_PLANNERS` is served as ``ompl.<suffix>`` by
+:func:`make`. Everything OMPL-specific is kept here, and every OMPL object lives only
+inside one :meth:`OMPLPlanner.solve` call (none at module level: the wheel reports
+"leaked" objects still alive at interpreter exit).
+
+Design (measured on ``armz_inspection``, 23 continuous joints):
+
+* **State space.** Continuous joints are ``SO2StateSpace`` subspaces (they wrap; the
+  Arm-Z twists are continuous), bounded joints one ``RealVectorStateSpace`` with the
+  joint limits; a robot without continuous joints gets a plain ``RealVectorStateSpace``.
+  Reading or writing a 23-joint compound state from Python costs ~4-6 µs, against
+  ~150-200 µs for one collision check, so the compound space costs nothing measurable.
+  OMPL's compound metric is the *sum* of the subspace distances (L1 over the continuous
+  joints, L2 over the bounded block); ``range`` is in those units.
+* **Validity and motions.** The state validity checker is plannerlab's
+  :class:`~plannerlab.collision.CollisionChecker` (every state counts in ``.checks``).
+  Motions are checked by default by a Python ``MotionValidator`` (``motion_check =
+  "batched"``) that interpolates the edge exactly as :func:`plannerlab.paths.densify` does
+  (no joint moves more than ``problem.joint_step`` between checked states) and asks
+  ``checker.first_invalid`` for the whole edge at once (vectorised FK and bounding-box
+  pre-test: ~50 µs per state instead of ~150). ``motion_check = "ompl"`` uses OMPL's
+  discrete validator with the longest-valid-segment fraction set to ``joint_step /
+  max_extent``: because the compound metric is L1, that is ``joint_step`` in the *sum*
+  of joint changes, conservative and ~several times more states per edge. Limitation of
+  the wheel: the ``checkMotion(s1, s2, lastValid)`` overload cannot be overridden from
+  Python, so with the batched validator KPIECE1/LBKPIECE1 never keep the valid prefix
+  of a failed motion (still correct, a little less efficient).
+* **Projection.** KPIECE1, BKPIECE1 and LBKPIECE1 get an explicit 3-D projection: the
+  tip position ``p_world`` [m], with cells of ``projection_cell_m`` (default: reach / 20,
+  reach = the sum of the link lengths; 0.84 m for the 24-module Arm-Z).
+* **Goal.** A ``GoalSampleableRegion`` whose ``distanceGoal`` is the normalised goal
+  distance :meth:`~plannerlab.goals.GoalRegion.distance` (threshold 0: inside means
+  inside both tolerances; OMPL tests ``distance < threshold`` strictly, so the threshold
+  is 1e-9) and whose ``sampleGoal`` hands out a pool of up to
+  ``goal_samples`` goal states found by :func:`plannerlab.ik.sample_goal_state`
+  (seeded from the leg start) *before* planning, within the budget; their checks count.
+* **Budget.** A ``PlannerTerminationCondition(callable)`` stops on iterations, collision
+  checks or time; in addition the validity checker and motion validator *refuse* (report
+  invalid, without checking) once the check budget is spent, so no planner can overshoot
+  it, even inside loops that do not poll the termination condition (RRT-Connect's
+  connect step). Iterations: the planner's own count where the wheel exposes it
+  (``numIterations`` of the RRT* family and BIT*, ``milestoneCount`` of PRM), else the
+  number of termination-condition polls (one per loop iteration of RRT, RRT-Connect,
+  KPIECE, …). Slack: checks used by the final fine re-validation of a found path are not
+  part of the planning budget (reported as ``extra["validation_checks"]``).
+* **PRM / PRM\\***: OMPL's ``PRM::solve`` checks for a solution in a second thread; with
+  Python callbacks the wheel deadlocks there (the caller keeps the GIL while joining).
+  These two are therefore driven single-threaded: ``constructRoadmap`` in slices, then
+  the start and the goal pool are connected to their nearest roadmap vertices and the
+  roadmap is searched (Dijkstra, scipy) in Python.
+* **After solving.** OMPL's ``PathSimplifier`` (within the remaining budget; path length
+  before and after in ``extra``), ``interpolate``, conversion to ``(m, dof)`` with
+  continuous joints wrapped into ``[-pi, pi)``, then ``checker.check_path(path,
+  problem.joint_step / 4)``: only a path that passes is SOLVED (else INVALID_PATH); an
+  approximate solution is APPROXIMATE.
+* **Logging.** The wheel's ``OutputHandler`` cannot be subclassed from Python (no
+  constructor is bound), so during a solve OMPL writes to an ``OutputHandlerFile`` in a
+  temporary file; afterwards each message is re-emitted on the ``plannerlab.ompl``
+  logger at its level, and the previous handler and log level are restored. OMPL's log
+  level follows that logger's effective level.
+* **Seeding.** ``solve`` derives an OMPL seed from ``rng`` and calls
+  ``ompl.util.RNG.setSeed`` first thing. OMPL's seed is process-global and only takes
+  effect before OMPL's first random generator exists, so only the first solve in a
+  process is reproducible; seeded trials run each in a fresh process (bench), and
+  :func:`seed_ompl` is for such a process to call before any OMPL object exists. A
+  later, ineffective setSeed makes OMPL log an error, re-emitted here at DEBUG level.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import logging
+import math
+import os
+import tempfile
+from collections.abc import Callable, Iterator, Mapping
+from contextlib import contextmanager
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+import ompl.base as ob
+import ompl.geometric as og
+import ompl.util as ou
+
+from plannerlab.collision import CollisionChecker
+from plannerlab.errors import PlannerlabError, UnknownNameError
+from plannerlab.goals import GoalRegion
+from plannerlab.ik import sample_goal_state
+from plannerlab.paths import interpolate_edge, path_length
+from plannerlab.planners.base import Deadline, PlanResult, Status, settings_dict, with_overrides
+from plannerlab.robots.base import Array, Robot, joint_difference, wrap_to_pi
+
+LOGGER = logging.getLogger("plannerlab.ompl")
+
+#: OMPL seeds must be in [1, 2**31 - 1] (0 means "random" to OMPL)
+_SEED_MAX = 2**31 - 1
+
+
+# ---------------------------------------------------------------------------- settings
+@dataclass(frozen=True)
+class OMPLSettings:
+    """Settings every OMPL planner shares.
+
+    Attributes:
+        simplify: run OMPL's PathSimplifier on the solution (within the remaining budget).
+        interpolate: densify the returned path so no joint moves more than
+            ``problem.joint_step`` between consecutive states.
+        goal_samples: size of the IK goal-state pool handed out by ``sampleGoal``.
+        max_goal_attempts: IK descents at most to fill the pool.
+        motion_check: ``"batched"`` (plannerlab edge check, Linf steps of joint_step) or
+            ``"ompl"`` (OMPL's discrete motion validator).
+    """
+
+    simplify: bool = True
+    interpolate: bool = True
+    goal_samples: int = 4
+    max_goal_attempts: int = 200
+    motion_check: str = "batched"
+
+
+@dataclass(frozen=True)
+class RangeSettings(OMPLSettings):
+    """Planners with a step size. ``range``: longest motion added at once, in the state
+    space's metric [rad, summed over joints]; 0 = OMPL's default (20 % of the extent)."""
+
+    range: float = 0.0
+
+
+@dataclass(frozen=True)
+class GoalBiasSettings(RangeSettings):
+    """Planners with a goal bias: probability of sampling a goal state instead of a
+    random one."""
+
+    goal_bias: float = 0.05
+
+
+@dataclass(frozen=True)
+class RRTstarSettings(GoalBiasSettings):
+    """RRT* family. ``rewire_factor`` scales the rewiring radius / k."""
+
+    rewire_factor: float = 1.1
+
+
+@dataclass(frozen=True)
+class SORRTstarSettings(RRTstarSettings):
+    """SORRT*: ``batch_size`` ordered informed samples per batch. Each sample's ordering
+    evaluates the goal heuristic (Python ``distanceGoal``) many times: measured ~1e6 calls
+    and ~30 s on a 5-joint toy problem with batch_size 10, and no termination with OMPL's
+    default 100 (the sampler does not poll the termination condition)."""
+
+    batch_size: int = 10
+
+
+@dataclass(frozen=True)
+class KPIECESettings(GoalBiasSettings):
+    """KPIECE1. ``projection_cell_m``: cell edge of the tip-position projection [m]
+    (None: reach / 20)."""
+
+    border_fraction: float = 0.9
+    failed_expansion_score_factor: float = 0.5
+    min_valid_path_fraction: float = 0.2
+    projection_cell_m: float | None = None
+
+
+@dataclass(frozen=True)
+class BKPIECESettings(RangeSettings):
+    """BKPIECE1 (bidirectional KPIECE)."""
+
+    border_fraction: float = 0.9
+    failed_expansion_score_factor: float = 0.5
+    min_valid_path_fraction: float = 0.5
+    projection_cell_m: float | None = None
+
+
+@dataclass(frozen=True)
+class LBKPIECESettings(RangeSettings):
+    """LBKPIECE1 (lazy bidirectional KPIECE)."""
+
+    border_fraction: float = 0.9
+    min_valid_path_fraction: float = 0.5
+    projection_cell_m: float | None = None
+
+
+@dataclass(frozen=True)
+class PRMSettings(OMPLSettings):
+    """PRM. ``max_nearest_neighbors``: k of the k-nearest connection strategy (also used
+    to connect the start and the goal pool); ``roadmap_slice_polls``: termination polls
+    per roadmap-growing slice between solution searches."""
+
+    max_nearest_neighbors: int = 10
+    roadmap_slice_polls: int = 50
+
+
+@dataclass(frozen=True)
+class PRMstarSettings(OMPLSettings):
+    """PRM* (k chosen by OMPL). See :class:`PRMSettings`."""
+
+    roadmap_slice_polls: int = 50
+
+
+@dataclass(frozen=True)
+class BITstarSettings(OMPLSettings):
+    """BIT*."""
+
+    samples_per_batch: int = 100
+    rewire_factor: float = 1.1
+    use_k_nearest: bool = True
+
+
+@dataclass(frozen=True)
+class FMTSettings(OMPLSettings):
+    """FMT* / BFMT*: ``num_samples`` states are sampled up front."""
+
+    num_samples: int = 1000
+    radius_multiplier: float = 1.1
+    nearest_k: bool = True
+
+
+#: OMPL class -> settings dataclass
+SETTINGS_BY_CLASS: Mapping[str, type[OMPLSettings]] = {
+    "RRTConnect": RangeSettings,
+    "RRT": GoalBiasSettings,
+    "RRTstar": RRTstarSettings,
+    "InformedRRTstar": RRTstarSettings,
+    "SORRTstar": SORRTstarSettings,
+    "KPIECE1": KPIECESettings,
+    "BKPIECE1": BKPIECESettings,
+    "LBKPIECE1": LBKPIECESettings,
+    "PRM": PRMSettings,
+    "PRMstar": PRMstarSettings,
+    "BITstar": BITstarSettings,
+    "FMT": FMTSettings,
+    "BFMT": FMTSettings,
+    "AORRTC": RangeSettings,
+}
+
+#: settings field -> OMPL setter (called when the planner has it)
+_SETTERS: Mapping[str, str] = {
+    "range": "setRange",
+    "goal_bias": "setGoalBias",
+    "rewire_factor": "setRewireFactor",
+    "batch_size": "setBatchSize",
+    "border_fraction": "setBorderFraction",
+    "failed_expansion_score_factor": "setFailedExpansionCellScoreFactor",
+    "min_valid_path_fraction": "setMinValidPathFraction",
+    "max_nearest_neighbors": "setMaxNearestNeighbors",
+    "samples_per_batch": "setSamplesPerBatch",
+    "use_k_nearest": "setUseKNearest",
+    "num_samples": "setNumSamples",
+    "radius_multiplier": "setRadiusMultiplier",
+    "nearest_k": "setNearestK",
+}
+
+_KPIECE = frozenset({"KPIECE1", "BKPIECE1", "LBKPIECE1"})
+_ROADMAP = frozenset({"PRM", "PRMstar"})
+#: planners whose informed samplers need a RealVector space (see ``_Space``)
+_LIFTED = frozenset({"InformedRRTstar", "SORRTstar", "BITstar", "AORRTC"})
+_MOTION_CHECKS = ("batched", "ompl")
+#: OMPL's GoalRegion is satisfied when distanceGoal < threshold (strict)
+_GOAL_THRESHOLD = 1e-9
+
+
+def seed_ompl(seed: int) -> None:
+    """Seed OMPL's process-global RNG. Call before any OMPL object exists (fresh process).
+
+    Args:
+        seed: any integer; mapped into OMPL's valid range [1, 2**31 - 1].
+    """
+    ou.RNG.setSeed(int(seed) % (_SEED_MAX - 1) + 1)
+
+
+# ---------------------------------------------------------------------------- logging
+_OMPL_PREFIXES = (
+    ("Debug:", logging.DEBUG),
+    ("Info:", logging.INFO),
+    ("Warning:", logging.WARNING),
+    ("Error:", logging.ERROR),
+)
+
+
+def _ompl_level(logger: logging.Logger) -> Any:
+    level = logger.getEffectiveLevel()
+    if level <= logging.DEBUG:
+        return ou.LOG_DEBUG
+    if level <= logging.INFO:
+        return ou.LOG_INFO
+    if level <= logging.WARNING:
+        return ou.LOG_WARN
+    if level <= logging.ERROR:
+        return ou.LOG_ERROR
+    return ou.LOG_NONE
+
+
+def _forward_log(text: str, logger: logging.Logger) -> None:
+    """Re-emit the lines an ``OutputHandlerFile`` wrote, one record per OMPL message."""
+    messages: list[tuple[int, str]] = []
+    for line in text.splitlines():
+        for prefix, level in _OMPL_PREFIXES:
+            if line.startswith(prefix):
+                messages.append((level, line[len(prefix):].strip()))
+                break
+        else:
+            if messages and line.strip():
+                lvl, msg = messages[-1]
+                messages[-1] = (lvl, f"{msg} ({line.strip()})")
+    for level, msg in messages:
+        if "Random number generation already started" in msg:
+            level = logging.DEBUG  # expected for every solve after the first in a process
+        logger.log(level, "OMPL: %s", msg)
+
+
+@contextmanager
+def _ompl_logging(logger: logging.Logger) -> Iterator[None]:
+    """Route OMPL's output into ``logger`` for the duration of the block."""
+    fd, filename = tempfile.mkstemp(prefix="plannerlab_ompl_", suffix=".log")
+    os.close(fd)
+    previous_level = ou.getLogLevel()
+    handler = ou.OutputHandlerFile(filename)
+    ou.useOutputHandler(handler)
+    ou.setLogLevel(_ompl_level(logger))
+    try:
+        yield
+    finally:
+        ou.restorePreviousOutputHandler()
+        ou.setLogLevel(previous_level)
+        del handler  # closes the file
+        try:
+            with open(filename, encoding="utf-8", errors="replace") as f:
+                _forward_log(f.read(), logger)
+        finally:
+            os.unlink(filename)
+
+
+# ---------------------------------------------------------------------------- helpers
+def _reach_m(robot: Robot, q: Array) -> float:
+    """An upper bound of the tip's distance from the base [m]: the sum of link lengths."""
+    seg = robot.link_segments(np.asarray(q, dtype=float))
+    return float(np.sum(np.linalg.norm(seg[:, 1] - seg[:, 0], axis=-1)))
+
+
+class _Space:
+    """Conversion between joint vectors and OMPL states for one robot (one solve).
+
+    ``lifted=False``: SO2 subspaces for continuous joints (+ one RealVector block for the
+    bounded ones). ``lifted=True``: a single RealVectorStateSpace in which each continuous
+    joint ranges over ``[c - 2 pi, c + 2 pi]`` around the start ``c`` (a double cover of
+    the circle: every path in it is a valid path of the robot, and every path that turns a
+    joint by less than ±pi net from the start is in it). Used by planners whose informed
+    samplers only accept real-vector spaces (InformedRRT*, SORRT*, BIT*, AORRTC).
+    """
+
+    def __init__(self, robot: Robot, lifted: bool = False,
+                 center: Array | None = None) -> None:
+        self.robot = robot
+        self.dof = robot.dof
+        self.lifted = lifted
+        cont = np.asarray(robot.continuous, dtype=bool)
+        self.center = (np.zeros(self.dof) if center is None
+                       else np.asarray(center, dtype=float).copy())
+        if lifted:
+            self.cont_idx: list[int] = []
+            self.bound_idx = list(range(self.dof))
+            lo = np.where(cont, self.center - 2.0 * np.pi, robot.lower)
+            hi = np.where(cont, self.center + 2.0 * np.pi, robot.upper)
+            self.space = self._real_vector(lo, hi)
+            self.compound = False
+            return
+        self.cont_idx = [int(i) for i in np.flatnonzero(cont)]
+        self.bound_idx = [int(i) for i in np.flatnonzero(~cont)]
+        self.compound = bool(self.cont_idx)
+        if self.compound:
+            space = ob.CompoundStateSpace()
+            for _ in self.cont_idx:
+                space.addSubspace(ob.SO2StateSpace(), 1.0)
+            if self.bound_idx:
+                space.addSubspace(self._real_vector(robot.lower[self.bound_idx],
+                                                    robot.upper[self.bound_idx]), 1.0)
+        else:
+            space = self._real_vector(robot.lower, robot.upper)
+        self.space = space
+
+    @staticmethod
+    def _real_vector(lower: Array, upper: Array) -> Any:
+        n = len(lower)
+        rv = ob.RealVectorStateSpace(n)
+        bounds = ob.RealVectorBounds(n)
+        for j in range(n):
+            bounds.setLow(j, float(lower[j]))
+            bounds.setHigh(j, float(upper[j]))
+        rv.setBounds(bounds)
+        return rv
+
+    def to_q(self, state: Any) -> Array:
+        q = np.empty(self.dof)
+        if self.compound:
+            for k, i in enumerate(self.cont_idx):
+                q[i] = state[k].value
+            if self.bound_idx:
+                rv = state[len(self.cont_idx)]
+                for j, i in enumerate(self.bound_idx):
+                    q[i] = rv[j]
+        else:
+            for j, i in enumerate(self.bound_idx):
+                q[i] = state[j]
+        return q
+
+    def set_state(self, state: Any, q: Array) -> None:
+        q = np.asarray(q, dtype=float)
+        if self.lifted:  # the lift of q nearest to the centre
+            q = self.center + joint_difference(q, self.center, self.robot.continuous)
+        else:
+            q = wrap_to_pi(q, self.robot.continuous)
+        if self.compound:
+            for k, i in enumerate(self.cont_idx):
+                state[k].value = float(q[i])
+            if self.bound_idx:
+                rv = state[len(self.cont_idx)]
+                for j, i in enumerate(self.bound_idx):
+                    rv[j] = float(q[i])
+        else:
+            for j, i in enumerate(self.bound_idx):
+                state[j] = float(q[i])
+
+    def metric(self, Q: Array, q: Array) -> Array:
+        """OMPL's distance from each row of Q (k, dof) to q: L1 continuous + L2 bounded."""
+        d = np.abs(joint_difference(Q, q[None, :], self.robot.continuous))
+        out = d[:, self.cont_idx].sum(axis=1) if self.cont_idx else np.zeros(len(Q))
+        if self.bound_idx:
+            out = out + np.linalg.norm(d[:, self.bound_idx], axis=1)
+        return out
+
+
+class _Budget:
+    """Collision-check, iteration and time limits of one solve, shared by callbacks."""
+
+    def __init__(self, budget: Any, checker: CollisionChecker) -> None:
+        self.deadline = Deadline(budget, checker)
+        self.max_checks = budget.max_collision_checks
+        self.polls = 0
+        self.refused = 0
+        self.iteration_source: Callable[[], int] | None = None
+
+    def checks_left(self) -> int | None:
+        if self.max_checks is None:
+            return None
+        return max(self.max_checks - self.deadline.checks_used, 0)
+
+    def iterations(self) -> int:
+        return self.iteration_source() if self.iteration_source is not None else self.polls
+
+    def exhausted(self) -> str | None:
+        return self.deadline.exhausted(self.iterations())
+
+    def poll(self) -> bool:
+        """The termination condition: True once any limit is reached."""
+        self.polls += 1
+        return self.exhausted() is not None
+
+
+class _GuardedChecker:
+    """The collision checker behind the budget: refuses (invalid, unchecked) once spent."""
+
+    def __init__(self, checker: CollisionChecker, budget: _Budget) -> None:
+        self.checker = checker
+        self.budget = budget
+
+    def is_valid(self, q: Array) -> bool:
+        left = self.budget.checks_left()
+        if left is not None and left <= 0:
+            self.budget.refused += 1
+            return False
+        return self.checker.is_valid(q)
+
+    def edge_valid(self, q_a: Array, q_b: Array, joint_step: float) -> bool:
+        """Every state of the edge after q_a (q_b included) is valid, checked in order."""
+        states = interpolate_edge(q_a, q_b, joint_step, self.checker.robot.continuous)[1:]
+        left = self.budget.checks_left()
+        if left is not None and left < len(states):
+            # not enough budget to check the whole edge: check what we may, then refuse
+            self.budget.refused += 1
+            if left > 0:
+                self.checker.first_invalid(states[:left])
+            return False
+        return self.checker.first_invalid(states) is None
+
+
+def _goal_class() -> type:
+    """The goal type (created per solve so no OMPL-derived type outlives a solve)."""
+
+    class PoolGoal(ob.GoalSampleableRegion):
+        """Goal region with normalised distance and a precomputed IK pool."""
+
+        def __init__(self, si: Any, distance: Callable[[Any], float],
+                     fill: Callable[[Any, int], None], pool_size: int) -> None:
+            super().__init__(si)
+            # GoalRegion.distance is exactly 0 inside the region; OMPL's isSatisfied tests
+            # distance < threshold (strictly), so "threshold 0" is a tiny positive number.
+            self.setThreshold(_GOAL_THRESHOLD)
+            self._distance = distance
+            self._fill = fill
+            self._size = pool_size
+            self._next = 0
+
+        def distanceGoal(self, state: Any) -> float:  # noqa: N802 - OMPL's name
+            return self._distance(state)
+
+        def sampleGoal(self, state: Any) -> None:  # noqa: N802
+            self._fill(state, self._next % self._size)
+            self._next += 1
+
+        def maxSampleCount(self) -> int:  # noqa: N802
+            return self._size
+
+        def couldSample(self) -> bool:  # noqa: N802
+            return self._size > 0
+
+    return PoolGoal
+
+
+def _projection(space: _Space, cell_m: float, center: Array, reach: float,
+                counter: list[int]) -> Any:
+    """Tip-position projection (3-D, metres) for the KPIECE family."""
+
+    class TipProjection(ob.ProjectionEvaluator):
+        def getDimension(self) -> int:  # noqa: N802
+            return 3
+
+        def project(self, state: Any, projection: Any) -> None:
+            counter[0] += 1
+            p, _ = space.robot.tip(space.to_q(state))
+            projection[:] = p
+
+    proj = TipProjection(space.space)
+    bounds = ob.RealVectorBounds(3)
+    for d in range(3):
+        bounds.setLow(d, float(center[d] - reach))
+        bounds.setHigh(d, float(center[d] + reach))
+    proj.setBounds(bounds)
+    proj.inferCellSizes()  # sizes the cell vector; then set the real sizes
+    for d in range(3):
+        proj.setCellSizes(d, float(cell_m))
+    return proj
+
+
+# ---------------------------------------------------------------------------- planner
+@dataclass(frozen=True)
+class OMPLPlanner:
+    """One OMPL geometric planner with frozen settings (see the module docstring)."""
+
+    name: str
+    ompl_class: str
+    settings: OMPLSettings
+
+    def solve(
+        self,
+        problem: Any,
+        leg: int,
+        budget: Any,
+        rng: np.random.Generator,
+        q_start: Array | None = None,
+        stepper: Any | None = None,
+    ) -> PlanResult:
+        """Plan leg ``leg`` of ``problem`` within ``budget``.
+
+        Args:
+            problem: the problem (robot, scene, goals, joint_step).
+            leg: leg index.
+            budget: iterations / collision checks / time; at least one must be set.
+            rng: the trial's generator (IK pool, OMPL seed).
+            q_start: (dof,) start; default: the problem's start.
+            stepper: unused (OMPL planners are open-loop).
+
+        Returns:
+            A :class:`PlanResult`; failures are statuses with reasons.
+        """
+        del stepper
+        if (budget.max_iterations is None and budget.max_collision_checks is None
+                and budget.time_limit_s is None):
+            raise PlannerlabError(f"{self.name}: the budget needs at least one limit "
+                                  "(max_iterations, max_collision_checks or time_limit_s)")
+        if self.settings.motion_check not in _MOTION_CHECKS:
+            raise PlannerlabError(f"{self.name}: motion_check must be one of "
+                                  f"{', '.join(_MOTION_CHECKS)}, got "
+                                  f"{self.settings.motion_check!r}")
+        ompl_seed = int(rng.integers(1, _SEED_MAX))
+        with _ompl_logging(LOGGER):
+            ou.RNG.setSeed(ompl_seed)  # effective only before OMPL's first generator
+            result = self._solve(problem, leg, budget, rng, q_start, ompl_seed)
+        return result
+
+    def _solve(self, problem: Any, leg: int, budget: Any, rng: np.random.Generator,
+               q_start: Array | None, ompl_seed: int) -> PlanResult:
+        checker = CollisionChecker(problem.robot, problem.scene)
+        bud = _Budget(budget, checker)
+        try:
+            return self._plan(problem, leg, rng, q_start, ompl_seed, checker, bud)
+        finally:
+            # Python callbacks held by OMPL objects reference the planner through this
+            # bound method: break the cycle so every OMPL object is freed with the solve.
+            bud.iteration_source = None
+
+    # ------------------------------------------------------------------ internals
+    def _plan(self, problem: Any, leg: int, rng: np.random.Generator, q_start: Array | None,
+              ompl_seed: int, checker: CollisionChecker, bud: _Budget) -> PlanResult:
+        s = self.settings
+        robot: Robot = problem.robot
+        goal: GoalRegion = problem.goal(leg)
+        guard = _GuardedChecker(checker, bud)
+        q0 = wrap_to_pi(np.asarray(problem.q_start if q_start is None else q_start,
+                                   dtype=float).reshape(robot.dof), robot.continuous)
+        fk = [0]
+        trace: list[float] = []
+        extra: dict[str, Any] = {"ompl_class": self.ompl_class, "ompl_seed": ompl_seed}
+
+        def result(status: Status, reason: str, path: Array, iterations: int) -> PlanResult:
+            pos_err, ang_err = (float(v) for v in goal.errors(robot, path[-1]))
+            extra["refused_checks"] = bud.refused
+            return PlanResult(
+                planner=self.name, problem=problem.name, leg=leg, goal=goal.name,
+                status=status, reason=reason, path=path,
+                time_s=bud.deadline.elapsed_s, iterations=iterations,
+                collision_checks=checker.checks, fk_calls=fk[0],
+                pos_err_m=pos_err, angle_err_deg=ang_err, trace=np.array(trace),
+                settings=settings_dict(s), extra=dict(extra),
+            )
+
+        if not checker.is_valid(q0):
+            pairs = ", ".join(f"{a} x {b}" for a, b in checker.colliding_pairs(q0))
+            return result(Status.INVALID_START, f"the start state collides: {pairs}",
+                          q0[None], 0)
+
+        # Goal pool (IK), within the budget.
+        pool: list[Array] = []
+        c_pool = checker.checks
+        per_slot = max(1, s.max_goal_attempts // max(s.goal_samples, 1))
+        for _ in range(s.goal_samples):
+            if bud.exhausted() is not None:
+                break
+            q_goal = sample_goal_state(robot, goal, guard, rng, seeds=[q0], attempts=per_slot)
+            if q_goal is not None:
+                pool.append(wrap_to_pi(q_goal, robot.continuous))
+        extra["goal_pool"] = len(pool)
+        extra["goal_pool_checks"] = checker.checks - c_pool
+
+        space = _Space(robot, lifted=self.ompl_class in _LIFTED, center=q0)
+        extra["state_space"] = ("lifted_real_vector" if space.lifted
+                                else "so2_compound" if space.compound else "real_vector")
+        si = ob.SpaceInformation(space.space)
+
+        def state_valid(state: Any) -> bool:
+            return guard.is_valid(space.to_q(state))
+
+        si.setStateValidityChecker(state_valid)
+        extent = space.space.getMaximumExtent()
+        si.setStateValidityCheckingResolution(min(problem.joint_step / extent, 1.0))
+        if s.motion_check == "batched":
+            step = problem.joint_step
+
+            class EdgeValidator(ob.MotionValidator):
+                def checkMotion(self, a: Any, b: Any) -> bool:  # noqa: N802
+                    return guard.edge_valid(space.to_q(a), space.to_q(b), step)
+
+            motion_validator = EdgeValidator(si)
+            si.setMotionValidator(motion_validator)
+        si.setup()
+
+        best = [math.inf]
+
+        def distance(state: Any) -> float:
+            fk[0] += 1
+            d = float(goal.distance(robot, space.to_q(state)))
+            if d < best[0]:
+                best[0] = d
+                trace.append(d)
+            return d
+
+        def fill(state: Any, i: int) -> None:
+            space.set_state(state, pool[i])
+
+        goal_obj = _goal_class()(si, distance, fill, len(pool))
+        pdef = ob.ProblemDefinition(si)
+        start = space.space.allocState()
+        space.set_state(start, q0)
+        pdef.addStartState(start)
+        pdef.setGoal(goal_obj)
+
+        planner = getattr(og, self.ompl_class)(si)
+        for field in dataclasses.fields(s):
+            setter = _SETTERS.get(field.name)
+            if setter is not None and hasattr(planner, setter):
+                getattr(planner, setter)(getattr(s, field.name))
+        if self.ompl_class in _KPIECE:
+            reach = _reach_m(robot, q0)
+            cell = s.projection_cell_m or reach / 20.0  # type: ignore[attr-defined]
+            extra["projection_cell_m"] = cell
+            planner.setProjectionEvaluator(
+                _projection(space, cell, robot.T_world_base[:3, 3], reach, fk))
+        if hasattr(planner, "numIterations"):
+            bud.iteration_source = planner.numIterations
+        elif self.ompl_class in _ROADMAP:
+            bud.iteration_source = planner.milestoneCount
+        planner.setProblemDefinition(pdef)
+        planner.setup()
+
+        ptc = ob.PlannerTerminationCondition(bud.poll)
+        if self.ompl_class in _ROADMAP:
+            ompl_path, exact, status_text = self._roadmap_solve(
+                planner, si, space, guard, pool, q0, goal, robot, bud, problem.joint_step)
+        else:
+            status = planner.solve(ptc)
+            status_text = status.asString()
+            kind = status.getStatus()
+            exact = kind == ob.PlannerStatus.PlannerStatusType.EXACT_SOLUTION
+            usable = exact or kind == ob.PlannerStatus.PlannerStatusType.APPROXIMATE_SOLUTION
+            ompl_path = (og.PathGeometric(pdef.getSolutionPath())
+                         if usable and pdef.hasSolution() else None)
+        iterations = bud.iterations()
+        extra["ompl_status"] = status_text
+        extra["planning_checks"] = checker.checks - c_pool - extra["goal_pool_checks"] + 0
+        why_stopped = bud.exhausted()
+
+        if ompl_path is None:
+            if not pool:
+                return result(Status.INVALID_GOAL,
+                              f"IK found no valid goal state in {s.max_goal_attempts} "
+                              f"attempts and {self.ompl_class} reached none "
+                              f"({status_text}; {why_stopped or 'no limit hit'})",
+                              q0[None], iterations)
+            return result(Status.BUDGET_EXHAUSTED if why_stopped else Status.FAILED,
+                          f"{self.ompl_class}: {status_text}"
+                          + (f"; {why_stopped}" if why_stopped else ""),
+                          q0[None], iterations)
+
+        extra["length_raw"] = float(ompl_path.length())
+        extra["waypoints_raw"] = int(ompl_path.getStateCount())
+        if s.simplify and bud.exhausted() is None:
+            simplifier = og.PathSimplifier(si, goal_obj)
+            c0 = checker.checks
+            simplifier.simplify(ompl_path, ob.PlannerTerminationCondition(bud.poll))
+            extra["simplify_checks"] = checker.checks - c0
+        extra["length_simplified"] = float(ompl_path.length())
+        extra["waypoints_simplified"] = int(ompl_path.getStateCount())
+        if s.interpolate:
+            ompl_path.interpolate()
+        path = np.array([space.to_q(ompl_path.getState(i))
+                         for i in range(ompl_path.getStateCount())])
+        path = wrap_to_pi(path, robot.continuous)
+        if float(np.max(np.abs(joint_difference(path[0], q0, robot.continuous)))) > 1e-6:
+            return result(Status.FAILED, f"{self.ompl_class} returned a path that does not "
+                          f"start at the start state ({status_text})", q0[None], iterations)
+        path[0] = q0  # exact copy (removes float noise of the OMPL round trip)
+        extra["path_length_rad"] = path_length(path, robot.continuous)
+
+        c0 = checker.checks
+        check = checker.check_path(path, problem.joint_step / 4.0)
+        extra["validation_checks"] = checker.checks - c0
+        if not check.valid:
+            return result(Status.INVALID_PATH,
+                          f"{self.ompl_class} path fails the re-check at joint_step/4 on "
+                          f"edge {check.first_invalid_edge}: "
+                          + ", ".join(f"{a} x {b}" for a, b in check.pairs),
+                          path, iterations)
+        if exact and bool(goal.contains(robot, path[-1])):
+            return result(Status.SOLVED, f"{self.ompl_class}: {status_text}", path, iterations)
+        return result(Status.APPROXIMATE,
+                      f"{self.ompl_class}: {status_text}; ends outside the goal region"
+                      + (f" ({why_stopped})" if why_stopped else ""), path, iterations)
+
+    def _roadmap_solve(self, planner: Any, si: Any, space: _Space, guard: _GuardedChecker,
+                       pool: list[Array], q0: Array, goal: GoalRegion, robot: Robot,
+                       bud: _Budget, joint_step: float) -> tuple[Any, bool, str]:
+        """PRM / PRM* without OMPL's solution thread (see the module docstring)."""
+        from scipy.sparse import coo_matrix
+        from scipy.sparse.csgraph import dijkstra
+
+        k = getattr(self.settings, "max_nearest_neighbors", 10)
+        slice_polls = self.settings.roadmap_slice_polls  # type: ignore[attr-defined]
+        if not pool:
+            return None, False, "no goal states to connect"
+        while True:
+            stop_at = bud.polls + slice_polls
+            planner.constructRoadmap(
+                ob.PlannerTerminationCondition(lambda s=stop_at: bud.poll() or bud.polls >= s))
+            data = ob.PlannerData(si)
+            planner.getPlannerData(data)
+            n = data.numVertices()
+            if n:
+                V = np.array([space.to_q(data.getVertex(i).getState()) for i in range(n)])
+                rows, cols = [], []
+                for i in range(n):
+                    for j in data.getEdges(i):
+                        rows.append(i)
+                        cols.append(int(j))
+                special = [q0, *pool]  # index n = start, n+1.. = goals
+                extra_rows, extra_cols, extra_w = [], [], []
+                for m, q in enumerate(special):
+                    dist = space.metric(V, q)
+                    for i in np.argsort(dist)[:k]:
+                        if guard.edge_valid(q, V[i], joint_step):
+                            extra_rows.append(n + m)
+                            extra_cols.append(int(i))
+                            extra_w.append(float(dist[i]))
+                allV = np.vstack([V, np.array(special)])
+                r = np.array(rows + extra_rows, dtype=int)
+                c = np.array(cols + extra_cols, dtype=int)
+                if len(r):
+                    w = np.array([float(space.metric(allV[a][None], allV[b])[0])
+                                  for a, b in zip(r[: len(rows)], c[: len(rows)], strict=True)]
+                                 + extra_w) + 1e-12
+                    size = len(allV)
+                    graph = coo_matrix((w, (r, c)), shape=(size, size)).tocsr()
+                    dist_from_start, pred = dijkstra(graph, directed=False, indices=n,
+                                                     return_predecessors=True)
+                    goals = np.arange(n + 1, size)
+                    reachable = goals[np.isfinite(dist_from_start[goals])]
+                    if len(reachable):
+                        g = int(reachable[np.argmin(dist_from_start[reachable])])
+                        chain = [g]
+                        while chain[-1] != n:
+                            chain.append(int(pred[chain[-1]]))
+                        path = og.PathGeometric(si)
+                        for idx in reversed(chain):
+                            st = space.space.allocState()
+                            space.set_state(st, allV[idx])
+                            path.append(st)
+                        return path, True, "Exact solution"
+            if bud.exhausted() is not None:
+                return None, False, "Timeout"
+
+
+def make(name: str, overrides: Mapping[str, Any] | None = None) -> OMPLPlanner:
+    """Registry factory: ``ompl.<suffix>`` with settings overridden by name.
+
+    Raises:
+        UnknownNameError: unknown planner or setting name (lists the known ones).
+    """
+    from plannerlab.planners import OMPL_PLANNERS
+
+    suffix = name.split(".", 1)[1] if name.startswith("ompl.") else name
+    if suffix not in OMPL_PLANNERS:
+        raise UnknownNameError("planner", name, [f"ompl.{k}" for k in OMPL_PLANNERS])
+    cls = OMPL_PLANNERS[suffix]
+    settings = with_overrides(SETTINGS_BY_CLASS[cls](), dict(overrides or {}), name)
+    return OMPLPlanner(name=name, ompl_class=cls, settings=settings)
+
+
+__all__ = [
+    "LOGGER",
+    "OMPLPlanner",
+    "OMPLSettings",
+    "SETTINGS_BY_CLASS",
+    "make",
+    "seed_ompl",
+]

@@ -1,0 +1,203 @@
+"""OMPL adapter and IK: names, settings, logging, budget, IK, and a small regression.
+
+The shared planner contract (solves, collision-free, determinism, budgets, JSON) is in
+``test_planner_contract.py``; this file covers what is specific to
+:mod:`plannerlab.planners.ompl` and :mod:`plannerlab.ik`. Budgets are collision checks,
+never wall-clock limits.
+"""
+
+from __future__ import annotations
+
+import ast
+import logging
+import multiprocessing as mp
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from plannerlab.collision import CollisionChecker
+from plannerlab.errors import UnknownNameError
+from plannerlab.goals import GoalRegion
+from plannerlab.ik import sample_goal_state, solve_ik
+from plannerlab.planners import OMPL_PLANNERS, REGISTRY, Status, get_entry, make_planner
+from plannerlab.problem import Budget, Problem
+from plannerlab.robots.armz import ArmZ
+from plannerlab.robots.base import trans
+from plannerlab.scene import Scene, Sphere
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+def toy_problem(radius_m: float = 0.3) -> Problem:
+    """6-module Arm-Z (5 joints) beside a sphere; goal a short way from the start."""
+    robot = ArmZ(n_modules=6, collision_radius_m=radius_m)
+    q0 = np.full(robot.dof, np.pi)
+    p, n = robot.tip(np.array([np.pi, 2.2, np.pi, 2.5, np.pi]))
+    scene = Scene((Sphere("ball", trans(1.2, 0.0, 2.0), 0.4),))
+    return Problem("toy", robot, scene, q0, (GoalRegion("near", p, n, 0.15, 15.0),),
+                   Budget(max_collision_checks=20_000), joint_step=0.05)
+
+
+# ---------------------------------------------------------------------------- names
+def test_every_ompl_planner_exists_in_the_wheel() -> None:
+    import ompl.geometric as og
+
+    missing = [cls for cls in OMPL_PLANNERS.values() if not hasattr(og, cls)]
+    assert not missing
+    for suffix in OMPL_PLANNERS:
+        assert f"ompl.{suffix}" in REGISTRY
+
+
+def test_unknown_planner_suggests_close_name() -> None:
+    # The best match comes first; errors.py may list up to two more close names after it.
+    pattern = r"did you mean 'ompl\.rrtconnect'[,?]"
+    with pytest.raises(UnknownNameError, match=pattern):
+        get_entry("ompl.rrtconect")
+    with pytest.raises(UnknownNameError, match=pattern):
+        make_planner("ompl.rrtconect")
+
+
+def test_unknown_setting_lists_known_ones() -> None:
+    with pytest.raises(UnknownNameError, match="goal_bias"):
+        make_planner("ompl.rrt", {"goal_bais": 0.1})
+
+
+@pytest.mark.parametrize("suffix", list(OMPL_PLANNERS))
+def test_settings_are_frozen_and_typed(suffix: str) -> None:
+    planner = make_planner(f"ompl.{suffix}")
+    s = planner.settings
+    assert s.simplify is True and s.goal_samples >= 1 and s.max_goal_attempts >= 1
+    with pytest.raises(AttributeError):
+        s.simplify = False  # type: ignore[misc]
+    if hasattr(s, "range"):
+        assert make_planner(f"ompl.{suffix}", {"range": "0.5"}).settings.range == 0.5
+
+
+def test_goal_bias_and_kpiece_settings_exist() -> None:
+    assert make_planner("ompl.rrt").settings.goal_bias == 0.05
+    k = make_planner("ompl.kpiece1", {"border_fraction": 0.8}).settings
+    assert k.border_fraction == 0.8 and k.goal_bias == 0.05
+
+
+def test_only_the_adapter_imports_ompl() -> None:
+    users = []
+    for path in (ROOT / "plannerlab").rglob("*.py"):
+        tree = ast.parse(path.read_text(encoding="utf-8"))
+        for node in ast.walk(tree):
+            names = []
+            if isinstance(node, ast.Import):
+                names = [a.name for a in node.names]
+            elif isinstance(node, ast.ImportFrom) and node.level == 0 and node.module:
+                names = [node.module]
+            if any(n == "ompl" or n.startswith("ompl.") for n in names):
+                users.append(path.relative_to(ROOT).as_posix())
+    assert sorted(set(users)) == ["plannerlab/planners/ompl.py"]
+
+
+# ---------------------------------------------------------------------------- behaviour
+def _rrtconnect_run(seed: int) -> dict:
+    """Spawned worker: one RRT-Connect solve on the toy problem, OMPL seeded first."""
+    from plannerlab.planners.ompl import seed_ompl
+
+    seed_ompl(seed)
+    r = make_planner("ompl.rrtconnect").solve(toy_problem(), 0, Budget(max_collision_checks=
+                                                                       20_000),
+                                              np.random.default_rng(seed))
+    return {"status": r.status.value, "checks": r.collision_checks, "path": r.path.tolist()}
+
+
+def test_log_goes_to_python_logging_not_stdout(caplog: pytest.LogCaptureFixture,
+                                               capfd: pytest.CaptureFixture[str]) -> None:
+    with caplog.at_level(logging.INFO, logger="plannerlab.ompl"):
+        r = make_planner("ompl.rrtconnect").solve(toy_problem(), 0, Budget(
+            max_collision_checks=20_000), np.random.default_rng(3))
+    assert r.solved, r.reason
+    assert any(rec.name == "plannerlab.ompl" and "RRTConnect" in rec.getMessage()
+               for rec in caplog.records)
+    out, err = capfd.readouterr()
+    assert "RRTConnect" not in out and "RRTConnect" not in err
+
+
+def test_extra_reports_simplification_and_validation() -> None:
+    r = make_planner("ompl.rrtconnect").solve(toy_problem(), 0, Budget(
+        max_collision_checks=20_000), np.random.default_rng(4))
+    assert r.solved, r.reason
+    for key in ("length_raw", "length_simplified", "validation_checks", "goal_pool",
+                "goal_pool_checks", "state_space"):
+        assert key in r.extra
+    assert r.extra["length_simplified"] <= r.extra["length_raw"] + 1e-9
+    assert r.extra["state_space"] == "so2_compound"
+    assert np.all(r.path >= -np.pi) and np.all(r.path < np.pi)  # wrapped
+
+
+def test_kpiece_gets_the_tip_projection() -> None:
+    r = make_planner("ompl.kpiece1").solve(toy_problem(), 0, Budget(
+        max_collision_checks=20_000), np.random.default_rng(5))
+    assert r.solved, r.reason
+    reach = float(np.sum(np.linalg.norm(np.diff(ArmZ(n_modules=6).fk(np.full(5, np.pi))[:, :3, 3],
+                                                axis=0), axis=1)))
+    assert r.extra["projection_cell_m"] == pytest.approx(reach / 20.0)
+
+
+def test_invalid_start_is_reported() -> None:
+    problem = toy_problem(radius_m=3.0)  # every module swallows the ball
+    r = make_planner("ompl.rrtconnect").solve(problem, 0, Budget(max_collision_checks=100),
+                                              np.random.default_rng(0))
+    assert r.status is Status.INVALID_START and "ball" in r.reason
+
+
+def test_budget_of_zero_refuses_every_check() -> None:
+    r = make_planner("ompl.rrt").solve(toy_problem(), 0, Budget(max_collision_checks=1),
+                                       np.random.default_rng(0))
+    assert r.collision_checks <= 1 + int(r.extra.get("validation_checks", 0))
+    assert r.status is not Status.SOLVED
+
+
+def test_rrtconnect_regression_fresh_processes() -> None:
+    """Fixed seed, check budget: the same path in two fresh processes, and solved."""
+    ctx = mp.get_context("spawn")
+    with ctx.Pool(2, maxtasksperchild=1) as pool:
+        a, b = pool.map(_rrtconnect_run, [11, 11])
+    assert a["status"] == "solved"
+    assert a == b
+
+
+# ---------------------------------------------------------------------------- IK
+def test_solve_ik_reaches_a_reachable_goal() -> None:
+    robot = ArmZ(n_modules=6)
+    q_target = np.array([1.0, 2.0, -2.5, 2.8, -1.0])
+    p, n = robot.tip(q_target)
+    goal = GoalRegion("t", p, n, 0.05, 5.0)
+    r = solve_ik(robot, goal, np.full(robot.dof, np.pi))
+    assert r.success, r.reason
+    assert bool(goal.contains(robot, r.q))
+    assert np.all(r.q >= -np.pi) and np.all(r.q < np.pi)
+
+
+def test_solve_ik_reports_unreachable() -> None:
+    robot = ArmZ(n_modules=6)
+    goal = GoalRegion("far", np.array([100.0, 0.0, 0.0]), np.array([0.0, 0.0, 1.0]), 0.1, 5.0)
+    r = solve_ik(robot, goal, np.zeros(robot.dof), max_iterations=30)
+    assert not r.success and "outside" in r.reason and r.iterations == 30
+
+
+def test_sample_goal_state_is_valid_and_inside() -> None:
+    problem = toy_problem()
+    checker = CollisionChecker(problem.robot, problem.scene)
+    goal = problem.goals[0]
+    q = sample_goal_state(problem.robot, goal, checker, np.random.default_rng(0),
+                          seeds=[problem.q_start])
+    assert q is not None
+    assert bool(goal.contains(problem.robot, q)) and checker.is_valid(q)
+    again = sample_goal_state(problem.robot, goal, checker, np.random.default_rng(0),
+                              seeds=[problem.q_start])
+    assert np.array_equal(q, again)
+
+
+def test_sample_goal_state_gives_up_with_none() -> None:
+    problem = toy_problem()
+    checker = CollisionChecker(problem.robot, problem.scene)
+    goal = GoalRegion("far", np.array([100.0, 0.0, 0.0]), np.array([0.0, 0.0, 1.0]), 0.1, 5.0)
+    assert sample_goal_state(problem.robot, goal, checker, np.random.default_rng(0),
+                             attempts=3, max_iterations=20) is None

@@ -1,0 +1,194 @@
+"""The shared check every registered planner must pass (cf. Gymnasium's ``check_env``).
+
+Parametrized over :data:`plannerlab.planners.REGISTRY` with planner names as test ids, on
+a trivial problem built here: a 6-module Arm-Z (5 joints) beside one sphere, goal a short
+way from the start. For each planner: it solves; the path starts at the start and ends in
+the goal region; every edge is collision-free at a fine resolution; the same seed gives
+the identical path; a tiny collision-check budget is respected; settings are unchanged by
+``solve``; the result survives a JSON round trip.
+
+Budget slack (documented): a planner may exceed ``max_collision_checks`` only by the
+checks of the final fine re-validation of a path it found (``extra["validation_checks"]``,
+0 when it found none) plus one (the start-state check).
+
+OMPL seeds are process-global and take effect only before OMPL's first generator exists,
+so the OMPL determinism check runs each of the two trials in a fresh ``spawn`` process.
+Regression budgets are collision checks, never wall-clock time.
+"""
+
+from __future__ import annotations
+
+import copy
+import importlib.util
+import json
+import multiprocessing as mp
+from typing import Any
+
+import numpy as np
+import pytest
+
+from plannerlab.collision import CollisionChecker
+from plannerlab.goals import GoalRegion
+from plannerlab.planners import REGISTRY, PlanResult, Status, make_planner
+from plannerlab.planners.base import settings_dict
+from plannerlab.problem import Budget, Problem
+from plannerlab.robots.armz import ArmZ
+from plannerlab.robots.base import joint_difference, trans
+from plannerlab.scene import Scene, Sphere
+
+SEED = 7
+#: planning budget of the contract solve [collision checks]; asymptotically optimal
+#: planners spend all of it, so it is kept small where they are slow per check
+CHECKS = 6_000
+BUDGETS: dict[str, int] = {
+    "ompl.prm": 20_000,  # long roadmap edges: ~12k checks to connect start and goal
+    "ompl.prmstar": 20_000,
+    "ompl.fmt": 20_000,
+    "ompl.bfmt": 20_000,
+    "ompl.informedrrtstar": 3_000,  # informed sampling calls the Python goal heuristic
+    "ompl.sorrtstar": 1_500,  # see KNOWN_FAILURES: anything larger runs for minutes
+}
+#: known failures, reported to the lead (xfail, not strict)
+KNOWN_FAILURES: dict[str, str] = {
+    "ompl.aorrtc": "AORRTC in the ompl 2.0.1 wheel returns 'Invalid goal' with a zero-length "
+                   "path for a GoalSampleableRegion goal (under investigation)",
+    "ompl.sorrtstar": "SORRT*'s ordered informed sampler calls the Python goal heuristic "
+                      "~1e6 times without polling the termination condition: with a budget "
+                      "it can finish in, it finds no solution on the toy problem",
+}
+#: tiny budget of the budget check [collision checks]
+TINY_CHECKS = 40
+#: settings that keep the contract cheap (FMT/BFMT sample this many states up front)
+OVERRIDES: dict[str, dict[str, Any]] = {
+    "ompl.fmt": {"num_samples": 150},
+    "ompl.bfmt": {"num_samples": 150},
+}
+
+
+def trivial_problem() -> Problem:
+    """6-module Arm-Z (5 joints), straight column start, one sphere, goal nearby."""
+    robot = ArmZ(n_modules=6, collision_radius_m=0.3)
+    q0 = np.full(robot.dof, np.pi)
+    q_goal = np.array([np.pi, 2.2, np.pi, 2.5, np.pi])
+    p, n = robot.tip(q_goal)
+    scene = Scene((Sphere("ball", trans(1.2, 0.0, 2.0), 0.4),))
+    goal = GoalRegion("near", p, n, 0.15, 15.0)
+    return Problem("trivial", robot, scene, q0, (goal,), Budget(max_collision_checks=CHECKS),
+                   joint_step=0.05)
+
+
+def _budget(name: str) -> Budget:
+    return Budget(max_collision_checks=BUDGETS.get(name, CHECKS))
+
+
+def _gradient_missing() -> bool:
+    return importlib.util.find_spec("plannerlab.planners.gradient") is None
+
+
+def _params() -> list[Any]:
+    params = []
+    for name, entry in REGISTRY.items():
+        marks = []
+        if entry.target.startswith("plannerlab.planners.gradient") and _gradient_missing():
+            marks.append(pytest.mark.xfail(
+                reason="plannerlab/planners/gradient.py not written yet (lead)", strict=False))
+        elif entry.needs_stepper:
+            marks.append(pytest.mark.skip(
+                reason=f"{name} needs a simulator stepper; covered by the sim tests"))
+        elif entry.robots is not None and "armz" not in entry.robots:
+            marks.append(pytest.mark.skip(
+                reason=f"{name} applies to {entry.robots}, not to the Arm-Z test problem"))
+        elif name in KNOWN_FAILURES:
+            marks.append(pytest.mark.xfail(reason=KNOWN_FAILURES[name], strict=False))
+        params.append(pytest.param(name, id=name, marks=marks))
+    return params
+
+
+def _solve(name: str, seed: int, budget: Budget | None = None) -> PlanResult:
+    problem = trivial_problem()
+    planner = make_planner(name, OVERRIDES.get(name, {}))
+    return planner.solve(problem, 0, budget or _budget(name), np.random.default_rng(seed))
+
+
+def _solve_in_fresh_process(name: str, seed: int) -> list[list[float]]:
+    """Spawned worker: seed OMPL before any OMPL object exists, then solve."""
+    if name.startswith("ompl."):
+        from plannerlab.planners.ompl import seed_ompl
+
+        seed_ompl(seed)
+    return _solve(name, seed).path.tolist()
+
+
+_CACHE: dict[str, PlanResult] = {}
+
+
+def _result(name: str) -> PlanResult:
+    if name not in _CACHE:
+        _CACHE[name] = _solve(name, SEED)
+    return _CACHE[name]
+
+
+PARAMS = _params()
+
+
+@pytest.mark.parametrize("name", PARAMS)
+def test_solves_trivial_problem(name: str) -> None:
+    r = _result(name)
+    assert r.status is Status.SOLVED, r.reason
+    problem = trivial_problem()
+    robot = problem.robot
+    assert r.path.shape[1] == robot.dof
+    assert np.allclose(joint_difference(r.path[0], problem.q_start, robot.continuous), 0.0,
+                       atol=1e-9)
+    assert bool(problem.goals[0].contains(robot, r.path[-1]))
+
+
+@pytest.mark.parametrize("name", PARAMS)
+def test_path_collision_free_at_fine_resolution(name: str) -> None:
+    r = _result(name)
+    if not r.solved:
+        pytest.fail(f"not solved: {r.reason}")
+    problem = trivial_problem()
+    check = CollisionChecker(problem.robot, problem.scene).check_path(r.path, 0.01)
+    assert check.valid, f"edge {check.first_invalid_edge} collides: {check.pairs}"
+
+
+@pytest.mark.parametrize("name", PARAMS)
+def test_same_seed_same_path(name: str) -> None:
+    if name.startswith("ompl."):
+        ctx = mp.get_context("spawn")
+        with ctx.Pool(2, maxtasksperchild=1) as pool:
+            a, b = pool.starmap(_solve_in_fresh_process, [(name, SEED), (name, SEED)])
+        assert np.array_equal(np.array(a), np.array(b))
+    else:
+        a, b = _solve(name, SEED), _solve(name, SEED)
+        assert np.array_equal(a.path, b.path)
+
+
+@pytest.mark.parametrize("name", PARAMS)
+def test_collision_check_budget_respected(name: str) -> None:
+    r = _solve(name, SEED, Budget(max_collision_checks=TINY_CHECKS))
+    slack = int(r.extra.get("validation_checks", 0)) + 1
+    assert r.collision_checks <= TINY_CHECKS + slack, (r.collision_checks, r.reason)
+
+
+@pytest.mark.parametrize("name", PARAMS)
+def test_settings_unchanged_by_solve(name: str) -> None:
+    planner = make_planner(name, OVERRIDES.get(name, {}))
+    before = copy.deepcopy(planner.settings)
+    before_dict = settings_dict(planner.settings)
+    problem = trivial_problem()
+    q_start = problem.q_start.copy()
+    planner.solve(problem, 0, Budget(max_collision_checks=500), np.random.default_rng(SEED))
+    assert planner.settings == before
+    assert settings_dict(planner.settings) == before_dict
+    assert np.array_equal(problem.q_start, q_start)
+
+
+@pytest.mark.parametrize("name", PARAMS)
+def test_result_survives_json_round_trip(name: str) -> None:
+    r = _result(name)
+    back = PlanResult.from_dict(json.loads(json.dumps(r.to_dict())))
+    assert back.status is r.status
+    assert np.array_equal(back.path, r.path)
+    assert back.planner == r.planner and back.collision_checks == r.collision_checks
