@@ -326,11 +326,19 @@ def run_trial(trial: Trial) -> dict[str, Any]:
         rec["final_pos_err_m"] = legs[-1]["pos_err_m"] if legs else None
         rec["final_angle_err_deg"] = legs[-1]["angle_err_deg"] if legs else None
         rec["execution"] = None
-        if trial.execute and plan.legs:
+        # Execution runs what the planner claims: the solved legs up to the first that is
+        # not solved. A failed plan's path (thousands of flailing descent steps, say) is
+        # not executed; ``executed_legs`` says how many legs were.
+        solved_prefix = 0
+        while solved_prefix < len(plan.legs) and plan.legs[solved_prefix].solved:
+            solved_prefix += 1
+        rec["executed_legs"] = solved_prefix if trial.execute else 0
+        if trial.execute and solved_prefix:
             from plannerlab.sim.execute import execute_legs
 
             executions = execute_legs(
-                problem, [r.path for r in plan.legs], first_leg=plan.legs[0].leg
+                problem, [r.path for r in plan.legs[:solved_prefix]],
+                first_leg=plan.legs[0].leg,
             )
             rec["execution"] = _execution_record(executions)
     except Exception as exc:  # a crashing trial is a record, never the end of the run

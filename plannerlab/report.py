@@ -327,9 +327,10 @@ TABLE_NOTES = (
     "that ran (median / 75th / 95th percentile). path len: joint-space length summed "
     "over legs, median over solved trials. pos/ang err: final tip error of the last "
     "leg, median over trials that ran. checks: collision checks per trial, median. "
-    "minima met / escaped: totals over trials. PyBullet ok: executions with a valid FCL "
-    "re-check, no contact and the goal reached; track err: median over executed trials "
-    "of the largest joint tracking error."
+    "minima met / escaped: totals over trials. PyBullet ok: of the trials whose plan "
+    "solved (only those are executed, solved legs up to the first failure), executions "
+    "with a valid FCL re-check, no contact and the goal reached; track err: median over "
+    "executed trials of the largest joint tracking error."
 )
 
 

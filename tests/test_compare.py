@@ -241,18 +241,26 @@ def test_a_raising_trial_is_recorded_and_execution_summarised(tmp_path: Path) ->
     path = resolve_problem_path(PROBLEM).resolve()
     bad = Trial.make(PROBLEM, tmp_path / "missing.toml", "gradient", 0)
     ok = Trial.make(
+        PROBLEM, path, "ompl.rrtconnect", 0, budget={"max_collision_checks": 30000}, execute=True
+    )
+    stalled = Trial.make(
         PROBLEM, path, "gradient.analytic", 0, budget={"max_collision_checks": 100}, execute=True
     )
-    run = run_comparison([bad, ok], tmp_path / "s.jsonl", jobs=2)
+    run = run_comparison([bad, ok, stalled], tmp_path / "s.jsonl", jobs=2)
     recs = {r["key"]: r for r in run.records}
     assert recs[bad.key]["status"] == ERROR_STATUS
     assert "missing.toml" in recs[bad.key]["error"]
+    assert recs[ok.key]["success"], recs[ok.key]["legs_run"]
     ex = recs[ok.key]["execution"]
     assert ex is not None and set(ex) >= {"success", "max_track_err_rad", "contacts"}
-    assert len(ex["legs"]) == len(recs[ok.key]["legs_run"])
-    rows = summarise(run.records)
-    assert [r["errors"] for r in rows] == [1, 0]
-    assert rows[1]["executed"] == 1 and math.isfinite(rows[1]["exec_track_err_median_rad"])
+    assert len(ex["legs"]) == len(recs[ok.key]["legs_run"]) == recs[ok.key]["executed_legs"]
+    # a plan that did not solve its leg is not executed
+    assert recs[stalled.key]["execution"] is None and recs[stalled.key]["executed_legs"] == 0
+    rows = {r["planner"]: r for r in summarise(run.records)}
+    assert rows["gradient"]["errors"] == 1 and rows["ompl.rrtconnect"]["errors"] == 0
+    assert rows["ompl.rrtconnect"]["executed"] == 1
+    assert math.isfinite(rows["ompl.rrtconnect"]["exec_track_err_median_rad"])
+    assert rows["gradient.analytic"]["executed"] == 0
 
 
 def test_a_trial_whose_process_dies_is_recorded(tmp_path: Path) -> None:
