@@ -4,10 +4,12 @@ Parametrized over :data:`plannerlab.planners.REGISTRY` with planner names as tes
 a trivial problem built here: a 6-module Arm-Z (5 joints) beside one sphere, goal a short
 way from the start (planners of another robot family get a bundled problem of theirs;
 closed-loop planners get a PyBullet world as their stepper). ``chord_arc`` touches
-obstacles by design: its path may collide only in the contacts it declares. For each planner: it solves; the path starts at the start and ends in
-the goal region; every edge is collision-free at a fine resolution; the same seed gives
-the identical path; a tiny collision-check budget is respected; settings are unchanged by
-``solve``; the result survives a JSON round trip.
+obstacles by design: its path may collide only in the contacts it declares.
+
+For each planner: it solves; the path starts at the start and ends in the goal region;
+every edge is collision-free at a fine resolution; the same seed gives the identical path;
+a tiny collision-check budget is respected; settings are unchanged by ``solve``; the
+result survives a JSON round trip.
 
 Budget slack (documented): a planner may exceed ``max_collision_checks`` only by the
 checks of the final fine re-validation of a path it found (``extra["validation_checks"]``,
