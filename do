@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # One entry point for set-up and the two jobs. Creates .venv (Python 3.11+) if it is
 # missing or if pyproject.toml changed since it was made, then runs the job.
-#   ./do main    the main job: planners compared on the Arm-Z paper's problem
+#   ./do main    the main job: planners compared on the Arm-Z paper's problem (a few
+#                minutes; results/runs/main/, a rerun resumes and only prints the table)
 #   ./do test    the test suite (what CI runs)
 #   ./do bench   the speed benchmarks (bench/)
 set -euo pipefail
@@ -22,7 +23,9 @@ job=${1:-main}
 shift || true
 case "$job" in
   main)
-    exec "$VENV/bin/plannerlab" execute armz_inspection --planner gradient --seed 0 "$@" ;;
+    exec "$VENV/bin/plannerlab" compare armz_inspection --legs enter \
+      --planners gradient,gradient+rrtconnect,gradient.multistart,ompl.rrtconnect \
+      --seeds 0-2 --max-checks 50000 --execute --jobs 2 --out results/runs --name main "$@" ;;
   test)
     exec "$VENV/bin/python" -m pytest -q "$@" ;;
   bench)

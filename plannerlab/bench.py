@@ -279,6 +279,8 @@ def run_trial(trial: Trial) -> dict[str, Any]:
     (except KeyboardInterrupt/SystemExit): an exception becomes status ``error``.
 
     Meant to run in a fresh process: OMPL is seeded first, before any OMPL object exists.
+    The legs are solved in order and the trial stops at the first leg that is not solved
+    (the task has failed there; ``legs_run`` shows how far it got).
     """
     t0 = time.perf_counter()
     ompl_seeded = _seed_ompl(trial.seed)  # first: before any OMPL object exists
@@ -303,6 +305,7 @@ def run_trial(trial: Trial) -> dict[str, Any]:
             legs=trial.legs,
             budget=budget,
             overrides=dict(trial.settings),
+            stop_on_failure=True,  # a task fails at its first failed leg
         )
         legs = [_leg_record(r, problem.robot.continuous) for r in plan.legs]
         rec["budget_used"] = budget.to_dict()
