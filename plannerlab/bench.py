@@ -274,6 +274,11 @@ def _trial_status(legs: Sequence[Mapping[str, Any]]) -> str:
     return "solved" if legs else "failed"
 
 
+#: per-leg numbers summed into a trial's ``totals``
+TOTAL_KEYS = ("time_s", "iterations", "collision_checks", "fk_calls", "path_length",
+              "local_minima", "escapes")
+
+
 def run_trial(trial: Trial) -> dict[str, Any]:
     """Run one trial and return its record (plain JSON-able data). Never raises
     (except KeyboardInterrupt/SystemExit): an exception becomes status ``error``.
@@ -314,18 +319,7 @@ def run_trial(trial: Trial) -> dict[str, Any]:
         rec["status"] = _trial_status(legs)
         rec["success"] = bool(legs) and all(x["status"] == "solved" for x in legs)
         rec["error"] = None
-        rec["totals"] = {
-            k: _num(sum((x[k] or 0) for x in legs))
-            for k in (
-                "time_s",
-                "iterations",
-                "collision_checks",
-                "fk_calls",
-                "path_length",
-                "local_minima",
-                "escapes",
-            )
-        }
+        rec["totals"] = {k: _num(sum((x[k] or 0) for x in legs)) for k in TOTAL_KEYS}
         rec["final_pos_err_m"] = legs[-1]["pos_err_m"] if legs else None
         rec["final_angle_err_deg"] = legs[-1]["angle_err_deg"] if legs else None
         rec["execution"] = None

@@ -52,7 +52,7 @@ from collections.abc import Iterable, Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
-from plannerlab.bench import ERROR_STATUS, SUMMARY_COLUMNS
+from plannerlab.bench import ERROR_STATUS, SUMMARY_COLUMNS, TOTAL_KEYS
 from plannerlab.io import write_json_atomic, write_text_atomic
 
 #: values of the ``status ENUM`` run property, in order (index = stored value)
@@ -204,18 +204,7 @@ def trial_rows(records: Iterable[Mapping[str, Any]]) -> list[dict[str, Any]]:
                 "error": r.get("error"),
                 "legs": len(legs),
                 "legs_solved": sum(1 for x in legs if x["status"] == "solved"),
-                **{
-                    k: tot.get(k)
-                    for k in (
-                        "time_s",
-                        "iterations",
-                        "collision_checks",
-                        "fk_calls",
-                        "path_length",
-                        "local_minima",
-                        "escapes",
-                    )
-                },
+                **{k: tot.get(k) for k in TOTAL_KEYS},
                 "final_pos_err_m": r.get("final_pos_err_m"),
                 "final_angle_err_deg": r.get("final_angle_err_deg"),
                 "exec_success": ex.get("success"),

@@ -52,7 +52,7 @@ from typing import Any
 
 import numpy as np
 
-from plannerlab.robots.base import Array, matrix_to_rpy, pose_matrix, urdf_origin
+from plannerlab.robots.base import Array, matrix_to_rpy, pose_matrix, rot_z, urdf_origin
 
 # --------------------------------------------------------------------------- section math
 
@@ -321,14 +321,7 @@ class ContinuumChain:
         """
         Q, single = self._as_batch(q)
         origins, psi = self._origins_headings(Q)
-        c, s = np.cos(psi), np.sin(psi)
-        T = np.zeros(psi.shape + (4, 4))
-        T[..., 0, 0] = c
-        T[..., 0, 1] = -s
-        T[..., 1, 0] = s
-        T[..., 1, 1] = c
-        T[..., 2, 2] = 1.0
-        T[..., 3, 3] = 1.0
+        T = rot_z(psi)
         T[..., :3, 3] = origins
         return T[0] if single else T
 
