@@ -48,7 +48,9 @@ Design (measured on ``armz_inspection``, 23 continuous joints):
   part of the planning budget (reported as ``extra["validation_checks"]``).
 * **PRM / PRM\\***: OMPL's ``PRM::solve`` checks for a solution in a second thread; with
   Python callbacks the wheel deadlocks there (the caller keeps the GIL while joining).
-  These two are therefore driven single-threaded: ``constructRoadmap`` in slices, then
+  These two are therefore driven single-threaded: ``growRoadmap``/``expandRoadmap`` in
+  slices of termination polls (not OMPL's ``constructRoadmap``, whose sub-slices are
+  timed and so depend on the machine's load), then
   the start and the goal pool are connected to their nearest roadmap vertices and the
   roadmap is searched (Dijkstra, scipy) in Python.
 * **After solving.** OMPL's ``PathSimplifier`` (within the remaining budget; path length
@@ -782,9 +784,16 @@ class OMPLPlanner:
         if not pool:
             return None, False, "no goal states to connect"
         while True:
-            stop_at = bud.polls + slice_polls
-            planner.constructRoadmap(
-                ob.PlannerTerminationCondition(lambda s=stop_at: bud.poll() or bud.polls >= s))
+            # OMPL's constructRoadmap alternates growing and expanding in *timed* sub-slices
+            # (so the roadmap would depend on the machine's load): do the alternation here,
+            # sliced by termination polls, which are deterministic.
+            grow_until = bud.polls + max(1, (2 * slice_polls) // 3)
+            planner.growRoadmapPtc(
+                ob.PlannerTerminationCondition(lambda s=grow_until: bud.poll() or bud.polls >= s))
+            expand_until = bud.polls + max(1, slice_polls // 3)
+            planner.expandRoadmapPtc(
+                ob.PlannerTerminationCondition(
+                    lambda s=expand_until: bud.poll() or bud.polls >= s))
             data = ob.PlannerData(si)
             planner.getPlannerData(data)
             n = data.numVertices()
