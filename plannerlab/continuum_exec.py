@@ -55,6 +55,7 @@ import numpy as np
 
 from plannerlab.errors import PlannerlabError
 from plannerlab.planners.base import PlanResult
+from plannerlab.planners.chord_arc import guide_obstacles
 from plannerlab.problem import Problem
 from plannerlab.sim.world import Contact, SimWorld
 
@@ -252,7 +253,7 @@ def execute_chord_arc(problem: Problem, plan_result: PlanResult, *,
     goal = problem.goal(plan_result.leg)
     path = np.asarray(plan_result.path, dtype=float)
     gravity = problem.simulation.gravity_mps2 if gravity_mps2 is None else gravity_mps2
-    guides = set(problem.extras.get("continuum", {}).get("guide_obstacles", []))
+    guides = guide_obstacles(problem)
 
     seen: dict[tuple[str, str, bool, bool], list[Any]] = {}
     tips_cmd = robot.tip(path)[0]

@@ -8,6 +8,7 @@ import subprocess
 import sys
 
 import pytest
+from conftest import PROBLEMS
 
 from plannerlab.cli import main
 
@@ -74,12 +75,31 @@ def test_table_output_names_every_leg(capsys, tmp_path):
         (("solve", "armz_pocket", "--planner", "gradient", "--legs", "nowhere"),
          "unknown leg 'nowhere'"),
         (("execute", "missing_plan.json"), "no such plan file"),
+        (("plot", str(PROBLEMS / "armz_pocket.toml")), "not JSON"),
     ],
 )
 def test_bad_input_exits_2_with_a_clear_message(capsys, argv, message):
     code, out, err = run(capsys, *argv)
     assert code == 2
     assert message in " ".join((out + err).split())
+
+
+def test_a_plan_file_of_another_format_is_refused(capsys, tmp_path):
+    bad = tmp_path / "plan.json"
+    bad.write_text(json.dumps({"format": "something/9", "legs": []}))
+    code, out, err = run(capsys, "plot", str(bad))
+    assert code == 2 and "[format] expected 'plannerlab.plan/1'" in " ".join(err.split())
+    bad.write_text(json.dumps({"format": "plannerlab.plan/1", "problem": "x"}))
+    code, out, err = run(capsys, "execute", str(bad))
+    assert code == 2 and "is missing" in err
+
+
+def test_a_bad_problem_file_shows_its_key_in_brackets(capsys, tmp_path):
+    src = tmp_path / "p.toml"
+    text = (PROBLEMS / "armz_pocket.toml").read_text(encoding="utf-8")
+    src.write_text(text.replace("n = [0.0059, 0.2202, 0.9754]", "n = [0.0, 0.0, 0.0]"))
+    code, out, err = run(capsys, "solve", str(src), "--planner", "gradient")
+    assert code == 2 and "[goals[0].n] a non-zero normal vector" in " ".join(err.split())
 
 
 def test_console_script_is_installed():

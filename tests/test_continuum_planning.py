@@ -27,6 +27,7 @@ import pytest
 from plannerlab.catalog import load_problem
 from plannerlab.planners import make_planner
 from plannerlab.planners.base import PlanResult, Status
+from plannerlab.problem import Budget
 from plannerlab.runner import leg_rng
 
 CASES = (1, 2, 3)
@@ -199,3 +200,31 @@ def test_execution_of_paper_model_case2_has_unexpected_contacts(executions) -> N
     e = executions["paper", 2].result(timeout=300)
     assert e["unexpected"] > 0
     assert e["tip_error_m"] > 0.005
+
+
+SMALL = Budget(max_iterations=100)
+
+
+def test_bad_guide_obstacles_and_missing_collision_points_name_the_key(tmp_path) -> None:
+    from plannerlab.errors import ProblemError
+
+    text = open(load_problem("continuum_case3").source, encoding="utf-8").read()
+    bad = tmp_path / "bad_guide.toml"
+    bad.write_text(text.replace('guide_obstacles = ["sleeve_left", "sleeve_right"]',
+                                'guide_obstacles = ["sleeve_left", "slieve"]'))
+    with pytest.raises(ProblemError, match=r"\[continuum.guide_obstacles\].*unknown: slieve"):
+        make_planner("chord_arc").solve(load_problem(bad), 0, SMALL, leg_rng(0, 0))
+    start = text.index("[continuum]")
+    none = tmp_path / "no_points.toml"
+    none.write_text(text[:start])
+    with pytest.raises(ProblemError, match=r"\[continuum.collision_points_m\] is missing"):
+        make_planner("chord_arc").solve(load_problem(none), 0, SMALL, leg_rng(0, 0))
+
+
+def test_continuum_cli_rejects_an_unknown_case_and_zero_runs(capsys) -> None:
+    from plannerlab.cli import main
+
+    assert main(["continuum", "9"]) == 2
+    assert "unknown problem" in " ".join(capsys.readouterr().err.split())
+    assert main(["continuum", "1", "--runs", "0"]) == 2
+    assert "--runs must be >= 1" in capsys.readouterr().err

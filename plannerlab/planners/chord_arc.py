@@ -284,6 +284,27 @@ def collision_points(problem: Any) -> tuple[tuple[float, float], ...]:
     return tuple(pts)
 
 
+def guide_obstacles(problem: Any) -> frozenset[str]:
+    """``[continuum] guide_obstacles`` of a problem: obstacles that guide the robot (the
+    insertion sleeve), whose contacts are expected. Empty if absent.
+
+    Raises:
+        ProblemError: not a list of names of the problem's obstacles.
+    """
+    key = "continuum.guide_obstacles"
+    table = problem.extras.get("continuum")
+    raw = table.get("guide_obstacles", []) if isinstance(table, dict) else []
+    names = set(problem.scene.names)
+    if not isinstance(raw, list) or not all(isinstance(n, str) for n in raw):
+        raise ProblemError(problem.source, key, f"a list of obstacle names, got {raw!r}")
+    unknown = [n for n in raw if n not in names]
+    if unknown:
+        raise ProblemError(problem.source, key,
+                           f"names of obstacles in this problem ({', '.join(sorted(names))}); "
+                           f"unknown: {', '.join(unknown)}")
+    return frozenset(raw)
+
+
 def _shape_dict(sol: ChordArcSolution, real: ChordArcQuery) -> dict[str, Any]:
     """A solution as data; ``contact_points_m`` are the problem's collision points (the
     obstacle corners), ``axis_points_m`` where the robot's axis passes them."""
@@ -341,6 +362,7 @@ class ChordArcPlanner:
         if not isinstance(robot, ContinuumChain):
             raise PlannerlabError(f"{self.name} plans for the continuum_chain robot, got "
                                   f"{getattr(robot, 'kind', type(robot).__name__)!r}")
+        guide_obstacles(problem)  # validated here, used when the plan is executed
         T = robot.T_world_base
         return ChordArcQuery(
             base_xy_m=(float(T[0, 3]), float(T[1, 3])),

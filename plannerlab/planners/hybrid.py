@@ -21,7 +21,7 @@ Both planners report ``local_minima`` (stalls met) and ``escapes``.
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
@@ -259,4 +259,4 @@ def make(name: str, overrides: dict) -> HybridPlanner:
     if settings.gradient not in ("analytic", "finite_difference"):
         raise PlannerlabError(f"gradient setting: 'analytic' or 'finite_difference', got "
                               f"{settings.gradient!r}")
-    return HybridPlanner(name, replace(settings))
+    return HybridPlanner(name, settings)
