@@ -65,8 +65,7 @@ def time_solve(query: ChordArcQuery, settings: ChordArcSettings, runs: int) -> T
     return Timing(float(np.median(ts)), float(np.percentile(ts, 90)), result)
 
 
-def random_scene(rng: np.random.Generator, n_points: int, length_m: float = 0.5
-                 ) -> ChordArcQuery:
+def random_scene(rng: np.random.Generator, n_points: int, length_m: float = 0.5) -> ChordArcQuery:
     """A random planar scene with ``n_points`` collision points on rectangle corners.
 
     Non-overlapping rectangles (4-12 cm sides, any yaw) in the box x ∈ [-0.25, 0.25],
@@ -80,8 +79,11 @@ def random_scene(rng: np.random.Generator, n_points: int, length_m: float = 0.5
     first = True
     while len(rects) < n_rect:
         size = rng.uniform(0.04, 0.12, 2)
-        c = (0.0, rng.uniform(0.15, 0.22)) if first else (
-            rng.uniform(-0.25, 0.25), rng.uniform(0.08, 0.5))
+        c = (
+            (0.0, rng.uniform(0.15, 0.22))
+            if first
+            else (rng.uniform(-0.25, 0.25), rng.uniform(0.08, 0.5))
+        )
         rad = float(np.hypot(*size) / 2)
         if any(np.hypot(c[0] - x, c[1] - y) < rad + r + 0.01 for x, y, r in discs):
             continue
@@ -105,8 +107,9 @@ def main() -> None:
     ap.add_argument("--seed", type=int, default=7, help="seed of the scaling scenes")
     ap.add_argument("--scenes", type=int, default=5, help="random scenes per size")
     ap.add_argument("--scaling-runs", type=int, default=5, help="timed runs per scene")
-    ap.add_argument("--max-expansions", type=int, default=20_000,
-                    help="search budget of the scaling runs")
+    ap.add_argument(
+        "--max-expansions", type=int, default=20_000, help="search budget of the scaling runs"
+    )
     ap.add_argument("--no-files", action="store_true", help="print only")
     ap.add_argument("--figures", action="store_true", help="draw each case to results/")
     args = ap.parse_args()
@@ -118,9 +121,19 @@ def main() -> None:
     rows: list[dict[str, object]] = []
 
     table = Table(title=f"Chord-arc search on the paper's three cases (median of {runs} runs)")
-    for col in ("case", "time [ms] median", "p90 [ms]", "target [ms]", "paper [ms]",
-                "collision points (paper)", "solutions (paper)", "geometric / dropped",
-                "expansions", "arcs checked", "met"):
+    for col in (
+        "case",
+        "time [ms] median",
+        "p90 [ms]",
+        "target [ms]",
+        "paper [ms]",
+        "collision points (paper)",
+        "solutions (paper)",
+        "geometric / dropped",
+        "expansions",
+        "arcs checked",
+        "met",
+    ):
         table.add_column(escape(col), justify="right")
     for case, (paper_s, paper_pts, paper_sol) in PAPER.items():
         with open(ROOT / "problems" / f"continuum_case{case}.toml", "rb") as f:
@@ -130,32 +143,61 @@ def main() -> None:
         target_s = paper_s / 10
         met = t.median_s <= target_s
         table.add_row(
-            str(case), f"{t.median_s * 1e3:.2f}", f"{t.p90_s * 1e3:.2f}", f"{target_s * 1e3:.0f}",
-            f"{paper_s * 1e3:.0f}", f"{len(query.collision_points_m)} ({paper_pts})",
+            str(case),
+            f"{t.median_s * 1e3:.2f}",
+            f"{t.p90_s * 1e3:.2f}",
+            f"{target_s * 1e3:.0f}",
+            f"{paper_s * 1e3:.0f}",
+            f"{len(query.collision_points_m)} ({paper_pts})",
             f"{len(res.plans)} ({paper_sol})",
             f"{len(res.search.solutions)} / {len(res.dropped)}",
-            str(res.search.expansions), str(res.search.arcs_checked),
+            str(res.search.expansions),
+            str(res.search.arcs_checked),
             "[green]yes[/green]" if met else "[red]no[/red]",
         )
-        rows.append({"table": "cases", "case": case, "points": len(query.collision_points_m),
-                     "median_ms": t.median_s * 1e3, "p90_ms": t.p90_s * 1e3,
-                     "solutions": len(res.plans), "geometric": len(res.search.solutions),
-                     "expansions": res.search.expansions, "budget_exhausted": False,
-                     "paper_ms": paper_s * 1e3, "paper_solutions": paper_sol})
+        rows.append(
+            {
+                "table": "cases",
+                "case": case,
+                "points": len(query.collision_points_m),
+                "median_ms": t.median_s * 1e3,
+                "p90_ms": t.p90_s * 1e3,
+                "solutions": len(res.plans),
+                "geometric": len(res.search.solutions),
+                "expansions": res.search.expansions,
+                "budget_exhausted": False,
+                "paper_ms": paper_s * 1e3,
+                "paper_solutions": paper_sol,
+            }
+        )
         if args.figures:
-            from plannerlab.continuum_figures import draw_case
+            from plannerlab.plot.continuum import draw_case
 
-            draw_case(query, res, ROOT / "results" / f"continuum_case{case}.png",
-                      title=f"case {case}: {len(res.plans)} solution(s), "
-                            f"{len(query.collision_points_m)} collision points")
+            draw_case(
+                query,
+                res,
+                ROOT / "results" / f"continuum_case{case}.png",
+                title=f"case {case}: {len(res.plans)} solution(s), "
+                f"{len(query.collision_points_m)} collision points",
+            )
     console.print(table)
 
     rng = np.random.default_rng(args.seed)
-    scale = Table(title=f"Scaling on random scenes (seed {args.seed}, {args.scenes} scenes per "
-                        f"size, median of {args.scaling_runs} runs each, budget "
-                        f"{args.max_expansions} expansions)")
-    for col in ("collision points", "time [ms] median", "time [ms] max", "solutions median",
-                "solutions max", "geometric median", "expansions median", "budget hit"):
+    scale = Table(
+        title=f"Scaling on random scenes (seed {args.seed}, {args.scenes} scenes per "
+        f"size, median of {args.scaling_runs} runs each, budget "
+        f"{args.max_expansions} expansions)"
+    )
+    for col in (
+        "collision points",
+        "time [ms] median",
+        "time [ms] max",
+        "solutions median",
+        "solutions max",
+        "geometric median",
+        "expansions median",
+        "budget hit",
+    ):
         scale.add_column(escape(col), justify="right")
     s_settings = ChordArcSettings(max_expansions=args.max_expansions)
     sizes = (5, 10, 15, 20, 25, 30, 35, 40)
@@ -175,18 +217,37 @@ def main() -> None:
             geo.append(len(t.result.search.solutions))
             exp.append(t.result.search.expansions)
             hit += t.result.search.budget_exhausted
-        scale.add_row(str(n), f"{np.median(times) * 1e3:.2f}", f"{np.max(times) * 1e3:.2f}",
-                      f"{np.median(sols):.0f}", str(max(sols)), f"{np.median(geo):.0f}",
-                      f"{np.median(exp):.0f}", f"{hit}/{args.scenes}")
+        scale.add_row(
+            str(n),
+            f"{np.median(times) * 1e3:.2f}",
+            f"{np.max(times) * 1e3:.2f}",
+            f"{np.median(sols):.0f}",
+            str(max(sols)),
+            f"{np.median(geo):.0f}",
+            f"{np.median(exp):.0f}",
+            f"{hit}/{args.scenes}",
+        )
         curve.append((n, float(np.median(times)), float(np.median(sols))))
-        rows.append({"table": "scaling", "case": "", "points": n,
-                     "median_ms": float(np.median(times)) * 1e3,
-                     "p90_ms": float(np.max(times)) * 1e3, "solutions": float(np.median(sols)),
-                     "geometric": float(np.median(geo)), "expansions": float(np.median(exp)),
-                     "budget_exhausted": hit, "paper_ms": "", "paper_solutions": ""})
+        rows.append(
+            {
+                "table": "scaling",
+                "case": "",
+                "points": n,
+                "median_ms": float(np.median(times)) * 1e3,
+                "p90_ms": float(np.max(times)) * 1e3,
+                "solutions": float(np.median(sols)),
+                "geometric": float(np.median(geo)),
+                "expansions": float(np.median(exp)),
+                "budget_exhausted": hit,
+                "paper_ms": "",
+                "paper_solutions": "",
+            }
+        )
     console.print(scale)
-    console.print(f"[dim]{platform.processor() or platform.machine()}, Python "
-                  f"{platform.python_version()}, numpy {np.__version__}[/dim]")
+    console.print(
+        f"[dim]{platform.processor() or platform.machine()}, Python "
+        f"{platform.python_version()}, numpy {np.__version__}[/dim]"
+    )
 
     if args.no_files:
         return

@@ -17,10 +17,10 @@ import numpy as np
 from rich.console import Console
 from rich.table import Table
 
-from plannerlab.catalog import load_problem
-from plannerlab.collision import CollisionChecker
-from plannerlab.objective import Objective
+from plannerlab.collision.fcl_checker import CollisionChecker
 from plannerlab.planners import make_planner
+from plannerlab.planners.objective import Objective
+from plannerlab.problem.catalog import load_problem
 
 
 def per_call(fn: Callable[[], object], calls: int) -> float:
@@ -54,16 +54,21 @@ def main() -> None:
 
     rows: list[tuple[str, float, str]] = []
     rows.append(("fk, one state", per_call(lambda: robot.fk(q()), 2000), "per state"))
-    rows.append(("fk, batch of all states",
-                 per_call(lambda: robot.fk(Q), 3) / len(Q), "per state"))
-    rows.append(("validity check, one state", per_call(lambda: checker.is_valid(q()), 1000),
-                 "per state"))
-    rows.append(("validity check, batch", per_call(lambda: checker.valid_batch(Q), 1) / len(Q),
-                 "per state"))
-    rows.append(("gradient, finite differences (approx_fprime)",
-                 per_call(lambda: fd.gradient(f, q()), 50), "per gradient"))
-    rows.append(("gradient, analytic", per_call(lambda: an.gradient(f, q()), 500),
-                 "per gradient"))
+    rows.append(("fk, batch of all states", per_call(lambda: robot.fk(Q), 3) / len(Q), "per state"))
+    rows.append(
+        ("validity check, one state", per_call(lambda: checker.is_valid(q()), 1000), "per state")
+    )
+    rows.append(
+        ("validity check, batch", per_call(lambda: checker.valid_batch(Q), 1) / len(Q), "per state")
+    )
+    rows.append(
+        (
+            "gradient, finite differences (approx_fprime)",
+            per_call(lambda: fd.gradient(f, q()), 50),
+            "per gradient",
+        )
+    )
+    rows.append(("gradient, analytic", per_call(lambda: an.gradient(f, q()), 500), "per gradient"))
     try:
         from plannerlab.sim import SimWorld
 
@@ -72,14 +77,21 @@ def main() -> None:
             target = problem.q_start + 0.01
             wall = per_call(lambda: world.move_towards(target, 100), 5)
         sim_s = 100 / 240
-        rows.append(("closed-loop iteration (100 PyBullet steps)", wall,
-                     f"{sim_s / wall:.1f}x faster than real time ({sim_s:.3f} s simulated)"))
+        rows.append(
+            (
+                "closed-loop iteration (100 PyBullet steps)",
+                wall,
+                f"{sim_s / wall:.1f}x faster than real time ({sim_s:.3f} s simulated)",
+            )
+        )
     except ImportError as exc:  # pragma: no cover - the sim package is part of the install
         rows.append((f"closed-loop iteration: {exc}", float("nan"), ""))
 
     base = rows[0][1]
-    table = Table(title=f"spine baseline on {problem.name} ({robot.dof} joints, "
-                        f"{len(problem.scene.obstacles)} obstacles, {len(Q)} random states)")
+    table = Table(
+        title=f"spine baseline on {problem.name} ({robot.dof} joints, "
+        f"{len(problem.scene.obstacles)} obstacles, {len(Q)} random states)"
+    )
     for col in ("operation", "time", "x fk(one state)", "note"):
         table.add_column(col)
     for name, sec, note in rows:

@@ -7,11 +7,11 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from plannerlab.goals import GoalRegion
-from plannerlab.problem import Budget, Problem
-from plannerlab.robots.armz import ArmZ
+from plannerlab.problem.goals import GoalRegion
+from plannerlab.problem.load import Budget, Problem
+from plannerlab.problem.scene import Box, Scene
+from plannerlab.robots.armz.model import ArmZ
 from plannerlab.robots.base import pose_matrix
-from plannerlab.scene import Box, Scene
 
 ROOT = Path(__file__).resolve().parents[1]
 PROBLEMS = ROOT / "problems"
@@ -32,7 +32,8 @@ def small_armz_problem(n_modules: int = 6, with_wall: bool = True) -> Problem:
     p, n = robot.tip(q_goal)
     obstacles = (
         (Box("wall", pose_matrix([2.0, 0.0, 2.0], [0, 0, 0]), [0.4, 4.0, 4.0]),)
-        if with_wall else ()
+        if with_wall
+        else ()
     )
     return Problem(
         name=f"small_armz_{n_modules}",
@@ -47,7 +48,7 @@ def small_armz_problem(n_modules: int = 6, with_wall: bool = True) -> Problem:
 
 def colliding_state(problem: Problem, seed: int = 0) -> np.ndarray:
     """The first of a fixed random sequence of states that collides in ``problem``."""
-    from plannerlab.collision import CollisionChecker
+    from plannerlab.collision.fcl_checker import CollisionChecker
 
     checker = CollisionChecker(problem.robot, problem.scene)
     Q = np.random.default_rng(seed).uniform(-np.pi, np.pi, (200, problem.robot.dof))

@@ -7,7 +7,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from hypothesis.extra.numpy import arrays
 
-from plannerlab.robots.armz import ArmZ
+from plannerlab.robots.armz.model import ArmZ
 from plannerlab.robots.base import pose_matrix
 
 ROBOT = ArmZ()
@@ -25,8 +25,9 @@ def test_all_pi_is_the_straight_column_of_the_papers_reach():
     # faces alternate ±ζ/2 about the chord: after 23 joints the top face leans by ζ/2
     assert np.isclose(np.degrees(np.arccos(n[2])), 11.25, atol=1e-3)
     origins = ROBOT.fk(q)[1:, :3, 3]
-    np.testing.assert_allclose(origins[:, :2], np.tile([0.0, ROBOT.delta_y_m], (ROBOT.dof + 1, 1)),
-                               atol=1e-5)
+    np.testing.assert_allclose(
+        origins[:, :2], np.tile([0.0, ROBOT.delta_y_m], (ROBOT.dof + 1, 1)), atol=1e-5
+    )
 
 
 def test_all_zero_closes_a_ring_after_16_modules():
@@ -88,8 +89,9 @@ def test_tip_jacobians_match_finite_differences(q):
 def test_tip_normal_is_unit_and_frames_are_rotations(q):
     F = ROBOT.fk(q)
     R = F[:, :3, :3]
-    np.testing.assert_allclose(R @ np.swapaxes(R, 1, 2), np.tile(np.eye(3), (len(F), 1, 1)),
-                               atol=1e-9)
+    np.testing.assert_allclose(
+        R @ np.swapaxes(R, 1, 2), np.tile(np.eye(3), (len(F), 1, 1)), atol=1e-9
+    )
     assert np.isclose(np.linalg.norm(ROBOT.tip(q)[1]), 1.0)
 
 

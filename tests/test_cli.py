@@ -10,7 +10,7 @@ import sys
 import pytest
 from conftest import PROBLEMS
 
-from plannerlab.cli import main
+from plannerlab.cli.main import main
 
 
 def run(capsys, *argv: str) -> tuple[int, str, str]:
@@ -25,14 +25,29 @@ def test_problems_and_planners_list_as_json(capsys):
     assert code == 0 and {"armz_inspection", "armz_pocket"} <= names
     code, out, _ = run(capsys, "planners", "--json")
     planners = {p["name"] for p in json.loads(out)}
-    assert {"gradient", "gradient.closed_loop", "gradient.analytic", "ompl.rrtconnect",
-            "ompl.kpiece1"} <= planners
+    assert {
+        "gradient",
+        "gradient.closed_loop",
+        "gradient.analytic",
+        "ompl.rrtconnect",
+        "ompl.kpiece1",
+    } <= planners
 
 
 def test_solve_execute_plot_round_trip(capsys, tmp_path):
     plan_path = tmp_path / "plan.json"
-    code, out, _ = run(capsys, "solve", "armz_pocket", "--planner", "gradient.analytic",
-                       "--seed", "3", "--out", str(plan_path), "--json")
+    code, out, _ = run(
+        capsys,
+        "solve",
+        "armz_pocket",
+        "--planner",
+        "gradient.analytic",
+        "--seed",
+        "3",
+        "--out",
+        str(plan_path),
+        "--json",
+    )
     assert code == 0
     plan = json.loads(out)
     assert plan == json.loads(plan_path.read_text())
@@ -40,8 +55,19 @@ def test_solve_execute_plot_round_trip(capsys, tmp_path):
     assert leg["status"] == "local_minimum" and leg["seed"] == 3
     assert plan["versions"]["pybullet"] and plan["versions"]["python-fcl"]
     # --strict turns the stall into a failing exit code
-    assert run(capsys, "solve", "armz_pocket", "--planner", "gradient.analytic",
-               "--out", str(tmp_path / "p2.json"), "--strict")[0] == 1
+    assert (
+        run(
+            capsys,
+            "solve",
+            "armz_pocket",
+            "--planner",
+            "gradient.analytic",
+            "--out",
+            str(tmp_path / "p2.json"),
+            "--strict",
+        )[0]
+        == 1
+    )
 
     code, out, _ = run(capsys, "execute", str(plan_path), "--json")
     assert code == 0
@@ -58,9 +84,19 @@ def test_solve_execute_plot_round_trip(capsys, tmp_path):
 
 
 def test_table_output_names_every_leg(capsys, tmp_path):
-    code, out, _ = run(capsys, "solve", "armz_inspection", "--planner", "gradient.analytic",
-                       "--legs", "enter", "--max-iterations", "20",
-                       "--out", str(tmp_path / "p.json"))
+    code, out, _ = run(
+        capsys,
+        "solve",
+        "armz_inspection",
+        "--planner",
+        "gradient.analytic",
+        "--legs",
+        "enter",
+        "--max-iterations",
+        "20",
+        "--out",
+        str(tmp_path / "p.json"),
+    )
     assert code == 0
     assert "enter" in out and "budget_exhausted" in out and "iteration budget of 20" in out
 
@@ -70,10 +106,14 @@ def test_table_output_names_every_leg(capsys, tmp_path):
     [
         (("solve", "armz_pocket", "--planner", "ompl.rrtconect"), "did you mean 'ompl.rrtconnect'"),
         (("solve", "armz_pockt", "--planner", "gradient"), "did you mean 'armz_pocket'"),
-        (("solve", "armz_pocket", "--planner", "gradient", "--set", "gama=1"),
-         "did you mean 'gamma'"),
-        (("solve", "armz_pocket", "--planner", "gradient", "--legs", "nowhere"),
-         "unknown leg 'nowhere'"),
+        (
+            ("solve", "armz_pocket", "--planner", "gradient", "--set", "gama=1"),
+            "did you mean 'gamma'",
+        ),
+        (
+            ("solve", "armz_pocket", "--planner", "gradient", "--legs", "nowhere"),
+            "unknown leg 'nowhere'",
+        ),
         (("execute", "missing_plan.json"), "no such plan file"),
         (("plot", str(PROBLEMS / "armz_pocket.toml")), "not JSON"),
     ],
@@ -103,7 +143,8 @@ def test_a_bad_problem_file_shows_its_key_in_brackets(capsys, tmp_path):
 
 
 def test_console_script_is_installed():
-    exe = shutil.which("plannerlab") or str(__import__("pathlib").Path(sys.executable).parent
-                                             / "plannerlab")
+    exe = shutil.which("plannerlab") or str(
+        __import__("pathlib").Path(sys.executable).parent / "plannerlab"
+    )
     done = subprocess.run([exe, "planners"], capture_output=True, text=True, timeout=120)
     assert done.returncode == 0 and "gradient" in done.stdout

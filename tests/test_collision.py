@@ -5,10 +5,10 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from plannerlab.collision import CollisionChecker
-from plannerlab.robots.armz import ArmZ
+from plannerlab.collision.fcl_checker import CollisionChecker
+from plannerlab.problem.scene import Box, Cylinder, Scene, Sphere
+from plannerlab.robots.armz.model import ArmZ
 from plannerlab.robots.base import pose_matrix
-from plannerlab.scene import Box, Cylinder, Scene, Sphere
 
 ROBOT = ArmZ()
 COLUMN = np.full(ROBOT.dof, np.pi)

@@ -20,7 +20,7 @@ from pathlib import Path
 
 import pytest
 
-from plannerlab.bench import (
+from plannerlab.bench.trials import (
     ERROR_STATUS,
     Trial,
     TrialStore,
@@ -29,9 +29,9 @@ from plannerlab.bench import (
     summarise,
     wilson_interval,
 )
-from plannerlab.catalog import resolve_problem_path
-from plannerlab.cli import main
+from plannerlab.cli.main import main
 from plannerlab.errors import PlannerlabError
+from plannerlab.problem.catalog import resolve_problem_path
 
 try:
     import plannerlab.planners.ompl  # noqa: F401
@@ -371,7 +371,7 @@ def test_unknown_planner_and_setting_fail_up_front(tmp_path: Path, capsys) -> No
 
 
 def test_cli_parses_the_issue_example() -> None:
-    from plannerlab.cli import build_parser
+    from plannerlab.cli.main import build_parser
 
     a = build_parser().parse_args(
         [

@@ -27,7 +27,7 @@ from plannerlab.planners.chord_arc_search import (
     solve_chord_arc,
 )
 from plannerlab.robots.base import Robot, pose_matrix
-from plannerlab.robots.continuum import (
+from plannerlab.robots.continuum.model import (
     ContinuumChain,
     arc_points,
     arc_points_local,
@@ -54,27 +54,31 @@ def test_tip_at_a1_is_the_chord_end(theta: float) -> None:
     L = 0.3
     T = section_tip(T0, theta, L)
     H = L * math.sin(theta / 2) / (theta / 2)  # the paper's chord length
-    np.testing.assert_allclose(T[:2, 2], H * np.array([math.sin(theta / 2),
-                                                       math.cos(theta / 2)]), atol=1e-15)
+    np.testing.assert_allclose(
+        T[:2, 2], H * np.array([math.sin(theta / 2), math.cos(theta / 2)]), atol=1e-15
+    )
     # the tangent (y axis) turned by θ toward +x; eq. (2) H(a) = H sin(aθ/2)/sin(θ/2)
     np.testing.assert_allclose(T[:2, 1], [math.sin(theta), math.cos(theta)], atol=1e-15)
     a = np.linspace(0.1, 1.0, 7)
-    np.testing.assert_allclose(chord_length(theta, L, a),
-                               H * np.sin(a * theta / 2) / math.sin(theta / 2), rtol=1e-12)
+    np.testing.assert_allclose(
+        chord_length(theta, L, a), H * np.sin(a * theta / 2) / math.sin(theta / 2), rtol=1e-12
+    )
     # every point of the arc lies on the circle of radius L/θ centred at (L/θ, 0)
     R = L / theta
     pts = arc_points(T0, theta, L, np.linspace(0.0, 1.0, 50))
     np.testing.assert_allclose(np.hypot(pts[:, 0] - R, pts[:, 1]), abs(R), rtol=1e-12)
     # vectorised over a: the frames of section_tip agree with arc_points
-    np.testing.assert_allclose(section_tip(T0, theta, L, a)[:, :2, 2],
-                               arc_points(T0, theta, L, a), atol=1e-15)
+    np.testing.assert_allclose(
+        section_tip(T0, theta, L, a)[:, :2, 2], arc_points(T0, theta, L, a), atol=1e-15
+    )
 
 
 def test_zero_bend_is_a_straight_segment() -> None:
     L = 0.25
     a = np.linspace(0.0, 1.0, 11)
-    np.testing.assert_array_equal(arc_points_local(0.0, L, a),
-                                  np.stack([np.zeros(11), a * L], axis=1))
+    np.testing.assert_array_equal(
+        arc_points_local(0.0, L, a), np.stack([np.zeros(11), a * L], axis=1)
+    )
     np.testing.assert_allclose(section_tip(T0, 0.0, L), [[1, 0, 0], [0, 1, L], [0, 0, 1]])
     for theta in (1e-9, -1e-9, 1e-15):
         T = section_tip(T0, theta, L)
@@ -85,10 +89,16 @@ def test_zero_bend_is_a_straight_segment() -> None:
 
 
 @settings(max_examples=200, deadline=None)
-@given(theta=st.floats(-1.9 * math.pi, 1.9 * math.pi), L=st.floats(0.01, 2.0),
-       x=st.floats(-1, 1), y=st.floats(-1, 1), phi=st.floats(-math.pi, math.pi))
-def test_inverse_of_forward_is_identity(theta: float, L: float, x: float, y: float,
-                                        phi: float) -> None:
+@given(
+    theta=st.floats(-1.9 * math.pi, 1.9 * math.pi),
+    L=st.floats(0.01, 2.0),
+    x=st.floats(-1, 1),
+    y=st.floats(-1, 1),
+    phi=st.floats(-math.pi, math.pi),
+)
+def test_inverse_of_forward_is_identity(
+    theta: float, L: float, x: float, y: float, phi: float
+) -> None:
     T = planar_frame([x, y], [math.cos(phi), math.sin(phi)])
     tip_world = section_tip(T, theta, L)[:2, 2]
     local = np.linalg.solve(T, np.append(tip_world, 1.0))[:2]
@@ -110,8 +120,12 @@ def test_bend_sign_convention() -> None:
 
 @pytest.fixture(scope="module")
 def chain() -> ContinuumChain:
-    return ContinuumChain(n_links=12, length_m=0.48, link_radius_m=0.003,
-                          T_world_base=pose_matrix([0.1, -0.2, 0.0], [0.0, 0.0, 1.2]))
+    return ContinuumChain(
+        n_links=12,
+        length_m=0.48,
+        link_radius_m=0.003,
+        T_world_base=pose_matrix([0.1, -0.2, 0.0], [0.0, 0.0, 1.2]),
+    )
 
 
 def _random_q(chain: ContinuumChain, rng: np.random.Generator, k: int) -> np.ndarray:
@@ -136,8 +150,9 @@ def test_chain_fk_batched_equals_looped(chain: ContinuumChain) -> None:
     np.testing.assert_allclose(n, F[:, -1, :3, 0])
     seg = chain.link_segments(Q)
     assert seg.shape == (9, chain.n_links, 2, 3)
-    np.testing.assert_allclose(np.linalg.norm(seg[..., 1, :] - seg[..., 0, :], axis=-1),
-                               chain.link_length_m)
+    np.testing.assert_allclose(
+        np.linalg.norm(seg[..., 1, :] - seg[..., 0, :], axis=-1), chain.link_length_m
+    )
     np.testing.assert_allclose(seg[:, -1, 1], p)
 
 
@@ -164,8 +179,9 @@ def test_chain_jacobian_matches_finite_differences(chain: ContinuumChain) -> Non
 
 
 def test_q_from_arcs_follows_the_arcs() -> None:
-    chain = ContinuumChain(n_links=40, length_m=0.5,
-                           T_world_base=pose_matrix([0, 0, 0], [0, 0, math.pi / 2]))
+    chain = ContinuumChain(
+        n_links=40, length_m=0.5, T_world_base=pose_matrix([0, 0, 0], [0, 0, math.pi / 2])
+    )
     arcs = [(0.9, 0.2), (-1.6, 0.15), (0.4, 0.1)]
     q = chain.q_from_arcs(arcs)
     assert q[0] == pytest.approx(0.45)  # insertion = Σ L; 0.05 m stays behind the port
@@ -199,8 +215,13 @@ def test_urdf_matches_fk_in_pybullet(chain: ContinuumChain, tmp_path: Path) -> N
     try:
         T = chain.T_world_base
         quat = pb.getQuaternionFromEuler([0.0, 0.0, chain.base_yaw_rad], physicsClientId=cid)
-        body = pb.loadURDF(str(path), basePosition=T[:3, 3].tolist(), baseOrientation=quat,
-                           useFixedBase=True, physicsClientId=cid)
+        body = pb.loadURDF(
+            str(path),
+            basePosition=T[:3, 3].tolist(),
+            baseOrientation=quat,
+            useFixedBase=True,
+            physicsClientId=cid,
+        )
         joints, links = {}, {}
         for j in range(pb.getNumJoints(body, physicsClientId=cid)):
             info = pb.getJointInfo(body, j, physicsClientId=cid)
@@ -212,8 +233,9 @@ def test_urdf_matches_fk_in_pybullet(chain: ContinuumChain, tmp_path: Path) -> N
                 pb.resetJointState(body, joints[name], float(v), physicsClientId=cid)
             F = chain.fk(q)
             for i, name in enumerate(chain.link_frame_names):
-                st_ = pb.getLinkState(body, links[name], computeForwardKinematics=True,
-                                      physicsClientId=cid)
+                st_ = pb.getLinkState(
+                    body, links[name], computeForwardKinematics=True, physicsClientId=cid
+                )
                 np.testing.assert_allclose(st_[4], F[i, :3, 3], atol=1e-6)
                 R = np.array(pb.getMatrixFromQuaternion(st_[5], physicsClientId=cid))
                 np.testing.assert_allclose(R.reshape(3, 3), F[i, :3, :3], atol=1e-6)
@@ -274,8 +296,9 @@ def test_leftover_length_and_budget() -> None:
     sol = solve_chord_arc(q).plans[0].solution
     assert sol.total_length_m == pytest.approx(sum(a.length_m for a in sol.arcs))
     assert sol.leftover_m == pytest.approx(0.6 - sol.total_length_m)
-    short = ChordArcQuery(q.base_xy_m, q.base_tangent, 0.38, q.obstacles,
-                          q.collision_points_m, q.target_xy_m)
+    short = ChordArcQuery(
+        q.base_xy_m, q.base_tangent, 0.38, q.obstacles, q.collision_points_m, q.target_xy_m
+    )
     r = search_chord_arc(short)  # the one-contact shapes need 0.388 m
     assert [s.contact_indices for s in r.solutions] == [(2, 1), (3, 0)]
     assert r.arcs_rejected_length > 0
@@ -294,8 +317,7 @@ def test_forward_constrained_contact_holds_when_bending_further() -> None:
     (c,) = plan.contacts
     assert (c.contact_type, c.side, c.ok) == ("forward", 1, True)
     assert c.kappa_out_per_m > c.kappa_in_per_m > 0
-    np.testing.assert_allclose(plan.solution.theta_rad, _two_arcs(pts[0], (0.10, 0.24)),
-                               atol=1e-12)
+    np.testing.assert_allclose(plan.solution.theta_rad, _two_arcs(pts[0], (0.10, 0.24)), atol=1e-12)
     far = solve_chord_arc(ChordArcQuery((0, 0), (0, 1), 0.5, (box,), pts, (0.20, 0.45)))
     assert far.plans == ()
     (d,) = far.dropped
@@ -347,17 +369,29 @@ def _shape_end(shape: tuple[tuple[float, float], ...]) -> tuple[float, float]:
 # --------------------------------------------------------------------------- the three cases
 
 EXPECTED = {
-    1: dict(points=8, geometric=5, plans={
-        (0,): (-0.8364486591584583, 2.600192536318529),
-        (1,): (0.8364486591584581, -2.600192536318528),
-    }),
-    2: dict(points=6, geometric=4, plans={
-        (0,): (-0.6435011087932845, 3.0113423269210218),
-        (1, 4): (1.3220863377013738, -1.6058804469097023, -1.646709217171524),
-    }),
-    3: dict(points=5, geometric=3, plans={
-        (1,): (0.5222975784932253, -0.9301031842318502),
-    }),
+    1: dict(
+        points=8,
+        geometric=5,
+        plans={
+            (0,): (-0.8364486591584583, 2.600192536318529),
+            (1,): (0.8364486591584581, -2.600192536318528),
+        },
+    ),
+    2: dict(
+        points=6,
+        geometric=4,
+        plans={
+            (0,): (-0.6435011087932845, 3.0113423269210218),
+            (1, 4): (1.3220863377013738, -1.6058804469097023, -1.646709217171524),
+        },
+    ),
+    3: dict(
+        points=5,
+        geometric=3,
+        plans={
+            (1,): (0.5222975784932253, -0.9301031842318502),
+        },
+    ),
 }
 
 
@@ -380,9 +414,13 @@ def test_paper_cases_regression(case: int) -> None:
     # unsolvable for a single section without contact
     assert all(s.contact_indices for s in res.search.solutions)
     # every plan fits the robot and maps onto the chain within its joint bounds
-    chain = ContinuumChain(n_links=data["robot"]["n_links"], length_m=data["robot"]["length_m"],
-                           T_world_base=pose_matrix(data["robot"]["base_xyz_m"],
-                                                    np.deg2rad(data["robot"]["base_rpy_deg"])))
+    chain = ContinuumChain(
+        n_links=data["robot"]["n_links"],
+        length_m=data["robot"]["length_m"],
+        T_world_base=pose_matrix(
+            data["robot"]["base_xyz_m"], np.deg2rad(data["robot"]["base_rpy_deg"])
+        ),
+    )
     goal = np.array(data["goals"][0]["p_m"])
     for p in res.plans:
         assert p.solution.total_length_m <= data["robot"]["length_m"]
@@ -397,25 +435,37 @@ def test_paper_cases_regression(case: int) -> None:
 
 def test_collision_point_off_the_boundary_is_named() -> None:
     q = _wall_query()
-    bad = ChordArcQuery(q.base_xy_m, q.base_tangent, 0.6, q.obstacles,
-                        (q.collision_points_m[0], (0.05, 0.23)), q.target_xy_m)
-    with pytest.raises(ChordArcInputError, match=r"collision point 1 at \(0\.05, 0\.23\).*"
-                       r"not on an obstacle boundary.*'wall'"):
+    bad = ChordArcQuery(
+        q.base_xy_m,
+        q.base_tangent,
+        0.6,
+        q.obstacles,
+        (q.collision_points_m[0], (0.05, 0.23)),
+        q.target_xy_m,
+    )
+    with pytest.raises(
+        ChordArcInputError,
+        match=r"collision point 1 at \(0\.05, 0\.23\).*"
+        r"not on an obstacle boundary.*'wall'",
+    ):
         solve_chord_arc(bad)
-    inside = ChordArcQuery(q.base_xy_m, q.base_tangent, 0.6, q.obstacles, ((0.0, 0.2),),
-                           q.target_xy_m)
+    inside = ChordArcQuery(
+        q.base_xy_m, q.base_tangent, 0.6, q.obstacles, ((0.0, 0.2),), q.target_xy_m
+    )
     with pytest.raises(ChordArcInputError, match="collision point 0"):
         search_chord_arc(inside)
 
 
 def test_target_inside_an_obstacle_is_an_error() -> None:
-    with pytest.raises(ChordArcInputError, match=r"target \(0\.01, 0\.2\) m lies inside "
-                       r"obstacle 'wall'"):
+    with pytest.raises(
+        ChordArcInputError,
+        match=r"target \(0\.01, 0\.2\) m lies inside "
+        r"obstacle 'wall'",
+    ):
         solve_chord_arc(_wall_query(target=(0.01, 0.2)))
     pillar = Circle((0.0, 0.3), 0.05, "pillar")
     with pytest.raises(ChordArcInputError, match="inside obstacle 'pillar'"):
-        solve_chord_arc(ChordArcQuery((0, 0), (0, 1), 0.5, (pillar,), ((0.0, 0.25),),
-                                      (0.01, 0.31)))
+        solve_chord_arc(ChordArcQuery((0, 0), (0, 1), 0.5, (pillar,), ((0.0, 0.25),), (0.01, 0.31)))
 
 
 def test_bad_obstacles_and_settings() -> None:
@@ -439,7 +489,7 @@ def test_motion_step_interpolates_the_last_arc() -> None:
 
 @pytest.mark.parametrize("case", [1, 2, 3], ids=lambda c: f"case{c}")
 def test_problem_files_load_as_continuum_chains(case: int) -> None:
-    from plannerlab.problem import parse_problem
+    from plannerlab.problem.load import parse_problem
 
     problem = parse_problem(PROBLEMS / f"continuum_case{case}.toml")
     robot = problem.robot
@@ -448,7 +498,7 @@ def test_problem_files_load_as_continuum_chains(case: int) -> None:
 
 
 def test_draw_case_writes_a_png(tmp_path: Path) -> None:
-    from plannerlab.continuum_figures import draw_case
+    from plannerlab.plot.continuum import draw_case
 
     q = _wall_query()
     out = draw_case(q, solve_chord_arc(q), tmp_path / "fig" / "wall.png")

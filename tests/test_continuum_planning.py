@@ -24,11 +24,11 @@ from concurrent.futures import ProcessPoolExecutor
 import numpy as np
 import pytest
 
-from plannerlab.catalog import load_problem
+from plannerlab.bench.task import leg_rng
 from plannerlab.planners import make_planner
 from plannerlab.planners.base import PlanResult, Status
-from plannerlab.problem import Budget
-from plannerlab.runner import leg_rng
+from plannerlab.problem.catalog import load_problem
+from plannerlab.problem.load import Budget
 
 CASES = (1, 2, 3)
 PAPER_SOLUTIONS = {1: 2, 2: 2, 3: 1}
@@ -44,7 +44,7 @@ def _solve(case: int, overrides: dict | None = None, seed: int = 0) -> PlanResul
 
 def _execute(case: int, overrides: dict) -> dict:
     """Worker: plan and execute in PyBullet; plain data back."""
-    from plannerlab.continuum_exec import execute_chord_arc
+    from plannerlab.sim.continuum import execute_chord_arc
 
     problem = load_problem(f"continuum_case{case}")
     return execute_chord_arc(problem, _solve(case, overrides)).to_dict()
@@ -52,9 +52,9 @@ def _execute(case: int, overrides: dict) -> dict:
 
 _RRT = """
 import json, sys
-from plannerlab.catalog import load_problem
+from plannerlab.problem.catalog import load_problem
 from plannerlab.planners import make_planner
-from plannerlab.runner import leg_rng
+from plannerlab.bench.task import leg_rng
 p = load_problem(sys.argv[1])
 r = make_planner("ompl.rrtconnect").solve(
     p, 0, p.budget.replace(max_collision_checks=int(sys.argv[2])), leg_rng(0, 0))
@@ -67,9 +67,15 @@ print(json.dumps({"status": r.status.value, "reason": r.reason,
 def rrt_runs():
     """RRT-Connect on each case, one fresh process per case (OMPL's seed is process-global),
     all started at once."""
-    procs = {c: subprocess.Popen([sys.executable, "-c", _RRT, f"continuum_case{c}",
-                                  str(RRT_CHECKS)], stdout=subprocess.PIPE,
-                                 stderr=subprocess.DEVNULL, text=True) for c in CASES}
+    procs = {
+        c: subprocess.Popen(
+            [sys.executable, "-c", _RRT, f"continuum_case{c}", str(RRT_CHECKS)],
+            stdout=subprocess.PIPE,
+            stderr=subprocess.DEVNULL,
+            text=True,
+        )
+        for c in CASES
+    }
     yield procs
     for proc in procs.values():
         if proc.poll() is None:
@@ -117,7 +123,8 @@ def test_chord_arc_solves_with_the_papers_solution_counts(case: int) -> None:
     chosen = sols[r.extra["chosen"]]
     assert r.extra["expected_contacts"]
     assert {e["collision_point"] for e in r.extra["expected_contacts"]} <= set(
-        chosen["contact_indices"])
+        chosen["contact_indices"]
+    )
     assert json.loads(json.dumps(r.to_dict())) == r.to_dict()
 
 
@@ -169,10 +176,14 @@ def test_without_the_sleeve_the_chain_is_no_single_section(tmp_path) -> None:
     text = open(load_problem("continuum_case3").source, encoding="utf-8").read()
     start = text.index("# The insertion channel behind the port")
     path = tmp_path / "no_sleeve.toml"
-    path.write_text(text[:start] + text[text.index("[[goals]]", start):])
+    path.write_text(text[:start] + text[text.index("[[goals]]", start) :])
     assert 'name = "sleeve' not in path.read_text()
-    done = subprocess.run([sys.executable, "-c", _RRT, str(path), str(RRT_CHECKS)],
-                          capture_output=True, text=True, timeout=300)
+    done = subprocess.run(
+        [sys.executable, "-c", _RRT, str(path), str(RRT_CHECKS)],
+        capture_output=True,
+        text=True,
+        timeout=300,
+    )
     out = json.loads(done.stdout.strip().splitlines()[-1])
     assert out["status"] == "solved", out
 
@@ -210,8 +221,12 @@ def test_bad_guide_obstacles_and_missing_collision_points_name_the_key(tmp_path)
 
     text = open(load_problem("continuum_case3").source, encoding="utf-8").read()
     bad = tmp_path / "bad_guide.toml"
-    bad.write_text(text.replace('guide_obstacles = ["sleeve_left", "sleeve_right"]',
-                                'guide_obstacles = ["sleeve_left", "slieve"]'))
+    bad.write_text(
+        text.replace(
+            'guide_obstacles = ["sleeve_left", "sleeve_right"]',
+            'guide_obstacles = ["sleeve_left", "slieve"]',
+        )
+    )
     with pytest.raises(ProblemError, match=r"\[continuum.guide_obstacles\].*unknown: slieve"):
         make_planner("chord_arc").solve(load_problem(bad), 0, SMALL, leg_rng(0, 0))
     start = text.index("[continuum]")
@@ -222,7 +237,7 @@ def test_bad_guide_obstacles_and_missing_collision_points_name_the_key(tmp_path)
 
 
 def test_continuum_cli_rejects_an_unknown_case_and_zero_runs(capsys) -> None:
-    from plannerlab.cli import main
+    from plannerlab.cli.main import main
 
     assert main(["continuum", "9"]) == 2
     assert "unknown problem" in " ".join(capsys.readouterr().err.split())

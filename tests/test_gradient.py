@@ -8,12 +8,12 @@ import numpy as np
 import pytest
 from conftest import colliding_state, small_armz_problem
 
-from plannerlab.catalog import load_problem
-from plannerlab.collision import CollisionChecker
+from plannerlab.collision.fcl_checker import CollisionChecker
 from plannerlab.errors import PlannerlabError, UnknownNameError
-from plannerlab.objective import Objective
 from plannerlab.planners import make_planner
 from plannerlab.planners.base import Status
+from plannerlab.planners.objective import Objective
+from plannerlab.problem.catalog import load_problem
 
 
 def test_objective_is_the_papers_formula(small_problem):
@@ -36,16 +36,17 @@ def test_analytic_gradient_matches_approx_fprime(small_problem):
 
 
 def test_gradient_solves_a_free_problem_and_stays_in_budget(small_problem):
-    r = make_planner("gradient").solve(small_problem, 0, small_problem.budget,
-                                       np.random.default_rng(0))
+    r = make_planner("gradient").solve(
+        small_problem, 0, small_problem.budget, np.random.default_rng(0)
+    )
     assert r.status is Status.SOLVED
     assert small_problem.goal(0).contains(small_problem.robot, r.path[-1])
     assert r.pos_err_m <= 0.1 and 5 < r.iterations <= 500
     np.testing.assert_array_equal(r.path[0], small_problem.q_start)
     assert len(r.trace) == r.iterations + 1 and r.trace[-1] < r.trace[0]
-    cut = make_planner("gradient").solve(small_problem, 0,
-                                         small_problem.budget.replace(max_iterations=3),
-                                         np.random.default_rng(0))
+    cut = make_planner("gradient").solve(
+        small_problem, 0, small_problem.budget.replace(max_iterations=3), np.random.default_rng(0)
+    )
     assert cut.status is Status.BUDGET_EXHAUSTED and cut.iterations == 3
 
 
@@ -67,8 +68,9 @@ def test_settings_are_frozen_and_not_changed_by_solve(small_problem):
 
 def test_closed_loop_mode_refuses_to_run_without_a_simulator(small_problem):
     with pytest.raises(PlannerlabError, match="stepper"):
-        make_planner("gradient.closed_loop").solve(small_problem, 0, small_problem.budget,
-                                                   np.random.default_rng(0))
+        make_planner("gradient.closed_loop").solve(
+            small_problem, 0, small_problem.budget, np.random.default_rng(0)
+        )
 
 
 def test_start_in_collision_is_reported_not_raised():
@@ -81,8 +83,10 @@ def test_start_in_collision_is_reported_not_raised():
 # ---------------------------------------------------------------- fixed-seed regressions
 def test_pocket_stalls_at_the_same_iteration_and_state_every_run():
     problem = load_problem("armz_pocket")
-    runs = [make_planner("gradient").solve(problem, 0, problem.budget, np.random.default_rng(s))
-            for s in (0, 1)]
+    runs = [
+        make_planner("gradient").solve(problem, 0, problem.budget, np.random.default_rng(s))
+        for s in (0, 1)
+    ]
     a, b = runs
     assert a.status is Status.LOCAL_MINIMUM and b.status is Status.LOCAL_MINIMUM
     assert a.iterations == b.iterations == a.extra["stall_iteration"]
@@ -102,8 +106,9 @@ def test_pocket_stalls_at_the_same_iteration_and_state_every_run():
 def test_analytic_variant_follows_the_faithful_one_on_the_pocket():
     problem = load_problem("armz_pocket")
     fd = make_planner("gradient").solve(problem, 0, problem.budget, np.random.default_rng(0))
-    an = make_planner("gradient.analytic").solve(problem, 0, problem.budget,
-                                                 np.random.default_rng(0))
+    an = make_planner("gradient.analytic").solve(
+        problem, 0, problem.budget, np.random.default_rng(0)
+    )
     assert fd.iterations == an.iterations
     np.testing.assert_allclose(fd.path[-1], an.path[-1], atol=1e-4)
     assert an.collision_checks < fd.collision_checks  # no dof+1 checks per gradient
@@ -112,8 +117,9 @@ def test_analytic_variant_follows_the_faithful_one_on_the_pocket():
 def test_inspection_leg_reaches_the_same_final_state_every_run():
     problem = load_problem("armz_inspection")
     budget = problem.budget.replace(max_iterations=150)
-    a, b = (make_planner("gradient").solve(problem, 0, budget, np.random.default_rng(s))
-            for s in (0, 7))
+    a, b = (
+        make_planner("gradient").solve(problem, 0, budget, np.random.default_rng(s)) for s in (0, 7)
+    )
     assert a.status == b.status
     np.testing.assert_array_equal(a.path[-1], b.path[-1])
     assert a.iterations == b.iterations <= 150
@@ -121,8 +127,9 @@ def test_inspection_leg_reaches_the_same_final_state_every_run():
 
 def test_descent_keeps_bounded_joints_inside_their_limits():
     problem = load_problem("irb6_pick_table")
-    r = make_planner("gradient.analytic").solve(problem, 0, problem.budget.replace(
-        max_iterations=300), np.random.default_rng(0))
+    r = make_planner("gradient.analytic").solve(
+        problem, 0, problem.budget.replace(max_iterations=300), np.random.default_rng(0)
+    )
     robot = problem.robot
     bounded = ~robot.continuous
     assert len(r.path) > 5

@@ -5,10 +5,10 @@ from __future__ import annotations
 
 import numpy as np
 
-from plannerlab.catalog import load_problem
-from plannerlab.collision import CollisionChecker
+from plannerlab.collision.fcl_checker import CollisionChecker
 from plannerlab.planners import make_planner
 from plannerlab.planners.base import Status
+from plannerlab.problem.catalog import load_problem
 from plannerlab.robots.base import joint_difference
 from plannerlab.sim.execute import execute
 
@@ -16,12 +16,15 @@ from plannerlab.sim.execute import execute
 def test_gradient_rrtconnect_escapes_the_pocket_and_executes_without_contact():
     problem = load_problem("armz_pocket")
     r = make_planner("gradient+rrtconnect").solve(
-        problem, 0, problem.budget.replace(max_collision_checks=50_000),
-        np.random.default_rng(0))
+        problem, 0, problem.budget.replace(max_collision_checks=50_000), np.random.default_rng(0)
+    )
     assert r.status is Status.SOLVED, r.reason
     assert r.local_minima == 1 and r.escapes == 1
-    assert CollisionChecker(problem.robot, problem.scene).check_path(
-        r.path, problem.joint_step / 4).valid
+    assert (
+        CollisionChecker(problem.robot, problem.scene)
+        .check_path(r.path, problem.joint_step / 4)
+        .valid
+    )
     # Without the retreat the path runs into the boulder in PyBullet (the descent stopped
     # one joint step from it and the arm overshoots: 8.7 mm, 0.22 rad tracking error).
     e = execute(problem, r.path, leg=0)
@@ -31,8 +34,9 @@ def test_gradient_rrtconnect_escapes_the_pocket_and_executes_without_contact():
 
 def test_retreat_cuts_the_descent_back_from_the_stall():
     problem = load_problem("armz_pocket")
-    stall = make_planner("gradient.analytic").solve(problem, 0, problem.budget,
-                                                    np.random.default_rng(0))
+    stall = make_planner("gradient.analytic").solve(
+        problem, 0, problem.budget, np.random.default_rng(0)
+    )
     assert stall.status is Status.LOCAL_MINIMUM
     planner = make_planner("gradient+rrtconnect")
     path = [p for p in stall.path]
@@ -46,9 +50,12 @@ def test_retreat_cuts_the_descent_back_from_the_stall():
 def test_multistart_counts_minima_and_escapes_consistently():
     problem = load_problem("armz_cavity")
     r = make_planner("gradient.multistart").solve(
-        problem, 0, problem.budget.replace(max_collision_checks=20_000),
-        np.random.default_rng(1))
+        problem, 0, problem.budget.replace(max_collision_checks=20_000), np.random.default_rng(1)
+    )
     assert r.local_minima >= 1
     assert 0 <= r.escapes <= r.local_minima
-    assert CollisionChecker(problem.robot, problem.scene).check_path(
-        r.path, problem.joint_step / 4).valid
+    assert (
+        CollisionChecker(problem.robot, problem.scene)
+        .check_path(r.path, problem.joint_step / 4)
+        .valid
+    )

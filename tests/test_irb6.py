@@ -12,9 +12,8 @@ import pytest
 
 from plannerlab.errors import PlannerlabError
 from plannerlab.robots.base import Robot, pose_matrix
-from plannerlab.robots.irb6 import IRb6
-from plannerlab.robots.irb6_goals import sample_irb6_goal
-from plannerlab.robots.irb6_ik import (
+from plannerlab.robots.irb6.goals import sample_irb6_goal
+from plannerlab.robots.irb6.ik import (
     flange_target,
     format_ik_answer,
     pose_from_approach,
@@ -23,6 +22,7 @@ from plannerlab.robots.irb6_ik import (
     wrist_annulus_m,
     wrist_radius_intervals_m,
 )
+from plannerlab.robots.irb6.model import IRb6
 
 # Hand-worked numbers for the default robot (λ1 = 0.700, l2 = 0.455, l3 = 0.670, λ5 = 0.095).
 # At the wrist height h_w = λ1 + l2·cos 40° = 0.700 + 0.455·0.766044 = 1.048550 m the slice of

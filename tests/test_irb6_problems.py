@@ -13,15 +13,15 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from plannerlab.catalog import load_problem, resolve_problem_path
-from plannerlab.cli import main
-from plannerlab.collision import CollisionChecker
+from plannerlab.cli.main import main
+from plannerlab.collision.fcl_checker import CollisionChecker
 from plannerlab.errors import PlannerlabError, ProblemError
 from plannerlab.planners import PlanResult, make_planner
-from plannerlab.problem import Problem
-from plannerlab.robots.irb6 import IRb6
-from plannerlab.robots.irb6_ik import solve_ik
-from plannerlab.scene import Scene
+from plannerlab.problem.catalog import load_problem, resolve_problem_path
+from plannerlab.problem.load import Problem
+from plannerlab.problem.scene import Scene
+from plannerlab.robots.irb6.ik import solve_ik
+from plannerlab.robots.irb6.model import IRb6
 
 IRB6_PROBLEMS = (
     "irb6_pick_table",
@@ -288,8 +288,11 @@ def test_rrtconnect_reaches_the_goal_through_the_analytic_ik_and_moves_the_track
 
     problem = load_problem("irb6_track_obstacle")
     r = make_planner("ompl.rrtconnect").solve(
-        problem, 0, problem.budget.replace(max_collision_checks=60000, max_iterations=None),
-        np.random.default_rng(0))
+        problem,
+        0,
+        problem.budget.replace(max_collision_checks=60000, max_iterations=None),
+        np.random.default_rng(0),
+    )
     assert r.status is Status.SOLVED, r.reason
     assert problem.goal(0).contains(problem.robot, r.path[-1])
     assert r.path[-1][0] >= 0.48  # the pillar forces the carriage along the track

@@ -13,12 +13,13 @@ NOTEBOOK = Path(__file__).resolve().parents[1] / "notebooks" / "compare.ipynb"
 def test_compare_notebook_runs_headless(tmp_path, monkeypatch):
     monkeypatch.setenv("PLANNERLAB_QUICK", "1")
     nb = nbformat.read(NOTEBOOK, as_version=4)
-    NotebookClient(nb, timeout=900, kernel_name="python3",
-                   resources={"metadata": {"path": str(tmp_path)}}).execute()
-    outputs = "".join(o.get("text", "") for c in nb.cells if c.cell_type == "code"
-                      for o in c.get("outputs", []))
+    NotebookClient(
+        nb, timeout=900, kernel_name="python3", resources={"metadata": {"path": str(tmp_path)}}
+    ).execute()
+    outputs = "".join(
+        o.get("text", "") for c in nb.cells if c.cell_type == "code" for o in c.get("outputs", [])
+    )
     assert "local_minimum" in outputs  # the paper's method stalls on the pocket
     assert "gradient+rrtconnect" in outputs
-    images = [o for c in nb.cells for o in c.get("outputs", [])
-              if "image/png" in o.get("data", {})]
+    images = [o for c in nb.cells for o in c.get("outputs", []) if "image/png" in o.get("data", {})]
     assert len(images) >= 2  # the arm snapshot and the objective trace

@@ -2,7 +2,7 @@
 
 The shared planner contract (solves, collision-free, determinism, budgets, JSON) is in
 ``test_planner_contract.py``; this file covers what is specific to
-:mod:`plannerlab.planners.ompl` and :mod:`plannerlab.ik`. Budgets are collision checks,
+:mod:`plannerlab.planners.ompl` and :mod:`plannerlab.problem.ik`. Budgets are collision checks,
 never wall-clock limits.
 """
 
@@ -16,15 +16,15 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from plannerlab.collision import CollisionChecker
+from plannerlab.collision.fcl_checker import CollisionChecker
 from plannerlab.errors import UnknownNameError
-from plannerlab.goals import GoalRegion
-from plannerlab.ik import sample_goal_state, solve_ik
 from plannerlab.planners import OMPL_PLANNERS, REGISTRY, Status, get_entry, make_planner
-from plannerlab.problem import Budget, Problem
-from plannerlab.robots.armz import ArmZ
+from plannerlab.problem.goals import GoalRegion
+from plannerlab.problem.ik import sample_goal_state, solve_ik
+from plannerlab.problem.load import Budget, Problem
+from plannerlab.problem.scene import Scene, Sphere
+from plannerlab.robots.armz.model import ArmZ
 from plannerlab.robots.base import trans
-from plannerlab.scene import Scene, Sphere
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -35,8 +35,15 @@ def toy_problem(radius_m: float = 0.3) -> Problem:
     q0 = np.full(robot.dof, np.pi)
     p, n = robot.tip(np.array([np.pi, 2.2, np.pi, 2.5, np.pi]))
     scene = Scene((Sphere("ball", trans(1.2, 0.0, 2.0), 0.4),))
-    return Problem("toy", robot, scene, q0, (GoalRegion("near", p, n, 0.15, 15.0),),
-                   Budget(max_collision_checks=20_000), joint_step=0.05)
+    return Problem(
+        "toy",
+        robot,
+        scene,
+        q0,
+        (GoalRegion("near", p, n, 0.15, 15.0),),
+        Budget(max_collision_checks=20_000),
+        joint_step=0.05,
+    )
 
 
 # ---------------------------------------------------------------------------- names
@@ -101,30 +108,40 @@ def _rrtconnect_run(seed: int) -> dict:
     from plannerlab.planners.ompl import seed_ompl
 
     seed_ompl(seed)
-    r = make_planner("ompl.rrtconnect").solve(toy_problem(), 0, Budget(max_collision_checks=
-                                                                       20_000),
-                                              np.random.default_rng(seed))
+    r = make_planner("ompl.rrtconnect").solve(
+        toy_problem(), 0, Budget(max_collision_checks=20_000), np.random.default_rng(seed)
+    )
     return {"status": r.status.value, "checks": r.collision_checks, "path": r.path.tolist()}
 
 
-def test_log_goes_to_python_logging_not_stdout(caplog: pytest.LogCaptureFixture,
-                                               capfd: pytest.CaptureFixture[str]) -> None:
+def test_log_goes_to_python_logging_not_stdout(
+    caplog: pytest.LogCaptureFixture, capfd: pytest.CaptureFixture[str]
+) -> None:
     with caplog.at_level(logging.INFO, logger="plannerlab.ompl"):
-        r = make_planner("ompl.rrtconnect").solve(toy_problem(), 0, Budget(
-            max_collision_checks=20_000), np.random.default_rng(3))
+        r = make_planner("ompl.rrtconnect").solve(
+            toy_problem(), 0, Budget(max_collision_checks=20_000), np.random.default_rng(3)
+        )
     assert r.solved, r.reason
-    assert any(rec.name == "plannerlab.ompl" and "RRTConnect" in rec.getMessage()
-               for rec in caplog.records)
+    assert any(
+        rec.name == "plannerlab.ompl" and "RRTConnect" in rec.getMessage() for rec in caplog.records
+    )
     out, err = capfd.readouterr()
     assert "RRTConnect" not in out and "RRTConnect" not in err
 
 
 def test_extra_reports_simplification_and_validation() -> None:
-    r = make_planner("ompl.rrtconnect").solve(toy_problem(), 0, Budget(
-        max_collision_checks=20_000), np.random.default_rng(4))
+    r = make_planner("ompl.rrtconnect").solve(
+        toy_problem(), 0, Budget(max_collision_checks=20_000), np.random.default_rng(4)
+    )
     assert r.solved, r.reason
-    for key in ("length_raw", "length_simplified", "validation_checks", "goal_pool",
-                "goal_pool_checks", "state_space"):
+    for key in (
+        "length_raw",
+        "length_simplified",
+        "validation_checks",
+        "goal_pool",
+        "goal_pool_checks",
+        "state_space",
+    ):
         assert key in r.extra
     assert r.extra["length_simplified"] <= r.extra["length_raw"] + 1e-9
     assert r.extra["state_space"] == "so2_compound"
@@ -132,24 +149,32 @@ def test_extra_reports_simplification_and_validation() -> None:
 
 
 def test_kpiece_gets_the_tip_projection() -> None:
-    r = make_planner("ompl.kpiece1").solve(toy_problem(), 0, Budget(
-        max_collision_checks=20_000), np.random.default_rng(5))
+    r = make_planner("ompl.kpiece1").solve(
+        toy_problem(), 0, Budget(max_collision_checks=20_000), np.random.default_rng(5)
+    )
     assert r.solved, r.reason
-    reach = float(np.sum(np.linalg.norm(np.diff(ArmZ(n_modules=6).fk(np.full(5, np.pi))[:, :3, 3],
-                                                axis=0), axis=1)))
+    reach = float(
+        np.sum(
+            np.linalg.norm(
+                np.diff(ArmZ(n_modules=6).fk(np.full(5, np.pi))[:, :3, 3], axis=0), axis=1
+            )
+        )
+    )
     assert r.extra["projection_cell_m"] == pytest.approx(reach / 20.0)
 
 
 def test_invalid_start_is_reported() -> None:
     problem = toy_problem(radius_m=3.0)  # every module swallows the ball
-    r = make_planner("ompl.rrtconnect").solve(problem, 0, Budget(max_collision_checks=100),
-                                              np.random.default_rng(0))
+    r = make_planner("ompl.rrtconnect").solve(
+        problem, 0, Budget(max_collision_checks=100), np.random.default_rng(0)
+    )
     assert r.status is Status.INVALID_START and "ball" in r.reason
 
 
 def test_budget_of_zero_refuses_every_check() -> None:
-    r = make_planner("ompl.rrt").solve(toy_problem(), 0, Budget(max_collision_checks=1),
-                                       np.random.default_rng(0))
+    r = make_planner("ompl.rrt").solve(
+        toy_problem(), 0, Budget(max_collision_checks=1), np.random.default_rng(0)
+    )
     assert r.collision_checks <= 1 + int(r.extra.get("validation_checks", 0))
     assert r.status is not Status.SOLVED
 
@@ -186,12 +211,14 @@ def test_sample_goal_state_is_valid_and_inside() -> None:
     problem = toy_problem()
     checker = CollisionChecker(problem.robot, problem.scene)
     goal = problem.goals[0]
-    q = sample_goal_state(problem.robot, goal, checker, np.random.default_rng(0),
-                          seeds=[problem.q_start])
+    q = sample_goal_state(
+        problem.robot, goal, checker, np.random.default_rng(0), seeds=[problem.q_start]
+    )
     assert q is not None
     assert bool(goal.contains(problem.robot, q)) and checker.is_valid(q)
-    again = sample_goal_state(problem.robot, goal, checker, np.random.default_rng(0),
-                              seeds=[problem.q_start])
+    again = sample_goal_state(
+        problem.robot, goal, checker, np.random.default_rng(0), seeds=[problem.q_start]
+    )
     assert np.array_equal(q, again)
 
 
@@ -199,5 +226,9 @@ def test_sample_goal_state_gives_up_with_none() -> None:
     problem = toy_problem()
     checker = CollisionChecker(problem.robot, problem.scene)
     goal = GoalRegion("far", np.array([100.0, 0.0, 0.0]), np.array([0.0, 0.0, 1.0]), 0.1, 5.0)
-    assert sample_goal_state(problem.robot, goal, checker, np.random.default_rng(0),
-                             attempts=3, max_iterations=20) is None
+    assert (
+        sample_goal_state(
+            problem.robot, goal, checker, np.random.default_rng(0), attempts=3, max_iterations=20
+        )
+        is None
+    )

@@ -31,14 +31,14 @@ from typing import Any
 import numpy as np
 import pytest
 
-from plannerlab.collision import CollisionChecker
-from plannerlab.goals import GoalRegion
+from plannerlab.collision.fcl_checker import CollisionChecker
 from plannerlab.planners import REGISTRY, PlanResult, Status, make_planner
 from plannerlab.planners.base import settings_dict
-from plannerlab.problem import Budget, Problem
-from plannerlab.robots.armz import ArmZ
+from plannerlab.problem.goals import GoalRegion
+from plannerlab.problem.load import Budget, Problem
+from plannerlab.problem.scene import Scene, Sphere
+from plannerlab.robots.armz.model import ArmZ
 from plannerlab.robots.base import joint_difference, trans
-from plannerlab.scene import Scene, Sphere
 
 SEED = 7
 #: planning budget of the contract solve [collision checks]; asymptotically optimal
@@ -55,10 +55,10 @@ BUDGETS: dict[str, int] = {
 #: known failures, reported to the lead (xfail, not strict)
 KNOWN_FAILURES: dict[str, str] = {
     "ompl.aorrtc": "AORRTC in the ompl 2.0.1 wheel returns 'Invalid goal' with a zero-length "
-                   "path for a GoalSampleableRegion goal (under investigation)",
+    "path for a GoalSampleableRegion goal (under investigation)",
     "ompl.sorrtstar": "SORRT*'s ordered informed sampler calls the Python goal heuristic "
-                      "~1e6 times without polling the termination condition: with a budget "
-                      "it can finish in, it finds no solution on the toy problem",
+    "~1e6 times without polling the termination condition: with a budget "
+    "it can finish in, it finds no solution on the toy problem",
 }
 #: tiny budget of the budget check [collision checks]
 TINY_CHECKS = 40
@@ -77,8 +77,9 @@ def trivial_problem() -> Problem:
     p, n = robot.tip(q_goal)
     scene = Scene((Sphere("ball", trans(1.2, 0.0, 2.0), 0.4),))
     goal = GoalRegion("near", p, n, 0.15, 15.0)
-    return Problem("trivial", robot, scene, q0, (goal,), Budget(max_collision_checks=CHECKS),
-                   joint_step=0.05)
+    return Problem(
+        "trivial", robot, scene, q0, (goal,), Budget(max_collision_checks=CHECKS), joint_step=0.05
+    )
 
 
 def problem_for(name: str) -> Problem:
@@ -86,7 +87,7 @@ def problem_for(name: str) -> Problem:
     they solve quickly (the continuum case 3 for ``chord_arc``)."""
     robots = REGISTRY[name].robots
     if robots is not None and "armz" not in robots:
-        from plannerlab.catalog import load_problem
+        from plannerlab.problem.catalog import load_problem
 
         return load_problem("continuum_case3")
     return trivial_problem()
@@ -105,8 +106,11 @@ def _params() -> list[Any]:
     for name, entry in REGISTRY.items():
         marks = []
         if entry.target.startswith("plannerlab.planners.gradient") and _gradient_missing():
-            marks.append(pytest.mark.xfail(
-                reason="plannerlab/planners/gradient.py not written yet (lead)", strict=False))
+            marks.append(
+                pytest.mark.xfail(
+                    reason="plannerlab/planners/gradient.py not written yet (lead)", strict=False
+                )
+            )
         elif name in KNOWN_FAILURES:
             marks.append(pytest.mark.xfail(reason=KNOWN_FAILURES[name], strict=False))
         params.append(pytest.param(name, id=name, marks=marks))
@@ -121,8 +125,9 @@ def _solve(name: str, seed: int, budget: Budget | None = None) -> PlanResult:
     if REGISTRY[name].needs_stepper:
         from plannerlab.sim import SimWorld
 
-        with SimWorld(problem.robot, problem.scene,
-                      gravity_mps2=problem.simulation.gravity_mps2) as world:
+        with SimWorld(
+            problem.robot, problem.scene, gravity_mps2=problem.simulation.gravity_mps2
+        ) as world:
             return planner.solve(problem, 0, budget, np.random.default_rng(seed), stepper=world)
     return planner.solve(problem, 0, budget, np.random.default_rng(seed))
 
@@ -155,8 +160,9 @@ def test_solves_trivial_problem(name: str) -> None:
     problem = problem_for(name)
     robot = problem.robot
     assert r.path.shape[1] == robot.dof
-    assert np.allclose(joint_difference(r.path[0], problem.q_start, robot.continuous), 0.0,
-                       atol=1e-9)
+    assert np.allclose(
+        joint_difference(r.path[0], problem.q_start, robot.continuous), 0.0, atol=1e-9
+    )
     assert bool(problem.goals[0].contains(robot, r.path[-1]))
 
 
@@ -206,8 +212,13 @@ def test_settings_unchanged_by_solve(name: str) -> None:
         from plannerlab.sim import SimWorld
 
         with SimWorld(problem.robot, problem.scene) as world:
-            planner.solve(problem, 0, Budget(max_collision_checks=500),
-                          np.random.default_rng(SEED), stepper=world)
+            planner.solve(
+                problem,
+                0,
+                Budget(max_collision_checks=500),
+                np.random.default_rng(SEED),
+                stepper=world,
+            )
     else:
         planner.solve(problem, 0, Budget(max_collision_checks=500), np.random.default_rng(SEED))
     assert planner.settings == before

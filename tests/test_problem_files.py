@@ -9,9 +9,9 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from plannerlab.catalog import list_problems, load_problem
-from plannerlab.collision import CollisionChecker
+from plannerlab.collision.fcl_checker import CollisionChecker
 from plannerlab.errors import ProblemError, UnknownNameError
+from plannerlab.problem.catalog import list_problems, load_problem
 
 GOOD = """
 [problem]
@@ -55,26 +55,49 @@ def test_every_bundled_problem_loads_with_a_free_start(path):
 
 BAD = {
     "missing_key": (GOOD.replace('name = "g"\n', ""), "goals[0].name", "missing"),
-    "zero_normal": (GOOD.replace("n = [0.0, 0.0, 1.0]", "n = [0.0, 0.0, 0.0]"), "goals[0].n",
-                    "non-zero"),
-    "nan": (GOOD.replace("p_m = [1.0, 0.0, 3.0]", "p_m = [1.0, nan, 3.0]"), "goals[0].p_m",
-            "finite"),
-    "wrong_joint_count": (GOOD.replace("fill_deg = 180.0", "q = [0.0, 1.0]"), "start.q",
-                          "5 joint values"),
-    "unknown_obstacle_type": (GOOD.replace('type = "box"', 'type = "cone"'),
-                              "obstacles[0].type", "one of box, cylinder, sphere"),
-    "unknown_robot_type": (GOOD.replace('type = "armz"', 'type = "armzz"'), "robot.type",
-                           "did you mean 'armz'"),
-    "negative_tolerance": (GOOD.replace("pos_tol_m = 0.1", "pos_tol_m = -0.1"),
-                           "goals[0].pos_tol_m", "positive"),
-    "string_for_number": (GOOD.replace("angle_tol_deg = 10.0", 'angle_tol_deg = "ten"'),
-                          "goals[0].angle_tol_deg", "a number"),
-    "misspelt_key": (GOOD.replace("size_m", "sizes_m"), "obstacles[0].sizes_m",
-                     "not a known key"),
+    "zero_normal": (
+        GOOD.replace("n = [0.0, 0.0, 1.0]", "n = [0.0, 0.0, 0.0]"),
+        "goals[0].n",
+        "non-zero",
+    ),
+    "nan": (
+        GOOD.replace("p_m = [1.0, 0.0, 3.0]", "p_m = [1.0, nan, 3.0]"),
+        "goals[0].p_m",
+        "finite",
+    ),
+    "wrong_joint_count": (
+        GOOD.replace("fill_deg = 180.0", "q = [0.0, 1.0]"),
+        "start.q",
+        "5 joint values",
+    ),
+    "unknown_obstacle_type": (
+        GOOD.replace('type = "box"', 'type = "cone"'),
+        "obstacles[0].type",
+        "one of box, cylinder, sphere",
+    ),
+    "unknown_robot_type": (
+        GOOD.replace('type = "armz"', 'type = "armzz"'),
+        "robot.type",
+        "did you mean 'armz'",
+    ),
+    "negative_tolerance": (
+        GOOD.replace("pos_tol_m = 0.1", "pos_tol_m = -0.1"),
+        "goals[0].pos_tol_m",
+        "positive",
+    ),
+    "string_for_number": (
+        GOOD.replace("angle_tol_deg = 10.0", 'angle_tol_deg = "ten"'),
+        "goals[0].angle_tol_deg",
+        "a number",
+    ),
+    "misspelt_key": (GOOD.replace("size_m", "sizes_m"), "obstacles[0].sizes_m", "not a known key"),
     "no_goals": (GOOD[: GOOD.index("[[goals]]")], "goals", "missing"),
     "syntax": (GOOD.replace("[robot]", "[robot"), "<syntax>", "valid TOML"),
-    "start_in_collision": (GOOD.replace("center_m = [3.0, 0.0, 2.0]", "center_m = [0.5, 0.0, 2.0]"),
-                           "start", "module_1 x wall"),
+    "start_in_collision": (
+        GOOD.replace("center_m = [3.0, 0.0, 2.0]", "center_m = [0.5, 0.0, 2.0]"),
+        "start",
+        "module_1 x wall",
+    ),
 }
 
 

@@ -11,12 +11,12 @@ import json
 import numpy as np
 import pytest
 
-from plannerlab.collision import CollisionChecker
-from plannerlab.goals import GoalRegion
-from plannerlab.problem import Problem
-from plannerlab.robots.armz import ArmZ
+from plannerlab.collision.fcl_checker import CollisionChecker
+from plannerlab.problem.goals import GoalRegion
+from plannerlab.problem.load import Problem
+from plannerlab.problem.scene import Box, Scene
+from plannerlab.robots.armz.model import ArmZ
 from plannerlab.robots.base import pose_matrix, trans
-from plannerlab.scene import Box, Scene
 from plannerlab.sim import Execution, SimWorld, execute, execute_legs
 
 

@@ -13,12 +13,12 @@ import dataclasses
 import numpy as np
 import pytest
 
-from plannerlab.catalog import load_problem
-from plannerlab.collision import CollisionChecker
+from plannerlab.collision.fcl_checker import CollisionChecker
 from plannerlab.planners import make_planner
 from plannerlab.planners.base import Status
+from plannerlab.problem.catalog import load_problem
+from plannerlab.problem.scene import Scene
 from plannerlab.robots.base import joint_difference
-from plannerlab.scene import Scene
 
 TRAPS = ("armz_pocket", "armz_window", "armz_cavity", "armz_thin_wall")
 
@@ -46,7 +46,8 @@ def test_witness_is_collision_free_from_the_start_into_the_goal(trap):
     witness = np.array(trap.extras["witness"]["path_rad"], dtype=float)
     assert witness.ndim == 2 and witness.shape[1] == trap.robot.dof and len(witness) >= 2
     np.testing.assert_allclose(
-        joint_difference(witness[0], trap.q_start, trap.robot.continuous), 0.0, atol=1e-6)
+        joint_difference(witness[0], trap.q_start, trap.robot.continuous), 0.0, atol=1e-6
+    )
     check = CollisionChecker(trap.robot, trap.scene).check_path(witness, trap.joint_step / 4)
     assert check.valid, f"witness collides on edge {check.first_invalid_edge}: {check.pairs}"
     assert trap.goal(0).contains(trap.robot, witness[-1])

@@ -37,49 +37,76 @@ class PlannerEntry:
 
 
 #: OMPL geometric planners shipped in the ``ompl`` wheel: registry suffix -> OMPL class
-OMPL_PLANNERS: Mapping[str, str] = MappingProxyType({
-    "rrtconnect": "RRTConnect",
-    "rrt": "RRT",
-    "rrtstar": "RRTstar",
-    "informedrrtstar": "InformedRRTstar",
-    "sorrtstar": "SORRTstar",
-    "kpiece1": "KPIECE1",
-    "bkpiece1": "BKPIECE1",
-    "lbkpiece1": "LBKPIECE1",
-    "prm": "PRM",
-    "prmstar": "PRMstar",
-    "bitstar": "BITstar",
-    "fmt": "FMT",
-    "bfmt": "BFMT",
-    "aorrtc": "AORRTC",
-})
+OMPL_PLANNERS: Mapping[str, str] = MappingProxyType(
+    {
+        "rrtconnect": "RRTConnect",
+        "rrt": "RRT",
+        "rrtstar": "RRTstar",
+        "informedrrtstar": "InformedRRTstar",
+        "sorrtstar": "SORRTstar",
+        "kpiece1": "KPIECE1",
+        "bkpiece1": "BKPIECE1",
+        "lbkpiece1": "LBKPIECE1",
+        "prm": "PRM",
+        "prmstar": "PRMstar",
+        "bitstar": "BITstar",
+        "fmt": "FMT",
+        "bfmt": "BFMT",
+        "aorrtc": "AORRTC",
+    }
+)
 
 
 def _entries() -> dict[str, PlannerEntry]:
     entries = [
-        PlannerEntry("gradient", "plannerlab.planners.gradient:make",
-                     "the Arm-Z paper's gradient method, faithful (finite differences, "
-                     "kinematic steps)"),
-        PlannerEntry("gradient.closed_loop", "plannerlab.planners.gradient:make",
-                     "the paper's gradient method with PyBullet in the loop (100 steps of "
-                     "1/240 s per iteration)", needs_stepper=True),
-        PlannerEntry("gradient.analytic", "plannerlab.planners.gradient:make",
-                     "faster variant: the same descent with the analytic Jacobian gradient "
-                     "instead of dof + 1 objective evaluations"),
+        PlannerEntry(
+            "gradient",
+            "plannerlab.planners.gradient:make",
+            "the Arm-Z paper's gradient method, faithful (finite differences, kinematic steps)",
+        ),
+        PlannerEntry(
+            "gradient.closed_loop",
+            "plannerlab.planners.gradient:make",
+            "the paper's gradient method with PyBullet in the loop (100 steps of "
+            "1/240 s per iteration)",
+            needs_stepper=True,
+        ),
+        PlannerEntry(
+            "gradient.analytic",
+            "plannerlab.planners.gradient:make",
+            "faster variant: the same descent with the analytic Jacobian gradient "
+            "instead of dof + 1 objective evaluations",
+        ),
     ]
-    entries.append(PlannerEntry(
-        "gradient+rrtconnect", "plannerlab.planners.hybrid:make",
-        "gradient descent; at a local minimum RRT-Connect plans from the stall to the goal"))
-    entries.append(PlannerEntry(
-        "gradient.multistart", "plannerlab.planners.hybrid:make",
-        "gradient descent restarted from random collision-free states near each stall"))
-    entries.append(PlannerEntry(
-        "chord_arc", "plannerlab.planners.chord_arc:make",
-        "continuum robot's chord-arc tree search with obstacle wrapping (contact at the "
-        "problem's collision points)", robots=("continuum_chain",)))
+    entries.append(
+        PlannerEntry(
+            "gradient+rrtconnect",
+            "plannerlab.planners.hybrid:make",
+            "gradient descent; at a local minimum RRT-Connect plans from the stall to the goal",
+        )
+    )
+    entries.append(
+        PlannerEntry(
+            "gradient.multistart",
+            "plannerlab.planners.hybrid:make",
+            "gradient descent restarted from random collision-free states near each stall",
+        )
+    )
+    entries.append(
+        PlannerEntry(
+            "chord_arc",
+            "plannerlab.planners.chord_arc:make",
+            "continuum robot's chord-arc tree search with obstacle wrapping (contact at the "
+            "problem's collision points)",
+            robots=("continuum_chain",),
+        )
+    )
     for suffix, cls in OMPL_PLANNERS.items():
-        entries.append(PlannerEntry(f"ompl.{suffix}", "plannerlab.planners.ompl:make",
-                                    f"OMPL {cls} (geometric)"))
+        entries.append(
+            PlannerEntry(
+                f"ompl.{suffix}", "plannerlab.planners.ompl:make", f"OMPL {cls} (geometric)"
+            )
+        )
     return {e.name: e for e in entries}
 
 

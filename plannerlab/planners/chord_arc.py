@@ -4,7 +4,7 @@ Source: ``003_d410ec97f064abf9.txt`` (digest in ``docs/papers.md`` §3). The sea
 the contact-type check and the motion sequence live in
 :mod:`plannerlab.planners.chord_arc_search` (pure functions over planar data); this module
 wraps them behind the planner contract ``solve(problem, leg, budget, rng) -> PlanResult``
-for a :class:`~plannerlab.robots.continuum.ContinuumChain` problem.
+for a :class:`~plannerlab.robots.continuum.model.ContinuumChain` problem.
 
 Build, then solve:
 
@@ -42,7 +42,7 @@ paper's: the robot is a curve, the obstacles and collision points are the proble
 With ``inflate_by_radius = True`` it plans the chain's *axis* instead: obstacles grown by
 the link radius r (:func:`grow_query`), collision points moved out of their obstacle by
 r, so the capsules touch the corners rather than cut them. Measured in PyBullet
-(:mod:`plannerlab.continuum_exec`): the paper's model deflects the chain at the corners
+(:mod:`plannerlab.sim.continuum`): the paper's model deflects the chain at the corners
 (case 2's chosen solution ended 95 mm off with contacts away from the collision points),
 the grown model ended 1.5-7 mm off with contact only at the collision points; but it
 finds fewer solutions (case 2: 1 instead of the paper's 2).
@@ -55,7 +55,7 @@ past it. The FCL re-check of this path (e.g.
 "every edge collision-free") therefore reports collisions at those points. This planner
 is the one contact-permitting planner: :attr:`ChordArcPlanner.allows_contact` is True.
 During ``solve`` every state of every surviving solution's path is checked with FCL
-(:class:`~plannerlab.collision.CollisionChecker`); a colliding (link, obstacle) pair is
+(:class:`~plannerlab.collision.fcl_checker.CollisionChecker`); a colliding (link, obstacle) pair is
 *expected* when the link's axis passes within ``contact_tolerance_m`` (= 2·r +
 ``contact_margin_m``) of one of the solution's collision points on that obstacle;
 ``extra["expected_contacts"]`` lists the chosen solution's expected pairs. Any other
@@ -82,7 +82,7 @@ from typing import Any
 
 import numpy as np
 
-from plannerlab.collision import CollisionChecker
+from plannerlab.collision.fcl_checker import CollisionChecker
 from plannerlab.errors import PlannerlabError, ProblemError
 from plannerlab.planners.base import (
     Deadline,
@@ -106,9 +106,9 @@ from plannerlab.planners.chord_arc_search import (
 )
 from plannerlab.planners.chord_arc_search import ChordArcSettings as SearchSettings
 from plannerlab.planners.chord_arc_search import prepare as prepare_check
+from plannerlab.problem.scene import Box, Cylinder, Scene, Sphere
 from plannerlab.robots.base import Array
-from plannerlab.robots.continuum import ContinuumChain
-from plannerlab.scene import Box, Cylinder, Scene, Sphere
+from plannerlab.robots.continuum.model import ContinuumChain
 
 #: values of :attr:`ChordArcSettings.choose`
 CHOICES: tuple[str, ...] = ("shortest", "fewest_contacts", "first")
@@ -157,14 +157,20 @@ class ChordArcSettings:
 
     def __post_init__(self) -> None:
         if self.choose not in CHOICES:
-            raise PlannerlabError(f"choose must be one of {', '.join(CHOICES)}, "
-                                  f"got {self.choose!r}")
+            raise PlannerlabError(
+                f"choose must be one of {', '.join(CHOICES)}, got {self.choose!r}"
+            )
         if self.max_expansions < 1:
             raise PlannerlabError(f"max_expansions must be >= 1, got {self.max_expansions}")
         if self.max_depth < 0:
             raise PlannerlabError(f"max_depth must be >= 0 (0: no limit), got {self.max_depth}")
-        for name in ("arc_step_m", "max_bend_rad", "push_length_m", "path_step_m",
-                     "path_joint_step_rad"):
+        for name in (
+            "arc_step_m",
+            "max_bend_rad",
+            "push_length_m",
+            "path_step_m",
+            "path_joint_step_rad",
+        ):
             if not getattr(self, name) > 0:
                 raise PlannerlabError(f"{name} must be > 0, got {getattr(self, name)}")
         for name in ("inside_tol_m", "boundary_tol_m", "contact_margin_m"):
@@ -177,9 +183,12 @@ class ChordArcSettings:
         if max_iterations is not None:
             expansions = max(1, min(expansions, int(max_iterations)))
         return SearchSettings(
-            max_depth=self.max_depth or None, max_expansions=expansions,
-            arc_step_m=self.arc_step_m, inside_tol_m=self.inside_tol_m,
-            boundary_tol_m=self.boundary_tol_m, max_bend_rad=self.max_bend_rad,
+            max_depth=self.max_depth or None,
+            max_expansions=expansions,
+            arc_step_m=self.arc_step_m,
+            inside_tol_m=self.inside_tol_m,
+            boundary_tol_m=self.boundary_tol_m,
+            max_bend_rad=self.max_bend_rad,
             push_length_m=self.push_length_m,
         )
 
@@ -206,12 +215,14 @@ def _planar_obstacles(scene: Scene, z_m: float, tol: float = 1e-9) -> tuple[Plan
         if abs(abs(float(T[2, 2])) - 1.0) > tol:
             raise ChordArcInputError(
                 f"obstacle {o.name!r}: only upright boxes and vertical cylinders can be cut "
-                f"by the robot's plane (local z = {T[:3, 2].round(6).tolist()})")
+                f"by the robot's plane (local z = {T[:3, 2].round(6).tolist()})"
+            )
         if isinstance(o, Box):
             if dz < o.size_m[2] / 2.0:
                 yaw = math.atan2(float(T[1, 0]), float(T[0, 0]))
-                out.append(ConvexPolygon.rectangle((c[0], c[1]), (o.size_m[0], o.size_m[1]),
-                                                   yaw, o.name))
+                out.append(
+                    ConvexPolygon.rectangle((c[0], c[1]), (o.size_m[0], o.size_m[1]), yaw, o.name)
+                )
         elif isinstance(o, Cylinder):
             if dz < o.length_m / 2.0:
                 out.append(Circle((c[0], c[1]), o.radius_m, o.name))
@@ -235,8 +246,9 @@ def _grown_polygon(poly: ConvexPolygon, r: float) -> ConvexPolygon:
     return ConvexPolygon(tuple(map(tuple, out)), poly.name)
 
 
-def grow_query(query: ChordArcQuery, radius_m: float,
-               boundary_tol_m: float = 1e-6) -> ChordArcQuery:
+def grow_query(
+    query: ChordArcQuery, radius_m: float, boundary_tol_m: float = 1e-6
+) -> ChordArcQuery:
     """The query for the axis of a robot of radius ``radius_m`` (configuration space).
 
     Circles grow by the radius; convex polygons grow by it with chamfered corners
@@ -251,10 +263,18 @@ def grow_query(query: ChordArcQuery, radius_m: float,
             obstacles.append(Circle(o.center_m, o.radius_m + radius_m, o.name))
         else:
             obstacles.append(_grown_polygon(o, radius_m))
-    points = tuple(tuple((np.asarray(p) - radius_m * prep.into[i]).tolist())
-                   for i, p in enumerate(query.collision_points_m))
-    return ChordArcQuery(query.base_xy_m, query.base_tangent, query.total_length_m,
-                         tuple(obstacles), points, query.target_xy_m)
+    points = tuple(
+        tuple((np.asarray(p) - radius_m * prep.into[i]).tolist())
+        for i, p in enumerate(query.collision_points_m)
+    )
+    return ChordArcQuery(
+        query.base_xy_m,
+        query.base_tangent,
+        query.total_length_m,
+        tuple(obstacles),
+        points,
+        query.target_xy_m,
+    )
 
 
 def collision_points(problem: Any) -> tuple[tuple[float, float], ...]:
@@ -266,20 +286,31 @@ def collision_points(problem: Any) -> tuple[tuple[float, float], ...]:
     key = "continuum.collision_points_m"
     table = problem.extras.get("continuum")
     if not isinstance(table, dict) or "collision_points_m" not in table:
-        raise ProblemError(problem.source, key,
-                           "is missing: the chord_arc planner needs the points where contact "
-                           "is allowed ([continuum] collision_points_m = [[x, y], ...])")
+        raise ProblemError(
+            problem.source,
+            key,
+            "is missing: the chord_arc planner needs the points where contact "
+            "is allowed ([continuum] collision_points_m = [[x, y], ...])",
+        )
     raw = table["collision_points_m"]
     pts: list[tuple[float, float]] = []
     if not isinstance(raw, list):
         raise ProblemError(problem.source, key, f"a list of [x, y] points, got {raw!r}")
     for i, p in enumerate(raw):
-        ok = (isinstance(p, list | tuple) and len(p) in (2, 3)
-              and all(isinstance(v, int | float) and not isinstance(v, bool)
-                      and math.isfinite(v) for v in p))
+        ok = (
+            isinstance(p, list | tuple)
+            and len(p) in (2, 3)
+            and all(
+                isinstance(v, int | float) and not isinstance(v, bool) and math.isfinite(v)
+                for v in p
+            )
+        )
         if not ok:
-            raise ProblemError(problem.source, f"{key}[{i}]",
-                               f"two or three finite numbers (x, y[, z]) [m], got {p!r}")
+            raise ProblemError(
+                problem.source,
+                f"{key}[{i}]",
+                f"two or three finite numbers (x, y[, z]) [m], got {p!r}",
+            )
         pts.append((float(p[0]), float(p[1])))
     return tuple(pts)
 
@@ -299,9 +330,12 @@ def guide_obstacles(problem: Any) -> frozenset[str]:
         raise ProblemError(problem.source, key, f"a list of obstacle names, got {raw!r}")
     unknown = [n for n in raw if n not in names]
     if unknown:
-        raise ProblemError(problem.source, key,
-                           f"names of obstacles in this problem ({', '.join(sorted(names))}); "
-                           f"unknown: {', '.join(unknown)}")
+        raise ProblemError(
+            problem.source,
+            key,
+            f"names of obstacles in this problem ({', '.join(sorted(names))}); "
+            f"unknown: {', '.join(unknown)}",
+        )
     return frozenset(raw)
 
 
@@ -360,8 +394,10 @@ class ChordArcPlanner:
         """
         robot = problem.robot
         if not isinstance(robot, ContinuumChain):
-            raise PlannerlabError(f"{self.name} plans for the continuum_chain robot, got "
-                                  f"{getattr(robot, 'kind', type(robot).__name__)!r}")
+            raise PlannerlabError(
+                f"{self.name} plans for the continuum_chain robot, got "
+                f"{getattr(robot, 'kind', type(robot).__name__)!r}"
+            )
         guide_obstacles(problem)  # validated here, used when the plan is executed
         T = robot.T_world_base
         return ChordArcQuery(
@@ -380,16 +416,18 @@ class ChordArcPlanner:
             return query
         return grow_query(query, problem.robot.link_radius_m, self.settings.boundary_tol_m)
 
-    def search(self, problem: Any, leg: int, max_iterations: int | None = None
-               ) -> tuple[ChordArcQuery, ChordArcResult]:
+    def search(
+        self, problem: Any, leg: int, max_iterations: int | None = None
+    ) -> tuple[ChordArcQuery, ChordArcResult]:
         """The problem's query (real obstacles and collision points) and the search
         module's result (search + motion check) on the planning query, e.g. for figures."""
         query = self.query(problem, leg)
         plan_q = self.planning_query(problem, query)
         return query, solve_chord_arc(plan_q, self.settings.search_settings(max_iterations))
 
-    def motion_path(self, robot: ContinuumChain, motion: Sequence[MotionStep]
-                    ) -> tuple[Array, Array]:
+    def motion_path(
+        self, robot: ContinuumChain, motion: Sequence[MotionStep]
+    ) -> tuple[Array, Array]:
         """Joint path (m, dof) of a motion sequence and the step index of each waypoint.
 
         Starts at the retracted straight robot (all zeros); see the module docstring for
@@ -402,24 +440,34 @@ class ChordArcPlanner:
             l0, l1 = step.start_shape[-1][1], step.end_shape[-1][1]
             n = _steps(l0, l1, s.path_step_m)
             for _ in range(4):  # refine until no joint jumps more than path_joint_step_rad
-                Q = np.array([robot.q_from_arcs(step.shape_at(a))
-                              for a in np.linspace(0.0, 1.0, n + 1)])
+                Q = np.array(
+                    [robot.q_from_arcs(step.shape_at(a)) for a in np.linspace(0.0, 1.0, n + 1)]
+                )
                 jump = float(np.max(np.abs(np.diff(Q[:, 1:], axis=0)), initial=0.0))
                 if jump <= s.path_joint_step_rad * (1.0 + 1e-9):
                     break
                 n = math.ceil(n * jump / s.path_joint_step_rad)
             gap = np.max(np.abs(Q[0] - states[-1]))
             if gap > 1e-9:  # pragma: no cover - the search's steps are continuous
-                raise PlannerlabError(f"motion step {k} ({step.kind}) does not start where "
-                                      f"the previous one ended ({gap:.3g} apart)")
+                raise PlannerlabError(
+                    f"motion step {k} ({step.kind}) does not start where "
+                    f"the previous one ended ({gap:.3g} apart)"
+                )
             states.extend(Q[1:])
             owner.extend([k] * (len(Q) - 1))
         return np.array(states), np.array(owner, dtype=int)
 
-    def _classify(self, robot: ContinuumChain, checker: CollisionChecker,
-                  deadline: Deadline, budget: Any, plan: ChordArcPlan, query: ChordArcQuery,
-                  path: Array, tol: float) -> tuple[list[dict[str, Any]], list[dict[str, Any]],
-                                                    bool]:
+    def _classify(
+        self,
+        robot: ContinuumChain,
+        checker: CollisionChecker,
+        deadline: Deadline,
+        budget: Any,
+        plan: ChordArcPlan,
+        query: ChordArcQuery,
+        path: Array,
+        tol: float,
+    ) -> tuple[list[dict[str, Any]], list[dict[str, Any]], bool]:
         """FCL contacts along a path, split into expected and unexpected (link, obstacle).
 
         Returns (expected, unexpected, cut short by the check budget).
@@ -430,10 +478,10 @@ class ChordArcPlanner:
             if left < len(path):
                 return [], [], True
         bad = np.flatnonzero(~checker.valid_batch(path))
-        pts = {i: np.asarray(query.collision_points_m[i])
-               for i in plan.solution.contact_indices}
-        owner = {i: c.obstacle for i, c in zip(plan.solution.contact_indices,
-                                                plan.contacts, strict=True)}
+        pts = {i: np.asarray(query.collision_points_m[i]) for i in plan.solution.contact_indices}
+        owner = {
+            i: c.obstacle for i, c in zip(plan.solution.contact_indices, plan.contacts, strict=True)
+        }
         link_index = {n: i for i, n in enumerate(robot.link_names)}
         expected: dict[tuple[str, str], dict[str, Any]] = {}
         unexpected: dict[tuple[str, str], dict[str, Any]] = {}
@@ -457,9 +505,13 @@ class ChordArcPlanner:
                         dist = float(np.linalg.norm(a + t * d - p))
                         if dist < best[0]:
                             best = (dist, i)
-                rec = {"link": link, "obstacle": other, "first_state": int(k),
-                       "collision_point": best[1],
-                       "distance_m": None if best[1] is None else best[0]}
+                rec = {
+                    "link": link,
+                    "obstacle": other,
+                    "first_state": int(k),
+                    "collision_point": best[1],
+                    "distance_m": None if best[1] is None else best[0],
+                }
                 if best[0] > tol:  # once anywhere else: unexpected
                     expected.pop(key, None)
                     unexpected[key] = rec
@@ -468,8 +520,15 @@ class ChordArcPlanner:
         return list(expected.values()), list(unexpected.values()), False
 
     # ------------------------------------------------------------------ solve
-    def solve(self, problem: Any, leg: int, budget: Any, rng: np.random.Generator,
-              q_start: Array | None = None, stepper: Stepper | None = None) -> PlanResult:
+    def solve(
+        self,
+        problem: Any,
+        leg: int,
+        budget: Any,
+        rng: np.random.Generator,
+        q_start: Array | None = None,
+        stepper: Stepper | None = None,
+    ) -> PlanResult:
         """Search every chord-arc solution to leg ``leg``'s target; return the chosen one.
 
         Args:
@@ -500,7 +559,8 @@ class ChordArcPlanner:
             if "target" not in str(exc):
                 raise
             query_error = str(exc) + (
-                " (obstacles grown by the link radius)" if s.inflate_by_radius else "")
+                " (obstacles grown by the link radius)" if s.inflate_by_radius else ""
+            )
             query = None
         checker = CollisionChecker(robot, problem.scene)
         deadline = Deadline(budget, checker)
@@ -510,34 +570,59 @@ class ChordArcPlanner:
         base_extra: dict[str, Any] = {
             "collision_points_m": [list(p) for p in real.collision_points_m],
             "inflated_by_m": robot.link_radius_m if s.inflate_by_radius else 0.0,
-            "contact_tolerance_m": tol, "solutions": [], "dropped": [], "chosen": None,
-            "expected_contacts": [], "allows_contact": True,
+            "contact_tolerance_m": tol,
+            "solutions": [],
+            "dropped": [],
+            "chosen": None,
+            "expected_contacts": [],
+            "allows_contact": True,
         }
 
-        def result(status: Status, reason: str, path: Array, iterations: int = 0,
-                   trace: Array | None = None, extra: dict[str, Any] | None = None
-                   ) -> PlanResult:
+        def result(
+            status: Status,
+            reason: str,
+            path: Array,
+            iterations: int = 0,
+            trace: Array | None = None,
+            extra: dict[str, Any] | None = None,
+        ) -> PlanResult:
             pe, ae = goal.errors(robot, path[-1])
             return PlanResult(
-                planner=self.name, problem=problem.name, leg=leg, goal=goal.name,
-                status=status, reason=reason, path=path, time_s=time.perf_counter() - t0,
-                iterations=iterations, collision_checks=deadline.checks_used,
-                fk_calls=0, pos_err_m=float(pe), angle_err_deg=float(ae),
-                trace=np.zeros(0) if trace is None else trace, settings=settings_dict(s),
+                planner=self.name,
+                problem=problem.name,
+                leg=leg,
+                goal=goal.name,
+                status=status,
+                reason=reason,
+                path=path,
+                time_s=time.perf_counter() - t0,
+                iterations=iterations,
+                collision_checks=deadline.checks_used,
+                fk_calls=0,
+                pos_err_m=float(pe),
+                angle_err_deg=float(ae),
+                trace=np.zeros(0) if trace is None else trace,
+                settings=settings_dict(s),
                 extra={**base_extra, **(extra or {})},
             )
 
         straight = robot.q_from_arcs([], insertion_m=0.0)
         if not np.allclose(q0, straight, atol=1e-9):
-            return result(Status.INVALID_START,
-                          "chord_arc moves the robot from the retracted straight state "
-                          "(insertion 0, every joint 0); the start differs by "
-                          f"{float(np.max(np.abs(q0 - straight))):.3g}", q0[None])
+            return result(
+                Status.INVALID_START,
+                "chord_arc moves the robot from the retracted straight state "
+                "(insertion 0, every joint 0); the start differs by "
+                f"{float(np.max(np.abs(q0 - straight))):.3g}",
+                q0[None],
+            )
         z_base = float(robot.T_world_base[2, 3])
         if abs(float(goal.p_world_m[2]) - z_base) > goal.pos_tol_m:
-            return result(Status.INVALID_GOAL,
-                          f"target {goal.p_world_m.tolist()} m is {goal.p_world_m[2] - z_base:.3g} "
-                          "m off the robot's plane", q0[None])
+            return result(
+                Status.INVALID_GOAL,
+                f"target {goal.p_world_m.tolist()} m is {goal.p_world_m[2] - z_base:.3g} "
+                "m off the robot's plane",
+                q0[None],
+            )
         if query is None:
             return result(Status.INVALID_GOAL, query_error, q0[None])
 
@@ -546,21 +631,30 @@ class ChordArcPlanner:
         search_s = time.perf_counter() - t_search
         srch = res.search
         base_extra["search"] = {
-            "time_s": search_s, "expansions": srch.expansions, "arcs_built": srch.arcs_built,
-            "arcs_checked": srch.arcs_checked, "rejected_bend": srch.arcs_rejected_bend,
+            "time_s": search_s,
+            "expansions": srch.expansions,
+            "arcs_built": srch.arcs_built,
+            "arcs_checked": srch.arcs_checked,
+            "rejected_bend": srch.arcs_rejected_bend,
             "rejected_length": srch.arcs_rejected_length,
             "rejected_obstacle": srch.arcs_rejected_obstacle,
-            "depth_reached": srch.depth_reached, "budget_exhausted": srch.budget_exhausted,
+            "depth_reached": srch.depth_reached,
+            "budget_exhausted": srch.budget_exhausted,
             "geometric_solutions": len(srch.solutions),
         }
         dropped: list[dict[str, Any]] = [
             {"reason": d.reason, "stage": "contact_type", **_shape_dict(d.solution, real)}
-            for d in res.dropped]
+            for d in res.dropped
+        ]
         iters = srch.expansions
         if budget.time_limit_s is not None and search_s >= budget.time_limit_s:
-            return result(Status.BUDGET_EXHAUSTED,
-                          f"time limit of {budget.time_limit_s:g} s reached: the search took "
-                          f"{search_s:.3g} s", q0[None], iters)
+            return result(
+                Status.BUDGET_EXHAUSTED,
+                f"time limit of {budget.time_limit_s:g} s reached: the search took "
+                f"{search_s:.3g} s",
+                q0[None],
+                iters,
+            )
 
         # the chain's view of each surviving solution: joint bounds, then FCL contacts
         cands: list[_Candidate] = []
@@ -572,27 +666,37 @@ class ChordArcPlanner:
             hi_ok = path <= robot.upper + 1e-12
             if not (lo_ok.all() and hi_ok.all()):
                 k, j = np.argwhere(~(lo_ok & hi_ok))[0]
-                reason = (f"the chain cannot follow it: {robot.joint_names[j]} would reach "
-                          f"{path[k, j]:.3g} (bounds [{robot.lower[j]:.3g}, "
-                          f"{robot.upper[j]:.3g}]) during step {owner[k]} "
-                          f"({plan.motion[owner[k]].kind})")
+                reason = (
+                    f"the chain cannot follow it: {robot.joint_names[j]} would reach "
+                    f"{path[k, j]:.3g} (bounds [{robot.lower[j]:.3g}, "
+                    f"{robot.upper[j]:.3g}]) during step {owner[k]} "
+                    f"({plan.motion[owner[k]].kind})"
+                )
             exp: list[dict[str, Any]] = []
             unexp: list[dict[str, Any]] = []
             if not reason and s.check_contacts and not cut_short:
-                exp, unexp, cut_short = self._classify(robot, checker, deadline, budget, plan,
-                                                       real, path, tol)
+                exp, unexp, cut_short = self._classify(
+                    robot, checker, deadline, budget, plan, real, path, tol
+                )
                 if unexp:
                     u = unexp[0]
-                    reason = (f"the {robot.link_radius_m * 1e3:.3g} mm-radius chain touches "
-                              f"{u['obstacle']!r} with {u['link']} away from the solution's "
-                              f"collision points (waypoint {u['first_state']}; "
-                              f"{len(unexp)} such pair(s))")
+                    reason = (
+                        f"the {robot.link_radius_m * 1e3:.3g} mm-radius chain touches "
+                        f"{u['obstacle']!r} with {u['link']} away from the solution's "
+                        f"collision points (waypoint {u['first_state']}; "
+                        f"{len(unexp)} such pair(s))"
+                    )
             cands.append(_Candidate(plan, path, owner, reason, tuple(exp), tuple(unexp)))
         for c in cands:
             if c.reason:
-                dropped.append({"reason": c.reason, "stage": "chain",
-                                **_shape_dict(c.plan.solution, real),
-                                "unexpected_contacts": list(c.unexpected)})
+                dropped.append(
+                    {
+                        "reason": c.reason,
+                        "stage": "chain",
+                        **_shape_dict(c.plan.solution, real),
+                        "unexpected_contacts": list(c.unexpected),
+                    }
+                )
         kept = [c for c in cands if not c.reason]
         solutions = []
         for c in kept:
@@ -600,8 +704,7 @@ class ChordArcPlanner:
             d["contact_obstacles"] = [ck.obstacle for ck in c.plan.contacts]
             d["contact_types"] = [ck.contact_type for ck in c.plan.contacts]
             d["contact_sides"] = [ck.side for ck in c.plan.contacts]
-            d["motion"] = [{"kind": m.kind, "description": m.description}
-                           for m in c.plan.motion]
+            d["motion"] = [{"kind": m.kind, "description": m.description} for m in c.plan.motion]
             d["path_waypoints"] = len(c.path)
             d["expected_contacts"] = list(c.expected)
             solutions.append(d)
@@ -610,48 +713,77 @@ class ChordArcPlanner:
         n_pts = len(query.collision_points_m)
 
         if cut_short:
-            return result(Status.BUDGET_EXHAUSTED,
-                          f"collision-check budget of {budget.max_collision_checks} used up "
-                          "while checking the solutions' contacts", q0[None], iters)
+            return result(
+                Status.BUDGET_EXHAUSTED,
+                f"collision-check budget of {budget.max_collision_checks} used up "
+                "while checking the solutions' contacts",
+                q0[None],
+                iters,
+            )
         if not kept:
             why = "; ".join(d["reason"] for d in dropped[:3])
             if not srch.solutions:
                 status = Status.BUDGET_EXHAUSTED if srch.budget_exhausted else Status.FAILED
-                reason = (f"no chord-arc shape reaches the target through the {n_pts} "
-                          f"collision points ({srch.expansions} expansions, depth "
-                          f"{srch.depth_reached}"
-                          + (", expansion budget used up)" if srch.budget_exhausted else ")"))
+                reason = (
+                    f"no chord-arc shape reaches the target through the {n_pts} "
+                    f"collision points ({srch.expansions} expansions, depth "
+                    f"{srch.depth_reached}"
+                    + (", expansion budget used up)" if srch.budget_exhausted else ")")
+                )
             else:
                 status = Status.FAILED
-                reason = (f"all {len(srch.solutions)} geometric solution(s) dropped: {why}"
-                          + (" …" if len(dropped) > 3 else ""))
+                reason = f"all {len(srch.solutions)} geometric solution(s) dropped: {why}" + (
+                    " …" if len(dropped) > 3 else ""
+                )
             return result(status, reason, q0[None], iters)
 
         if s.choose == "shortest":
             chosen = min(range(len(kept)), key=lambda i: kept[i].plan.solution.total_length_m)
         elif s.choose == "fewest_contacts":
-            chosen = min(range(len(kept)), key=lambda i: (
-                len(kept[i].plan.solution.contact_indices), kept[i].plan.solution.total_length_m))
+            chosen = min(
+                range(len(kept)),
+                key=lambda i: (
+                    len(kept[i].plan.solution.contact_indices),
+                    kept[i].plan.solution.total_length_m,
+                ),
+            )
         else:
             chosen = 0
         c = kept[chosen]
         tips = robot.tip(c.path)[0]
         trace = np.linalg.norm(tips - goal.p_world_m, axis=1)
-        extra = {"chosen": chosen, "expected_contacts": list(c.expected),
-                 "motion_step_of_waypoint": c.step_of.tolist()}
+        extra = {
+            "chosen": chosen,
+            "expected_contacts": list(c.expected),
+            "motion_step_of_waypoint": c.step_of.tolist(),
+        }
         q_end = c.path[-1]
-        summary = (f"{len(kept)} solution(s) of {len(srch.solutions)} geometric "
-                   f"({len(dropped)} dropped) in {srch.expansions} expansions; chose "
-                   f"{s.choose} #{chosen}: {len(c.plan.solution.contact_indices)} contact(s) "
-                   f"at point(s) {list(c.plan.solution.contact_indices)}, "
-                   f"{c.plan.solution.total_length_m:.4g} m")
+        summary = (
+            f"{len(kept)} solution(s) of {len(srch.solutions)} geometric "
+            f"({len(dropped)} dropped) in {srch.expansions} expansions; chose "
+            f"{s.choose} #{chosen}: {len(c.plan.solution.contact_indices)} contact(s) "
+            f"at point(s) {list(c.plan.solution.contact_indices)}, "
+            f"{c.plan.solution.total_length_m:.4g} m"
+        )
         if not goal.contains(robot, q_end):
             pe, _ = goal.errors(robot, q_end)
-            return result(Status.APPROXIMATE,
-                          f"{summary}; the chain's tip ends {float(pe):.3g} m from the target "
-                          f"(tolerance {goal.pos_tol_m:g} m)", c.path, iters, trace, extra)
-        return result(Status.SOLVED, summary + "; contact at the collision points by design",
-                      c.path, iters, trace, extra)
+            return result(
+                Status.APPROXIMATE,
+                f"{summary}; the chain's tip ends {float(pe):.3g} m from the target "
+                f"(tolerance {goal.pos_tol_m:g} m)",
+                c.path,
+                iters,
+                trace,
+                extra,
+            )
+        return result(
+            Status.SOLVED,
+            summary + "; contact at the collision points by design",
+            c.path,
+            iters,
+            trace,
+            extra,
+        )
 
 
 def make(name: str, overrides: dict[str, Any]) -> ChordArcPlanner:

@@ -13,7 +13,7 @@ base → contacts → target. The robot is a curve of zero thickness (as in the 
 **Search** (:func:`search_chord_arc`). Breadth-first over "bases" (a point and a tangent;
 the first is the port). From every base, chords go to every collision point not yet used
 on that branch and to the target; each chord gives the signed bend ``θ = 2·atan2(X, Y)``
-and the arc length ``L = |p|·(θ/2)/sin(θ/2)`` (:mod:`plannerlab.robots.continuum`); the
+and the arc length ``L = |p|·(θ/2)/sin(θ/2)`` (:mod:`plannerlab.robots.continuum.model`); the
 arc is sampled every ``arc_step_m`` or finer and dropped if any sample lies deeper than
 ``inside_tol_m`` inside an obstacle (so an arc may end *on* the boundary at its collision
 point, or slide along an edge). Arcs bending more than ``max_bend_rad`` are dropped, and so
@@ -74,7 +74,7 @@ import numpy as np
 
 from plannerlab.errors import PlannerlabError
 from plannerlab.robots.base import Array
-from plannerlab.robots.continuum import arc_points_local, sinc, tangent_after
+from plannerlab.robots.continuum.model import arc_points_local, sinc, tangent_after
 
 Point = tuple[float, float]
 Shape = tuple[tuple[float, float], ...]  # ((θ_k [rad], L_k [m]), ...)
@@ -106,8 +106,9 @@ class Circle:
     def __post_init__(self) -> None:
         object.__setattr__(self, "center_m", _point(self.center_m, f"circle {self.name!r} centre"))
         if not (math.isfinite(self.radius_m) and self.radius_m > 0):
-            raise ChordArcInputError(f"circle {self.name!r}: radius must be > 0, "
-                                     f"got {self.radius_m}")
+            raise ChordArcInputError(
+                f"circle {self.name!r}: radius must be > 0, got {self.radius_m}"
+            )
         object.__setattr__(self, "radius_m", float(self.radius_m))
 
 
@@ -129,12 +130,18 @@ class ConvexPolygon:
             cross = -cross[::-1]
         if not np.all(cross > 0):
             raise ChordArcInputError(
-                f"polygon {self.name!r} is not strictly convex (or has repeated vertices)")
+                f"polygon {self.name!r} is not strictly convex (or has repeated vertices)"
+            )
         object.__setattr__(self, "vertices_m", tuple((float(x), float(y)) for x, y in v))
 
     @classmethod
-    def rectangle(cls, center_m: Sequence[float], size_m: Sequence[float],
-                  yaw_rad: float = 0.0, name: str = "") -> ConvexPolygon:
+    def rectangle(
+        cls,
+        center_m: Sequence[float],
+        size_m: Sequence[float],
+        yaw_rad: float = 0.0,
+        name: str = "",
+    ) -> ConvexPolygon:
         """Rectangle of full sizes ``size_m`` (sx, sy), turned by ``yaw_rad`` about +z."""
         cx, cy = _point(center_m, f"rectangle {name!r} centre")
         sx, sy = _point(size_m, f"rectangle {name!r} size")
@@ -183,12 +190,31 @@ class _Geometry:
         # polygon k, so one matrix product with [x; y; 1] gives every signed edge value
         # and the max over edges is a reduction over the leading axis (broadcasting and
         # reductions over a short trailing axis are slow in numpy).
-        self.Wh = np.concatenate(
-            [np.concatenate([normals[:, e, :], -offsets[:, e, None]], axis=1)
-             for e in range(e_max)], axis=0) if poly else np.zeros((0, 3))
+        self.Wh = (
+            np.concatenate(
+                [
+                    np.concatenate([normals[:, e, :], -offsets[:, e, None]], axis=1)
+                    for e in range(e_max)
+                ],
+                axis=0,
+            )
+            if poly
+            else np.zeros((0, 3))
+        )
         # Circles: x² + y² - 2 c·p + |c|² - r² < 0 as one product with [x; y; x² + y²; 1].
-        self.Ch = np.stack([-2.0 * self.cc[:, 0], -2.0 * self.cc[:, 1], np.ones(len(circ)),
-                            (self.cc**2).sum(1)], axis=1) if circ else np.zeros((0, 4))
+        self.Ch = (
+            np.stack(
+                [
+                    -2.0 * self.cc[:, 0],
+                    -2.0 * self.cc[:, 1],
+                    np.ones(len(circ)),
+                    (self.cc**2).sum(1),
+                ],
+                axis=1,
+            )
+            if circ
+            else np.zeros((0, 4))
+        )
 
     def inside_any(self, pts: Array, tol: float) -> Array:
         """(N,) True where a point (N, 2) is deeper than ``tol`` inside some obstacle."""
@@ -286,10 +312,12 @@ class ChordArcQuery:
         for o in self.obstacles:
             if not isinstance(o, Circle | ConvexPolygon):
                 raise ChordArcInputError(
-                    f"obstacles must be Circle or ConvexPolygon, got {type(o).__name__}")
+                    f"obstacles must be Circle or ConvexPolygon, got {type(o).__name__}"
+                )
         object.__setattr__(self, "obstacles", tuple(self.obstacles))
-        pts = tuple(_point(p, f"collision point {i}")
-                    for i, p in enumerate(self.collision_points_m))
+        pts = tuple(
+            _point(p, f"collision point {i}") for i, p in enumerate(self.collision_points_m)
+        )
         object.__setattr__(self, "collision_points_m", pts)
         object.__setattr__(self, "target_xy_m", _point(self.target_xy_m, "target_xy_m"))
 
@@ -356,7 +384,8 @@ def prepare(query: ChordArcQuery, settings: ChordArcSettings) -> _Prepared:
     if len(pts):
         if not query.obstacles:
             raise ChordArcInputError(
-                f"collision point 0 at {query.collision_points_m[0]} m: there are no obstacles")
+                f"collision point 0 at {query.collision_points_m[0]} m: there are no obstacles"
+            )
         sd = geo.signed_distance(pts)
         owner = np.argmin(np.abs(sd), axis=1)
         off = np.abs(sd[np.arange(len(pts)), owner])
@@ -364,13 +393,15 @@ def prepare(query: ChordArcQuery, settings: ChordArcSettings) -> _Prepared:
             raise ChordArcInputError(
                 f"collision point {i} at {query.collision_points_m[i]} m is not on an "
                 f"obstacle boundary: nearest is {geo.names[owner[i]]!r}, "
-                f"{off[i]:.3g} m away (tolerance {tol:g} m)")
+                f"{off[i]:.3g} m away (tolerance {tol:g} m)"
+            )
         deep = sd < -tol
         for i in np.flatnonzero(deep.any(axis=1)):
             j = int(np.flatnonzero(deep[i])[0])
             raise ChordArcInputError(
                 f"collision point {i} at {query.collision_points_m[i]} m lies inside "
-                f"obstacle {geo.names[j]!r}")
+                f"obstacle {geo.names[j]!r}"
+            )
     target = np.array(query.target_xy_m)
     base = np.array(query.base_xy_m)
     if query.obstacles:
@@ -380,9 +411,11 @@ def prepare(query: ChordArcQuery, settings: ChordArcSettings) -> _Prepared:
                 j = int(np.argmin(sd))
                 raise ChordArcInputError(
                     f"{what} {tuple(p.tolist())} m lies inside obstacle {geo.names[j]!r} "
-                    f"({-sd[j]:.3g} m deep)")
-    into = np.array([geo.into_direction(int(owner[i]), pts[i], tol)
-                     for i in range(len(pts))]).reshape(-1, 2)
+                    f"({-sd[j]:.3g} m deep)"
+                )
+    into = np.array(
+        [geo.into_direction(int(owner[i]), pts[i], tol) for i in range(len(pts))]
+    ).reshape(-1, 2)
     return _Prepared(geo, pts, owner, into, target)
 
 
@@ -549,8 +582,9 @@ def _sample_fractions(max_length_m: float, step_m: float) -> Array:
     return np.linspace(0.0, 1.0, n)
 
 
-def _arcs_free(geo: _Geometry, p0: Array, t0: Array, theta: Array, length: Array,
-               settings: ChordArcSettings) -> Array:
+def _arcs_free(
+    geo: _Geometry, p0: Array, t0: Array, theta: Array, length: Array, settings: ChordArcSettings
+) -> Array:
     """(K,) True where arcs (starting at p0 (K, 2) with tangents t0 (K, 2)) are free.
 
     Arc k gets ``ceil(L_k / step) + 1`` samples, both ends included; all samples of a
@@ -564,16 +598,25 @@ def _arcs_free(geo: _Geometry, p0: Array, t0: Array, theta: Array, length: Array
     if not geo.obstacles or len(theta) == 0:
         return free
     if settings.coarse_factor > 1:
-        free = _sampled_free(geo, p0, t0, theta, length,
-                             settings.arc_step_m * settings.coarse_factor, settings)
+        free = _sampled_free(
+            geo, p0, t0, theta, length, settings.arc_step_m * settings.coarse_factor, settings
+        )
     idx = np.flatnonzero(free)
-    free[idx] = _sampled_free(geo, p0[idx], t0[idx], theta[idx], length[idx],
-                              settings.arc_step_m, settings)
+    free[idx] = _sampled_free(
+        geo, p0[idx], t0[idx], theta[idx], length[idx], settings.arc_step_m, settings
+    )
     return free
 
 
-def _sampled_free(geo: _Geometry, p0: Array, t0: Array, theta: Array, length: Array,
-                  step_m: float, settings: ChordArcSettings) -> Array:
+def _sampled_free(
+    geo: _Geometry,
+    p0: Array,
+    t0: Array,
+    theta: Array,
+    length: Array,
+    step_m: float,
+    settings: ChordArcSettings,
+) -> Array:
     k_arcs = len(theta)
     free = np.ones(k_arcs, dtype=bool)
     if k_arcs == 0:
@@ -614,16 +657,19 @@ class _Level:
     used: Array  # (N, m) bool
 
 
-def _search(query: ChordArcQuery, prep: _Prepared,
-            settings: ChordArcSettings) -> SearchResult:
+def _search(query: ChordArcQuery, prep: _Prepared, settings: ChordArcSettings) -> SearchResult:
     m = len(prep.points)
     goals = np.vstack([prep.points, prep.target[None]])  # (m + 1, 2); column m = target
     max_depth = settings.max_depth if settings.max_depth is not None else m + 1
     total = query.total_length_m
     root = _Level(
-        parent=np.array([-1]), point=np.array([-1]),
-        p=np.array([query.base_xy_m]), t=np.array([query.base_tangent]),
-        theta=np.zeros(1), length=np.zeros(1), used_length=np.zeros(1),
+        parent=np.array([-1]),
+        point=np.array([-1]),
+        p=np.array([query.base_xy_m]),
+        t=np.array([query.base_tangent]),
+        theta=np.zeros(1),
+        length=np.zeros(1),
+        used_length=np.zeros(1),
         used=np.zeros((1, m), dtype=bool),
     )
     levels = [root]
@@ -678,18 +724,27 @@ def _search(query: ChordArcQuery, prep: _Prepared,
         node, goal, th, ln = node[keep], goal[keep], th[keep], ln[keep]
         used = lev.used[node].copy()
         used[np.arange(len(node)), goal] = True
-        levels.append(_Level(
-            parent=node, point=goal, p=goals[goal],
-            t=tangent_after(t[node], th), theta=th, length=ln,
-            used_length=used_len[node] + ln, used=used,
-        ))
+        levels.append(
+            _Level(
+                parent=node,
+                point=goal,
+                p=goals[goal],
+                t=tangent_after(t[node], th),
+                theta=th,
+                length=ln,
+                used_length=used_len[node] + ln,
+                used=used,
+            )
+        )
     solutions = tuple(_rebuild(query, levels, prep, f) for f in found)
-    return SearchResult(solutions, expansions, built, checked, rej_bend, rej_len, rej_obs,
-                        depth_reached, exhausted)
+    return SearchResult(
+        solutions, expansions, built, checked, rej_bend, rej_len, rej_obs, depth_reached, exhausted
+    )
 
 
-def _rebuild(query: ChordArcQuery, levels: list[_Level], prep: _Prepared,
-             last: tuple[int, int, float, float]) -> ChordArcSolution:
+def _rebuild(
+    query: ChordArcQuery, levels: list[_Level], prep: _Prepared, last: tuple[int, int, float, float]
+) -> ChordArcSolution:
     li, node, th_last, l_last = last
     chain: list[tuple[int, int]] = []  # (level, node) from the last base back to the port
     while li > 0:
@@ -704,13 +759,29 @@ def _rebuild(query: ChordArcQuery, levels: list[_Level], prep: _Prepared,
         lev = levels[li]
         th, ln = float(lev.theta[node]), float(lev.length[node])
         end_p, end_t = lev.p[node], lev.t[node]
-        arcs.append(Arc(tuple(p.tolist()), tuple(t.tolist()), th, ln,
-                        tuple(end_p.tolist()), tuple(end_t.tolist())))
+        arcs.append(
+            Arc(
+                tuple(p.tolist()),
+                tuple(t.tolist()),
+                th,
+                ln,
+                tuple(end_p.tolist()),
+                tuple(end_t.tolist()),
+            )
+        )
         contacts.append(int(lev.point[node]))
         p, t = end_p, end_t
     end_t = tangent_after(t, th_last)
-    arcs.append(Arc(tuple(p.tolist()), tuple(t.tolist()), th_last, l_last,
-                    tuple(prep.target.tolist()), tuple(np.asarray(end_t).tolist())))
+    arcs.append(
+        Arc(
+            tuple(p.tolist()),
+            tuple(t.tolist()),
+            th_last,
+            l_last,
+            tuple(prep.target.tolist()),
+            tuple(np.asarray(end_t).tolist()),
+        )
+    )
     total = float(sum(a.length_m for a in arcs))
     return ChordArcSolution(
         contact_indices=tuple(contacts),
@@ -721,8 +792,9 @@ def _rebuild(query: ChordArcQuery, levels: list[_Level], prep: _Prepared,
     )
 
 
-def search_chord_arc(query: ChordArcQuery,
-                     settings: ChordArcSettings = ChordArcSettings()) -> SearchResult:  # noqa: B008
+def search_chord_arc(
+    query: ChordArcQuery, settings: ChordArcSettings = ChordArcSettings()
+) -> SearchResult:  # noqa: B008
     """The paper's tree search: every geometric solution within the budget.
 
     Raises:
@@ -739,17 +811,23 @@ def _fmt_pt(p: Point) -> str:
     return f"({p[0]:.4g}, {p[1]:.4g})"
 
 
-def _check(solution: ChordArcSolution, prep: _Prepared,
-           settings: ChordArcSettings) -> ChordArcPlan | DroppedSolution:
+def _check(
+    solution: ChordArcSolution, prep: _Prepared, settings: ChordArcSettings
+) -> ChordArcPlan | DroppedSolution:
     geo = prep.geometry
     checks: list[ContactCheck] = []
     motion: list[MotionStep] = []
     first = solution.arcs[0]
-    motion.append(MotionStep(
-        "follow", 0,
-        f"insert {first.length_m:.4g} m while bending to θ1 = {first.theta_rad:.4g} rad "
-        "(the tip traces arc 1)",
-        ((0.0, 0.0),), ((first.theta_rad, first.length_m),)))
+    motion.append(
+        MotionStep(
+            "follow",
+            0,
+            f"insert {first.length_m:.4g} m while bending to θ1 = {first.theta_rad:.4g} rad "
+            "(the tip traces arc 1)",
+            ((0.0, 0.0),),
+            ((first.theta_rad, first.length_m),),
+        )
+    )
     done: Shape = ((first.theta_rad, first.length_m),)
     failure = ""
     for j, pi in enumerate(solution.contact_indices):
@@ -770,24 +848,32 @@ def _check(solution: ChordArcSolution, prep: _Prepared,
             reason = f"{where}: the robot meets the obstacle head-on, no side holds it"
         elif side * dk <= settings.min_kappa_change_per_m:
             if abs(dk) <= settings.min_kappa_change_per_m:
-                reason = (f"{where}: curvature unchanged ({k_in:.4g} 1/m), the contact carries "
-                          "no load")
+                reason = (
+                    f"{where}: curvature unchanged ({k_in:.4g} 1/m), the contact carries no load"
+                )
             elif ctype == "forward":
-                reason = (f"{where} is forward-constrained (obstacle on the concave side: it "
-                          f"blocks further bending) but the next arc bends less (κ {k_in:.4g} → "
-                          f"{k_out:.4g} 1/m): the section would unbend as one and leave it")
+                reason = (
+                    f"{where} is forward-constrained (obstacle on the concave side: it "
+                    f"blocks further bending) but the next arc bends less (κ {k_in:.4g} → "
+                    f"{k_out:.4g} 1/m): the section would unbend as one and leave it"
+                )
             else:
-                reason = (f"{where} is backward-constrained (obstacle on the convex side: it "
-                          f"blocks unbending) but the next arc bends further (κ {k_in:.4g} → "
-                          f"{k_out:.4g} 1/m): the section would bend as one and leave it")
+                reason = (
+                    f"{where} is backward-constrained (obstacle on the convex side: it "
+                    f"blocks unbending) but the next arc bends further (κ {k_in:.4g} → "
+                    f"{k_out:.4g} 1/m): the section would bend as one and leave it"
+                )
         push = min(settings.push_length_m, 0.5 * a_out.length_m)
         if not reason:
             a_push = 1.0 + push / a_in.length_m
-            ext = a_in.points(np.linspace(1.0, a_push, 1 + max(2, math.ceil(
-                push / settings.arc_step_m))))
+            ext = a_in.points(
+                np.linspace(1.0, a_push, 1 + max(2, math.ceil(push / settings.arc_step_m)))
+            )
             if geo.inside_any(ext, settings.inside_tol_m).any():
-                reason = (f"{where}: the initial push by {push:.3g} m (a = {a_push:.6g}) "
-                          "enters an obstacle")
+                reason = (
+                    f"{where}: the initial push by {push:.3g} m (a = {a_push:.6g}) "
+                    "enters an obstacle"
+                )
         if not reason:
             ks = k_in + np.linspace(0.0, 1.0, settings.rebend_steps + 1)[1:] * dk
             th = ks * push
@@ -795,45 +881,71 @@ def _check(solution: ChordArcSolution, prep: _Prepared,
             loc = arc_points_local(th[:, None], push, a[None, :])
             pts = c + loc[..., :1] * r + loc[..., 1:] * t
             if geo.inside_any(pts.reshape(-1, 2), settings.inside_tol_m).any():
-                reason = (f"{where}: re-bending the pushed {push:.3g} m from κ {k_in:.4g} to "
-                          f"{k_out:.4g} 1/m sweeps into an obstacle")
-        checks.append(ContactCheck(j + 1, int(pi), name, side, ctype, k_in, k_out,
-                                   not reason, reason))
+                reason = (
+                    f"{where}: re-bending the pushed {push:.3g} m from κ {k_in:.4g} to "
+                    f"{k_out:.4g} 1/m sweeps into an obstacle"
+                )
+        checks.append(
+            ContactCheck(j + 1, int(pi), name, side, ctype, k_in, k_out, not reason, reason)
+        )
         if reason and not failure:
             failure = reason
         if failure:
             continue
-        pushed = done[:-1] + ((a_in.theta_rad * (1.0 + push / a_in.length_m),
-                               a_in.length_m + push),)
-        motion.append(MotionStep(
-            "push", j,
-            f"initial push by {push:.4g} m at contact {j + 1} (a = 1 + l/L = "
-            f"{1.0 + push / a_in.length_m:.6g})", done, pushed))
+        pushed = done[:-1] + (
+            (a_in.theta_rad * (1.0 + push / a_in.length_m), a_in.length_m + push),
+        )
+        motion.append(
+            MotionStep(
+                "push",
+                j,
+                f"initial push by {push:.4g} m at contact {j + 1} (a = 1 + l/L = "
+                f"{1.0 + push / a_in.length_m:.6g})",
+                done,
+                pushed,
+            )
+        )
         start = done + ((k_in * push, push),)
         bent = done + ((k_out * push, push),)
-        motion.append(MotionStep(
-            "rebend", j + 1, f"{ctype}-constrained contact {j + 1} holds arc {j + 1}; the "
-            f"pushed {push:.4g} m re-bends to κ = {k_out:.4g} 1/m", start, bent))
+        motion.append(
+            MotionStep(
+                "rebend",
+                j + 1,
+                f"{ctype}-constrained contact {j + 1} holds arc {j + 1}; the "
+                f"pushed {push:.4g} m re-bends to κ = {k_out:.4g} 1/m",
+                start,
+                bent,
+            )
+        )
         done = done + ((a_out.theta_rad, a_out.length_m),)
-        motion.append(MotionStep(
-            "follow", j + 1,
-            f"insert to {a_out.length_m:.4g} m past contact {j + 1} bending a·θ{j + 2}, "
-            f"θ{j + 2} = {a_out.theta_rad:.4g} rad", bent, done))
+        motion.append(
+            MotionStep(
+                "follow",
+                j + 1,
+                f"insert to {a_out.length_m:.4g} m past contact {j + 1} bending a·θ{j + 2}, "
+                f"θ{j + 2} = {a_out.theta_rad:.4g} rad",
+                bent,
+                done,
+            )
+        )
     if failure:
         return DroppedSolution(solution, tuple(checks), failure)
     return ChordArcPlan(solution, tuple(checks), tuple(motion))
 
 
-def check_motion(solution: ChordArcSolution, query: ChordArcQuery,
-                 settings: ChordArcSettings = ChordArcSettings()  # noqa: B008
-                 ) -> ChordArcPlan | DroppedSolution:
+def check_motion(
+    solution: ChordArcSolution,
+    query: ChordArcQuery,
+    settings: ChordArcSettings = ChordArcSettings(),  # noqa: B008
+) -> ChordArcPlan | DroppedSolution:
     """Check a solution's contact types, push and re-bend; build its motion sequence."""
     return _check(solution, prepare(query, settings), settings)
 
 
-def solve_chord_arc(query: ChordArcQuery,
-                    settings: ChordArcSettings = ChordArcSettings()  # noqa: B008
-                    ) -> ChordArcResult:
+def solve_chord_arc(
+    query: ChordArcQuery,
+    settings: ChordArcSettings = ChordArcSettings(),  # noqa: B008
+) -> ChordArcResult:
     """Search, then check every solution's motion. Deterministic: no randomness.
 
     Raises:
@@ -873,7 +985,8 @@ def query_from_toml_data(data: Mapping[str, Any]) -> ChordArcQuery:
             roll, pitch, oyaw = (math.radians(v) for v in o.get("rpy_deg", [0.0, 0.0, 0.0]))
             if o["type"] in ("box", "cylinder") and (abs(roll) > 1e-12 or abs(pitch) > 1e-12):
                 raise ChordArcInputError(
-                    f"obstacle {o['name']!r}: only yaw is supported in the plane")
+                    f"obstacle {o['name']!r}: only yaw is supported in the plane"
+                )
             if o["type"] == "box":
                 sx, sy, sz = o["size_m"]
                 if abs(cz) < sz / 2:
@@ -883,8 +996,9 @@ def query_from_toml_data(data: Mapping[str, Any]) -> ChordArcQuery:
                     obstacles.append(Circle((cx, cy), o["radius_m"], o["name"]))
             elif o["type"] == "sphere":
                 if abs(cz) < o["radius_m"]:
-                    obstacles.append(Circle((cx, cy), math.sqrt(o["radius_m"] ** 2 - cz**2),
-                                            o["name"]))
+                    obstacles.append(
+                        Circle((cx, cy), math.sqrt(o["radius_m"] ** 2 - cz**2), o["name"])
+                    )
             else:
                 raise ChordArcInputError(f"obstacle {o['name']!r}: unknown type {o['type']!r}")
         return ChordArcQuery(

@@ -40,10 +40,8 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.optimize import approx_fprime
 
-from plannerlab.collision import CollisionChecker
+from plannerlab.collision.fcl_checker import CollisionChecker
 from plannerlab.errors import PlannerlabError
-from plannerlab.objective import Objective
-from plannerlab.paths import interpolate_edge
 from plannerlab.planners.base import (
     Deadline,
     PlanResult,
@@ -52,7 +50,9 @@ from plannerlab.planners.base import (
     settings_dict,
     with_overrides,
 )
+from plannerlab.planners.objective import Objective
 from plannerlab.robots.base import Array, wrap_to_pi
+from plannerlab.robots.paths import interpolate_edge
 
 
 @dataclass(frozen=True)
@@ -92,7 +92,8 @@ class GradientSettings:
     def __post_init__(self) -> None:
         if self.gradient not in ("finite_difference", "analytic"):
             raise PlannerlabError(
-                f"gradient setting: 'finite_difference' or 'analytic', got {self.gradient!r}")
+                f"gradient setting: 'finite_difference' or 'analytic', got {self.gradient!r}"
+            )
         if self.mode not in ("kinematic", "closed_loop"):
             raise PlannerlabError(f"mode setting: 'kinematic' or 'closed_loop', got {self.mode!r}")
         if not self.gamma > 0:
@@ -126,8 +127,9 @@ class GradientPlanner:
             return f.smooth_gradient(q)
         return approx_fprime(q, f, self.settings.fd_step)
 
-    def _advance_kinematic(self, problem, checker: CollisionChecker, q: Array,
-                           q_target: Array, max_states: int | None) -> tuple[Array, bool]:
+    def _advance_kinematic(
+        self, problem, checker: CollisionChecker, q: Array, q_target: Array, max_states: int | None
+    ) -> tuple[Array, bool]:
         """Move along q → q_target up to the last collision-free state (blocked by contact).
 
         At most ``max_states`` states are checked (the rest of the check budget); an edge
@@ -146,8 +148,15 @@ class GradientPlanner:
         return (states[bad - 1] if bad > 0 else q), True
 
     # ------------------------------------------------------------------ solve
-    def solve(self, problem, leg: int, budget, rng: np.random.Generator,
-              q_start: Array | None = None, stepper: Stepper | None = None) -> PlanResult:
+    def solve(
+        self,
+        problem,
+        leg: int,
+        budget,
+        rng: np.random.Generator,
+        q_start: Array | None = None,
+        stepper: Stepper | None = None,
+    ) -> PlanResult:
         """Descend f from q_start (default: the problem's start) towards leg's goal.
 
         ``rng`` is unused: the method is deterministic (kept for the common signature).
@@ -165,20 +174,39 @@ class GradientPlanner:
         if closed:
             if stepper is None:
                 raise PlannerlabError(
-                    f"{self.name} runs PyBullet in its loop: pass a stepper (plannerlab.sim)")
+                    f"{self.name} runs PyBullet in its loop: pass a stepper (plannerlab.sim)"
+                )
             stepper.reset(q)
 
-        def result(status: Status, reason: str, path: list[Array], trace: list[float],
-                   iterations: int, minima: int = 0, extra: dict | None = None) -> PlanResult:
+        def result(
+            status: Status,
+            reason: str,
+            path: list[Array],
+            trace: list[float],
+            iterations: int,
+            minima: int = 0,
+            extra: dict | None = None,
+        ) -> PlanResult:
             pos_err, ang_err = goal.errors(robot, path[-1])
             return PlanResult(
-                planner=self.name, problem=problem.name, leg=leg, goal=goal.name,
-                status=status, reason=reason, path=np.array(path),
-                time_s=time.perf_counter() - t0, iterations=iterations,
-                collision_checks=checker.checks, fk_calls=f.evaluations,
-                pos_err_m=float(pos_err), angle_err_deg=float(ang_err),
-                trace=np.array(trace), local_minima=minima, escapes=0,
-                settings=settings_dict(s), extra=extra or {},
+                planner=self.name,
+                problem=problem.name,
+                leg=leg,
+                goal=goal.name,
+                status=status,
+                reason=reason,
+                path=np.array(path),
+                time_s=time.perf_counter() - t0,
+                iterations=iterations,
+                collision_checks=checker.checks,
+                fk_calls=f.evaluations,
+                pos_err_m=float(pos_err),
+                angle_err_deg=float(ang_err),
+                trace=np.array(trace),
+                local_minima=minima,
+                escapes=0,
+                settings=settings_dict(s),
+                extra=extra or {},
             )
 
         if not checker.is_valid(q):
@@ -193,21 +221,37 @@ class GradientPlanner:
         iteration = 0
         while True:
             if goal.contains(robot, q):
-                return result(Status.SOLVED, f"in the goal region after {iteration} iterations",
-                              path, trace, iteration)
+                return result(
+                    Status.SOLVED,
+                    f"in the goal region after {iteration} iterations",
+                    path,
+                    trace,
+                    iteration,
+                )
             if s.stop_at_epsilon and value < s.epsilon:
-                return result(Status.APPROXIMATE,
-                              f"f = {value:.3g} < epsilon = {s.epsilon} but outside the goal "
-                              f"region", path, trace, iteration)
+                return result(
+                    Status.APPROXIMATE,
+                    f"f = {value:.3g} < epsilon = {s.epsilon} but outside the goal region",
+                    path,
+                    trace,
+                    iteration,
+                )
             if value >= s.epsilon and iteration - best_iter >= s.stall_window:
                 return result(
                     Status.LOCAL_MINIMUM,
                     f"stalled at iteration {iteration}: best f = {best:.4g} has not improved by "
                     f"{s.stall_min_decrease} in {s.stall_window} iterations "
                     f"({blocked_steps} steps blocked by contact)",
-                    path, trace, iteration, minima=1,
-                    extra={"stall_iteration": iteration, "q_stall": q.tolist(),
-                           "blocked_steps": blocked_steps})
+                    path,
+                    trace,
+                    iteration,
+                    minima=1,
+                    extra={
+                        "stall_iteration": iteration,
+                        "q_stall": q.tolist(),
+                        "blocked_steps": blocked_steps,
+                    },
+                )
             exhausted = deadline.exhausted(iteration)
             # An iteration costs the gradient's checks (dof + 1 with finite differences),
             # at least one state of the step and, in closed loop, one check of the state
@@ -215,8 +259,10 @@ class GradientPlanner:
             grad_cost = robot.dof + 1 if s.gradient == "finite_difference" else 0
             left = deadline.checks_left()
             if exhausted is None and left is not None and left < grad_cost + 1 + int(closed):
-                exhausted = (f"collision-check budget of {budget.max_collision_checks} used up "
-                             f"(an iteration needs {grad_cost + 1 + int(closed)})")
+                exhausted = (
+                    f"collision-check budget of {budget.max_collision_checks} used up "
+                    f"(an iteration needs {grad_cost + 1 + int(closed)})"
+                )
             if exhausted:
                 return result(Status.BUDGET_EXHAUSTED, exhausted, path, trace, iteration)
 
@@ -224,8 +270,9 @@ class GradientPlanner:
             if s.max_step_rad > 0:
                 step = np.clip(step, -s.max_step_rad, s.max_step_rad)
             # joints with limits stay inside them (continuous joints wrap)
-            q_target = np.where(robot.continuous, q - step,
-                                np.clip(q - step, robot.lower, robot.upper))
+            q_target = np.where(
+                robot.continuous, q - step, np.clip(q - step, robot.lower, robot.upper)
+            )
             if closed:
                 q_next = wrap_to_pi(stepper.move_towards(q_target, s.sim_steps), robot.continuous)
             else:

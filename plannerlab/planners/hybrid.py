@@ -26,14 +26,14 @@ from typing import Any
 
 import numpy as np
 
-from plannerlab.collision import CollisionChecker
+from plannerlab.collision.fcl_checker import CollisionChecker
 from plannerlab.errors import PlannerlabError
-from plannerlab.objective import Objective
-from plannerlab.paths import interpolate_edge
 from plannerlab.planners.base import PlanResult, Status, settings_dict, with_overrides
 from plannerlab.planners.gradient import GradientPlanner, GradientSettings
-from plannerlab.problem import Budget
+from plannerlab.planners.objective import Objective
+from plannerlab.problem.load import Budget
 from plannerlab.robots.base import Array, joint_difference, wrap_to_pi
+from plannerlab.robots.paths import interpolate_edge
 
 
 @dataclass(frozen=True)
@@ -74,10 +74,13 @@ class HybridSettings:
     retreat_rad: float = 0.3
 
     def descent(self) -> GradientSettings:
-        return GradientSettings(gamma=self.gamma, epsilon=self.epsilon,
-                                stall_window=self.stall_window,
-                                stall_min_decrease=self.stall_min_decrease,
-                                gradient=self.gradient)
+        return GradientSettings(
+            gamma=self.gamma,
+            epsilon=self.epsilon,
+            stall_window=self.stall_window,
+            stall_min_decrease=self.stall_min_decrease,
+            gradient=self.gradient,
+        )
 
 
 class _Ledger:
@@ -101,8 +104,11 @@ class _Ledger:
         it = None if b.max_iterations is None else b.max_iterations - self.iterations
         ch = None if b.max_collision_checks is None else b.max_collision_checks - self.checks
         tl = None if b.time_limit_s is None else b.time_limit_s - (time.perf_counter() - self.t0)
-        if (it is not None and it <= 0) or (ch is not None and ch <= 0) or (
-                tl is not None and tl <= 0):
+        if (
+            (it is not None and it <= 0)
+            or (ch is not None and ch <= 0)
+            or (tl is not None and tl <= 0)
+        ):
             return None
         if checks_cap is not None:
             ch = checks_cap if ch is None else min(ch, checks_cap)
@@ -125,8 +131,15 @@ class HybridPlanner:
         self.settings = settings
         self._descent = GradientPlanner(f"{name}/descent", settings.descent())
 
-    def solve(self, problem: Any, leg: int, budget: Budget, rng: np.random.Generator,
-              q_start: Array | None = None, stepper: Any = None) -> PlanResult:
+    def solve(
+        self,
+        problem: Any,
+        leg: int,
+        budget: Budget,
+        rng: np.random.Generator,
+        q_start: Array | None = None,
+        stepper: Any = None,
+    ) -> PlanResult:
         del stepper
         s = self.settings
         t0 = time.perf_counter()
@@ -146,12 +159,25 @@ class HybridPlanner:
             p = np.array(path)
             pos_err, ang_err = goal.errors(robot, p[-1])
             return PlanResult(
-                planner=self.name, problem=problem.name, leg=leg, goal=goal.name,
-                status=status, reason=reason, path=p, time_s=time.perf_counter() - t0,
-                iterations=ledger.iterations, collision_checks=ledger.checks,
-                fk_calls=ledger.fk_calls, pos_err_m=float(pos_err),
-                angle_err_deg=float(ang_err), trace=np.array(trace), local_minima=minima,
-                escapes=escapes, settings=settings_dict(s), extra={"steps": notes})
+                planner=self.name,
+                problem=problem.name,
+                leg=leg,
+                goal=goal.name,
+                status=status,
+                reason=reason,
+                path=p,
+                time_s=time.perf_counter() - t0,
+                iterations=ledger.iterations,
+                collision_checks=ledger.checks,
+                fk_calls=ledger.fk_calls,
+                pos_err_m=float(pos_err),
+                angle_err_deg=float(ang_err),
+                trace=np.array(trace),
+                local_minima=minima,
+                escapes=escapes,
+                settings=settings_dict(s),
+                extra={"steps": notes},
+            )
 
         while True:
             sub = ledger.remaining()
@@ -162,14 +188,12 @@ class HybridPlanner:
             path.extend(r.path[1:])
             trace.extend(r.trace.tolist())
             q = r.path[-1]
-            if stall_f is not None and (r.solved or r.trace.min() < stall_f
-                                        - s.stall_min_decrease):
+            if stall_f is not None and (r.solved or r.trace.min() < stall_f - s.stall_min_decrease):
                 escapes += 1
                 stall_f = None
             notes.append(f"descent: {r.status.value} after {r.iterations} iterations")
             if r.status in (Status.SOLVED, Status.INVALID_START):
-                return done(r.status, f"{r.reason}; {minima} local minima met, "
-                                      f"{escapes} escaped")
+                return done(r.status, f"{r.reason}; {minima} local minima met, {escapes} escaped")
             if r.status is not Status.LOCAL_MINIMUM:
                 return done(r.status, r.reason)
             minima += 1
@@ -177,9 +201,11 @@ class HybridPlanner:
             if s.retreat_rad > 0:
                 q = self._retreat(path, len(r.path) - 1, robot.continuous)
             if minima > s.max_escapes:
-                return done(Status.LOCAL_MINIMUM,
-                            f"{minima} local minima met, {escapes} escaped; gave up after "
-                            f"{s.max_escapes} escape attempts")
+                return done(
+                    Status.LOCAL_MINIMUM,
+                    f"{minima} local minima met, {escapes} escaped; gave up after "
+                    f"{s.max_escapes} escape attempts",
+                )
             if self.name == "gradient+rrtconnect":
                 rrt = self._rrt_escape(problem, leg, ledger, rng, q)
                 if rrt is None:
@@ -188,9 +214,11 @@ class HybridPlanner:
                 if rrt.solved:
                     path.extend(rrt.path[1:])
                     escapes += 1
-                    return done(Status.SOLVED,
-                                f"descent stalled; RRT-Connect reached the goal region from "
-                                f"stall {minima}; {minima} local minima met, {escapes} escaped")
+                    return done(
+                        Status.SOLVED,
+                        f"descent stalled; RRT-Connect reached the goal region from "
+                        f"stall {minima}; {minima} local minima met, {escapes} escaped",
+                    )
             # restart near the stall (multistart always; rrtconnect after a failed slice)
             q_new = self._restart(problem, ledger, rng, q, noise)
             noise *= s.restart_noise_growth
@@ -201,8 +229,7 @@ class HybridPlanner:
             q = q_new[-1]
 
     # ------------------------------------------------------------------ escapes
-    def _retreat(self, path: list[Array], descent_states: int,
-                 continuous: np.ndarray) -> Array:
+    def _retreat(self, path: list[Array], descent_states: int, continuous: np.ndarray) -> Array:
         """Cut ``path`` back along the descent to the last state at least ``retreat_rad``
         (largest joint difference) from the stall, or to the descent's first state, and
         return it: the escape starts there."""
@@ -210,14 +237,17 @@ class HybridPlanner:
         stall = path[-1]
         first = max(len(path) - 1 - descent_states, 0)
         i = len(path) - 1
-        while i > first and np.max(np.abs(joint_difference(path[i], stall, continuous))) \
-                < s.retreat_rad:
+        while (
+            i > first
+            and np.max(np.abs(joint_difference(path[i], stall, continuous))) < s.retreat_rad
+        ):
             i -= 1
-        del path[i + 1:]
+        del path[i + 1 :]
         return path[-1]
 
-    def _rrt_escape(self, problem: Any, leg: int, ledger: _Ledger, rng: np.random.Generator,
-                    q: Array) -> PlanResult | None:
+    def _rrt_escape(
+        self, problem: Any, leg: int, ledger: _Ledger, rng: np.random.Generator, q: Array
+    ) -> PlanResult | None:
         from plannerlab.planners import make_planner
 
         sub = ledger.remaining(checks_cap=self.settings.escape_checks)
@@ -229,8 +259,9 @@ class HybridPlanner:
         ledger.add(r)
         return r
 
-    def _restart(self, problem: Any, ledger: _Ledger, rng: np.random.Generator, q: Array,
-                 noise_rad: float) -> Array | None:
+    def _restart(
+        self, problem: Any, ledger: _Ledger, rng: np.random.Generator, q: Array, noise_rad: float
+    ) -> Array | None:
         """A straight, collision-free edge from q to a random state near it: (m, dof)."""
         robot = problem.robot
         checker = CollisionChecker(robot, problem.scene)
@@ -257,6 +288,7 @@ def make(name: str, overrides: dict) -> HybridPlanner:
         raise PlannerlabError(f"{name} is not a hybrid planner ({', '.join(VARIANTS)})")
     settings = with_overrides(HybridSettings(), overrides, name)
     if settings.gradient not in ("analytic", "finite_difference"):
-        raise PlannerlabError(f"gradient setting: 'analytic' or 'finite_difference', got "
-                              f"{settings.gradient!r}")
+        raise PlannerlabError(
+            f"gradient setting: 'analytic' or 'finite_difference', got {settings.gradient!r}"
+        )
     return HybridPlanner(name, settings)

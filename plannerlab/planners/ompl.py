@@ -16,9 +16,9 @@ Design (measured on ``armz_inspection``, 23 continuous joints):
   OMPL's compound metric is the *sum* of the subspace distances (L1 over the continuous
   joints, L2 over the bounded block); ``range`` is in those units.
 * **Validity and motions.** The state validity checker is plannerlab's
-  :class:`~plannerlab.collision.CollisionChecker` (every state counts in ``.checks``).
+  :class:`~plannerlab.collision.fcl_checker.CollisionChecker` (every state counts in ``.checks``).
   Motions are checked by default by a Python ``MotionValidator`` (``motion_check =
-  "batched"``) that interpolates the edge exactly as :func:`plannerlab.paths.densify` does
+  "batched"``) that interpolates the edge exactly as :func:`plannerlab.robots.paths.densify` does
   (no joint moves more than ``problem.joint_step`` between checked states) and asks
   ``checker.first_invalid`` for the whole edge at once (vectorised FK and bounding-box
   pre-test: ~50 µs per state instead of ~150). ``motion_check = "ompl"`` uses OMPL's
@@ -32,10 +32,10 @@ Design (measured on ``armz_inspection``, 23 continuous joints):
   tip position ``p_world`` [m], with cells of ``projection_cell_m`` (default: reach / 20,
   reach = the sum of the link lengths; 0.84 m for the 24-module Arm-Z).
 * **Goal.** A ``GoalSampleableRegion`` whose ``distanceGoal`` is the normalised goal
-  distance :meth:`~plannerlab.goals.GoalRegion.distance` (threshold 0: inside means
+  distance :meth:`~plannerlab.problem.goals.GoalRegion.distance` (threshold 0: inside means
   inside both tolerances; OMPL tests ``distance < threshold`` strictly, so the threshold
   is 1e-9) and whose ``sampleGoal`` hands out a pool of up to
-  ``goal_samples`` goal states found by :func:`plannerlab.ik.sample_goal_state`
+  ``goal_samples`` goal states found by :func:`plannerlab.problem.ik.sample_goal_state`
   (seeded from the leg start) *before* planning, within the budget; their checks count.
 * **Budget.** A ``PlannerTerminationCondition(callable)`` stops on iterations, collision
   checks or time; in addition the validity checker and motion validator *refuse* (report
@@ -88,13 +88,13 @@ import ompl.base as ob
 import ompl.geometric as og
 import ompl.util as ou
 
-from plannerlab.collision import CollisionChecker
+from plannerlab.collision.fcl_checker import CollisionChecker
 from plannerlab.errors import PlannerlabError, UnknownNameError
-from plannerlab.goals import GoalRegion
-from plannerlab.ik import sample_goal_state
-from plannerlab.paths import interpolate_edge, path_length
 from plannerlab.planners.base import Deadline, PlanResult, Status, settings_dict, with_overrides
+from plannerlab.problem.goals import GoalRegion
+from plannerlab.problem.ik import sample_goal_state
 from plannerlab.robots.base import Array, Robot, joint_difference, wrap_to_pi
+from plannerlab.robots.paths import interpolate_edge, path_length
 
 LOGGER = logging.getLogger("plannerlab.ompl")
 
@@ -303,7 +303,7 @@ def _forward_log(text: str, logger: logging.Logger) -> None:
     for line in text.splitlines():
         for prefix, level in _OMPL_PREFIXES:
             if line.startswith(prefix):
-                messages.append((level, line[len(prefix):].strip()))
+                messages.append((level, line[len(prefix) :].strip()))
                 break
         else:
             if messages and line.strip():
@@ -355,14 +355,14 @@ class _Space:
     samplers only accept real-vector spaces (InformedRRT*, SORRT*, BIT*, AORRTC).
     """
 
-    def __init__(self, robot: Robot, lifted: bool = False,
-                 center: Array | None = None) -> None:
+    def __init__(self, robot: Robot, lifted: bool = False, center: Array | None = None) -> None:
         self.robot = robot
         self.dof = robot.dof
         self.lifted = lifted
         cont = np.asarray(robot.continuous, dtype=bool)
-        self.center = (np.zeros(self.dof) if center is None
-                       else np.asarray(center, dtype=float).copy())
+        self.center = (
+            np.zeros(self.dof) if center is None else np.asarray(center, dtype=float).copy()
+        )
         if lifted:
             self.cont_idx: list[int] = []
             self.bound_idx = list(range(self.dof))
@@ -379,8 +379,9 @@ class _Space:
             for _ in self.cont_idx:
                 space.addSubspace(ob.SO2StateSpace(), 1.0)
             if self.bound_idx:
-                space.addSubspace(self._real_vector(robot.lower[self.bound_idx],
-                                                    robot.upper[self.bound_idx]), 1.0)
+                space.addSubspace(
+                    self._real_vector(robot.lower[self.bound_idx], robot.upper[self.bound_idx]), 1.0
+                )
         else:
             space = self._real_vector(robot.lower, robot.upper)
         self.space = space
@@ -496,8 +497,13 @@ def _goal_class() -> type:
     class PoolGoal(ob.GoalSampleableRegion):
         """Goal region with normalised distance and a precomputed IK pool."""
 
-        def __init__(self, si: Any, distance: Callable[[Any], float],
-                     fill: Callable[[Any, int], None], pool_size: int) -> None:
+        def __init__(
+            self,
+            si: Any,
+            distance: Callable[[Any], float],
+            fill: Callable[[Any, int], None],
+            pool_size: int,
+        ) -> None:
             super().__init__(si)
             # GoalRegion.distance is exactly 0 inside the region; OMPL's isSatisfied tests
             # distance < threshold (strictly), so "threshold 0" is a tiny positive number.
@@ -523,8 +529,9 @@ def _goal_class() -> type:
     return PoolGoal
 
 
-def _projection(space: _Space, cell_m: float, center: Array, reach: float,
-                counter: list[int]) -> Any:
+def _projection(
+    space: _Space, cell_m: float, center: Array, reach: float, counter: list[int]
+) -> Any:
     """Tip-position projection (3-D, metres) for the KPIECE family."""
 
     class TipProjection(ob.ProjectionEvaluator):
@@ -580,22 +587,36 @@ class OMPLPlanner:
             A :class:`PlanResult`; failures are statuses with reasons.
         """
         del stepper
-        if (budget.max_iterations is None and budget.max_collision_checks is None
-                and budget.time_limit_s is None):
-            raise PlannerlabError(f"{self.name}: the budget needs at least one limit "
-                                  "(max_iterations, max_collision_checks or time_limit_s)")
+        if (
+            budget.max_iterations is None
+            and budget.max_collision_checks is None
+            and budget.time_limit_s is None
+        ):
+            raise PlannerlabError(
+                f"{self.name}: the budget needs at least one limit "
+                "(max_iterations, max_collision_checks or time_limit_s)"
+            )
         if self.settings.motion_check not in _MOTION_CHECKS:
-            raise PlannerlabError(f"{self.name}: motion_check must be one of "
-                                  f"{', '.join(_MOTION_CHECKS)}, got "
-                                  f"{self.settings.motion_check!r}")
+            raise PlannerlabError(
+                f"{self.name}: motion_check must be one of "
+                f"{', '.join(_MOTION_CHECKS)}, got "
+                f"{self.settings.motion_check!r}"
+            )
         ompl_seed = int(rng.integers(1, _SEED_MAX))
         with _ompl_logging(LOGGER):
             ou.RNG.setSeed(ompl_seed)  # effective only before OMPL's first generator
             result = self._solve(problem, leg, budget, rng, q_start, ompl_seed)
         return result
 
-    def _solve(self, problem: Any, leg: int, budget: Any, rng: np.random.Generator,
-               q_start: Array | None, ompl_seed: int) -> PlanResult:
+    def _solve(
+        self,
+        problem: Any,
+        leg: int,
+        budget: Any,
+        rng: np.random.Generator,
+        q_start: Array | None,
+        ompl_seed: int,
+    ) -> PlanResult:
         checker = CollisionChecker(problem.robot, problem.scene)
         bud = _Budget(budget, checker)
         try:
@@ -606,14 +627,26 @@ class OMPLPlanner:
             bud.iteration_source = None
 
     # ------------------------------------------------------------------ internals
-    def _plan(self, problem: Any, leg: int, rng: np.random.Generator, q_start: Array | None,
-              ompl_seed: int, checker: CollisionChecker, bud: _Budget) -> PlanResult:
+    def _plan(
+        self,
+        problem: Any,
+        leg: int,
+        rng: np.random.Generator,
+        q_start: Array | None,
+        ompl_seed: int,
+        checker: CollisionChecker,
+        bud: _Budget,
+    ) -> PlanResult:
         s = self.settings
         robot: Robot = problem.robot
         goal: GoalRegion = problem.goal(leg)
         guard = _GuardedChecker(checker, bud)
-        q0 = wrap_to_pi(np.asarray(problem.q_start if q_start is None else q_start,
-                                   dtype=float).reshape(robot.dof), robot.continuous)
+        q0 = wrap_to_pi(
+            np.asarray(problem.q_start if q_start is None else q_start, dtype=float).reshape(
+                robot.dof
+            ),
+            robot.continuous,
+        )
         fk = [0]
         trace: list[float] = []
         extra: dict[str, Any] = {"ompl_class": self.ompl_class, "ompl_seed": ompl_seed}
@@ -622,18 +655,27 @@ class OMPLPlanner:
             pos_err, ang_err = (float(v) for v in goal.errors(robot, path[-1]))
             extra["refused_checks"] = bud.refused
             return PlanResult(
-                planner=self.name, problem=problem.name, leg=leg, goal=goal.name,
-                status=status, reason=reason, path=path,
-                time_s=bud.deadline.elapsed_s, iterations=iterations,
-                collision_checks=checker.checks, fk_calls=fk[0],
-                pos_err_m=pos_err, angle_err_deg=ang_err, trace=np.array(trace),
-                settings=settings_dict(s), extra=dict(extra),
+                planner=self.name,
+                problem=problem.name,
+                leg=leg,
+                goal=goal.name,
+                status=status,
+                reason=reason,
+                path=path,
+                time_s=bud.deadline.elapsed_s,
+                iterations=iterations,
+                collision_checks=checker.checks,
+                fk_calls=fk[0],
+                pos_err_m=pos_err,
+                angle_err_deg=ang_err,
+                trace=np.array(trace),
+                settings=settings_dict(s),
+                extra=dict(extra),
             )
 
         if not checker.is_valid(q0):
             pairs = ", ".join(f"{a} x {b}" for a, b in checker.colliding_pairs(q0))
-            return result(Status.INVALID_START, f"the start state collides: {pairs}",
-                          q0[None], 0)
+            return result(Status.INVALID_START, f"the start state collides: {pairs}", q0[None], 0)
 
         # Goal pool (IK), within the budget.
         pool: list[Array] = []
@@ -649,8 +691,13 @@ class OMPLPlanner:
         extra["goal_pool_checks"] = checker.checks - c_pool
 
         space = _Space(robot, lifted=self.ompl_class in _LIFTED, center=q0)
-        extra["state_space"] = ("lifted_real_vector" if space.lifted
-                                else "so2_compound" if space.compound else "real_vector")
+        extra["state_space"] = (
+            "lifted_real_vector"
+            if space.lifted
+            else "so2_compound"
+            if space.compound
+            else "real_vector"
+        )
         si = ob.SpaceInformation(space.space)
 
         def state_valid(state: Any) -> bool:
@@ -700,7 +747,8 @@ class OMPLPlanner:
             cell = s.projection_cell_m or reach / 20.0  # type: ignore[attr-defined]
             extra["projection_cell_m"] = cell
             planner.setProjectionEvaluator(
-                _projection(space, cell, robot.T_world_base[:3, 3], reach, fk))
+                _projection(space, cell, robot.T_world_base[:3, 3], reach, fk)
+            )
         if hasattr(planner, "numIterations"):
             bud.iteration_source = planner.numIterations
         elif self.ompl_class in _ROADMAP:
@@ -711,15 +759,17 @@ class OMPLPlanner:
         ptc = ob.PlannerTerminationCondition(bud.poll)
         if self.ompl_class in _ROADMAP:
             ompl_path, exact, status_text = self._roadmap_solve(
-                planner, si, space, guard, pool, q0, goal, robot, bud, problem.joint_step)
+                planner, si, space, guard, pool, q0, goal, robot, bud, problem.joint_step
+            )
         else:
             status = planner.solve(ptc)
             status_text = status.asString()
             kind = status.getStatus()
             exact = kind == ob.PlannerStatus.PlannerStatusType.EXACT_SOLUTION
             usable = exact or kind == ob.PlannerStatus.PlannerStatusType.APPROXIMATE_SOLUTION
-            ompl_path = (og.PathGeometric(pdef.getSolutionPath())
-                         if usable and pdef.hasSolution() else None)
+            ompl_path = (
+                og.PathGeometric(pdef.getSolutionPath()) if usable and pdef.hasSolution() else None
+            )
         iterations = bud.iterations()
         extra["ompl_status"] = status_text
         extra["planning_checks"] = checker.checks - c_pool - extra["goal_pool_checks"] + 0
@@ -727,15 +777,20 @@ class OMPLPlanner:
 
         if ompl_path is None:
             if not pool:
-                return result(Status.INVALID_GOAL,
-                              f"IK found no valid goal state in {s.max_goal_attempts} "
-                              f"attempts and {self.ompl_class} reached none "
-                              f"({status_text}; {why_stopped or 'no limit hit'})",
-                              q0[None], iterations)
-            return result(Status.BUDGET_EXHAUSTED if why_stopped else Status.FAILED,
-                          f"{self.ompl_class}: {status_text}"
-                          + (f"; {why_stopped}" if why_stopped else ""),
-                          q0[None], iterations)
+                return result(
+                    Status.INVALID_GOAL,
+                    f"IK found no valid goal state in {s.max_goal_attempts} "
+                    f"attempts and {self.ompl_class} reached none "
+                    f"({status_text}; {why_stopped or 'no limit hit'})",
+                    q0[None],
+                    iterations,
+                )
+            return result(
+                Status.BUDGET_EXHAUSTED if why_stopped else Status.FAILED,
+                f"{self.ompl_class}: {status_text}" + (f"; {why_stopped}" if why_stopped else ""),
+                q0[None],
+                iterations,
+            )
 
         extra["length_raw"] = float(ompl_path.length())
         extra["waypoints_raw"] = int(ompl_path.getStateCount())
@@ -748,12 +803,18 @@ class OMPLPlanner:
         extra["waypoints_simplified"] = int(ompl_path.getStateCount())
         if s.interpolate:
             ompl_path.interpolate()
-        path = np.array([space.to_q(ompl_path.getState(i))
-                         for i in range(ompl_path.getStateCount())])
+        path = np.array(
+            [space.to_q(ompl_path.getState(i)) for i in range(ompl_path.getStateCount())]
+        )
         path = wrap_to_pi(path, robot.continuous)
         if float(np.max(np.abs(joint_difference(path[0], q0, robot.continuous)))) > 1e-6:
-            return result(Status.FAILED, f"{self.ompl_class} returned a path that does not "
-                          f"start at the start state ({status_text})", q0[None], iterations)
+            return result(
+                Status.FAILED,
+                f"{self.ompl_class} returned a path that does not "
+                f"start at the start state ({status_text})",
+                q0[None],
+                iterations,
+            )
         path[0] = q0  # exact copy (removes float noise of the OMPL round trip)
         extra["path_length_rad"] = path_length(path, robot.continuous)
 
@@ -761,20 +822,37 @@ class OMPLPlanner:
         check = checker.check_path(path, problem.joint_step / 4.0)
         extra["validation_checks"] = checker.checks - c0
         if not check.valid:
-            return result(Status.INVALID_PATH,
-                          f"{self.ompl_class} path fails the re-check at joint_step/4 on "
-                          f"edge {check.first_invalid_edge}: "
-                          + ", ".join(f"{a} x {b}" for a, b in check.pairs),
-                          path, iterations)
+            return result(
+                Status.INVALID_PATH,
+                f"{self.ompl_class} path fails the re-check at joint_step/4 on "
+                f"edge {check.first_invalid_edge}: "
+                + ", ".join(f"{a} x {b}" for a, b in check.pairs),
+                path,
+                iterations,
+            )
         if exact and bool(goal.contains(robot, path[-1])):
             return result(Status.SOLVED, f"{self.ompl_class}: {status_text}", path, iterations)
-        return result(Status.APPROXIMATE,
-                      f"{self.ompl_class}: {status_text}; ends outside the goal region"
-                      + (f" ({why_stopped})" if why_stopped else ""), path, iterations)
+        return result(
+            Status.APPROXIMATE,
+            f"{self.ompl_class}: {status_text}; ends outside the goal region"
+            + (f" ({why_stopped})" if why_stopped else ""),
+            path,
+            iterations,
+        )
 
-    def _roadmap_solve(self, planner: Any, si: Any, space: _Space, guard: _GuardedChecker,
-                       pool: list[Array], q0: Array, goal: GoalRegion, robot: Robot,
-                       bud: _Budget, joint_step: float) -> tuple[Any, bool, str]:
+    def _roadmap_solve(
+        self,
+        planner: Any,
+        si: Any,
+        space: _Space,
+        guard: _GuardedChecker,
+        pool: list[Array],
+        q0: Array,
+        goal: GoalRegion,
+        robot: Robot,
+        bud: _Budget,
+        joint_step: float,
+    ) -> tuple[Any, bool, str]:
         """PRM / PRM* without OMPL's solution thread (see the module docstring)."""
         from scipy.sparse import coo_matrix
         from scipy.sparse.csgraph import dijkstra
@@ -789,11 +867,12 @@ class OMPLPlanner:
             # sliced by termination polls, which are deterministic.
             grow_until = bud.polls + max(1, (2 * slice_polls) // 3)
             planner.growRoadmapPtc(
-                ob.PlannerTerminationCondition(lambda s=grow_until: bud.poll() or bud.polls >= s))
+                ob.PlannerTerminationCondition(lambda s=grow_until: bud.poll() or bud.polls >= s)
+            )
             expand_until = bud.polls + max(1, slice_polls // 3)
             planner.expandRoadmapPtc(
-                ob.PlannerTerminationCondition(
-                    lambda s=expand_until: bud.poll() or bud.polls >= s))
+                ob.PlannerTerminationCondition(lambda s=expand_until: bud.poll() or bud.polls >= s)
+            )
             data = ob.PlannerData(si)
             planner.getPlannerData(data)
             n = data.numVertices()
@@ -817,13 +896,21 @@ class OMPLPlanner:
                 r = np.array(rows + extra_rows, dtype=int)
                 c = np.array(cols + extra_cols, dtype=int)
                 if len(r):
-                    w = np.array([float(space.metric(allV[a][None], allV[b])[0])
-                                  for a, b in zip(r[: len(rows)], c[: len(rows)], strict=True)]
-                                 + extra_w) + 1e-12
+                    w = (
+                        np.array(
+                            [
+                                float(space.metric(allV[a][None], allV[b])[0])
+                                for a, b in zip(r[: len(rows)], c[: len(rows)], strict=True)
+                            ]
+                            + extra_w
+                        )
+                        + 1e-12
+                    )
                     size = len(allV)
                     graph = coo_matrix((w, (r, c)), shape=(size, size)).tocsr()
-                    dist_from_start, pred = dijkstra(graph, directed=False, indices=n,
-                                                     return_predecessors=True)
+                    dist_from_start, pred = dijkstra(
+                        graph, directed=False, indices=n, return_predecessors=True
+                    )
                     goals = np.arange(n + 1, size)
                     reachable = goals[np.isfinite(dist_from_start[goals])]
                     if len(reachable):

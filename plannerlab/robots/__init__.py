@@ -12,13 +12,13 @@ from typing import TYPE_CHECKING
 from plannerlab.robots.base import Robot
 
 if TYPE_CHECKING:
-    from plannerlab.problem import TableReader
+    from plannerlab.problem.load import TableReader
 
 #: robot type in a problem file -> "module:function" building it from the [robot] table
 ROBOT_TYPES: dict[str, str] = {
-    "armz": "plannerlab.robots.armz:from_table",
-    "irb6": "plannerlab.robots.irb6:from_table",
-    "continuum_chain": "plannerlab.robots.continuum:from_table",
+    "armz": "plannerlab.robots.armz.model:from_table",
+    "irb6": "plannerlab.robots.irb6.model:from_table",
+    "continuum_chain": "plannerlab.robots.continuum.model:from_table",
 }
 
 

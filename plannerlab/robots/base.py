@@ -3,7 +3,7 @@
 A robot is a joint-vector robot: a state is ``q`` of shape ``(dof,)`` and every batched
 function also takes ``(k, dof)``. Collision geometry is a set of capsules ("links"), each a
 segment between two world points with a radius; the checker in
-:mod:`plannerlab.collision` turns them into FCL objects. Frames are 4x4 homogeneous
+:mod:`plannerlab.collision.fcl_checker` turns them into FCL objects. Frames are 4x4 homogeneous
 transforms ``T_world_frame``.
 
 Only numpy/scipy are used here (see ``docs/architecture.md``).

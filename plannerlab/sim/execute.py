@@ -2,7 +2,7 @@
 
 :func:`execute` takes a problem and a joint path (m, dof) and
 
-1. re-checks the path with the FCL :class:`~plannerlab.collision.CollisionChecker` at a
+1. re-checks the path with the FCL :class:`~plannerlab.collision.fcl_checker.CollisionChecker` at a
    finer resolution than planners use (``problem.joint_step / 4`` by default), before any
    simulation, and records the verdict and the colliding pairs;
 2. drives the simulated robot along it by position control with the Arm-Z paper's
@@ -53,11 +53,11 @@ from typing import Any
 
 import numpy as np
 
-from plannerlab.collision import CollisionChecker
+from plannerlab.collision.fcl_checker import CollisionChecker
 from plannerlab.errors import PlannerlabError
-from plannerlab.paths import densify
-from plannerlab.problem import Problem
+from plannerlab.problem.load import Problem
 from plannerlab.robots.base import Array, joint_difference
+from plannerlab.robots.paths import densify
 from plannerlab.sim.world import SimWorld
 
 #: physics steps per densified waypoint (0.1 s)

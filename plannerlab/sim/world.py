@@ -23,7 +23,7 @@ Decisions:
 * **Self-collision** is reported (``URDF_USE_SELF_COLLISION``) but switched off, in the
   physics and in :meth:`SimWorld.contacts`, for the robot's ``excluded_pairs`` (modules
   that always overlap) and for its fixed links against the scene (the base stands on its
-  pedestal), the same pairs :mod:`plannerlab.collision` never checks.
+  pedestal), the same pairs :mod:`plannerlab.collision.fcl_checker` never checks.
   ``..._EXCLUDE_ALL_PARENTS`` is not used: in a serial chain every pair of links is
   ancestor and descendant, so it would switch all self-collision off.
 * **Link names**: PyBullet link indices are mapped to the robot's links by name (the child
@@ -52,8 +52,8 @@ from pybullet_utils.bullet_client import BulletClient
 from scipy.spatial.transform import Rotation
 
 from plannerlab.errors import PlannerlabError
+from plannerlab.problem.scene import Box, Cylinder, Obstacle, Scene, Sphere
 from plannerlab.robots.base import Array, Robot, joint_difference
-from plannerlab.scene import Box, Cylinder, Obstacle, Scene, Sphere
 
 #: the paper's control step [s]
 DT_S: float = 1.0 / 240.0

@@ -1,12 +1,12 @@
 """Tables backed by files: a comparison's CSV, Markdown and OMPL benchmark log.
 
-Everything here turns trial records (:func:`plannerlab.bench.run_trial`) and summary rows
-(:func:`plannerlab.bench.summarise`) into text, and :func:`write_reports` writes them
-atomically (:func:`plannerlab.io.write_text_atomic`) into the comparison's folder:
+Everything here turns trial records (:func:`plannerlab.bench.trials.run_trial`) and summary rows
+(:func:`plannerlab.bench.trials.summarise`) into text, and :func:`write_reports` writes them
+atomically (:func:`plannerlab.record.files.write_text_atomic`) into the comparison's folder:
 
 * ``trials.csv``: one row per trial; ``legs.csv``: one row per leg of every trial;
   ``summary.csv``: one row per (problem, planner), columns
-  :data:`plannerlab.bench.SUMMARY_COLUMNS`;
+  :data:`plannerlab.bench.trials.SUMMARY_COLUMNS`;
 * ``report.md``: a table per problem, with the exact command, seeds, budget, settings,
   package versions and the machine;
 * ``meta.json``: the same metadata as data;
@@ -52,8 +52,8 @@ from collections.abc import Iterable, Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
-from plannerlab.bench import ERROR_STATUS, SUMMARY_COLUMNS, TOTAL_KEYS
-from plannerlab.io import write_json_atomic, write_text_atomic
+from plannerlab.bench.trials import ERROR_STATUS, SUMMARY_COLUMNS, TOTAL_KEYS
+from plannerlab.record.files import write_json_atomic, write_text_atomic
 
 #: values of the ``status ENUM`` run property, in order (index = stored value)
 STATUS_ENUM: tuple[str, ...] = (

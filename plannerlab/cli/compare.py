@@ -16,7 +16,7 @@ CSV, Markdown and OMPL benchmark logs in ``DIR/NAME/`` (load a log with
 
 Budgets are per leg; use ``--max-checks`` or ``--max-iterations`` for reproducible
 numbers, ``--time-limit`` for benchmarks. Argument parsing and printing only: the work
-is :mod:`plannerlab.bench` and :mod:`plannerlab.report`.
+is :mod:`plannerlab.bench.trials` and :mod:`plannerlab.bench.report`.
 """
 
 from __future__ import annotations
@@ -161,7 +161,8 @@ def _json_safe(x: Any) -> Any:
 
 # ---------------------------------------------------------------------- command
 def cmd_compare(args: argparse.Namespace, console: Console) -> int:
-    from plannerlab.bench import (
+    from plannerlab.bench.report import machine_info, write_reports
+    from plannerlab.bench.trials import (
         ERROR_STATUS,
         Trial,
         TrialStore,
@@ -171,10 +172,9 @@ def cmd_compare(args: argparse.Namespace, console: Console) -> int:
         store_path,
         summarise,
     )
-    from plannerlab.catalog import load_problem, resolve_problem_path
-    from plannerlab.io import versions
     from plannerlab.planners import get_entry, make_planner
-    from plannerlab.report import machine_info, write_reports
+    from plannerlab.problem.catalog import load_problem, resolve_problem_path
+    from plannerlab.record.files import versions
 
     # -- validate everything before the first process starts
     if args.jobs < 1:
@@ -367,7 +367,7 @@ def cmd_compare(args: argparse.Namespace, console: Console) -> int:
 
 
 def _print_tables(console: Console, rows: list[dict[str, Any]], executed: bool) -> None:
-    from plannerlab.report import EXEC_HEADERS, TABLE_HEADERS, TABLE_NOTES, summary_cells
+    from plannerlab.bench.report import EXEC_HEADERS, TABLE_HEADERS, TABLE_NOTES, summary_cells
 
     headers = TABLE_HEADERS + (EXEC_HEADERS if executed else ())
     for problem in dict.fromkeys(r["problem"] for r in rows):

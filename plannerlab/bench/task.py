@@ -18,12 +18,12 @@ from typing import Any
 
 import numpy as np
 
-from plannerlab.catalog import load_problem, resolve_problem_path
 from plannerlab.errors import PlanFileError
-from plannerlab.io import versions, write_json_atomic
 from plannerlab.planners import get_entry, make_planner
 from plannerlab.planners.base import PlanResult, Status
-from plannerlab.problem import Budget, Problem
+from plannerlab.problem.catalog import load_problem, resolve_problem_path
+from plannerlab.problem.load import Budget, Problem
+from plannerlab.record.files import versions, write_json_atomic
 
 PLAN_FORMAT = "plannerlab.plan/1"
 
@@ -130,12 +130,16 @@ def solve_legs(
             from plannerlab.sim import SimWorld
 
             stepper = stack.enter_context(
-                SimWorld(problem.robot, problem.scene, gui=gui,
-                         gravity_mps2=problem.simulation.gravity_mps2))
+                SimWorld(
+                    problem.robot,
+                    problem.scene,
+                    gui=gui,
+                    gravity_mps2=problem.simulation.gravity_mps2,
+                )
+            )
         q = None  # the first leg starts at the problem's start state
         for leg in legs:
-            r = planner.solve(problem, leg, budget, leg_rng(seed, leg), q_start=q,
-                              stepper=stepper)
+            r = planner.solve(problem, leg, budget, leg_rng(seed, leg), q_start=q, stepper=stepper)
             r = r.replace(seed=seed)
             results.append(r)
             if on_leg is not None:

@@ -1,7 +1,7 @@
 """Analytic inverse kinematics of the IRb-6 on the LP-1 track, every solution.
 
 Follows Lubiński (``docs/papers.md`` §2). All poses are in the *station frame* S of
-:mod:`plannerlab.robots.irb6` (x_s horizontal, y_s up, z_s along the track); the target is
+:mod:`plannerlab.robots.irb6.model` (x_s horizontal, y_s up, z_s along the track); the target is
 the flange pose ``T = X · E⁻¹`` (:func:`flange_target`) with columns a, b, c (approach),
 d (position).
 
@@ -48,7 +48,7 @@ import numpy as np
 
 from plannerlab.errors import PlannerlabError
 from plannerlab.robots.base import Array
-from plannerlab.robots.irb6 import IRb6
+from plannerlab.robots.irb6.model import IRb6
 
 #: reason codes of an unreachable pose, in order of how far the solver got
 REASON_CODES = (

@@ -56,7 +56,7 @@ import numpy as np
 from plannerlab.errors import PlannerlabError
 from plannerlab.planners.base import PlanResult
 from plannerlab.planners.chord_arc import guide_obstacles
-from plannerlab.problem import Problem
+from plannerlab.problem.load import Problem
 from plannerlab.sim.world import Contact, SimWorld
 
 #: physics time step [s] (see the module docstring)
@@ -96,11 +96,16 @@ class ClassifiedContact:
 
     def to_dict(self) -> dict[str, Any]:
         return {
-            "link_name": self.link_name, "other_name": self.other_name,
-            "other_is_link": self.other_is_link, "expected": self.expected,
-            "p_world_m": list(self.p_world_m), "max_depth_m": self.max_depth_m,
-            "first_time_s": self.first_time_s, "points": self.points,
-            "collision_point": self.collision_point, "distance_m": self.distance_m,
+            "link_name": self.link_name,
+            "other_name": self.other_name,
+            "other_is_link": self.other_is_link,
+            "expected": self.expected,
+            "p_world_m": list(self.p_world_m),
+            "max_depth_m": self.max_depth_m,
+            "first_time_s": self.first_time_s,
+            "points": self.points,
+            "collision_point": self.collision_point,
+            "distance_m": self.distance_m,
         }
 
 
@@ -162,25 +167,36 @@ class ContinuumExecution:
     def to_dict(self) -> dict[str, Any]:
         """Plain JSON-able data (non-finite numbers become None)."""
         return {
-            "problem": self.problem, "leg": self.leg, "goal": self.goal,
-            "chosen": self.chosen, "collision_points_used": list(self.collision_points_used),
-            "tolerance_m": self.tolerance_m, "tip_error_m": _num(self.tip_error_m),
+            "problem": self.problem,
+            "leg": self.leg,
+            "goal": self.goal,
+            "chosen": self.chosen,
+            "collision_points_used": list(self.collision_points_used),
+            "tolerance_m": self.tolerance_m,
+            "tip_error_m": _num(self.tip_error_m),
             "goal_reached": self.goal_reached,
             "max_tip_track_err_m": _num(self.max_tip_track_err_m),
             "final_track_err": _num(self.final_track_err),
             "contacts": [c.to_dict() for c in self.contacts],
             "expected": len(self.expected_contacts),
             "unexpected": len(self.unexpected_contacts),
-            "success": self.success, "waypoints": self.waypoints, "dt_s": self.dt_s,
+            "success": self.success,
+            "waypoints": self.waypoints,
+            "dt_s": self.dt_s,
             "steps_per_waypoint": self.steps_per_waypoint,
-            "settle_steps": self.settle_steps, "sim_time_s": self.sim_time_s,
-            "wall_time_s": self.wall_time_s, "reason": self.reason,
+            "settle_steps": self.settle_steps,
+            "sim_time_s": self.sim_time_s,
+            "wall_time_s": self.wall_time_s,
+            "reason": self.reason,
         }
 
 
-def classify_point(contact: Contact, points_m: Mapping[int, tuple[float, float]],
-                   owners: Mapping[int, str], tolerance_m: float
-                   ) -> tuple[bool, int | None, float | None]:
+def classify_point(
+    contact: Contact,
+    points_m: Mapping[int, tuple[float, float]],
+    owners: Mapping[int, str],
+    tolerance_m: float,
+) -> tuple[bool, int | None, float | None]:
     """(expected, nearest collision point on that obstacle, its planar distance [m]).
 
     Args:
@@ -202,12 +218,18 @@ def classify_point(contact: Contact, points_m: Mapping[int, tuple[float, float]]
     return best[0] <= tolerance_m, best[1], best[0]
 
 
-def execute_chord_arc(problem: Problem, plan_result: PlanResult, *,
-                      tolerance_m: float | None = None, dt_s: float = DT_S,
-                      steps_per_waypoint: int = STEPS_PER_WAYPOINT,
-                      settle_steps: int = SETTLE_STEPS, min_depth_m: float = 0.0,
-                      gravity_mps2: tuple[float, float, float] | None = None,
-                      gui: bool = False) -> ContinuumExecution:
+def execute_chord_arc(
+    problem: Problem,
+    plan_result: PlanResult,
+    *,
+    tolerance_m: float | None = None,
+    dt_s: float = DT_S,
+    steps_per_waypoint: int = STEPS_PER_WAYPOINT,
+    settle_steps: int = SETTLE_STEPS,
+    min_depth_m: float = 0.0,
+    gravity_mps2: tuple[float, float, float] | None = None,
+    gui: bool = False,
+) -> ContinuumExecution:
     """Execute a solved ``chord_arc`` result's path in PyBullet and classify its contacts.
 
     The world is reset to the path's first state (the retracted robot); each waypoint is
@@ -239,15 +261,19 @@ def execute_chord_arc(problem: Problem, plan_result: PlanResult, *,
         raise PlannerlabError(
             f"execute_chord_arc needs a chord_arc result with a chosen solution; got "
             f"{plan_result.planner!r} with status {plan_result.status.value} "
-            f"({plan_result.reason})")
+            f"({plan_result.reason})"
+        )
     if steps_per_waypoint < 1 or settle_steps < 0 or not dt_s > 0:
-        raise PlannerlabError(f"need dt_s > 0, steps_per_waypoint >= 1, settle_steps >= 0; "
-                              f"got {dt_s}, {steps_per_waypoint}, {settle_steps}")
+        raise PlannerlabError(
+            f"need dt_s > 0, steps_per_waypoint >= 1, settle_steps >= 0; "
+            f"got {dt_s}, {steps_per_waypoint}, {settle_steps}"
+        )
     sol = extra["solutions"][int(chosen)]
     tol = float(extra["contact_tolerance_m"] if tolerance_m is None else tolerance_m)
     idx = [int(i) for i in sol["contact_indices"]]
-    points = {i: (float(p[0]), float(p[1]))
-              for i, p in zip(idx, sol["contact_points_m"], strict=True)}
+    points = {
+        i: (float(p[0]), float(p[1])) for i, p in zip(idx, sol["contact_points_m"], strict=True)
+    }
     owners = dict(zip(idx, sol["contact_obstacles"], strict=True))
     robot = problem.robot
     goal = problem.goal(plan_result.leg)
@@ -291,15 +317,27 @@ def execute_chord_arc(problem: Problem, plan_result: PlanResult, *,
     tip_err = float(pe)
     reached = bool(goal.contains(robot, q_final))
     contacts = tuple(
-        ClassifiedContact(link, other, is_link, ok, tuple(float(v) for v in rec[2]),
-                          float(rec[0]), float(rec[1]), int(rec[3]), rec[4],
-                          None if rec[5] is None else float(rec[5]))
-        for (link, other, is_link, ok), rec in sorted(seen.items(), key=lambda kv: kv[1][1]))
+        ClassifiedContact(
+            link,
+            other,
+            is_link,
+            ok,
+            tuple(float(v) for v in rec[2]),
+            float(rec[0]),
+            float(rec[1]),
+            int(rec[3]),
+            rec[4],
+            None if rec[5] is None else float(rec[5]),
+        )
+        for (link, other, is_link, ok), rec in sorted(seen.items(), key=lambda kv: kv[1][1])
+    )
     unexpected = [c for c in contacts if not c.expected]
-    words = [f"tip {tip_err * 1e3:.3g} mm from the target"
-             + ("" if reached else f" (outside the {goal.pos_tol_m * 1e3:g} mm goal region)"),
-             f"{len(contacts) - len(unexpected)} expected contact pair(s) at collision "
-             f"point(s) {sorted(points)}"]
+    words = [
+        f"tip {tip_err * 1e3:.3g} mm from the target"
+        + ("" if reached else f" (outside the {goal.pos_tol_m * 1e3:g} mm goal region)"),
+        f"{len(contacts) - len(unexpected)} expected contact pair(s) at collision "
+        f"point(s) {sorted(points)}",
+    ]
     if unexpected:
         u = max(unexpected, key=lambda c: c.max_depth_m)
         if u.other_is_link:
@@ -308,22 +346,41 @@ def execute_chord_arc(problem: Problem, plan_result: PlanResult, *,
             where = "no chosen collision point on it"
         else:
             where = f"{u.distance_m * 1e3:.3g} mm from point {u.collision_point}"
-        words.append(f"{len(unexpected)} UNEXPECTED, deepest {u.link_name} x {u.other_name} "
-                     f"{u.max_depth_m * 1e3:.2g} mm at "
-                     f"{np.round(u.p_world_m[:2], 4).tolist()} ({where})")
+        words.append(
+            f"{len(unexpected)} UNEXPECTED, deepest {u.link_name} x {u.other_name} "
+            f"{u.max_depth_m * 1e3:.2g} mm at "
+            f"{np.round(u.p_world_m[:2], 4).tolist()} ({where})"
+        )
     else:
         words.append("no unexpected contact")
     return ContinuumExecution(
-        problem=problem.name, leg=plan_result.leg, goal=plan_result.goal, chosen=int(chosen),
-        collision_points_used=tuple(idx), tolerance_m=tol, tip_error_m=tip_err,
-        goal_reached=reached, max_tip_track_err_m=float(np.max(tip_track, initial=0.0)),
+        problem=problem.name,
+        leg=plan_result.leg,
+        goal=plan_result.goal,
+        chosen=int(chosen),
+        collision_points_used=tuple(idx),
+        tolerance_m=tol,
+        tip_error_m=tip_err,
+        goal_reached=reached,
+        max_tip_track_err_m=float(np.max(tip_track, initial=0.0)),
         final_track_err=float(np.max(np.abs(q_final - path[-1]), initial=0.0)),
-        contacts=contacts, waypoints=len(path), dt_s=float(dt_s),
-        steps_per_waypoint=int(steps_per_waypoint), settle_steps=int(settle_steps),
-        sim_time_s=float(sim_time), wall_time_s=time.perf_counter() - t0,
+        contacts=contacts,
+        waypoints=len(path),
+        dt_s=float(dt_s),
+        steps_per_waypoint=int(steps_per_waypoint),
+        settle_steps=int(settle_steps),
+        sim_time_s=float(sim_time),
+        wall_time_s=time.perf_counter() - t0,
         reason="; ".join(words),
     )
 
 
-__all__ = ["ClassifiedContact", "ContinuumExecution", "DT_S", "SETTLE_STEPS",
-           "STEPS_PER_WAYPOINT", "classify_point", "execute_chord_arc"]
+__all__ = [
+    "ClassifiedContact",
+    "ContinuumExecution",
+    "DT_S",
+    "SETTLE_STEPS",
+    "STEPS_PER_WAYPOINT",
+    "classify_point",
+    "execute_chord_arc",
+]

@@ -100,15 +100,15 @@ def T_tr(h_m: Array | float) -> Array:
     return T
 
 
-def chord_length(theta_rad: Array | float, length_m: Array | float,
-                 a: Array | float = 1.0) -> Array:
+def chord_length(
+    theta_rad: Array | float, length_m: Array | float, a: Array | float = 1.0
+) -> Array:
     """``H(a) = a·L·sinc(aθ/2)`` [m]: distance from the base to the arc point at a."""
     a = np.asarray(a, dtype=float)
     return a * np.asarray(length_m, dtype=float) * sinc(a * np.asarray(theta_rad) / 2.0)
 
 
-def section_tip(T_base: Array, theta_rad: float, length_m: float,
-                a: Array | float = 1.0) -> Array:
+def section_tip(T_base: Array, theta_rad: float, length_m: float, a: Array | float = 1.0) -> Array:
     """Eq. (1): frame at arc fraction ``a`` (..., 3, 3), vectorised over ``a``.
 
     Args:
@@ -122,8 +122,7 @@ def section_tip(T_base: Array, theta_rad: float, length_m: float,
     return T_base @ half @ T_tr(chord_length(theta_rad, length_m, a)) @ half
 
 
-def arc_points_local(theta_rad: Array | float, length_m: Array | float,
-                     a: Array | float) -> Array:
+def arc_points_local(theta_rad: Array | float, length_m: Array | float, a: Array | float) -> Array:
     """Points of arcs in their section frames (..., 2) = H(a)·(sin(aθ/2), cos(aθ/2)).
 
     ``theta_rad``, ``length_m`` and ``a`` broadcast against each other (e.g. θ (K, 1),
@@ -361,8 +360,9 @@ class ContinuumChain:
         return seg[0] if single else seg
 
     # ------------------------------------------------------------------ arcs -> joints
-    def q_from_arcs(self, arcs: Sequence[tuple[float, float]],
-                    insertion_m: float | None = None) -> Array:
+    def q_from_arcs(
+        self, arcs: Sequence[tuple[float, float]], insertion_m: float | None = None
+    ) -> Array:
         """Joint vector (dof,) approximating a chain of constant-curvature arcs.
 
         Args:
@@ -424,7 +424,7 @@ class ContinuumChain:
                 )
             return (
                 f'  <link name="{name}">\n'
-                f"    <inertial>{body}<mass value=\"{m!r}\"/>"
+                f'    <inertial>{body}<mass value="{m!r}"/>'
                 f'<inertia ixx="{ix!r}" ixy="0" ixz="0" iyy="{iy!r}" iyz="0" izz="{iy!r}"/>'
                 f"</inertial>\n"
                 f'    <visual>{body}<geometry><cylinder radius="{r!r}" length="{ell!r}"/>'
@@ -434,12 +434,21 @@ class ContinuumChain:
                 f"  </link>\n"
             )
 
-        def joint(name: str, kind: str, parent: str, child: str, x_m: float,
-                  axis: str, limits: tuple[float, float] | None) -> str:
+        def joint(
+            name: str,
+            kind: str,
+            parent: str,
+            child: str,
+            x_m: float,
+            axis: str,
+            limits: tuple[float, float] | None,
+        ) -> str:
             lim = ""
             if limits is not None:
-                lim = (f'<limit lower="{limits[0]!r}" upper="{limits[1]!r}" effort="100" '
-                       f'velocity="10"/>')
+                lim = (
+                    f'<limit lower="{limits[0]!r}" upper="{limits[1]!r}" effort="100" '
+                    f'velocity="10"/>'
+                )
             ax = f'<axis xyz="{axis}"/>' if axis else ""
             return (
                 f'  <joint name="{name}" type="{kind}">\n'
@@ -451,13 +460,31 @@ class ContinuumChain:
         parts = ['<?xml version="1.0"?>\n<robot name="continuum_chain">\n']
         parts.append(link("base", False))
         parts.append(link("carriage", False))
-        parts.append(joint("insertion", "prismatic", "base", "carriage", -self.length_m,
-                           "1 0 0", (0.0, self.length_m)))
+        parts.append(
+            joint(
+                "insertion",
+                "prismatic",
+                "base",
+                "carriage",
+                -self.length_m,
+                "1 0 0",
+                (0.0, self.length_m),
+            )
+        )
         parent = "carriage"
         for i, name in enumerate(self.link_names, start=1):
             parts.append(link(name, True))
-            parts.append(joint(f"joint_{i}", "revolute", parent, name, 0.0 if i == 1 else ell,
-                               "0 0 1", (-self.max_joint_rad, self.max_joint_rad)))
+            parts.append(
+                joint(
+                    f"joint_{i}",
+                    "revolute",
+                    parent,
+                    name,
+                    0.0 if i == 1 else ell,
+                    "0 0 1",
+                    (-self.max_joint_rad, self.max_joint_rad),
+                )
+            )
             parent = name
         parts.append(link("tip", False))
         parts.append(joint("tip_joint", "fixed", parent, "tip", ell, "", None))
@@ -467,10 +494,19 @@ class ContinuumChain:
 
 def from_table(reader: Any) -> ContinuumChain:
     """Build a chain from a problem file's ``[robot]`` table (a ``problem.TableReader``)."""
-    reader.unknown_keys((
-        "type", "n_links", "length_m", "link_radius_m", "max_joint_deg", "base_xyz_m",
-        "base_rpy_deg", "link_mass_kg", "note",
-    ))
+    reader.unknown_keys(
+        (
+            "type",
+            "n_links",
+            "length_m",
+            "link_radius_m",
+            "max_joint_deg",
+            "base_xyz_m",
+            "base_rpy_deg",
+            "link_mass_kg",
+            "note",
+        )
+    )
     T = reader.pose("base_xyz_m", "base_rpy_deg") if reader.has("base_xyz_m") else np.eye(4)
     rpy = matrix_to_rpy(T[:3, :3])
     if abs(rpy[0]) > 1e-9 or abs(rpy[1]) > 1e-9:

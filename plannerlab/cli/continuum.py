@@ -11,7 +11,7 @@ the median time of the whole ``solve`` (plus the joint paths and the FCL contact
 classification), collision points, solutions found, solutions dropped, and the chosen
 one. A figure like the paper's Fig. 4 (obstacles, collision points, every solution,
 target) is written per case to ``--figures`` (default ``results/``). ``--execute`` also
-runs the chosen solution in PyBullet (:func:`plannerlab.continuum_exec.execute_chord_arc`)
+runs the chosen solution in PyBullet (:func:`plannerlab.sim.continuum.execute_chord_arc`)
 and shows the tip error and the expected / unexpected contacts.
 
 Argument parsing and printing only; the work is done by the library.
@@ -44,18 +44,32 @@ PAPER: dict[str, tuple[float, int, int]] = {
 def add_continuum_parser(subparsers: Any) -> argparse.ArgumentParser:
     """Register ``plannerlab continuum`` on the CLI's subparsers."""
     p = subparsers.add_parser(
-        "continuum", help="the continuum paper's table and Fig. 4 (chord_arc planner)",
-        description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    p.add_argument("cases", nargs="+", metavar="CASE",
-                   help="problem name or .toml path, or N for continuum_caseN")
+        "continuum",
+        help="the continuum paper's table and Fig. 4 (chord_arc planner)",
+        description=__doc__,
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
+    p.add_argument(
+        "cases",
+        nargs="+",
+        metavar="CASE",
+        help="problem name or .toml path, or N for continuum_caseN",
+    )
     p.add_argument("--runs", type=int, default=20, help="timed runs per case (default 20)")
-    p.add_argument("--figures", default="results", metavar="DIR",
-                   help="folder for the Fig.-4-like PNGs (default results/)")
+    p.add_argument(
+        "--figures",
+        default="results",
+        metavar="DIR",
+        help="folder for the Fig.-4-like PNGs (default results/)",
+    )
     p.add_argument("--no-figures", action="store_true", help="draw nothing")
-    p.add_argument("--execute", action="store_true",
-                   help="execute the chosen solution in PyBullet")
-    p.add_argument("--set", action="append", metavar="KEY=VALUE",
-                   help="override a chord_arc setting (repeatable)")
+    p.add_argument("--execute", action="store_true", help="execute the chosen solution in PyBullet")
+    p.add_argument(
+        "--set",
+        action="append",
+        metavar="KEY=VALUE",
+        help="override a chord_arc setting (repeatable)",
+    )
     p.add_argument("--json", action="store_true", help="machine-readable output")
     p.set_defaults(func=cmd_continuum)
     return p
@@ -85,26 +99,32 @@ def _case_name(case: str) -> str:
 
 def _figure(planner: Any, problem: Any, result: Any, out: Path) -> Path:
     """Fig. 4: the search's curves, split into the planner's kept and dropped ones."""
-    from plannerlab.continuum_figures import draw_case
     from plannerlab.planners.chord_arc_search import ChordArcResult, DroppedSolution
+    from plannerlab.plot.continuum import draw_case
 
     query, res = planner.search(problem, result.leg)
     kept = {tuple(s["contact_indices"]) for s in result.extra["solutions"]}
     plans = tuple(p for p in res.plans if p.solution.contact_indices in kept)
-    chain_dropped = tuple(DroppedSolution(p.solution, p.contacts, "dropped by the chain check")
-                          for p in res.plans if p.solution.contact_indices not in kept)
+    chain_dropped = tuple(
+        DroppedSolution(p.solution, p.contacts, "dropped by the chain check")
+        for p in res.plans
+        if p.solution.contact_indices not in kept
+    )
     shown = ChordArcResult(res.search, plans, res.dropped + chain_dropped)
-    title = (f"{problem.name}: {len(plans)} solution(s), "
-             f"{len(query.collision_points_m)} collision points")
+    title = (
+        f"{problem.name}: {len(plans)} solution(s), "
+        f"{len(query.collision_points_m)} collision points"
+    )
     return draw_case(query, shown, out / f"{problem.name}.png", title=title)
 
 
-def run_case(case: str, runs: int, overrides: dict[str, Any], figures: Path | None,
-             do_execute: bool) -> dict[str, Any]:
+def run_case(
+    case: str, runs: int, overrides: dict[str, Any], figures: Path | None, do_execute: bool
+) -> dict[str, Any]:
     """One row of the table as data (JSON-able)."""
-    from plannerlab.catalog import load_problem
+    from plannerlab.bench.task import leg_rng
     from plannerlab.planners import make_planner
-    from plannerlab.runner import leg_rng
+    from plannerlab.problem.catalog import load_problem
 
     problem = load_problem(_case_name(case))
     planner = make_planner("chord_arc", overrides)
@@ -120,23 +140,30 @@ def run_case(case: str, runs: int, overrides: dict[str, Any], figures: Path | No
     sol = first.extra["solutions"]
     chosen = first.extra["chosen"]
     row: dict[str, Any] = {
-        "problem": problem.name, "status": first.status.value, "reason": first.reason,
-        "runs": runs, "search_median_s": statistics.median(search_s) if runs else None,
+        "problem": problem.name,
+        "status": first.status.value,
+        "reason": first.reason,
+        "runs": runs,
+        "search_median_s": statistics.median(search_s) if runs else None,
         "solve_median_s": statistics.median(solve_s) if runs else None,
         "collision_points": len(first.extra["collision_points_m"]),
-        "solutions": len(sol), "dropped": len(first.extra["dropped"]),
+        "solutions": len(sol),
+        "dropped": len(first.extra["dropped"]),
         "dropped_reasons": [d["reason"] for d in first.extra["dropped"]],
         "chosen": chosen,
         "chosen_contacts": sol[chosen]["contact_indices"] if chosen is not None else None,
-        "expansions": first.iterations, "same_every_run": len(counts) <= 1,
-        "paper": None if paper is None else
-        {"time_s": paper[0], "collision_points": paper[1], "solutions": paper[2]},
-        "solutions_data": sol, "settings": dict(first.settings),
+        "expansions": first.iterations,
+        "same_every_run": len(counts) <= 1,
+        "paper": None
+        if paper is None
+        else {"time_s": paper[0], "collision_points": paper[1], "solutions": paper[2]},
+        "solutions_data": sol,
+        "settings": dict(first.settings),
     }
     if figures is not None and sol:
         row["figure"] = str(_figure(planner, problem, first, figures))
     if do_execute and first.extra.get("chosen") is not None:
-        from plannerlab.continuum_exec import execute_chord_arc
+        from plannerlab.sim.continuum import execute_chord_arc
 
         row["execution"] = execute_chord_arc(problem, first).to_dict()
     return row
@@ -144,7 +171,7 @@ def run_case(case: str, runs: int, overrides: dict[str, Any], figures: Path | No
 
 def cmd_continuum(args: argparse.Namespace, console: Console) -> int:
     """``plannerlab continuum``: print the table (or JSON); write the figures."""
-    from plannerlab.cli import _parse_overrides
+    from plannerlab.cli.main import _parse_overrides
     from plannerlab.errors import PlannerlabError
 
     if args.runs < 1:
@@ -154,16 +181,31 @@ def cmd_continuum(args: argparse.Namespace, console: Console) -> int:
     rows = []
     with console.status("chord_arc") as status, _stdout_to_stderr(args.json):
         for case in args.cases:
-            status.update(f"chord_arc on {_case_name(case)}: {args.runs} runs"
-                          + (" and PyBullet" if args.execute else ""))
+            status.update(
+                f"chord_arc on {_case_name(case)}: {args.runs} runs"
+                + (" and PyBullet" if args.execute else "")
+            )
             rows.append(run_case(case, args.runs, overrides, figures, args.execute))
     if args.json:
         print(json.dumps(rows))
         return 0
-    t = Table(title=f"chord_arc on the continuum paper's cases (median of {args.runs} runs; "
-                    "paper: MATLAB 2019a, i7-4790K)", caption_justify="left")
-    cols = ["case", "status", "search ms", "solve ms", "paper ms", "points (paper)",
-            "solutions (paper)", "dropped", "chosen: points", "same"]
+    t = Table(
+        title=f"chord_arc on the continuum paper's cases (median of {args.runs} runs; "
+        "paper: MATLAB 2019a, i7-4790K)",
+        caption_justify="left",
+    )
+    cols = [
+        "case",
+        "status",
+        "search ms",
+        "solve ms",
+        "paper ms",
+        "points (paper)",
+        "solutions (paper)",
+        "dropped",
+        "chosen: points",
+        "same",
+    ]
     if args.execute:
         cols += ["tip err mm", "expected", "unexpected"]
     for col in cols:
@@ -176,9 +218,14 @@ def cmd_continuum(args: argparse.Namespace, console: Console) -> int:
         p_sol = f" ({paper['solutions']})" if paper else ""
         style = "green" if r["status"] == "solved" else "red"
         cells = [
-            r["problem"].removeprefix("continuum_"), f"[{style}]{r['status']}[/{style}]",
-            f"{r['search_median_s'] * 1e3:.2f}", f"{r['solve_median_s'] * 1e3:.0f}", p_ms,
-            f"{r['collision_points']}{p_pts}", f"{r['solutions']}{p_sol}", str(r["dropped"]),
+            r["problem"].removeprefix("continuum_"),
+            f"[{style}]{r['status']}[/{style}]",
+            f"{r['search_median_s'] * 1e3:.2f}",
+            f"{r['solve_median_s'] * 1e3:.0f}",
+            p_ms,
+            f"{r['collision_points']}{p_pts}",
+            f"{r['solutions']}{p_sol}",
+            str(r["dropped"]),
             "-" if r["chosen"] is None else f"#{r['chosen']}: {r['chosen_contacts']}",
             "yes" if r["same_every_run"] else "[red]no[/red]",
         ]
@@ -188,19 +235,28 @@ def cmd_continuum(args: argparse.Namespace, console: Console) -> int:
                 cells += ["-", "-", "-"]
             else:
                 u = e["unexpected"]
-                cells += [f"{e['tip_error_m'] * 1e3:.2f}", str(e["expected"]),
-                          f"[red]{u}[/red]" if u else "0"]
+                cells += [
+                    f"{e['tip_error_m'] * 1e3:.2f}",
+                    str(e["expected"]),
+                    f"[red]{u}[/red]" if u else "0",
+                ]
                 notes.append(f"{r['problem']} execution: {e['reason']}")
         t.add_row(*cells)
         for d in r["dropped_reasons"]:
             notes.append(f"{r['problem']} dropped: {d}")
         if "figure" in r:
             notes.append(f"{r['problem']} figure: {r['figure']}")
-    t.caption = escape("\n".join(
-        ["search ms: search + contact-type check (what the paper times); solve ms: the "
-         "planner's whole solve (joint paths, FCL contact classification); same: every "
-         "run gave the same status and counts; expected / unexpected: contact pairs in "
-         "PyBullet"] + notes))
+    t.caption = escape(
+        "\n".join(
+            [
+                "search ms: search + contact-type check (what the paper times); solve ms: the "
+                "planner's whole solve (joint paths, FCL contact classification); same: every "
+                "run gave the same status and counts; expected / unexpected: contact pairs in "
+                "PyBullet"
+            ]
+            + notes
+        )
+    )
     console.print(t)
     return 0
 

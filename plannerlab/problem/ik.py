@@ -23,7 +23,7 @@ from typing import Protocol
 
 import numpy as np
 
-from plannerlab.goals import GoalRegion
+from plannerlab.problem.goals import GoalRegion
 from plannerlab.robots.base import Array, Robot, wrap_to_pi
 
 
@@ -109,8 +109,10 @@ def solve_ik(
     for iterations in range(1, max_iterations + 1):  # noqa: B007 - count survives the loop
         p, n = robot.tip(q)
         pos_err, ang_err = goal.errors_from_tip(p, n)
-        if (pos_err <= target_fraction * goal.pos_tol_m
-                and ang_err <= target_fraction * goal.angle_tol_deg):
+        if (
+            pos_err <= target_fraction * goal.pos_tol_m
+            and ang_err <= target_fraction * goal.angle_tol_deg
+        ):
             iterations -= 1
             break
         e = np.concatenate([(goal.p_world_m - p) * pos_scale, (goal.n_world - n) * ang_scale])
@@ -124,12 +126,19 @@ def solve_ik(
     pos_err, ang_err = (float(v) for v in goal.errors(robot, q))
     inside = pos_err <= goal.pos_tol_m and ang_err <= goal.angle_tol_deg
     if not inside:
-        return IKResult(q, False, iterations,
-                        f"ended outside the region after {iterations} steps "
-                        f"({pos_err:.3g} m, {ang_err:.3g} deg)", pos_err, ang_err)
+        return IKResult(
+            q,
+            False,
+            iterations,
+            f"ended outside the region after {iterations} steps "
+            f"({pos_err:.3g} m, {ang_err:.3g} deg)",
+            pos_err,
+            ang_err,
+        )
     if checker is not None and not checker.is_valid(q):
-        return IKResult(q, False, iterations, "reached the region but the state collides",
-                        pos_err, ang_err)
+        return IKResult(
+            q, False, iterations, "reached the region but the state collides", pos_err, ang_err
+        )
     return IKResult(q, True, iterations, "inside both tolerances", pos_err, ang_err)
 
 

@@ -1,6 +1,6 @@
 """Finding and loading problems: what users call.
 
-:func:`load_problem` parses a problem file (see :mod:`plannerlab.problem`) and then makes
+:func:`load_problem` parses a problem file (see :mod:`plannerlab.problem.load`) and then makes
 the checks that need the collision checker: the start state must be collision-free
 (the error names the colliding pairs).
 """
@@ -10,16 +10,16 @@ from __future__ import annotations
 import os
 from pathlib import Path
 
-from plannerlab.collision import CollisionChecker
+from plannerlab.collision.fcl_checker import CollisionChecker
 from plannerlab.errors import ProblemError, UnknownNameError
-from plannerlab.problem import Problem, parse_problem
+from plannerlab.problem.load import Problem, parse_problem
 
 
 def problems_dir() -> Path:
     """The folder of bundled problems: ``$PLANNERLAB_PROBLEMS`` or the repository's
     ``problems/``."""
     env = os.environ.get("PLANNERLAB_PROBLEMS")
-    return Path(env) if env else Path(__file__).resolve().parents[1] / "problems"
+    return Path(env) if env else Path(__file__).resolve().parents[2] / "problems"
 
 
 def list_problems() -> list[Path]:
@@ -45,8 +45,9 @@ def check_start(problem: Problem, checker: CollisionChecker | None = None) -> No
     if not checker.is_valid(problem.q_start):
         pairs = checker.colliding_pairs(problem.q_start)
         listing = ", ".join(f"{a} x {b}" for a, b in pairs)
-        raise ProblemError(problem.source, "start",
-                           f"a collision-free start state; it collides: {listing}")
+        raise ProblemError(
+            problem.source, "start", f"a collision-free start state; it collides: {listing}"
+        )
 
 
 def load_problem(name_or_path: str | Path) -> Problem:

@@ -17,9 +17,9 @@ from dataclasses import dataclass
 import fcl
 import numpy as np
 
-from plannerlab.paths import densify
+from plannerlab.problem.scene import Box, Cylinder, Scene, Sphere
 from plannerlab.robots.base import Array, Robot
-from plannerlab.scene import Box, Cylinder, Scene, Sphere
+from plannerlab.robots.paths import densify
 
 
 @dataclass(frozen=True)
@@ -129,11 +129,14 @@ class CollisionChecker:
         lo = np.minimum(segs[:, :, 0], segs[:, :, 1]) - r  # (k, L, 3)
         hi = np.maximum(segs[:, :, 0], segs[:, :, 1]) + r
         if len(self._obstacles):
-            scene = np.all(
-                (lo[:, :, None, :] <= self._obs_hi[None, None])
-                & (hi[:, :, None, :] >= self._obs_lo[None, None]),
-                axis=-1,
-            ) & self._scene_mask[None]
+            scene = (
+                np.all(
+                    (lo[:, :, None, :] <= self._obs_hi[None, None])
+                    & (hi[:, :, None, :] >= self._obs_lo[None, None]),
+                    axis=-1,
+                )
+                & self._scene_mask[None]
+            )
         else:
             scene = np.zeros(segs.shape[:2] + (0,), dtype=bool)
         if len(self._self_pairs):
@@ -146,8 +149,9 @@ class CollisionChecker:
     def _collide(self, o1: fcl.CollisionObject, o2: fcl.CollisionObject) -> bool:
         return fcl.collide(o1, o2, self._request, fcl.CollisionResult()) > 0
 
-    def _state_pairs(self, seg: Array, scene: Array, selfc: Array,
-                     first_only: bool) -> list[tuple[int, int, bool]]:
+    def _state_pairs(
+        self, seg: Array, scene: Array, selfc: Array, first_only: bool
+    ) -> list[tuple[int, int, bool]]:
         """Colliding pairs of one state among the candidates: (link, other, other_is_link)."""
         self._place(seg)
         hits: list[tuple[int, int, bool]] = []

@@ -4,7 +4,7 @@ Problems live in TOML files (``problems/*.toml``); :func:`parse_problem` reads o
 validates every value when the problem is built. Anything wrong raises
 :class:`~plannerlab.errors.ProblemError` naming the file, the key and what was expected.
 Checks that need the collision checker (a start in collision) are made by
-:func:`plannerlab.catalog.load_problem`, which is what users call.
+:func:`plannerlab.problem.catalog.load_problem`, which is what users call.
 
 File layout (every key is documented in ``docs/problem-format.md``)::
 
@@ -32,13 +32,21 @@ from typing import Any
 import numpy as np
 
 from plannerlab.errors import ProblemError, UnknownNameError
-from plannerlab.goals import GoalRegion
+from plannerlab.problem.goals import GoalRegion
+from plannerlab.problem.scene import OBSTACLE_TYPES, Box, Cylinder, Obstacle, Scene, Sphere
 from plannerlab.robots import build_robot
 from plannerlab.robots.base import Array, Robot, pose_matrix
-from plannerlab.scene import OBSTACLE_TYPES, Box, Cylinder, Obstacle, Scene, Sphere
 
-KNOWN_TABLES = ("problem", "robot", "start", "obstacles", "goals", "budget", "checking",
-                "simulation")
+KNOWN_TABLES = (
+    "problem",
+    "robot",
+    "start",
+    "obstacles",
+    "goals",
+    "budget",
+    "checking",
+    "simulation",
+)
 
 
 @dataclass(frozen=True, eq=False)
@@ -159,8 +167,9 @@ class TableReader:
             raise self.fail(name, f"a string, got {v!r}")
         return v
 
-    def number(self, name: str, default: Any = ..., *, positive: bool = False,
-               nonnegative: bool = False) -> float:
+    def number(
+        self, name: str, default: Any = ..., *, positive: bool = False, nonnegative: bool = False
+    ) -> float:
         v = self.raw(name, default)
         if isinstance(v, bool) or not isinstance(v, int | float):
             raise self.fail(name, f"a number, got {v!r}")
@@ -225,10 +234,13 @@ def _obstacle(reader: TableReader) -> Obstacle:
             raise reader.fail("size_m", f"three positive edge lengths, got {size.tolist()}")
         return Box(name, T, size)
     if kind == "cylinder":
-        reader.unknown_keys(("name", "type", "center_m", "rpy_deg", "radius_m", "length_m",
-                             "note"))
-        return Cylinder(name, T, reader.number("radius_m", positive=True),
-                        reader.number("length_m", positive=True))
+        reader.unknown_keys(("name", "type", "center_m", "rpy_deg", "radius_m", "length_m", "note"))
+        return Cylinder(
+            name,
+            T,
+            reader.number("radius_m", positive=True),
+            reader.number("length_m", positive=True),
+        )
     reader.unknown_keys(("name", "type", "center_m", "rpy_deg", "radius_m", "note"))
     return Sphere(name, T, reader.number("radius_m", positive=True))
 
@@ -251,16 +263,20 @@ def _goal(reader: TableReader) -> GoalRegion:
 def _start(reader: TableReader, robot: Robot) -> Array:
     keys = [k for k in ("q", "q_deg", "fill", "fill_deg") if reader.has(k)]
     if len(keys) != 1:
-        raise reader.fail("q", "exactly one of q, q_deg, fill, fill_deg"
-                          + (f"; got {', '.join(keys)}" if keys else ""))
+        raise reader.fail(
+            "q",
+            "exactly one of q, q_deg, fill, fill_deg"
+            + (f"; got {', '.join(keys)}" if keys else ""),
+        )
     k = keys[0]
     if k.startswith("fill"):
         q = np.full(robot.dof, reader.number(k))
     else:
         q = reader.vector(k)
         if q.shape != (robot.dof,):
-            raise reader.fail(k, f"{robot.dof} joint values for this {robot.kind} robot, "
-                                 f"got {q.size}")
+            raise reader.fail(
+                k, f"{robot.dof} joint values for this {robot.kind} robot, got {q.size}"
+            )
     if k.endswith("_deg"):
         q = np.deg2rad(q)
     lo, hi = robot.lower, robot.upper
@@ -268,8 +284,9 @@ def _start(reader: TableReader, robot: Robot) -> Array:
     bad = np.flatnonzero(bounded & ((q < lo - 1e-12) | (q > hi + 1e-12)))
     if bad.size:
         i = int(bad[0])
-        raise reader.fail(k, f"joint {robot.joint_names[i]} within [{lo[i]:.6g}, {hi[i]:.6g}],"
-                             f" got {q[i]:.6g}")
+        raise reader.fail(
+            k, f"joint {robot.joint_names[i]} within [{lo[i]:.6g}, {hi[i]:.6g}], got {q[i]:.6g}"
+        )
     return q
 
 

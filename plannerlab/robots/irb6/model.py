@@ -80,7 +80,7 @@ from plannerlab.errors import PlannerlabError
 from plannerlab.robots.base import Array, pose_matrix, rot_x, rot_y, rot_z, trans, urdf_origin
 
 if TYPE_CHECKING:
-    from plannerlab.goals import GoalRegion
+    from plannerlab.problem.goals import GoalRegion
 
 #: rotation flange-at-θ5=0 in the wrist frame: columns a = y_w, b = z_w, c = x_w
 _R_WRIST_FLANGE0 = np.array([[0.0, 0.0, 1.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]])
@@ -354,7 +354,7 @@ class IRb6:
 
         This is the hook the common goal sampler calls for robots that have an analytic
         inverse kinematics (instead of restarting a numeric descent): it wraps
-        :func:`plannerlab.robots.irb6_goals.sample_irb6_goal`, which draws a flange pose
+        :func:`plannerlab.robots.irb6.goals.sample_irb6_goal`, which draws a flange pose
         inside the region (position ball, approach cone, free roll) and solves it; in the
         ambiguous cases λ0 is drawn uniformly from the pose's feasible λ0 set, so repeated
         calls spread over every interval of the track that reaches the goal.
@@ -374,7 +374,7 @@ class IRb6:
         Returns:
             q (6,) or None when no attempt of the sampler reached the region.
         """
-        from plannerlab.robots.irb6_goals import sample_irb6_goal  # imports this module
+        from plannerlab.robots.irb6.goals import sample_irb6_goal  # imports this module
 
         previous_theta5 = None
         if seeds is not None and len(seeds) > 0:
@@ -565,7 +565,7 @@ def from_table(reader: Any) -> IRb6:
     ``base_rpy_deg`` (URDF roll, pitch, yaw) [deg]. Errors name the file and the key.
 
     Args:
-        reader: a :class:`plannerlab.problem.TableReader` on the ``[robot]`` table.
+        reader: a :class:`plannerlab.problem.load.TableReader` on the ``[robot]`` table.
     """
     reader.unknown_keys(ROBOT_TABLE_KEYS)
     d = IRb6()

@@ -189,8 +189,13 @@ class ArmZ:
         mid = (0.0, self.delta_y_m / 2.0, self.delta_z_m / 2.0)
         r = self.collision_radius_m
 
-        def module_body(name: str, mid_xyz: tuple[float, float, float], tilt_rad: float,
-                        length_m: float, mass_kg: float) -> str:
+        def module_body(
+            name: str,
+            mid_xyz: tuple[float, float, float],
+            tilt_rad: float,
+            length_m: float,
+            mass_kg: float,
+        ) -> str:
             xyz = " ".join(repr(float(v)) for v in mid_xyz)
             return (
                 f'  <link name="{name}">\n'
@@ -254,13 +259,24 @@ class ArmZ:
         return "".join(parts)
 
 
-def from_table(reader) -> ArmZ:  # reader: plannerlab.problem.TableReader
+def from_table(reader) -> ArmZ:  # reader: plannerlab.problem.load.TableReader
     """Build an Arm-Z from a problem file's ``[robot]`` table (defaults = the paper's)."""
-    reader.unknown_keys((
-        "type", "n_modules", "zeta_deg", "delta_y_m", "delta_z_m", "collision_radius_m",
-        "self_exclude_within", "base_xyz_m", "base_rpy_deg", "module_mass_kg",
-        "joint_torque_limit_nm", "note",
-    ))
+    reader.unknown_keys(
+        (
+            "type",
+            "n_modules",
+            "zeta_deg",
+            "delta_y_m",
+            "delta_z_m",
+            "collision_radius_m",
+            "self_exclude_within",
+            "base_xyz_m",
+            "base_rpy_deg",
+            "module_mass_kg",
+            "joint_torque_limit_nm",
+            "note",
+        )
+    )
     T = reader.pose("base_xyz_m", "base_rpy_deg") if reader.has("base_xyz_m") else np.eye(4)
     return ArmZ(
         n_modules=reader.integer("n_modules", 24, minimum=2),

@@ -12,7 +12,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from plannerlab.goals import GoalRegion
+from plannerlab.problem.goals import GoalRegion
 from plannerlab.robots.base import Array, Robot
 
 

@@ -21,7 +21,7 @@ Decisions:
   only, when a child has sent it, so there is a single writer.
 * **Seeding.** The child seeds OMPL (``seed_ompl(seed)``) before anything else whenever
   :mod:`plannerlab.planners.ompl` imports, whatever the planner (a planner may use OMPL
-  inside); numpy generators come from :func:`plannerlab.runner.leg_rng`.
+  inside); numpy generators come from :func:`plannerlab.bench.task.leg_rng`.
 * **Trial key.** ``problem/planner/s<seed>/<hash>`` where the hash (sha256, 10 hex) covers
   the budget and settings overrides, the legs and the execute flag, so one store can hold
   runs of the same grid under different budgets without mixing them.
@@ -86,7 +86,7 @@ class Trial:
         planner: registry name.
         seed: the trial's seed (numpy streams per leg, and OMPL's global seed).
         budget: overrides of the problem's budget, sorted ``(key, value)`` pairs with keys
-            of :class:`~plannerlab.problem.Budget` (``max_iterations``,
+            of :class:`~plannerlab.problem.load.Budget` (``max_iterations``,
             ``max_collision_checks``, ``time_limit_s``).
         settings: planner settings overrides, sorted ``(key, value)`` pairs.
         legs: leg indices to solve, in order (None: every leg).
@@ -210,7 +210,7 @@ def _seed_ompl(seed: int) -> bool:
 
 
 def _leg_record(r: Any, continuous: np.ndarray) -> dict[str, Any]:
-    from plannerlab.paths import path_length
+    from plannerlab.robots.paths import path_length
 
     path = np.ascontiguousarray(r.path, dtype=float)
     extra_lengths = {
@@ -275,8 +275,15 @@ def _trial_status(legs: Sequence[Mapping[str, Any]]) -> str:
 
 
 #: per-leg numbers summed into a trial's ``totals``
-TOTAL_KEYS = ("time_s", "iterations", "collision_checks", "fk_calls", "path_length",
-              "local_minima", "escapes")
+TOTAL_KEYS = (
+    "time_s",
+    "iterations",
+    "collision_checks",
+    "fk_calls",
+    "path_length",
+    "local_minima",
+    "escapes",
+)
 
 
 def run_trial(trial: Trial) -> dict[str, Any]:
@@ -289,7 +296,7 @@ def run_trial(trial: Trial) -> dict[str, Any]:
     """
     t0 = time.perf_counter()
     ompl_seeded = _seed_ompl(trial.seed)  # first: before any OMPL object exists
-    from plannerlab.io import versions
+    from plannerlab.record.files import versions
 
     rec: dict[str, Any] = {
         "format": RECORD_FORMAT,
@@ -298,8 +305,8 @@ def run_trial(trial: Trial) -> dict[str, Any]:
         "ompl_seeded": ompl_seeded,
     }
     try:
-        from plannerlab.catalog import load_problem
-        from plannerlab.runner import solve_legs
+        from plannerlab.bench.task import solve_legs
+        from plannerlab.problem.catalog import load_problem
 
         problem = load_problem(trial.problem_file)
         budget = problem.budget.replace(**dict(trial.budget))
@@ -334,7 +341,8 @@ def run_trial(trial: Trial) -> dict[str, Any]:
             from plannerlab.sim.execute import execute_legs
 
             executions = execute_legs(
-                problem, [r.path for r in plan.legs[:solved_prefix]],
+                problem,
+                [r.path for r in plan.legs[:solved_prefix]],
                 first_leg=plan.legs[0].leg,
             )
             rec["execution"] = _execution_record(executions)

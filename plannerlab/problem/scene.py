@@ -1,4 +1,4 @@
-"""Obstacles as plain data. No collision library here: :mod:`plannerlab.collision` turns
+"""Obstacles as plain data. No collision library here: :mod:`plannerlab.collision.fcl_checker` turns
 these into FCL objects.
 
 Every obstacle has a name (unique in its scene), a pose ``T_world_obstacle`` (4, 4) whose

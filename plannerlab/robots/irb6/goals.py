@@ -22,8 +22,8 @@ import numpy as np
 
 from plannerlab.errors import PlannerlabError
 from plannerlab.robots.base import Array
-from plannerlab.robots.irb6 import IRb6
-from plannerlab.robots.irb6_ik import IKAnswer, solve_ik, solve_with_lambda0
+from plannerlab.robots.irb6.ik import IKAnswer, solve_ik, solve_with_lambda0
+from plannerlab.robots.irb6.model import IRb6
 
 
 def _perpendicular_basis(c: Array) -> tuple[Array, Array]:

@@ -21,9 +21,9 @@ from matplotlib import colormaps
 from matplotlib.figure import Figure
 from scipy.spatial import ConvexHull
 
-from plannerlab.problem import Problem
+from plannerlab.problem.load import Problem
+from plannerlab.problem.scene import Box, Cylinder, Obstacle
 from plannerlab.robots.base import Array
-from plannerlab.scene import Box, Cylinder, Obstacle
 
 VIEWS = {"front (x-z)": (0, 2), "top (x-y)": (0, 1)}
 
@@ -37,12 +37,14 @@ def obstacle_points(o: Obstacle, n: int = 24) -> Array:
     elif isinstance(o, Cylinder):
         a = np.linspace(0, 2 * np.pi, n, endpoint=False)
         ring = np.stack([o.radius_m * np.cos(a), o.radius_m * np.sin(a)], axis=1)
-        local = np.concatenate([np.c_[ring, np.full(n, z)] for z in (-o.length_m / 2,
-                                                                      o.length_m / 2)])
+        local = np.concatenate(
+            [np.c_[ring, np.full(n, z)] for z in (-o.length_m / 2, o.length_m / 2)]
+        )
     else:
         u, v = np.meshgrid(np.linspace(0, 2 * np.pi, n), np.linspace(0, np.pi, n // 2))
-        local = o.radius_m * np.stack([np.cos(u) * np.sin(v), np.sin(u) * np.sin(v),
-                                       np.cos(v)], axis=-1).reshape(-1, 3)
+        local = o.radius_m * np.stack(
+            [np.cos(u) * np.sin(v), np.sin(u) * np.sin(v), np.cos(v)], axis=-1
+        ).reshape(-1, 3)
     return local @ T[:3, :3].T + T[:3, 3]
 
 
@@ -67,8 +69,9 @@ def draw_scene_3d(ax: Any, problem: Problem, skip: Sequence[str] = ("ground",)) 
             ax.plot(*pts.T, color="0.55", lw=0.4)
 
 
-def draw_scene_2d(ax: Any, problem: Problem, dims: tuple[int, int],
-                  skip: Sequence[str] = ("ground",)) -> None:
+def draw_scene_2d(
+    ax: Any, problem: Problem, dims: tuple[int, int], skip: Sequence[str] = ("ground",)
+) -> None:
     for o in problem.scene.obstacles:
         if o.name in skip:
             continue
@@ -80,15 +83,28 @@ def draw_scene_2d(ax: Any, problem: Problem, dims: tuple[int, int],
         ax.fill(*hull.T, color="0.8", alpha=0.5, lw=0.5, edgecolor="0.5")
 
 
-def draw_arm(ax: Any, problem: Problem, q: Array, dims: tuple[int, int] | None,
-             color: str, label: str | None = None) -> None:
+def draw_arm(
+    ax: Any,
+    problem: Problem,
+    q: Array,
+    dims: tuple[int, int] | None,
+    color: str,
+    label: str | None = None,
+) -> None:
     seg = problem.robot.link_segments(q)  # (L, 2, 3)
     chain = np.concatenate([seg[:, 0], seg[-1:, 1]])
     if dims is None:
         ax.plot(*chain.T, color=color, lw=2.5, marker="o", ms=2.5, label=label)
     else:
-        ax.plot(chain[:, dims[0]], chain[:, dims[1]], color=color, lw=2.5, marker="o", ms=2.5,
-                label=label)
+        ax.plot(
+            chain[:, dims[0]],
+            chain[:, dims[1]],
+            color=color,
+            lw=2.5,
+            marker="o",
+            ms=2.5,
+            label=label,
+        )
 
 
 def draw_goals(ax: Any, problem: Problem, dims: tuple[int, int] | None) -> None:
@@ -167,16 +183,25 @@ def plot_plan(plan: Any, problem: Problem, out_dir: str | Path) -> list[Path]:
     out_dir = Path(out_dir)
     files = []
     title = f"{plan.planner} on {plan.problem} (seed {plan.seed})"
-    files.append(save(snapshot_figure(problem, [("start", plan.legs[0].path[0])],
-                                      f"{title}: start"), out_dir / "start.png"))
+    files.append(
+        save(
+            snapshot_figure(problem, [("start", plan.legs[0].path[0])], f"{title}: start"),
+            out_dir / "start.png",
+        )
+    )
     for r in plan.legs:
         tag = "stall" if r.status.value == "local_minimum" else "end"
-        files.append(save(
-            snapshot_figure(problem, [("leg start", r.path[0]), (f"{tag}: {r.status.value}",
-                                                                 r.path[-1])],
-                            f"{title}: leg {r.leg} '{r.goal}' {tag} after {r.iterations} "
-                            f"iterations"),
-            out_dir / f"leg{r.leg}_{r.goal}_{tag}.png"))
-    files.append(save(trace_figure(plan.legs, f"{title}: objective per iteration"),
-                      out_dir / "trace.png"))
+        files.append(
+            save(
+                snapshot_figure(
+                    problem,
+                    [("leg start", r.path[0]), (f"{tag}: {r.status.value}", r.path[-1])],
+                    f"{title}: leg {r.leg} '{r.goal}' {tag} after {r.iterations} iterations",
+                ),
+                out_dir / f"leg{r.leg}_{r.goal}_{tag}.png",
+            )
+        )
+    files.append(
+        save(trace_figure(plan.legs, f"{title}: objective per iteration"), out_dir / "trace.png")
+    )
     return files

@@ -12,7 +12,7 @@ the track; ``--frame world`` reads them in the world frame of ``--problem``'s ro
 angles in degrees. Exit status: 0 when a solution exists, 1 when the pose is unreachable,
 2 on bad input (the CLI's main prints the :class:`PlannerlabError`).
 
-Argument parsing and printing only; the solver is :mod:`plannerlab.robots.irb6_ik`.
+Argument parsing and printing only; the solver is :mod:`plannerlab.robots.irb6.ik`.
 """
 
 from __future__ import annotations
@@ -106,14 +106,14 @@ def _finite(value: float | None, option: str) -> float | None:
 
 def _robot(args: argparse.Namespace) -> tuple[Any, str | None]:
     """The IRb-6 model (defaults, or a problem's [robot] table) and the problem's name."""
-    from plannerlab.robots.irb6 import IRb6
+    from plannerlab.robots.irb6.model import IRb6
 
     if args.problem is None:
         if args.frame == "world":
             raise PlannerlabError("--frame world needs --problem (the world of which problem?)")
         return IRb6(), None
-    from plannerlab.catalog import resolve_problem_path
-    from plannerlab.problem import parse_problem
+    from plannerlab.problem.catalog import resolve_problem_path
+    from plannerlab.problem.load import parse_problem
 
     problem = parse_problem(resolve_problem_path(args.problem))
     if not isinstance(problem.robot, IRb6):
@@ -145,7 +145,7 @@ def ik_report(
         ``solutions`` (each with ``q``, ``lambda0_m``, ``theta_deg``, ``pos_err_m``,
         ``rot_err_deg``, ``approach_err_deg``), ``reachable``, ``reason_code``, ``reason``.
     """
-    from plannerlab.robots.irb6_ik import pose_from_approach, solve_ik
+    from plannerlab.robots.irb6.ik import pose_from_approach, solve_ik
 
     T_target = pose_from_approach(p_station_m, c_station, roll_rad)
     answer = solve_ik(robot, T_target, previous_theta5_rad)
