@@ -171,12 +171,12 @@ def run_case(
 
 def cmd_continuum(args: argparse.Namespace, console: Console) -> int:
     """``plannerlab continuum``: print the table (or JSON); write the figures."""
-    from plannerlab.cli.main import _parse_overrides
+    from plannerlab.cli.common import parse_overrides
     from plannerlab.errors import PlannerlabError
 
     if args.runs < 1:
         raise PlannerlabError(f"--runs must be >= 1, got {args.runs}")
-    overrides = _parse_overrides(args.set)
+    overrides = parse_overrides(args.set)
     figures = None if args.no_figures else Path(args.figures)
     rows = []
     with console.status("chord_arc") as status, _stdout_to_stderr(args.json):

@@ -1,0 +1,86 @@
+"""`plannerlab execute`: run a plan (or plan first) in PyBullet."""
+
+from __future__ import annotations
+
+import argparse
+import json
+from pathlib import Path
+from typing import Any
+
+from rich.console import Console
+from rich.table import Table
+
+from plannerlab.cli.common import fmt
+from plannerlab.cli.solve import add_plan_arguments, leg_table, solve_and_save
+from plannerlab.errors import PlannerlabError
+
+
+def cmd_execute(args: argparse.Namespace, console: Console) -> int:
+    from dataclasses import replace
+
+    from plannerlab.bench.task import Plan
+    from plannerlab.sim.execute import execute_legs
+
+    if args.problem.endswith(".json"):
+        out = Path(args.problem)
+        plan = Plan.load(out)
+    else:
+        if not args.planner:
+            raise PlannerlabError("execute PROBLEM needs --planner NAME (or give a PLAN.json)")
+        plan, out = solve_and_save(args, console)
+    problem = plan.load_problem()
+    with console.status(f"executing {len(plan.legs)} legs in PyBullet"):
+        executions = execute_legs(
+            problem, [r.path for r in plan.legs], first_leg=plan.legs[0].leg, gui=args.gui
+        )
+    plan = replace(plan, executions=tuple(e.to_dict() for e in executions))
+    plan.save(out)
+    if args.json:
+        print(json.dumps(plan.to_dict()))
+        return 1 if args.strict and not all(e.success for e in executions) else 0
+    console.print(leg_table(plan, f"{plan.planner} on {plan.problem}, seed {plan.seed}: plan"))
+    t = Table(title="execution in PyBullet")
+    for col in (
+        "leg",
+        "goal",
+        "FCL re-check",
+        "pos err m",
+        "ang err °",
+        "max track err rad",
+        "contacts",
+        "sim s",
+        "wall s",
+        "ok",
+    ):
+        t.add_column(col, overflow="fold")
+    for r, e in zip(plan.legs, executions, strict=True):
+        names = [f"{c.link_name} x {c.other_name}" for c in e.contacts]
+        contacts = ", ".join(names[:2]) + (f" +{len(names) - 2} more" if len(names) > 2 else "")
+        contacts = contacts or "none"
+        recheck = (
+            "valid"
+            if e.path_valid
+            else f"collides on edge {e.recheck_first_invalid_edge}: "
+            + ", ".join(f"{a} x {b}" for a, b in e.recheck_pairs)
+        )
+        t.add_row(
+            str(r.leg),
+            r.goal,
+            recheck,
+            fmt(e.final_pos_err_m),
+            fmt(e.final_angle_err_deg),
+            fmt(e.max_track_err_rad),
+            contacts,
+            fmt(e.sim_time_s),
+            fmt(e.wall_time_s),
+            "[green]yes[/green]" if e.success else "[red]no[/red]",
+        )
+    console.print(t)
+    console.print(f"plan and execution written to {out}")
+    return 1 if args.strict and not all(e.success for e in executions) else 0
+
+
+def add_parser(sub: Any) -> None:
+    p = sub.add_parser("execute", help="plan (or load a plan) and execute it in PyBullet")
+    add_plan_arguments(p, "execute")
+    p.set_defaults(func=cmd_execute)

@@ -1,0 +1,41 @@
+"""`plannerlab planners`: the registered planners."""
+
+from __future__ import annotations
+
+import argparse
+import json
+from typing import Any
+
+from rich.console import Console
+from rich.table import Table
+
+
+def cmd_planners(args: argparse.Namespace, console: Console) -> int:
+    from plannerlab.planners import REGISTRY
+
+    rows = [
+        {
+            "name": e.name,
+            "summary": e.summary,
+            "needs_simulator": e.needs_stepper,
+            "robots": list(e.robots) if e.robots else "any",
+        }
+        for e in REGISTRY.values()
+    ]
+    if args.json:
+        print(json.dumps(rows, indent=1))
+        return 0
+    t = Table(title="planners")
+    for col in ("name", "robots", "summary"):
+        t.add_column(col)
+    for r in rows:
+        robots = r["robots"] if isinstance(r["robots"], str) else ", ".join(r["robots"])
+        t.add_row(r["name"], robots, r["summary"])
+    console.print(t)
+    return 0
+
+
+def add_parser(sub: Any) -> None:
+    p = sub.add_parser("planners", help="list the registered planners")
+    p.add_argument("--json", action="store_true", help="print one JSON document")
+    p.set_defaults(func=cmd_planners)

@@ -1,0 +1,33 @@
+"""`plannerlab plot`: figures of a plan."""
+
+from __future__ import annotations
+
+import argparse
+import json
+from pathlib import Path
+from typing import Any
+
+from rich.console import Console
+
+
+def cmd_plot(args: argparse.Namespace, console: Console) -> int:
+    from plannerlab.bench.task import Plan
+    from plannerlab.plot.plans import plot_plan
+
+    plan = Plan.load(args.plan)
+    out_dir = Path(args.out) if args.out else Path(args.plan).with_suffix("")
+    files = plot_plan(plan, plan.load_problem(), out_dir)
+    if args.json:
+        print(json.dumps([str(f) for f in files]))
+    else:
+        for f in files:
+            console.print(f"wrote {f}")
+    return 0
+
+
+def add_parser(sub: Any) -> None:
+    p = sub.add_parser("plot", help="draw a plan: the arm at start, leg ends, stalls; f trace")
+    p.add_argument("plan", help="PLAN.json written by solve/execute")
+    p.add_argument("--out", help="folder for the PNG files (default: beside the plan)")
+    p.add_argument("--json", action="store_true")
+    p.set_defaults(func=cmd_plot)

@@ -1,0 +1,123 @@
+"""`plannerlab solve`: plan every leg of a problem and write a plan file."""
+
+from __future__ import annotations
+
+import argparse
+import json
+from pathlib import Path
+from typing import Any
+
+from rich.console import Console
+from rich.table import Table
+
+from plannerlab.cli.common import (
+    RESULTS_DIR,
+    add_budget_args,
+    budget_from_args,
+    fmt,
+    legs_from_spec,
+    parse_overrides,
+)
+
+
+def leg_table(plan: Any, title: str) -> Table:
+    t = Table(title=title, caption_justify="left")
+    for col in ("leg", "goal", "status", "iters", "time s", "checks", "pos err m", "ang err °"):
+        t.add_column(col, no_wrap=(col == "status"))
+    reasons = []
+    for r in plan.legs:
+        style = "green" if r.solved else ("yellow" if r.status == "local_minimum" else "red")
+        t.add_row(
+            str(r.leg),
+            r.goal,
+            f"[{style}]{r.status.value}[/{style}]",
+            str(r.iterations),
+            fmt(r.time_s),
+            str(r.collision_checks),
+            fmt(r.pos_err_m),
+            fmt(r.angle_err_deg),
+        )
+        reasons.append(f"{r.leg} {r.goal}: {r.reason}")
+    t.caption = "\n".join(reasons)
+    return t
+
+
+def _default_plan_path(problem: str, planner: str, seed: int) -> Path:
+    return RESULTS_DIR / "plans" / f"{problem}__{planner}__seed{seed}.json"
+
+
+def solve_and_save(args: argparse.Namespace, console: Console) -> Any:
+    from plannerlab.bench.task import solve_legs
+    from plannerlab.problem.catalog import load_problem
+
+    problem = load_problem(args.problem)
+    overrides = parse_overrides(args.set)
+    legs = legs_from_spec(problem, args.legs)
+    n_legs = len(legs) if legs is not None else problem.legs
+    status = console.status(f"{args.planner} on {problem.name}: leg 1/{n_legs}")
+
+    done = []
+
+    def on_leg(r: Any) -> None:
+        done.append(r)
+        status.update(
+            f"{args.planner} on {problem.name}: leg {len(done) + 1}/{n_legs} "
+            f"(last: {r.goal} {r.status.value})"
+        )
+
+    with status:
+        plan = solve_legs(
+            problem,
+            args.planner,
+            args.seed,
+            legs=legs,
+            budget=budget_from_args(problem, args),
+            overrides=overrides,
+            gui=getattr(args, "gui", False),
+            on_leg=on_leg,
+        )
+    out = Path(args.out) if args.out else _default_plan_path(problem.name, args.planner, args.seed)
+    plan.save(out)
+    return plan, out
+
+
+def cmd_solve(args: argparse.Namespace, console: Console) -> int:
+    plan, out = solve_and_save(args, console)
+    if args.json:
+        print(json.dumps(plan.to_dict()))
+    else:
+        console.print(leg_table(plan, f"{plan.planner} on {plan.problem}, seed {plan.seed}"))
+        console.print(f"plan written to {out}")
+    return 1 if args.strict and not plan.solved else 0
+
+
+def add_plan_arguments(p: argparse.ArgumentParser, name: str) -> None:
+    """The arguments `solve` and `execute` share."""
+    p.add_argument(
+        "problem",
+        help="problem name or .toml path" + (" (or a PLAN.json)" if name == "execute" else ""),
+    )
+    p.add_argument("--planner", required=(name == "solve"), help="registry name")
+    p.add_argument("--seed", type=int, default=0)
+    p.add_argument("--legs", help="comma-separated leg names or indices (default: all)")
+    p.add_argument(
+        "--set",
+        action="append",
+        metavar="KEY=VALUE",
+        help="override a planner setting (repeatable)",
+    )
+    p.add_argument("--out", help="plan file to write (default results/plans/...)")
+    p.add_argument("--json", action="store_true", help="machine-readable output")
+    p.add_argument("--gui", action="store_true", help="PyBullet window instead of DIRECT")
+    p.add_argument(
+        "--strict",
+        action="store_true",
+        help="exit 1 unless every leg is solved (and executed cleanly)",
+    )
+    add_budget_args(p)
+
+
+def add_parser(sub: Any) -> None:
+    p = sub.add_parser("solve", help="plan every leg of a problem and print a table per leg")
+    add_plan_arguments(p, "solve")
+    p.set_defaults(func=cmd_solve)
