@@ -224,3 +224,42 @@ def test_execution_json_round_trip() -> None:
         assert back.goal_reached == ex.goal_reached
     assert np.isnan(back.final_pos_err_m) and back.goal_reached is None
     assert back.gravity_mps2 == (0.0, 0.0, 0.0) and with_contacts.gravity_mps2 == (0, 0, -9.81)
+
+
+def test_a_path_the_arm_cannot_follow_is_not_executed_cleanly() -> None:
+    """The verdict includes tracking: the arm reaches the goal after settling, but lagged
+    far behind the commanded path on the way, so the execution is not clean."""
+    robot = ArmZ(n_modules=8)
+    q0 = np.full(robot.dof, np.pi)
+    q1 = q0 + 0.5
+    problem = make_problem(robot, Scene(), q1)
+    kw = dict(leg=0, steps_per_waypoint=1, settle_steps=2400, gravity_mps2=(0.0, 0.0, 0.0))
+    fast = execute(problem, np.stack([q0, q1]), **kw)
+    assert fast.path_valid and not fast.contacts and fast.goal_reached
+    assert fast.track_err_limit_rad == problem.simulation.max_track_err_rad == 0.05
+    assert fast.max_track_err_rad > 0.05
+    assert not fast.tracked and not fast.success
+    assert "tracking error" in fast.reason and "max_track_err_rad" in fast.reason
+    # the limit is the problem's: a looser one accepts the same motion
+    loose = execute(problem, np.stack([q0, q1]), max_track_err_rad=1.0, **kw)
+    assert loose.track_err_limit_rad == 1.0 and loose.tracked and loose.success
+    back = Execution.from_dict(json.loads(json.dumps(fast.to_dict())))
+    assert back.track_err_limit_rad == 0.05 and not back.success
+
+
+def test_problem_file_sets_the_tracking_limit(tmp_path) -> None:
+    from plannerlab.errors import ProblemError
+    from plannerlab.problem.load import parse_problem
+
+    text = (
+        "[problem]\nname = 't'\n[robot]\ntype = 'armz'\nn_modules = 6\n"
+        "[start]\nfill = 3.141592653589793\n"
+        "[[goals]]\nname = 'g'\np_m = [0, 0, 3]\nn = [0, 0, 1]\npos_tol_m = 0.1\n"
+        "angle_tol_deg = 10\n[simulation]\nmax_track_err_rad = 0.02\n"
+    )
+    path = tmp_path / "t.toml"
+    path.write_text(text)
+    assert parse_problem(path).simulation.max_track_err_rad == 0.02
+    path.write_text(text.replace("0.02", "-1"))
+    with pytest.raises(ProblemError, match=r"simulation\.max_track_err_rad"):
+        parse_problem(path)

@@ -16,7 +16,7 @@ File layout (every key is documented in ``docs/problem-format.md``)::
     [[goals]]   name, p_m, n, pos_tol_m, angle_tol_deg     (one per leg, in order)
     [budget]    max_iterations, max_collision_checks, time_limit_s
     [checking]  joint_step       (largest joint step between checked states on an edge)
-    [simulation] gravity_mps2
+    [simulation] gravity_mps2, max_track_err_rad
     any other table (e.g. [witness], [continuum]) is kept in ``Problem.extras``.
 """
 
@@ -83,9 +83,13 @@ class SimSettings:
 
     Attributes:
         gravity_mps2: gravity in the world frame [m/s²].
+        max_track_err_rad: largest joint tracking error [rad] (max over joints and over
+            the execution of the wrapped |commanded − actual|) an execution may show and
+            still count as executed cleanly.
     """
 
     gravity_mps2: tuple[float, float, float] = (0.0, 0.0, -9.81)
+    max_track_err_rad: float = 0.05
 
 
 @dataclass(frozen=True, eq=False)
@@ -328,9 +332,10 @@ def problem_from_dict(data: Mapping[str, Any], source: str) -> Problem:
     joint_step = c.number("joint_step", 0.05, positive=True)
 
     sim = TableReader(source, "simulation", top.raw("simulation", {}))
-    sim.unknown_keys(("gravity_mps2", "note"))
+    sim.unknown_keys(("gravity_mps2", "max_track_err_rad", "note"))
     simulation = SimSettings(
-        gravity_mps2=tuple(float(v) for v in sim.vector("gravity_mps2", 3, (0.0, 0.0, -9.81)))
+        gravity_mps2=tuple(float(v) for v in sim.vector("gravity_mps2", 3, (0.0, 0.0, -9.81))),
+        max_track_err_rad=sim.number("max_track_err_rad", 0.05, positive=True),
     )
 
     extras = {k: v for k, v in data.items() if k not in KNOWN_TABLES}

@@ -38,8 +38,11 @@ Decisions:
   paper's 100 N·m motors cannot hold poses whose static gravity torque is larger (a
   200-waypoint 24-module path through poses needing up to 285 N·m sagged by 3 rad onto
   the room floor). ``gravity_mps2=(0, 0, 0)`` separates such failures from kinematic ones.
-* **Success** = the path passed the re-check, no contact was recorded and, when a leg was
-  given, the final state lies inside that leg's goal region.
+* **Success** ("executed cleanly") = the path passed the re-check, no contact was
+  recorded, the maximum joint tracking error stayed within the problem's
+  ``[simulation] max_track_err_rad`` (default 0.05 rad) and, when a leg was given, the
+  final state lies inside that leg's goal region. A path that reached its goal while the
+  arm was far off the planned path did not execute *that* path, so it is not clean.
 """
 
 from __future__ import annotations
@@ -176,6 +179,8 @@ class Execution:
         sim_time_s: simulated time of this execution (physics steps × dt) [s].
         wall_time_s: wall-clock time of this execution, re-check included [s].
         reason: why it succeeded or failed, in words.
+        track_err_limit_rad: the largest ``max_track_err_rad`` a clean execution may
+            show [rad] (the problem's ``[simulation] max_track_err_rad``).
     """
 
     problem: str
@@ -210,6 +215,7 @@ class Execution:
     sim_time_s: float
     wall_time_s: float
     reason: str
+    track_err_limit_rad: float = 0.05
 
     def __post_init__(self) -> None:
         for name in _ARRAY_FIELDS:
@@ -235,9 +241,20 @@ class Execution:
         )
 
     @property
+    def tracked(self) -> bool:
+        """The maximum joint tracking error stayed within ``track_err_limit_rad``."""
+        return self.max_track_err_rad <= self.track_err_limit_rad
+
+    @property
     def success(self) -> bool:
-        """Re-check valid, no contact, and (with a leg) the final state in the goal."""
-        return self.path_valid and not self.contacts and self.goal_reached is not False
+        """Executed cleanly: re-check valid, no contact, tracking error within the limit,
+        and (with a leg) the final state in the goal."""
+        return (
+            self.path_valid
+            and not self.contacts
+            and self.tracked
+            and self.goal_reached is not False
+        )
 
     @property
     def max_track_err_rad(self) -> float:
@@ -279,9 +296,13 @@ class Execution:
         Raises:
             PlannerlabError: ``data`` is not an execution record.
         """
-        names = {f.name for f in dataclasses.fields(cls)}
+        fields = dataclasses.fields(cls)
         try:
-            values = {k: data[k] for k in names}
+            values = {
+                f.name: data[f.name]
+                for f in fields
+                if f.name in data or f.default is dataclasses.MISSING
+            }
             for k in ("sim_time_s", "wall_time_s", "dt_s", "contact_tol_m"):
                 values[k] = float(values[k])
             return cls(**values)
@@ -312,6 +333,7 @@ def _run(
     steps_per_waypoint: int,
     settle_steps: int,
     contact_tol_m: float,
+    track_err_limit_rad: float | None,
 ) -> Execution:
     t0 = time.perf_counter()
     robot = problem.robot
@@ -321,6 +343,13 @@ def _run(
             f"steps_per_waypoint >= 1 and settle_steps >= 0, got {steps_per_waypoint}, "
             f"{settle_steps}"
         )
+    track_limit = (
+        float(track_err_limit_rad)
+        if track_err_limit_rad is not None
+        else problem.simulation.max_track_err_rad
+    )
+    if not track_limit > 0:
+        raise PlannerlabError(f"max_track_err_rad must be positive, got {track_limit}")
     recheck_step = float(joint_step) if joint_step is not None else problem.joint_step / 4.0
     wp_step = float(waypoint_step) if waypoint_step is not None else problem.joint_step
     if not (recheck_step > 0 and wp_step > 0):
@@ -403,6 +432,13 @@ def _run(
             f"{goal.name!r} (tolerance {goal.pos_tol_m:g} m / "
             f"{goal.angle_tol_deg:g} deg)"
         )
+    max_track = float(np.max(track, initial=0.0))
+    if max_track > track_limit:
+        worst_k = int(np.argmax(track))
+        problems.append(
+            f"tracking error {max_track:.3g} rad at t = {t_s[worst_k]:.3f} s exceeds the "
+            f"limit {track_limit:g} rad ([simulation] max_track_err_rad)"
+        )
     if problems:
         reason = "; ".join(problems)
     else:
@@ -446,6 +482,7 @@ def _run(
         sim_time_s=(world.steps_taken - steps0) * world.dt_s,
         wall_time_s=time.perf_counter() - t0,
         reason=reason,
+        track_err_limit_rad=track_limit,
     )
 
 
@@ -459,6 +496,7 @@ def execute(
     settle_steps: int = SETTLE_STEPS,
     contact_tol_m: float = CONTACT_TOL_M,
     gravity_mps2: tuple[float, float, float] | None = None,
+    max_track_err_rad: float | None = None,
     gui: bool = False,
     leg: int | str | None = None,
 ) -> Execution:
@@ -479,6 +517,8 @@ def execute(
         gravity_mps2: gravity in the world frame [m/s²]; default: the problem's
             ``[simulation] gravity_mps2`` (zero it to separate kinematic from torque-limit
             failures).
+        max_track_err_rad: the largest joint tracking error of a clean execution [rad];
+            default: the problem's ``[simulation] max_track_err_rad``.
         gui: show PyBullet's GUI.
         leg: the leg (index or goal name) whose goal the final state is measured against.
 
@@ -508,6 +548,7 @@ def execute(
             steps_per_waypoint,
             settle_steps,
             contact_tol_m,
+            max_track_err_rad,
         )
 
 
@@ -522,6 +563,7 @@ def execute_legs(
     settle_steps: int = SETTLE_STEPS,
     contact_tol_m: float = CONTACT_TOL_M,
     gravity_mps2: tuple[float, float, float] | None = None,
+    max_track_err_rad: float | None = None,
     gui: bool = False,
 ) -> list[Execution]:
     """Execute consecutive legs in ONE world, each from where the previous one ended.
@@ -556,6 +598,7 @@ def execute_legs(
                     steps_per_waypoint,
                     settle_steps,
                     contact_tol_m,
+                    max_track_err_rad,
                 )
             )
     return out
