@@ -4,6 +4,7 @@ leave it, and their paths hold up in PyBullet."""
 from __future__ import annotations
 
 import numpy as np
+import pytest
 
 from plannerlab.collision.fcl_checker import CollisionChecker
 from plannerlab.planners import make_planner
@@ -13,20 +14,36 @@ from plannerlab.robots.base import joint_difference
 from plannerlab.sim.execute import execute
 
 
-def test_gradient_rrtconnect_escapes_the_pocket_and_executes_without_contact():
+def test_gradient_rrtconnect_escapes_from_the_stall_itself():
     problem = load_problem("armz_pocket")
     r = make_planner("gradient+rrtconnect").solve(
         problem, 0, problem.budget.replace(max_collision_checks=50_000), np.random.default_rng(0)
     )
     assert r.status is Status.SOLVED, r.reason
     assert r.local_minima == 1 and r.escapes == 1
+    (record,) = r.extra["escapes"]
+    assert record["start_from_stall_rad"] == 0.0
+    assert record["start_from_leg_start_rad"] == pytest.approx(record["descent_before_stall_rad"])
+    assert record["left_stall"]
     assert (
         CollisionChecker(problem.robot, problem.scene)
         .check_path(r.path, problem.joint_step / 4)
         .valid
     )
-    # Without the retreat the path runs into the boulder in PyBullet (the descent stopped
-    # one joint step from it and the arm overshoots: 8.7 mm, 0.22 rad tracking error).
+
+
+def test_with_a_retreat_the_escape_starts_back_at_the_start_and_executes_without_contact():
+    """armz_pocket's descent stalls 0.076 rad from the start: a 0.3 rad retreat goes back
+    to the start (the record says so), and that path does not touch the boulder in
+    PyBullet (from the stall itself the tracking arm touches it, 8.7 mm)."""
+    problem = load_problem("armz_pocket")
+    r = make_planner("gradient+rrtconnect", {"retreat_rad": 0.3}).solve(
+        problem, 0, problem.budget.replace(max_collision_checks=50_000), np.random.default_rng(0)
+    )
+    assert r.status is Status.SOLVED, r.reason
+    (record,) = r.extra["escapes"]
+    assert record["start_from_leg_start_rad"] == 0.0
+    assert record["start_from_stall_rad"] > 0.0
     e = execute(problem, r.path, leg=0)
     assert e.success, e.reason
     assert not e.contacts
@@ -38,7 +55,7 @@ def test_retreat_cuts_the_descent_back_from_the_stall():
         problem, 0, problem.budget, np.random.default_rng(0)
     )
     assert stall.status is Status.LOCAL_MINIMUM
-    planner = make_planner("gradient+rrtconnect")
+    planner = make_planner("gradient+rrtconnect", {"retreat_rad": 0.3})
     path = [p for p in stall.path]
     q = planner._retreat(path, len(stall.path) - 1, problem.robot.continuous)
     far = np.max(np.abs(joint_difference(q, stall.path[-1], problem.robot.continuous)))

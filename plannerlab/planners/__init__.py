@@ -92,6 +92,24 @@ def _entries() -> dict[str, PlannerEntry]:
             "gradient descent restarted from random collision-free states near each stall",
         )
     )
+    for name, summary in (
+        (
+            "gradient.clearance",
+            "the paper's objective plus a smooth clearance term (link distances to the scene "
+            "and each other): the descent slides along walls; no escape",
+        ),
+        (
+            "gradient.clearance+detour",
+            "gradient.clearance; at a stall, sub-goals near the stall (the goal's approach "
+            "point, then the tip drawn back along its own body), the descent resumes",
+        ),
+        (
+            "gradient.clearance+rrtconnect",
+            "gradient.clearance; at a stall, RRT-Connect from the stall to a goal state "
+            "found by the clearance descent from the stall",
+        ),
+    ):
+        entries.append(PlannerEntry(name, "plannerlab.planners.gradient_clearance:make", summary))
     entries.append(
         PlannerEntry(
             "chord_arc",

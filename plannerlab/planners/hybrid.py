@@ -13,9 +13,13 @@
     restart) and descends again. Each restart is part of the path, so the result is an
     executable path, not only a goal state.
 
-A local minimum is *escaped* when, after it, the planner reaches the goal region or a
-state whose objective is lower than the stall's by more than ``stall_min_decrease``.
-Both planners report ``local_minima`` (stalls met) and ``escapes``.
+Which escape runs is a setting (``escape``: "rrtconnect" or "restart"), not the name.
+An escape is counted only when the planner *leaves a stall state*: the escape starts at
+the stall (or, with ``retreat_rad`` > 0, at the state the path was cut back to, and the
+record says how far that is) and its path moves away from it. Every escape is recorded in
+``extra["escapes"]``: where it started (joint-space Euclidean distance from the leg's
+start and from the stall [rad]), how far the descent travelled before stalling [rad],
+and whether it left the stall. Both planners report ``local_minima`` and ``escapes``.
 """
 
 from __future__ import annotations
@@ -30,10 +34,9 @@ from plannerlab.collision.fcl_checker import CollisionChecker
 from plannerlab.errors import PlannerlabError
 from plannerlab.planners.base import PlanResult, Status, settings_dict, with_overrides
 from plannerlab.planners.gradient import GradientPlanner, GradientSettings
-from plannerlab.planners.objective import Objective
 from plannerlab.problem.load import Budget
 from plannerlab.robots.base import Array, joint_difference, wrap_to_pi
-from plannerlab.robots.paths import interpolate_edge
+from plannerlab.robots.paths import interpolate_edge, path_length
 
 
 @dataclass(frozen=True)
@@ -54,10 +57,11 @@ class HybridSettings:
         restart_tries: samples per restart before the noise grows.
         retreat_rad: before escaping, the path is cut back along the descent to the last
             state at least this far (largest joint difference) from the stall, or to the
-            descent's start, and the escape starts there (0: from the stall itself). A
-            kinematic descent stalls one joint step from contact, and a real arm tracking
-            that path overshoots into the obstacle (measured in PyBullet on the traps:
-            8.7 mm into the boulder, 0.22 rad of tracking error).
+            descent's start, and the escape starts there (0, the default: from the stall
+            itself). On the shallow traps the descent stalls within 0.3 rad of the start,
+            so a retreat of 0.3 rad escapes from the start: the record says so.
+        escape: "rrtconnect" (RRT-Connect from the stall) or "restart" (random restarts
+            near the stall).
     """
 
     gamma: float = 0.05
@@ -71,7 +75,8 @@ class HybridSettings:
     restart_noise_rad: float = 0.3
     restart_noise_growth: float = 1.5
     restart_tries: int = 20
-    retreat_rad: float = 0.3
+    retreat_rad: float = 0.0
+    escape: str = "rrtconnect"
 
     def descent(self) -> GradientSettings:
         return GradientSettings(
@@ -151,9 +156,7 @@ class HybridPlanner:
         trace: list[float] = []
         minima = escapes = 0
         notes: list[str] = []
-        stall_f: float | None = None
         noise = s.restart_noise_rad
-        objective = Objective(robot, goal, None)
 
         def done(status: Status, reason: str) -> PlanResult:
             p = np.array(path)
@@ -176,8 +179,14 @@ class HybridPlanner:
                 local_minima=minima,
                 escapes=escapes,
                 settings=settings_dict(s),
-                extra={"steps": notes},
+                extra={"steps": notes, "escapes": escapes_log, "descent_rad": descent_rad},
             )
+
+        escapes_log: list[dict] = []
+        descent_rad: list[float] = []
+
+        def dist(a: Array, b: Array) -> float:
+            return float(np.linalg.norm(joint_difference(a, b, robot.continuous)))
 
         while True:
             sub = ledger.remaining()
@@ -187,17 +196,15 @@ class HybridPlanner:
             ledger.add(r)
             path.extend(r.path[1:])
             trace.extend(r.trace.tolist())
+            descent_rad.append(path_length(r.path, robot.continuous))
             q = r.path[-1]
-            if stall_f is not None and (r.solved or r.trace.min() < stall_f - s.stall_min_decrease):
-                escapes += 1
-                stall_f = None
             notes.append(f"descent: {r.status.value} after {r.iterations} iterations")
             if r.status in (Status.SOLVED, Status.INVALID_START):
                 return done(r.status, f"{r.reason}; {minima} local minima met, {escapes} escaped")
             if r.status is not Status.LOCAL_MINIMUM:
                 return done(r.status, r.reason)
             minima += 1
-            stall_f = float(objective(q))
+            q_stall = np.array(q)
             if s.retreat_rad > 0:
                 q = self._retreat(path, len(r.path) - 1, robot.continuous)
             if minima > s.max_escapes:
@@ -206,25 +213,37 @@ class HybridPlanner:
                     f"{minima} local minima met, {escapes} escaped; gave up after "
                     f"{s.max_escapes} escape attempts",
                 )
-            if self.name == "gradient+rrtconnect":
+            record = {
+                "kind": s.escape,
+                "stall": minima,
+                "start_from_leg_start_rad": dist(q, path[0]),
+                "start_from_stall_rad": dist(q, q_stall),
+                "descent_before_stall_rad": descent_rad[-1],
+                "left_stall": False,
+            }
+            escapes_log.append(record)
+            if s.escape == "rrtconnect":
                 rrt = self._rrt_escape(problem, leg, ledger, rng, q)
                 if rrt is None:
                     return done(Status.BUDGET_EXHAUSTED, ledger.exhausted_reason())
                 notes.append(f"rrtconnect from stall {minima}: {rrt.status.value}")
                 if rrt.solved:
                     path.extend(rrt.path[1:])
-                    escapes += 1
+                    record["left_stall"] = len(rrt.path) > 1
+                    escapes += int(record["left_stall"])
                     return done(
                         Status.SOLVED,
                         f"descent stalled; RRT-Connect reached the goal region from "
                         f"stall {minima}; {minima} local minima met, {escapes} escaped",
                     )
-            # restart near the stall (multistart always; rrtconnect after a failed slice)
+            # restart near the stall (restart always; rrtconnect after a failed slice)
             q_new = self._restart(problem, ledger, rng, q, noise)
             noise *= s.restart_noise_growth
             if q_new is None:
                 notes.append(f"no collision-free restart near stall {minima}")
                 continue
+            record["left_stall"] = True
+            escapes += 1
             path.extend(q_new[1:])
             q = q_new[-1]
 
@@ -279,14 +298,19 @@ class HybridPlanner:
         return None
 
 
-VARIANTS = ("gradient+rrtconnect", "gradient.multistart")
+VARIANTS: dict[str, dict[str, object]] = {
+    "gradient+rrtconnect": {"escape": "rrtconnect"},
+    "gradient.multistart": {"escape": "restart"},
+}
 
 
 def make(name: str, overrides: dict) -> HybridPlanner:
     """Registry factory for ``gradient+rrtconnect`` and ``gradient.multistart``."""
     if name not in VARIANTS:
         raise PlannerlabError(f"{name} is not a hybrid planner ({', '.join(VARIANTS)})")
-    settings = with_overrides(HybridSettings(), overrides, name)
+    settings = with_overrides(HybridSettings(**VARIANTS[name]), overrides, name)  # type: ignore[arg-type]
+    if settings.escape not in ("rrtconnect", "restart"):
+        raise PlannerlabError(f"escape setting: 'rrtconnect' or 'restart', got {settings.escape!r}")
     if settings.gradient not in ("analytic", "finite_difference"):
         raise PlannerlabError(
             f"gradient setting: 'analytic' or 'finite_difference', got {settings.gradient!r}"

@@ -115,6 +115,10 @@ class OMPLSettings:
         max_goal_attempts: IK descents at most to fill the pool.
         motion_check: ``"batched"`` (plannerlab edge check, Linf steps of joint_step) or
             ``"ompl"`` (OMPL's discrete motion validator).
+        goal_selection: ``"ik"`` (numeric IK restarts seeded from the leg start, see
+            :func:`~plannerlab.problem.ik.sample_goal_state`) or ``"near"`` (the goal state
+            ``gradient.clearance`` selects: its descent from the leg start with the path
+            unchecked, so the goal stays near the start; one state, one check).
     """
 
     simplify: bool = True
@@ -122,6 +126,7 @@ class OMPLSettings:
     goal_samples: int = 4
     max_goal_attempts: int = 200
     motion_check: str = "batched"
+    goal_selection: str = "ik"
 
 
 @dataclass(frozen=True)
@@ -555,6 +560,17 @@ def _projection(
     return proj
 
 
+def _near_goal(
+    problem: Any, leg: int, q0: Array, checker: CollisionChecker, bud: _Budget
+) -> Array | None:
+    """The goal state ``gradient.clearance`` selects near q0 (see ``goal_selection``)."""
+    from plannerlab.planners.gradient_clearance import make as make_clearance
+
+    return make_clearance("gradient.clearance", {}).near_goal_state(
+        problem, leg, q0, checker, bud.deadline
+    )
+
+
 # ---------------------------------------------------------------------------- planner
 @dataclass(frozen=True)
 class OMPLPlanner:
@@ -601,6 +617,11 @@ class OMPLPlanner:
                 f"{self.name}: motion_check must be one of "
                 f"{', '.join(_MOTION_CHECKS)}, got "
                 f"{self.settings.motion_check!r}"
+            )
+        if self.settings.goal_selection not in ("ik", "near"):
+            raise PlannerlabError(
+                f"{self.name}: goal_selection must be 'ik' or 'near', got "
+                f"{self.settings.goal_selection!r}"
             )
         ompl_seed = int(rng.integers(1, _SEED_MAX))
         with _ompl_logging(LOGGER):
@@ -684,7 +705,10 @@ class OMPLPlanner:
         for _ in range(s.goal_samples):
             if bud.exhausted() is not None:
                 break
-            q_goal = sample_goal_state(robot, goal, guard, rng, seeds=[q0], attempts=per_slot)
+            if s.goal_selection == "near":
+                q_goal = _near_goal(problem, leg, q0, checker, bud)
+            else:
+                q_goal = sample_goal_state(robot, goal, guard, rng, seeds=[q0], attempts=per_slot)
             if q_goal is not None:
                 pool.append(wrap_to_pi(q_goal, robot.continuous))
         extra["goal_pool"] = len(pool)

@@ -1,0 +1,222 @@
+"""A smooth clearance field: signed distances of the robot's links to the scene and to
+each other, with their gradient in joint space.
+
+Each link capsule (axis segment ``a → b``, radius ``r``) is represented by ``k`` spheres of
+radius ``r`` centred at ``p = a + t (b − a)`` for evenly spaced ``t`` in [0, 1], spaced at
+most ``0.4 r`` apart (so the spheres under-cover the capsule by less than 2 % of r).
+Obstacles are exact (boxes, cylinders, spheres: signed point distances), so the field is
+a close, slightly optimistic estimate of the checker's distances; validity is always
+decided by the collision checker, the field only steers. The pairs are the checker's
+(fixed links never against the scene, the robot's ``excluded_pairs`` never against each
+other).
+
+The gradient of a distance ``d`` w.r.t. q is ``n · J_p`` with ``n`` the unit direction that
+increases ``d`` when the sphere centre moves along it and ``J_p`` the Jacobian of the centre,
+``(1 − t) J_a + t J_b`` from the Jacobians of the segment end points. For an Arm-Z those
+are analytic (joint ``j`` turns about the z axis of frame ``j``); for any other robot they
+come from one batched forward kinematics of ``dof + 1`` states (finite differences).
+
+Only numpy here; no collision library.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from plannerlab.problem.scene import Box, Cylinder, Scene, Sphere
+from plannerlab.robots.base import Array, Robot
+
+
+@dataclass(frozen=True)
+class Clearance:
+    """The field at one state.
+
+    Attributes:
+        cost: ``Σ (margin − d)² / margin`` over the sphere pairs closer than the margin.
+        gradient: (dof,) ∇cost.
+        min_distance_m: the smallest sphere-pair distance (≈ the smallest link distance) [m].
+        close_pairs: how many sphere pairs are inside the margin.
+        distances_m: (m,) every sphere pair's distance, in a fixed order [m].
+    """
+
+    cost: float
+    gradient: Array
+    min_distance_m: float
+    close_pairs: int
+    distances_m: Array
+
+
+def _box_distance(p: Array, R: Array, c: Array, half: Array) -> tuple[Array, Array]:
+    """Signed distance of points p (m, 3) to a box and its outward unit gradient (m, 3)."""
+    local = (p - c) @ R  # (m, 3) in the box frame
+    q = np.abs(local) - half
+    out = np.maximum(q, 0.0)
+    out_norm = np.linalg.norm(out, axis=1)
+    inside = np.minimum(q.max(axis=1), 0.0)
+    d = out_norm + inside
+    sign = np.where(local >= 0, 1.0, -1.0)
+    g_out = sign * out / np.where(out_norm > 1e-12, out_norm, 1.0)[:, None]
+    k = np.argmax(q, axis=1)
+    g_in = np.zeros_like(local)
+    g_in[np.arange(len(p)), k] = sign[np.arange(len(p)), k]
+    g_local = np.where((out_norm > 1e-12)[:, None], g_out, g_in)
+    return d, g_local @ R.T
+
+
+def _cylinder_distance(
+    p: Array, R: Array, c: Array, radius: float, half_len: float
+) -> tuple[Array, Array]:
+    local = (p - c) @ R
+    rho = np.hypot(local[:, 0], local[:, 1])
+    radial_dir = np.zeros_like(local)
+    safe = np.where(rho > 1e-12, rho, 1.0)
+    radial_dir[:, 0] = np.where(rho > 1e-12, local[:, 0] / safe, 1.0)
+    radial_dir[:, 1] = np.where(rho > 1e-12, local[:, 1] / safe, 0.0)
+    axial_dir = np.zeros_like(local)
+    axial_dir[:, 2] = np.where(local[:, 2] >= 0, 1.0, -1.0)
+    q = np.stack([rho - radius, np.abs(local[:, 2]) - half_len], axis=1)
+    out = np.maximum(q, 0.0)
+    out_norm = np.linalg.norm(out, axis=1)
+    d = out_norm + np.minimum(q.max(axis=1), 0.0)
+    w = out / np.where(out_norm > 1e-12, out_norm, 1.0)[:, None]
+    g_out = w[:, :1] * radial_dir + w[:, 1:] * axial_dir
+    g_in = np.where((q[:, 0] >= q[:, 1])[:, None], radial_dir, axial_dir)
+    g_local = np.where((out_norm > 1e-12)[:, None], g_out, g_in)
+    return d, g_local @ R.T
+
+
+class ClearanceField:
+    """Clearance cost and gradient for one robot in one scene (see the module docstring).
+
+    Args:
+        robot: the robot (``link_segments``, ``link_radii_m``, ``fixed_links``,
+            ``excluded_pairs``; Arm-Z frames for analytic Jacobians).
+        scene: the obstacles.
+        margin_m: pairs farther apart than this cost nothing.
+        include_self: also link against link.
+    """
+
+    def __init__(self, robot: Robot, scene: Scene, margin_m: float, include_self: bool = True):
+        if not margin_m > 0:
+            raise ValueError(f"margin_m must be > 0, got {margin_m}")
+        self.robot = robot
+        self.scene = scene
+        self.margin_m = float(margin_m)
+        radii = np.asarray(robot.link_radii_m, dtype=float)
+        L = len(radii)
+        q_ref = np.clip(np.zeros(robot.dof), robot.lower, robot.upper)
+        seg = robot.link_segments(q_ref)
+        lengths = np.linalg.norm(seg[:, 1] - seg[:, 0], axis=-1)
+        counts = [
+            max(2, int(np.ceil(ln / (0.4 * r))) + 1) for ln, r in zip(lengths, radii, strict=True)
+        ]
+        self._link = np.concatenate([np.full(k, i) for i, k in enumerate(counts)])
+        self._t = np.concatenate([np.linspace(0.0, 1.0, k) for k in counts])
+        self._r = radii[self._link]
+        moving = np.array([self._link[s] not in robot.fixed_links for s in range(len(self._t))])
+        self._scene_spheres = np.flatnonzero(moving)
+        excluded = robot.excluded_pairs
+        ia, ib = [], []
+        for a in range(len(self._t)):
+            for b in range(a + 1, len(self._t)):
+                i, j = int(self._link[a]), int(self._link[b])
+                if i == j or (min(i, j), max(i, j)) in excluded:
+                    continue
+                if i in robot.fixed_links and j in robot.fixed_links:
+                    continue
+                ia.append(a)
+                ib.append(b)
+        self._self_a = np.array(ia, dtype=int) if include_self else np.zeros(0, dtype=int)
+        self._self_b = np.array(ib, dtype=int) if include_self else np.zeros(0, dtype=int)
+        self._n_links = L
+        self._analytic = getattr(robot, "kind", "") == "armz"
+
+    # ------------------------------------------------------------------ geometry
+    def _centres_and_jacobians(self, q: Array) -> tuple[Array, Array]:
+        """Sphere centres (s, 3) and their Jacobians (s, 3, dof)."""
+        robot = self.robot
+        t = self._t[:, None]
+        if self._analytic:
+            F = robot.fk(q)  # (dof + 2, 4, 4); link i runs from frame i to frame i + 1
+            o = F[:, :3, 3]
+            a, b = o[self._link], o[self._link + 1]
+            p = a + t * (b - a)
+            z = F[1:-1, :3, 2]  # joint j (1-based) turns about frame j's z
+            oj = F[1:-1, :3, 3]
+            # centre on link i moves with joints 1..i
+            J = np.cross(z[None, :, :], p[:, None, :] - oj[None, :, :])  # (s, dof, 3)
+            dof = robot.dof
+            mask = np.arange(1, dof + 1)[None, :] <= self._link[:, None]
+            J = J * mask[:, :, None]
+            return p, np.transpose(J, (0, 2, 1))
+        h = 1e-6
+        Q = np.repeat(np.asarray(q, dtype=float)[None, :], robot.dof + 1, axis=0)
+        Q[1:] += h * np.eye(robot.dof)
+        seg = robot.link_segments(Q)  # (dof + 1, L, 2, 3)
+        P = seg[:, self._link, 0] + t[None] * (seg[:, self._link, 1] - seg[:, self._link, 0])
+        J = (P[1:] - P[0][None]) / h  # (dof, s, 3)
+        return P[0], np.transpose(J, (1, 2, 0))
+
+    def distances(self, q: Array) -> tuple[Array, Array, Array, Array]:
+        """Every sphere pair: distance d (m,), direction n (m, 3), spheres a and b (b = −1:
+        an obstacle)."""
+        p, _ = self._centres_and_jacobians(q)
+        return self._pairs(p)
+
+    def _pairs(self, p: Array) -> tuple[Array, Array, Array, Array]:
+        ds, ns, sa, sb = [], [], [], []
+        idx = self._scene_spheres
+        ps = p[idx]
+        for o in self.scene.obstacles:
+            T = o.T_world_obstacle
+            R, c = T[:3, :3], T[:3, 3]
+            if isinstance(o, Box):
+                d, n = _box_distance(ps, R, c, np.asarray(o.size_m) / 2.0)
+            elif isinstance(o, Cylinder):
+                d, n = _cylinder_distance(ps, R, c, float(o.radius_m), float(o.length_m) / 2.0)
+            elif isinstance(o, Sphere):
+                diff = ps - c
+                nd = np.linalg.norm(diff, axis=1)
+                d = nd - float(o.radius_m)
+                n = diff / np.where(nd > 1e-12, nd, 1.0)[:, None]
+            else:  # pragma: no cover - scene types are closed
+                raise TypeError(f"unknown obstacle {o!r}")
+            ds.append(d - self._r[idx])
+            ns.append(n)
+            sa.append(idx)
+            sb.append(np.full(len(idx), -1))
+        if len(self._self_a):
+            diff = p[self._self_a] - p[self._self_b]
+            nd = np.linalg.norm(diff, axis=1)
+            ds.append(nd - self._r[self._self_a] - self._r[self._self_b])
+            ns.append(diff / np.where(nd > 1e-12, nd, 1.0)[:, None])
+            sa.append(self._self_a)
+            sb.append(self._self_b)
+        if not ds:
+            z = np.zeros(0)
+            return z, np.zeros((0, 3)), z.astype(int), z.astype(int)
+        return np.concatenate(ds), np.concatenate(ns), np.concatenate(sa), np.concatenate(sb)
+
+    def __call__(self, q: Array) -> Clearance:
+        """Cost and gradient at q (dof,)."""
+        q = np.asarray(q, dtype=float)
+        p, J = self._centres_and_jacobians(q)
+        d, n, a, b = self._pairs(p)
+        m = self.margin_m
+        close = d < m
+        min_d = float(d.min()) if len(d) else np.inf
+        if not close.any():
+            return Clearance(0.0, np.zeros(self.robot.dof), min_d, 0, d)
+        all_d = d
+        d, n, a, b = d[close], n[close], a[close], b[close]
+        gap = m - d
+        cost = float(np.sum(gap**2) / m)
+        # d(cost)/dd = −2 gap / m; dd/dq = n · (J_a − J_b)
+        w = (-2.0 * gap / m)[:, None] * n  # (c, 3)
+        grad = np.einsum("ck,ckj->j", w, J[a])
+        is_self = b >= 0
+        if is_self.any():
+            grad -= np.einsum("ck,ckj->j", w[is_self], J[b[is_self]])
+        return Clearance(cost, grad, min_d, int(close.sum()), all_d)

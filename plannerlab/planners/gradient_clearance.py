@@ -1,0 +1,545 @@
+"""The gradient method with a clearance term: a descent that slides along walls.
+
+The paper's objective ``f(S) = r1 |p − p_d| + r2 (1 − n·n_d)²`` (eq. 3) replaces the
+collision penalty A(S), which is flat everywhere but at contact, by a smooth clearance
+term (:mod:`plannerlab.planners.clearance`)::
+
+    F(S) = f(S) + w · Σ_pairs (m − d)² / m        over link pairs closer than m
+
+so a link that nears a wall or another link is pushed away before it touches, and the
+descent slides along the wall instead of stopping at it. Every accepted state is checked
+by the collision checker (steps are at most ``joint_step`` per joint, so the path is
+checked edge by edge at the problem's resolution).
+
+Two step rules, both on F:
+
+``direction = "gradient"``
+    Steepest descent, the paper's rule, with the step scaled so that its largest joint
+    change is the trust radius (the paper's γ∇f on a 16-m arm moves the base by radians).
+``direction = "gauss_newton"``
+    F written as a sum of squares (the tip residuals in units of the goal's tolerances,
+    one residual ``√(w/m)(m − d)`` per close pair) and a damped Gauss-Newton step on it:
+    the same minimum, a step that does not let the base joints' long lever arms dominate.
+
+The trust radius grows by 1.5 after an accepted step (up to ``joint_step``) and halves
+after a rejected one (F did not decrease or the state collides). A **stall** is declared
+when the best ``f`` has not decreased by ``stall_min_decrease`` in ``stall_window``
+iterations, or the trust radius falls below ``min_step_rad``: status ``local_minimum``
+with ``extra["q_stall"]`` and ``extra["descent_rad"]`` (joint-space distance travelled).
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass
+
+import numpy as np
+
+from plannerlab.collision.fcl_checker import CollisionChecker
+from plannerlab.errors import PlannerlabError
+from plannerlab.planners.base import Deadline, PlanResult, Status, settings_dict, with_overrides
+from plannerlab.planners.clearance import ClearanceField
+from plannerlab.robots.base import Array, joint_difference, wrap_to_pi
+
+
+@dataclass(frozen=True)
+class ClearanceSettings:
+    """Settings of the clearance descent.
+
+    Attributes:
+        r1, r2: weights of the tip position and normal terms (paper: 1, 1).
+        clearance_weight: w, weight of the clearance term.
+        margin_m: m, distance below which a pair costs [m].
+        direction: "gradient" or "gauss_newton" (see the module docstring).
+        damping: Gauss-Newton damping λ (in tolerance units).
+        max_step_rad: largest joint change per step [rad]; 0 = the problem's joint_step.
+        min_step_rad: trust radius below which the descent has stalled [rad].
+        stall_window: iterations without improvement of the best f that make a stall.
+        stall_min_decrease: improvement of the best f that resets the stall window.
+        goal_depth: aim at this fraction of the goal tolerances (Gauss-Newton residuals).
+    """
+
+    r1: float = 1.0
+    r2: float = 1.0
+    clearance_weight: float = 0.2
+    margin_m: float = 0.3
+    direction: str = "gauss_newton"
+    damping: float = 0.1
+    max_step_rad: float = 0.0
+    min_step_rad: float = 1e-4
+    stall_window: int = 60
+    stall_min_decrease: float = 1e-3
+    goal_depth: float = 0.3
+    deepen_iterations: int = 100
+    min_clearance_m: float = 0.03
+    escape: str = "none"
+    max_escapes: int = 3
+    escape_checks: int = 50000
+    approach_m: float = 2.5
+    retract_step: int = 2
+    subgoal_pos_tol_m: float = 0.5
+    subgoal_angle_tol_deg: float = 30.0
+
+    def __post_init__(self) -> None:
+        if self.direction not in ("gradient", "gauss_newton"):
+            raise PlannerlabError(
+                f"direction setting: 'gradient' or 'gauss_newton', got {self.direction!r}"
+            )
+        if not self.margin_m > 0:
+            raise PlannerlabError(f"margin_m must be > 0, got {self.margin_m}")
+        if self.escape not in ("none", "detour", "rrtconnect"):
+            raise PlannerlabError(
+                f"escape setting: 'none', 'detour' or 'rrtconnect', got {self.escape!r}"
+            )
+        if self.retract_step < 1:
+            raise PlannerlabError(f"retract_step must be >= 1, got {self.retract_step}")
+        if self.stall_window < 2:
+            raise PlannerlabError(f"stall_window must be >= 2, got {self.stall_window}")
+
+
+class ClearanceDescent:
+    """One descent of F from a start state (see the module docstring)."""
+
+    def __init__(self, name: str, settings: ClearanceSettings) -> None:
+        self.name = name
+        self.settings = settings
+
+    # ------------------------------------------------------------------ pieces
+    def _f(self, robot, goal, q: Array) -> float:
+        p, n = robot.tip(q)
+        s = self.settings
+        return float(
+            s.r1 * np.linalg.norm(p - goal.p_world_m) + s.r2 * (1.0 - n @ goal.n_world) ** 2
+        )
+
+    def _direction(self, robot, goal, field: ClearanceField, q: Array) -> tuple[Array, float]:
+        """Descent direction (dof,) and F at q."""
+        s = self.settings
+        c = field(q)
+        p, n = robot.tip(q)
+        J_p, J_n = robot.tip_jacobian(q)
+        diff = p - goal.p_world_m
+        dist = float(np.linalg.norm(diff))
+        cn = 1.0 - float(n @ goal.n_world)
+        F = s.r1 * dist + s.r2 * cn**2 + s.clearance_weight * c.cost
+        if s.direction == "gradient":
+            g_pos = (diff / dist) @ J_p if dist > 1e-12 else np.zeros(robot.dof)
+            g = s.r1 * g_pos - 2.0 * s.r2 * cn * (goal.n_world @ J_n)
+            g = g + s.clearance_weight * c.gradient
+            return -g, F
+        # Gauss-Newton on scaled tip residuals + clearance residuals
+        pos_scale = 1.0 / goal.pos_tol_m
+        ang_scale = 1.0 / np.deg2rad(goal.angle_tol_deg)
+        e = np.concatenate([(goal.p_world_m - p) * pos_scale, (goal.n_world - n) * ang_scale])
+        # aim only as deep as goal_depth of the tolerances: no pull once well inside
+        pos_err = dist / goal.pos_tol_m
+        ang_err = np.arccos(np.clip(1.0 - cn, -1.0, 1.0)) * ang_scale
+        if pos_err < s.goal_depth:
+            e[:3] = 0.0
+        if ang_err < s.goal_depth:
+            e[3:] = 0.0
+        J = np.vstack([J_p * pos_scale, J_n * ang_scale])
+        A = J.T @ J
+        b = J.T @ e
+        if c.close_pairs:
+            # residual r = k (m − d), k = √(w/m); J_r = −k ∇d; Gauss-Newton uses −J_r^T r
+            # = k² (m − d) ∇d = −(w/2) ∇cost, and J_r^T J_r = k² ∇d ∇d^T
+            dd = self._distance_gradients(field, q)
+            k2 = s.clearance_weight / s.margin_m
+            A = A + k2 * dd.T @ dd
+            b = b - 0.5 * s.clearance_weight * c.gradient
+        A = A + s.damping**2 * np.eye(robot.dof)
+        return np.linalg.solve(A, b), F
+
+    @staticmethod
+    def _distance_gradients(field: ClearanceField, q: Array) -> Array:
+        """∇d (c, dof) of the pairs inside the margin."""
+        p, J = field._centres_and_jacobians(q)
+        d, n, a, b = field._pairs(p)
+        close = d < field.margin_m
+        n, a, b = n[close], a[close], b[close]
+        g = np.einsum("ck,ckj->cj", n, J[a])
+        is_self = b >= 0
+        if is_self.any():
+            g[is_self] -= np.einsum("ck,ckj->cj", n[is_self], J[b[is_self]])
+        return g
+
+    def _F(self, robot, goal, field: ClearanceField, q: Array) -> float:
+        return self._f(robot, goal, q) + self.settings.clearance_weight * field(q).cost
+
+    # ------------------------------------------------------------------ solve
+    def descend(
+        self,
+        problem,
+        leg: int,
+        q_start: Array,
+        checker: CollisionChecker | None,
+        deadline: Deadline,
+        goal=None,
+        iterations_before: int = 0,
+    ) -> tuple[Status, str, list[Array], list[float], int]:
+        """Descend from q_start; returns status, reason, path, f per iteration, iterations.
+
+        ``goal`` overrides the leg's goal region (sub-goals of escapes). ``checker`` None:
+        the states are not checked (goal selection near q_start). ``iterations_before``:
+        iterations the leg has already used (the budget is the leg's).
+        """
+        s = self.settings
+        robot = problem.robot
+        goal = goal if goal is not None else problem.goal(leg)
+        field = ClearanceField(robot, problem.scene, s.margin_m)
+        max_step = s.max_step_rad if s.max_step_rad > 0 else problem.joint_step
+        q = np.array(q_start, dtype=float)
+        path = [q.copy()]
+        f_now = self._f(robot, goal, q)
+        trace = [f_now]
+        best, best_iter = f_now, 0
+        radius = max_step
+        iteration = 0
+        inside_since = 0
+        d_now = field(q).distances_m
+        direction, F_now = self._direction(robot, goal, field, q)
+        while True:
+            pos_err, ang_err = goal.errors(robot, q)
+            inside = pos_err <= goal.pos_tol_m and ang_err <= goal.angle_tol_deg
+            deep = (
+                pos_err <= s.goal_depth * goal.pos_tol_m
+                and ang_err <= s.goal_depth * goal.angle_tol_deg
+            )
+            stalled = iteration - best_iter >= s.stall_window or radius < s.min_step_rad
+            # inside the region the descent goes on towards goal_depth of the tolerances
+            # (an executed path then ends inside too), as long as it makes progress
+            if deep or (inside and (stalled or iteration - inside_since >= s.deepen_iterations)):
+                return (
+                    Status.SOLVED,
+                    f"in the goal region after {iteration} iterations",
+                    path,
+                    trace,
+                    iteration,
+                )
+            if not inside:
+                inside_since = iteration + 1
+            if stalled:
+                why = (
+                    f"best f = {best:.4g} has not improved by {s.stall_min_decrease} in "
+                    f"{s.stall_window} iterations"
+                    if radius >= s.min_step_rad
+                    else f"no step of {s.min_step_rad} rad lowers F"
+                )
+                return (
+                    Status.LOCAL_MINIMUM,
+                    f"stalled at iteration {iteration}: {why}",
+                    path,
+                    trace,
+                    iteration,
+                )
+            exhausted = deadline.exhausted(iterations_before + iteration)
+            left = deadline.checks_left()
+            if exhausted is None and left is not None and left < 1:
+                exhausted = (
+                    f"collision-check budget of {deadline.budget.max_collision_checks} used up"
+                )
+            if exhausted:
+                return Status.BUDGET_EXHAUSTED, exhausted, path, trace, iteration
+            iteration += 1
+            big = float(np.max(np.abs(direction), initial=0.0))
+            if big < 1e-12:
+                radius = 0.0
+                continue
+            step = direction * min(1.0, radius / big)
+            q_new = wrap_to_pi(q + step, robot.continuous)
+            c_new = field(q_new)
+            F_new = self._f(robot, goal, q_new) + s.clearance_weight * c_new.cost
+            # keep min_clearance_m (a tracking arm overshoots a little), unless already closer
+            d_new = c_new.distances_m
+            spacious = bool(np.all((d_new >= s.min_clearance_m) | (d_new >= d_now - 1e-9)))
+            if F_new < F_now and spacious and (checker is None or checker.is_valid(q_new)):
+                d_now = d_new
+                q = q_new
+                path.append(q.copy())
+                radius = min(radius * 1.5, max_step)
+                direction, F_now = self._direction(robot, goal, field, q)
+                f_now = self._f(robot, goal, q)
+            else:
+                radius *= 0.5
+            trace.append(f_now)
+            if f_now < best - s.stall_min_decrease:
+                best, best_iter = f_now, iteration
+
+    # ------------------------------------------------------------------ goals near q
+    def near_goal_state(
+        self, problem, leg: int, q: Array, checker: CollisionChecker, deadline: Deadline
+    ) -> Array | None:
+        """A collision-free state in leg's goal region found by descending F from q with
+        the path left unchecked (the clearance term still steers): a goal *near* q, the
+        part of the arm that F does not need to move stays where it is. One check."""
+        status, _, path, _, _ = self.leg_descent(problem, leg, q, None, deadline)
+        q_goal = path[-1]
+        if status is Status.SOLVED and checker.is_valid(q_goal):
+            return q_goal
+        return None
+
+    # ------------------------------------------------------------------ the leg's descent
+    def leg_descent(
+        self,
+        problem,
+        leg: int,
+        q_start: Array,
+        checker: CollisionChecker | None,
+        deadline: Deadline,
+        used: int = 0,
+    ) -> tuple[Status, str, list[Array], list[float], int]:
+        """The descent of one leg: with ``approach_m`` > 0, first to the goal's approach
+        point (the tip at ``p_d − approach_m · n_d`` with the goal's normal, within the
+        sub-goal tolerances: the tip comes in along the inspection normal), then to the
+        goal; if the approach stalls, the descent to the goal continues from there."""
+        from plannerlab.problem.goals import GoalRegion
+
+        s = self.settings
+        goal = problem.goal(leg)
+        path = [np.array(q_start)]
+        trace: list[float] = []
+        iterations = 0
+        if s.approach_m > 0 and not goal.contains(problem.robot, q_start):
+            sub = GoalRegion(
+                "approach",
+                goal.p_world_m - s.approach_m * goal.n_world,
+                goal.n_world,
+                s.subgoal_pos_tol_m,
+                s.subgoal_angle_tol_deg,
+            )
+            st, reason, seg, tr, it = self.descend(
+                problem, leg, path[-1], checker, deadline, sub, used
+            )
+            iterations += it
+            path.extend(seg[1:])
+            trace.extend(tr)
+            if st not in (Status.SOLVED, Status.LOCAL_MINIMUM):
+                return st, reason, path, trace, iterations
+        st, reason, seg, tr, it = self.descend(
+            problem, leg, path[-1], checker, deadline, None, used + iterations
+        )
+        path.extend(seg[1:])
+        trace.extend(tr)
+        return st, reason, path, trace, iterations + it
+
+    # ------------------------------------------------------------------ escapes
+    def _detour(
+        self,
+        problem,
+        leg: int,
+        q_stall: Array,
+        checker: CollisionChecker,
+        deadline: Deadline,
+        used: int,
+    ) -> tuple[list[Array], int, str]:
+        """Sub-goals near the stall: the tip drawn back along its own body, to the face
+        ``retract_step``, ``2 retract_step``, … modules behind the stall's tip (normal
+        along the body), each retract followed by the leg's descent (:meth:`leg_descent`).
+
+        Returns the kept path from q_stall (its last state is in the goal region when the
+        detour succeeded, else just [q_stall]), the iterations and how far it retracted.
+        """
+        from plannerlab.problem.goals import GoalRegion
+
+        s = self.settings
+        robot = problem.robot
+        iterations = 0
+        # retract along the body of the stall state
+        F = robot.fk(q_stall)
+        kept = [np.array(q_stall)]
+        q = np.array(q_stall)
+        last_face = F.shape[0] - 1
+        for back in range(s.retract_step, robot.dof, s.retract_step):
+            if deadline.exhausted(used + iterations) is not None:
+                break
+            face = last_face - back
+            sub = GoalRegion(
+                f"retract{back}",
+                F[face, :3, 3],
+                F[face, :3, 2],
+                s.subgoal_pos_tol_m,
+                s.subgoal_angle_tol_deg,
+            )
+            st, _, seg, _, it = self.descend(
+                problem, leg, q, checker, deadline, sub, used + iterations
+            )
+            iterations += it
+            kept.extend(seg[1:])
+            q = kept[-1]
+            st2, _, seg2, _, it2 = self.leg_descent(
+                problem, leg, q, checker, deadline, used + iterations
+            )
+            iterations += it2
+            if st2 is Status.SOLVED:
+                return kept + seg2[1:], iterations, f"retract {back} modules"
+        return [np.array(q_stall)], iterations, "none"
+
+    def _rrtconnect(
+        self,
+        problem,
+        leg: int,
+        q_stall: Array,
+        checker: CollisionChecker,
+        deadline: Deadline,
+        rng: np.random.Generator,
+    ) -> tuple[list[Array], int, str]:
+        """RRT-Connect from the stall to a goal state found near it (see near_goal_state)."""
+        from plannerlab.planners import make_planner
+        from plannerlab.problem.load import Budget
+
+        s = self.settings
+        left = deadline.checks_left()
+        cap = s.escape_checks if left is None else min(left, s.escape_checks)
+        if cap <= 0:
+            return [np.array(q_stall)], 0, "no checks left"
+        b = deadline.budget
+        tl = None if b.time_limit_s is None else max(b.time_limit_s - deadline.elapsed_s, 1e-3)
+        rrt = make_planner("ompl.rrtconnect", {"goal_selection": "near", "goal_samples": 1})
+        r = rrt.solve(
+            problem,
+            leg,
+            Budget(max_iterations=None, max_collision_checks=cap, time_limit_s=tl),
+            rng,
+            q_start=q_stall,
+        )
+        checker.checks += r.collision_checks  # the sub-planner's checks count here
+        if r.solved:
+            return list(r.path), r.iterations, "rrtconnect"
+        return [np.array(q_stall)], r.iterations, f"rrtconnect: {r.status.value}"
+
+    # ------------------------------------------------------------------ solve
+    def solve(
+        self,
+        problem,
+        leg: int,
+        budget,
+        rng: np.random.Generator,
+        q_start: Array | None = None,
+        stepper=None,
+    ) -> PlanResult:
+        """Descend F from q_start (default: the problem's start) into leg's goal region;
+        at a stall, escape from the stall state (``escape`` setting) and descend again."""
+        del stepper  # kinematic
+        s = self.settings
+        t0 = time.perf_counter()
+        robot = problem.robot
+        goal = problem.goal(leg)
+        checker = CollisionChecker(robot, problem.scene)
+        q0 = np.array(problem.q_start if q_start is None else q_start, dtype=float)
+        deadline = Deadline(budget, checker)
+        path: list[Array] = [q0]
+        trace: list[float] = []
+        escapes_log: list[dict] = []
+        iterations = 0
+        minima = escapes = 0
+        descent_rad: list[float] = []
+
+        def length(seg: list[Array]) -> float:
+            if len(seg) < 2:
+                return 0.0
+            P = np.asarray(seg)
+            d = joint_difference(P[1:], P[:-1], robot.continuous)
+            return float(np.sum(np.linalg.norm(d, axis=1)))
+
+        def dist(a: Array, b: Array) -> float:
+            return float(np.linalg.norm(joint_difference(a, b, robot.continuous)))
+
+        def done(status: Status, reason: str) -> PlanResult:
+            P = np.array(path)
+            pos_err, ang_err = goal.errors(robot, P[-1])
+            extra: dict = {
+                "descent_rad": descent_rad,
+                "escapes": escapes_log,
+                "path_rad": length(path),
+            }
+            if status is Status.LOCAL_MINIMUM:
+                extra["q_stall"] = P[-1].tolist()
+            return PlanResult(
+                planner=self.name,
+                problem=problem.name,
+                leg=leg,
+                goal=goal.name,
+                status=status,
+                reason=reason,
+                path=P,
+                time_s=time.perf_counter() - t0,
+                iterations=iterations,
+                collision_checks=checker.checks,
+                pos_err_m=float(pos_err),
+                angle_err_deg=float(ang_err),
+                trace=np.array(trace),
+                local_minima=minima,
+                escapes=escapes,
+                settings=settings_dict(s),
+                extra=extra,
+            )
+
+        if not checker.is_valid(q0):
+            pairs = ", ".join(f"{a} x {b}" for a, b in checker.colliding_pairs(q0))
+            return done(Status.INVALID_START, f"start in collision: {pairs}")
+        q = q0
+        while True:
+            st, reason, seg, tr, it = self.leg_descent(
+                problem, leg, q, checker, deadline, iterations
+            )
+            iterations += it
+            trace.extend(tr)
+            path.extend(seg[1:])
+            descent_rad.append(length(seg))
+            if st is Status.SOLVED:
+                return done(st, f"{reason}; {minima} local minima met, {escapes} escaped")
+            if st is not Status.LOCAL_MINIMUM:
+                return done(st, f"{reason}; {minima} local minima met, {escapes} escaped")
+            minima += 1
+            q_stall = np.array(path[-1])
+            if s.escape == "none":
+                return done(st, reason)
+            if minima > s.max_escapes:
+                return done(st, f"{reason}; {minima} local minima met, {escapes} escaped; gave up")
+            c0 = checker.checks
+            if s.escape == "detour":
+                esc, it, how = self._detour(problem, leg, q_stall, checker, deadline, iterations)
+            else:
+                esc, it, how = self._rrtconnect(problem, leg, q_stall, checker, deadline, rng)
+            iterations += it
+            left_stall = len(esc) > 1
+            escapes += int(left_stall)
+            escapes_log.append(
+                {
+                    "kind": s.escape,
+                    "how": how,
+                    "stall": minima,
+                    "start_from_leg_start_rad": dist(esc[0], q0),
+                    "start_from_stall_rad": dist(esc[0], q_stall),
+                    "descent_before_stall_rad": descent_rad[-1],
+                    "left_stall": left_stall,
+                    "checks": checker.checks - c0,
+                }
+            )
+            if not left_stall:
+                return done(
+                    Status.LOCAL_MINIMUM,
+                    f"{reason}; the {s.escape} escape from stall {minima} failed ({how})",
+                )
+            path.extend(esc[1:])
+            q = np.array(path[-1])
+            if goal.contains(robot, q):
+                return done(
+                    Status.SOLVED,
+                    f"descent stalled {minima} times; escaped from the stall by {how}",
+                )
+
+
+VARIANTS: dict[str, dict[str, object]] = {
+    "gradient.clearance": {},
+    "gradient.clearance+detour": {"escape": "detour"},
+    "gradient.clearance+rrtconnect": {"escape": "rrtconnect"},
+}
+
+
+def make(name: str, overrides: dict) -> ClearanceDescent:
+    if name not in VARIANTS:
+        raise PlannerlabError(f"{name} is not a clearance descent ({', '.join(VARIANTS)})")
+    base = ClearanceSettings(**VARIANTS[name])  # type: ignore[arg-type]
+    return ClearanceDescent(name, with_overrides(base, overrides, name))
