@@ -6,6 +6,12 @@ import difflib
 from collections.abc import Iterable
 
 
+def did_you_mean(name: str, known: Iterable[str]) -> str:
+    """`` did you mean 'x'?`` for the closest known names, or ``""``."""
+    close = difflib.get_close_matches(name, sorted(known), n=3, cutoff=0.5)
+    return f" did you mean {', '.join(repr(c) for c in close)}?" if close else ""
+
+
 class PlannerlabError(Exception):
     """Base class of every error plannerlab raises on purpose."""
 
@@ -30,8 +36,7 @@ class UnknownNameError(PlannerlabError, KeyError):
         self.kind = kind
         self.name = name
         self.known = sorted(known)
-        close = difflib.get_close_matches(name, self.known, n=3, cutoff=0.5)
-        hint = f" did you mean {', '.join(repr(c) for c in close)}?" if close else ""
+        hint = did_you_mean(name, self.known)
         listing = ", ".join(self.known)
         msg = f"unknown {kind} {name!r};{hint} known: {listing}"
         super().__init__(msg)

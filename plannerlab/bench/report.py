@@ -66,6 +66,7 @@ STATUS_ENUM: tuple[str, ...] = (
     "invalid_path",
     "failed",
     ERROR_STATUS,
+    "unreachable",  # appended: earlier indices keep their meaning
 )
 
 TRIAL_COLUMNS = (

@@ -22,6 +22,7 @@ from plannerlab.errors import PlanFileError
 from plannerlab.planners import get_entry, make_planner
 from plannerlab.planners.base import PlanResult, Status
 from plannerlab.problem.catalog import load_problem, resolve_problem_path
+from plannerlab.problem.goals import unreachable_reason
 from plannerlab.problem.load import Budget, Problem
 from plannerlab.record.files import versions, write_json_atomic
 
@@ -103,6 +104,26 @@ class Plan:
         return load_problem(self.problem_file)
 
 
+def _unreachable(
+    problem: Problem, planner_name: str, leg: int, why: str, q_start: np.ndarray | None
+) -> PlanResult:
+    """The result of a leg whose goal is out of reach: not planned, the path stays put."""
+    q = problem.q_start if q_start is None else np.asarray(q_start, dtype=float)
+    goal = problem.goal(leg)
+    pos_err, ang_err = (float(v) for v in goal.errors(problem.robot, q))
+    return PlanResult(
+        planner=planner_name,
+        problem=problem.name,
+        leg=leg,
+        goal=goal.name,
+        status=Status.UNREACHABLE,
+        reason=why,
+        path=np.asarray(q, dtype=float)[None],
+        pos_err_m=pos_err,
+        angle_err_deg=ang_err,
+    )
+
+
 def solve_legs(
     problem: Problem,
     planner_name: str,
@@ -139,7 +160,13 @@ def solve_legs(
             )
         q = None  # the first leg starts at the problem's start state
         for leg in legs:
-            r = planner.solve(problem, leg, budget, leg_rng(seed, leg), q_start=q, stepper=stepper)
+            why = unreachable_reason(problem.robot, problem.goal(leg))
+            if why is not None:
+                r = _unreachable(problem, planner_name, leg, why, q)
+            else:
+                r = planner.solve(
+                    problem, leg, budget, leg_rng(seed, leg), q_start=q, stepper=stepper
+                )
             r = r.replace(seed=seed)
             results.append(r)
             if on_leg is not None:

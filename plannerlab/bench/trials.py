@@ -153,6 +153,10 @@ class Trial:
         }
 
 
+#: most seeds one comparison may ask for (each is one trial per planner and problem)
+MAX_SEEDS = 100_000
+
+
 def parse_seeds(spec: str) -> list[int]:
     """``"0-19"``, ``"0,3,5-7"`` or ``"4"`` -> sorted unique seeds.
 
@@ -170,17 +174,19 @@ def parse_seeds(spec: str) -> list[int]:
                 lo, hi = int(a), int(b)
                 if hi < lo:
                     raise ValueError
+                if hi - lo >= MAX_SEEDS:
+                    raise PlannerlabError(f"--seeds: at most {MAX_SEEDS} seeds, got {part!r}")
                 seeds.update(range(lo, hi + 1))
             else:
                 seeds.add(int(part))
         except ValueError:
             raise PlannerlabError(
-                f"seeds: expected integers and ranges like 0-19 or 0,3,5-7, got {part!r}"
+                f"--seeds: expected integers and ranges like 0-19 or 0,3,5-7, got {part!r}"
             ) from None
     if not seeds:
-        raise PlannerlabError(f"seeds: no seed in {spec!r}")
+        raise PlannerlabError(f"--seeds: no seed in {spec!r}")
     if min(seeds) < 0:
-        raise PlannerlabError(f"seeds: must be >= 0, got {min(seeds)}")
+        raise PlannerlabError(f"--seeds: must be >= 0, got {min(seeds)}")
     return sorted(seeds)
 
 

@@ -33,10 +33,70 @@ def parse_overrides(items: Sequence[str] | None) -> dict[str, str]:
     return out
 
 
+# ------------------------------------------------------------------ argument types
+# argparse reports a type's ArgumentTypeError as "argument --flag: message" and exits 2.
+def positive_int(text: str) -> int:
+    """An integer >= 1 (budgets)."""
+    try:
+        v = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected a whole number >= 1, got {text!r}") from None
+    if v < 1:
+        raise argparse.ArgumentTypeError(f"expected a whole number >= 1, got {v}")
+    return v
+
+
+def seed_int(text: str) -> int:
+    """A seed: an integer in [0, 2**63)."""
+    try:
+        v = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected a whole number >= 0, got {text!r}") from None
+    if not 0 <= v < 2**63:
+        raise argparse.ArgumentTypeError(f"expected a whole number in [0, 2^63), got {v}")
+    return v
+
+
+def positive_seconds(text: str) -> float:
+    """A finite duration > 0 [s]."""
+    try:
+        v = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected seconds > 0, got {text!r}") from None
+    if not math.isfinite(v) or v <= 0:
+        raise argparse.ArgumentTypeError(f"expected a finite number of seconds > 0, got {text}")
+    return v
+
+
+def leg_spec(text: str) -> str:
+    """``all`` or comma-separated leg names / indices, none empty."""
+    parts = [x.strip() for x in text.split(",")]
+    if not text.strip() or any(not x for x in parts):
+        raise argparse.ArgumentTypeError(
+            f"expected 'all' or comma-separated leg names or indices (e.g. 0,2), got {text!r}"
+        )
+    return text
+
+
 def add_budget_args(p: argparse.ArgumentParser) -> None:
-    p.add_argument("--max-iterations", type=int, help="iteration budget per leg")
-    p.add_argument("--max-checks", type=int, help="collision-check budget per leg")
-    p.add_argument("--time-limit", type=float, help="time limit per leg [s]")
+    p.add_argument(
+        "--max-iterations",
+        type=positive_int,
+        metavar="N",
+        help="iteration budget per leg (default: the problem file's [budget])",
+    )
+    p.add_argument(
+        "--max-checks",
+        type=positive_int,
+        metavar="N",
+        help="collision-check budget per leg (default: the problem file's [budget])",
+    )
+    p.add_argument(
+        "--time-limit",
+        type=positive_seconds,
+        metavar="S",
+        help="time limit per leg [s] (default: the problem file's [budget])",
+    )
 
 
 def budget_from_args(problem: Any, args: argparse.Namespace) -> Any:
@@ -48,6 +108,19 @@ def budget_from_args(problem: Any, args: argparse.Namespace) -> Any:
 
 
 def legs_from_spec(problem: Any, spec: str | None) -> list[int] | None:
-    if not spec or spec == "all":
+    if spec is None or spec.strip() == "all":
         return None
-    return [problem.resolve_leg(x.strip()) for x in spec.split(",")]
+    legs = []
+    for x in spec.split(","):
+        x = x.strip()
+        try:
+            legs.append(problem.resolve_leg(x))
+        except (IndexError, KeyError) as exc:
+            names = ", ".join(f"{i} {g.name}" for i, g in enumerate(problem.goals))
+            raise PlannerlabError(
+                f"--legs: unknown leg {x!r} of {problem.name} ({problem.source}); "
+                f"its legs are: {names}"
+            ) from exc
+    if len(set(legs)) != len(legs):
+        raise PlannerlabError(f"--legs: {spec!r} names a leg twice")
+    return legs

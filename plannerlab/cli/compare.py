@@ -44,6 +44,7 @@ from rich.progress import (
 )
 from rich.table import Table
 
+from plannerlab.cli.common import add_budget_args, leg_spec, legs_from_spec, positive_int
 from plannerlab.errors import PlannerlabError
 
 DEFAULT_OUT = Path("results") / "compare"
@@ -64,10 +65,10 @@ def add_compare_parser(subparsers: Any) -> argparse.ArgumentParser:
     p.add_argument(
         "--seeds", default="0-19", help="seeds: a range 0-19, a list 0,3,5-7 (default 0-19)"
     )
-    p.add_argument("--time-limit", type=float, metavar="S", help="time limit per leg [s]")
-    p.add_argument("--max-checks", type=int, metavar="N", help="collision-check budget per leg")
-    p.add_argument("--max-iterations", type=int, metavar="N", help="iteration budget per leg")
-    p.add_argument("--legs", help="comma-separated leg names or indices (default: all)")
+    add_budget_args(p)
+    p.add_argument(
+        "--legs", type=leg_spec, help="comma-separated leg names or indices (default: all)"
+    )
     p.add_argument(
         "--set",
         action="append",
@@ -79,7 +80,7 @@ def add_compare_parser(subparsers: Any) -> argparse.ArgumentParser:
         action="store_true",
         help="also execute every plan in PyBullet (success, tracking error)",
     )
-    p.add_argument("--jobs", type=int, default=1, help="trials run at once (default 1)")
+    p.add_argument("--jobs", type=positive_int, default=1, help="trials run at once (default 1)")
     p.add_argument("--name", help="comparison name (default: from problems and planners)")
     p.add_argument(
         "--out",
@@ -209,9 +210,7 @@ def cmd_compare(args: argparse.Namespace, console: Console) -> int:
                 )
     legs_by_problem: dict[str, list[int] | None] = {}
     for problem, _ in problems:
-        legs_by_problem[problem.name] = (
-            [problem.resolve_leg(x) for x in _split(args.legs)] if args.legs else None
-        )
+        legs_by_problem[problem.name] = legs_from_spec(problem, args.legs)
     budget = {
         "max_iterations": args.max_iterations,
         "max_collision_checks": args.max_checks,

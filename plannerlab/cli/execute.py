@@ -18,17 +18,21 @@ from plannerlab.errors import PlannerlabError
 def cmd_execute(args: argparse.Namespace, console: Console) -> int:
     from dataclasses import replace
 
-    from plannerlab.bench.task import Plan
+    from plannerlab.bench.plan_check import check_plan, read_plan
     from plannerlab.sim.execute import execute_legs
 
     if args.problem.endswith(".json"):
         out = Path(args.problem)
-        plan = Plan.load(out)
+        plan = read_plan(out)
     else:
         if not args.planner:
             raise PlannerlabError("execute PROBLEM needs --planner NAME (or give a PLAN.json)")
         plan, out = solve_and_save(args, console)
     problem = plan.load_problem()
+    if args.problem.endswith(".json"):
+        check_plan(plan, problem, args.problem)
+    if not args.json:
+        console.print(f"simulation: {problem.simulation.origin}", highlight=False)
     with console.status(f"executing {len(plan.legs)} legs in PyBullet"):
         executions = execute_legs(
             problem, [r.path for r in plan.legs], first_leg=plan.legs[0].leg, gui=args.gui

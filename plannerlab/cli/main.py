@@ -1,18 +1,14 @@
-"""The ``plannerlab`` command: argument parsing and printing only.
-
-plannerlab problems
-plannerlab planners
-plannerlab solve PROBLEM --planner NAME --seed N [--json] [--out PLAN.json]
-plannerlab execute PROBLEM --planner NAME --seed N | plannerlab execute PLAN.json
-plannerlab plot PLAN.json [--out DIR]
-"""
+"""The ``plannerlab`` command: argument parsing and printing only."""
 
 from __future__ import annotations
 
 import argparse
+import contextlib
+import io
 import logging
+import os
 import sys
-from collections.abc import Sequence
+from collections.abc import Iterator, Sequence
 
 from rich.console import Console
 from rich.markup import escape
@@ -20,14 +16,89 @@ from rich.markup import escape
 from plannerlab.cli import execute, planners, plot, problems, solve
 from plannerlab.errors import PlannerlabError
 
+DESCRIPTION = """\
+Compare motion planners on hyper-redundant, industrial and continuum robots.
+
+A problem is a TOML file (see docs/problem-format.md); give its path, or a name that is
+looked up in ./problems first, then among the bundled problems (plannerlab problems).
+
+typical use:
+  plannerlab problems                                   list the problems
+  plannerlab planners                                   list the planners
+  plannerlab solve armz_pocket --planner ompl.rrtconnect --seed 3
+  plannerlab execute results/plans/armz_pocket__ompl.rrtconnect__seed3.json
+  plannerlab plot results/plans/armz_pocket__ompl.rrtconnect__seed3.json
+  plannerlab compare armz_pocket --planners gradient,ompl.rrtconnect --seeds 0-4
+
+Every subcommand has its own help: plannerlab SUBCOMMAND --help.
+Exit codes: 0 done, 1 --strict and a leg failed, 2 bad input (the message names the
+file, the key or flag, and what was expected), 130 interrupted.
+"""
+
+
+class HelpFormatter(argparse.RawDescriptionHelpFormatter):
+    """Keeps the descriptions' line breaks and appends each flag's default to its help
+    (unless the help already states it, or there is no default)."""
+
+    def _get_help_string(self, action: argparse.Action) -> str:
+        text = action.help or ""
+        if "default" in text or "%(default)" in text:
+            return text
+        default = action.default
+        if default is None or default is False or default == argparse.SUPPRESS:
+            return text
+        if not action.option_strings:
+            return text
+        if isinstance(default, list) and not default:
+            return text
+        return f"{text} (default: %(default)s)"
+
+
+@contextlib.contextmanager
+def engine_output_kept_off_stdout(verbose: bool) -> Iterator[None]:
+    """Keep what C code (PyBullet's banner and ``argv[0]=``, OMPL's log lines) writes to
+    file descriptor 1 off stdout: it goes to stderr with ``-v``, else to /dev/null.
+    Python's ``sys.stdout`` keeps writing to the real stdout, so ``--json`` prints exactly
+    one JSON document. Does nothing if stdout is not file descriptor 1 (e.g. captured)."""
+    try:
+        fd = sys.stdout.fileno()
+    except (AttributeError, OSError, io.UnsupportedOperation, ValueError):
+        fd = -1
+    if fd != 1:
+        yield
+        return
+    sys.stdout.flush()
+    saved = os.dup(1)
+    target = os.dup(2) if verbose else os.open(os.devnull, os.O_WRONLY)
+    os.dup2(target, 1)
+    os.close(target)
+    previous = sys.stdout
+    real = open(  # noqa: SIM115 - closed below
+        saved, "w", encoding=previous.encoding, errors="replace", closefd=False, buffering=1
+    )
+    sys.stdout = real
+    try:
+        yield
+    finally:
+        real.flush()
+        sys.stdout = previous
+        os.dup2(saved, 1)
+        os.close(saved)
+        real.close()
+
 
 # ---------------------------------------------------------------------- parser
 def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(
-        prog="plannerlab", description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter
+        prog="plannerlab", description=DESCRIPTION, formatter_class=HelpFormatter
     )
-    parser.add_argument("-v", "--verbose", action="store_true", help="log at INFO level")
-    sub = parser.add_subparsers(dest="command", required=True)
+    parser.add_argument(
+        "-v",
+        "--verbose",
+        action="store_true",
+        help="log at INFO level and let PyBullet's and OMPL's own output through (on stderr)",
+    )
+    sub = parser.add_subparsers(dest="command", required=True, metavar="SUBCOMMAND")
 
     for module in (problems, planners, solve, execute, plot):
         module.add_parser(sub)
@@ -40,6 +111,11 @@ def build_parser() -> argparse.ArgumentParser:
     from plannerlab.cli.continuum import add_continuum_parser
 
     add_continuum_parser(sub)
+    for name, p in sub.choices.items():
+        p.formatter_class = HelpFormatter
+        if not p.description:
+            help_text = next((a.help for a in sub._choices_actions if a.dest == name), None)
+            p.description = help_text
     return parser
 
 
@@ -54,10 +130,19 @@ def main(argv: Sequence[str] | None = None) -> int:
     # In a log or a pipe rich would wrap at 80 columns: tables read better wider.
     console = Console(stderr=to_stderr, width=None if stream.isatty() else 150)
     try:
-        return int(args.func(args, console) or 0)
+        with engine_output_kept_off_stdout(args.verbose):
+            return int(args.func(args, console) or 0)
     except PlannerlabError as exc:
         # escape: messages name keys in brackets ("[goals[0].n]"), which rich would eat
         Console(stderr=True).print(f"[red]error:[/red] {escape(str(exc))}", highlight=False)
+        return 2
+    except OSError as exc:
+        if exc.filename is None:
+            raise
+        # a path given on the command line (--out, a plan or problem file) that cannot be
+        # read or written
+        msg = f"{exc.filename}: {exc.strerror or exc}"
+        Console(stderr=True).print(f"[red]error:[/red] {escape(msg)}", highlight=False)
         return 2
     except KeyboardInterrupt:
         Console(stderr=True).print("interrupted")

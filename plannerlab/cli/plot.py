@@ -11,12 +11,14 @@ from rich.console import Console
 
 
 def cmd_plot(args: argparse.Namespace, console: Console) -> int:
-    from plannerlab.bench.task import Plan
+    from plannerlab.bench.plan_check import check_plan, read_plan
     from plannerlab.plot.plans import plot_plan
 
-    plan = Plan.load(args.plan)
+    plan = read_plan(args.plan)
+    problem = plan.load_problem()
+    check_plan(plan, problem, args.plan)
     out_dir = Path(args.out) if args.out else Path(args.plan).with_suffix("")
-    files = plot_plan(plan, plan.load_problem(), out_dir)
+    files = plot_plan(plan, problem, out_dir)
     if args.json:
         print(json.dumps([str(f) for f in files]))
     else:

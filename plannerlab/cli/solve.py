@@ -15,8 +15,10 @@ from plannerlab.cli.common import (
     add_budget_args,
     budget_from_args,
     fmt,
+    leg_spec,
     legs_from_spec,
     parse_overrides,
+    seed_int,
 )
 
 
@@ -51,9 +53,13 @@ def solve_and_save(args: argparse.Namespace, console: Console) -> Any:
     from plannerlab.problem.catalog import load_problem
 
     problem = load_problem(args.problem)
+    if not getattr(args, "json", False):
+        console.print(f"problem {problem.name} from {problem.source}", highlight=False)
     overrides = parse_overrides(args.set)
     legs = legs_from_spec(problem, args.legs)
     n_legs = len(legs) if legs is not None else problem.legs
+    out = Path(args.out) if args.out else _default_plan_path(problem.name, args.planner, args.seed)
+    out.parent.mkdir(parents=True, exist_ok=True)  # a path that cannot exist fails now
     status = console.status(f"{args.planner} on {problem.name}: leg 1/{n_legs}")
 
     done = []
@@ -76,7 +82,6 @@ def solve_and_save(args: argparse.Namespace, console: Console) -> Any:
             gui=getattr(args, "gui", False),
             on_leg=on_leg,
         )
-    out = Path(args.out) if args.out else _default_plan_path(problem.name, args.planner, args.seed)
     plan.save(out)
     return plan, out
 
@@ -95,11 +100,25 @@ def add_plan_arguments(p: argparse.ArgumentParser, name: str) -> None:
     """The arguments `solve` and `execute` share."""
     p.add_argument(
         "problem",
-        help="problem name or .toml path" + (" (or a PLAN.json)" if name == "execute" else ""),
+        help="problem: a .toml path, or a name looked up in ./problems, then among the "
+        "bundled problems" + (" (or a PLAN.json written by solve)" if name == "execute" else ""),
     )
-    p.add_argument("--planner", required=(name == "solve"), help="registry name")
-    p.add_argument("--seed", type=int, default=0)
-    p.add_argument("--legs", help="comma-separated leg names or indices (default: all)")
+    p.add_argument(
+        "--planner",
+        required=(name == "solve"),
+        help="planner name, as listed by 'plannerlab planners'",
+    )
+    p.add_argument(
+        "--seed",
+        type=seed_int,
+        default=0,
+        help="random seed (>= 0); the same seed gives the same plan",
+    )
+    p.add_argument(
+        "--legs",
+        type=leg_spec,
+        help="comma-separated leg names or indices, or 'all' (default: all)",
+    )
     p.add_argument(
         "--set",
         action="append",

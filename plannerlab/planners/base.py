@@ -30,6 +30,7 @@ class Status(enum.StrEnum):
     BUDGET_EXHAUSTED = "budget_exhausted"  #: ran out of iterations, checks or time
     INVALID_START = "invalid_start"  #: the start state is in collision
     INVALID_GOAL = "invalid_goal"  #: no valid goal state could be found
+    UNREACHABLE = "unreachable"  #: the goal is farther than the robot reaches (not planned)
     INVALID_PATH = "invalid_path"  #: a path was found but failed the fine re-check
     FAILED = "failed"  #: any other failure, see ``reason``
 

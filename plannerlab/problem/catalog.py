@@ -28,11 +28,18 @@ def list_problems() -> list[Path]:
     return sorted(d.glob("*.toml")) if d.is_dir() else []
 
 
-def resolve_problem_path(name_or_path: str | Path) -> Path:
-    """A problem file from a path or a bundled problem's name (``armz_pocket``)."""
+def resolve_problem_path(name_or_path: str | Path, cwd: Path | None = None) -> Path:
+    """A problem file from a path or a problem's name (``armz_pocket``).
+
+    A name is looked up in ``./problems`` (relative to ``cwd``, default the current
+    directory) first, then in :func:`problems_dir` (the bundled problems).
+    """
     p = Path(name_or_path)
-    if p.suffix == ".toml" or p.exists():
+    if p.suffix == ".toml" or p.exists() or len(p.parts) > 1:
         return p
+    local = (cwd or Path.cwd()) / "problems" / f"{name_or_path}.toml"
+    if local.is_file():
+        return local
     candidate = problems_dir() / f"{name_or_path}.toml"
     if candidate.exists():
         return candidate

@@ -75,3 +75,43 @@ class GoalRegion:
         pos_err, ang_err = self.errors(robot, q)
         scaled = np.maximum(pos_err / self.pos_tol_m, ang_err / self.angle_tol_deg)
         return np.maximum(scaled - 1.0, 0.0)
+
+
+def unreachable_reason(robot: Robot, goal: GoalRegion) -> str | None:
+    """Why no state of ``robot`` can put its tip in ``goal``'s position ball, or None.
+
+    A cheap necessary condition checked before planning: the tip cannot be farther from
+    the base than the chain is long. Fixed-base chains (Arm-Z, continuum): the bound is the
+    base-to-first-link offset plus every link's length plus the last link-to-tip offset.
+    IRb-6 on its track: the flange is at most lower arm + upper arm + wrist-to-flange from
+    the shoulder, which slides along the track at the shoulder's height.
+    """
+    p = np.asarray(goal.p_world_m, dtype=float)
+    T = np.asarray(robot.T_world_base, dtype=float)
+    if robot.kind == "irb6":
+        lo, hi = robot.track_range_m  # type: ignore[attr-defined]
+        p_s = T[:3, :3].T @ (p - T[:3, 3])
+        h = robot.shoulder_height_m  # type: ignore[attr-defined]
+        closest = np.array([0.0, h, min(max(p_s[2], lo), hi)])
+        dist = float(np.linalg.norm(p_s - closest))
+        reach = float(
+            robot.lower_arm_m + robot.upper_arm_m + robot.wrist_to_flange_m  # type: ignore[attr-defined]
+        )
+        where = f"the shoulder's line along the track (λ0 in [{lo:g}, {hi:g}] m)"
+    else:
+        q = np.zeros(robot.dof)
+        seg = np.asarray(robot.link_segments(q), dtype=float)
+        tip, _ = robot.tip(q)
+        reach = float(
+            np.linalg.norm(seg[0, 0] - T[:3, 3])
+            + np.sum(np.linalg.norm(seg[:, 1] - seg[:, 0], axis=-1))
+            + np.linalg.norm(np.asarray(tip) - seg[-1, 1])
+        )
+        dist = float(np.linalg.norm(p - T[:3, 3]))
+        where = "the base"
+    if dist - goal.pos_tol_m > reach * (1.0 + 1e-9):
+        return (
+            f"goal {goal.name!r} at {p.round(3).tolist()} m is {dist:.3g} m from {where}, "
+            f"but the {robot.kind} reaches at most {reach:.3g} m (+ pos_tol {goal.pos_tol_m:g} m)"
+        )
+    return None

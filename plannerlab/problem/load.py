@@ -16,8 +16,12 @@ File layout (every key is documented in ``docs/problem-format.md``)::
     [[goals]]   name, p_m, n, pos_tol_m, angle_tol_deg     (one per leg, in order)
     [budget]    max_iterations, max_collision_checks, time_limit_s
     [checking]  joint_step       (largest joint step between checked states on an edge)
-    [simulation] gravity_mps2, max_track_err_rad
-    any other table (e.g. [witness], [continuum]) is kept in ``Problem.extras``.
+    [simulation] gravity_mps2 (default: Arm-Z off, others -9.81 along -z), max_track_err_rad
+    [witness]   path_rad        (a known collision-free path, for tests)
+    [continuum] collision_points_m, guide_obstacles   (continuum planners)
+    [ik_expected] free-form     (what tests expect of the IRb-6 analytic IK)
+    Any other table or key is an error ("did you mean ...").
+    The last three tables are kept, validated, in ``Problem.extras``.
 """
 
 from __future__ import annotations
@@ -31,7 +35,7 @@ from typing import Any
 
 import numpy as np
 
-from plannerlab.errors import ProblemError, UnknownNameError
+from plannerlab.errors import ProblemError, UnknownNameError, did_you_mean
 from plannerlab.problem.goals import GoalRegion
 from plannerlab.problem.scene import OBSTACLE_TYPES, Box, Cylinder, Obstacle, Scene, Sphere
 from plannerlab.robots import build_robot
@@ -47,6 +51,14 @@ KNOWN_TABLES = (
     "checking",
     "simulation",
 )
+#: tables kept in ``Problem.extras`` (validated here, used by tests and some planners)
+EXTRA_TABLES = ("witness", "continuum", "ik_expected")
+
+#: smallest ``[checking] joint_step`` [rad]: edges are checked every joint_step and
+#: re-checked every joint_step / 4, so the cost grows as 1 / joint_step
+MIN_JOINT_STEP_RAD = 1e-3
+#: largest goal angle tolerance [deg]: the angle between two directions is at most 180°
+MAX_ANGLE_TOL_DEG = 180.0
 
 
 @dataclass(frozen=True, eq=False)
@@ -90,6 +102,8 @@ class SimSettings:
 
     gravity_mps2: tuple[float, float, float] = (0.0, 0.0, -9.81)
     max_track_err_rad: float = 0.05
+    #: where the setting came from, in words (shown by ``execute``)
+    origin: str = "default"
 
 
 @dataclass(frozen=True, eq=False)
@@ -186,12 +200,25 @@ class TableReader:
             raise self.fail(name, f"a number >= 0, got {v}")
         return v
 
-    def integer(self, name: str, default: Any = ..., *, minimum: int | None = None) -> int:
+    def integer(
+        self,
+        name: str,
+        default: Any = ...,
+        *,
+        minimum: int | None = None,
+        maximum: int | None = None,
+        why_maximum: str = "",
+    ) -> int:
         v = self.raw(name, default)
         if isinstance(v, bool) or not isinstance(v, int):
             raise self.fail(name, f"an integer, got {v!r}")
         if minimum is not None and v < minimum:
             raise self.fail(name, f"an integer >= {minimum}, got {v}")
+        if maximum is not None and v > maximum:
+            raise self.fail(
+                name,
+                f"an integer <= {maximum}, got {v}" + (f" ({why_maximum})" if why_maximum else ""),
+            )
         return v
 
     def optional_integer(self, name: str, *, minimum: int | None = None) -> int | None:
@@ -215,14 +242,20 @@ class TableReader:
         return a
 
     def pose(self, xyz_name: str, rpy_name: str) -> Array:
-        xyz = self.vector(xyz_name, 3)
+        """A pose from a position [m] and roll, pitch, yaw [deg]; either may be left out
+        (zero)."""
+        xyz = self.vector(xyz_name, 3, default=[0.0, 0.0, 0.0])
         rpy_deg = self.vector(rpy_name, 3, default=[0.0, 0.0, 0.0])
         return pose_matrix(xyz, np.deg2rad(rpy_deg))
 
     def unknown_keys(self, allowed: tuple[str, ...]) -> None:
         extra = sorted(set(self.table) - set(allowed))
         if extra:
-            raise self.fail(extra[0], f"is not a known key here; allowed: {', '.join(allowed)}")
+            raise self.fail(
+                extra[0],
+                f"is not a known key here;{did_you_mean(extra[0], allowed)} "
+                f"allowed: {', '.join(allowed)}",
+            )
 
 
 def _obstacle(reader: TableReader) -> Obstacle:
@@ -255,12 +288,22 @@ def _goal(reader: TableReader) -> GoalRegion:
     n = reader.vector("n", 3)
     if float(np.linalg.norm(n)) < 1e-9:
         raise reader.fail("n", f"a non-zero normal vector, got {n.tolist()}")
+    name = reader.string("name")
+    if not name.strip():
+        raise reader.fail("name", "a non-empty name (legs are chosen by it: --legs NAME)")
+    angle_tol_deg = reader.number("angle_tol_deg", positive=True)
+    if angle_tol_deg > MAX_ANGLE_TOL_DEG:
+        raise reader.fail(
+            "angle_tol_deg",
+            f"an angle in (0, {MAX_ANGLE_TOL_DEG:g}] deg (the angle between two directions is "
+            f"at most 180°; 180 accepts any direction), got {angle_tol_deg:g}",
+        )
     return GoalRegion(
-        name=reader.string("name"),
+        name=name,
         p_world_m=p,
         n_world=n,
         pos_tol_m=reader.number("pos_tol_m", positive=True),
-        angle_tol_deg=reader.number("angle_tol_deg", positive=True),
+        angle_tol_deg=angle_tol_deg,
     )
 
 
@@ -294,10 +337,91 @@ def _start(reader: TableReader, robot: Robot) -> Array:
     return q
 
 
+def _check_tables(top: TableReader) -> None:
+    known = KNOWN_TABLES + EXTRA_TABLES
+    for k in top.table:
+        if k not in known:
+            raise top.fail(
+                k,
+                f"is not a known table;{did_you_mean(k, known)} known tables: {', '.join(known)}",
+            )
+
+
+def _witness(reader: TableReader, robot: Robot) -> None:
+    reader.unknown_keys(("path_rad", "note"))
+    raw = reader.raw("path_rad")
+    if not isinstance(raw, list) or len(raw) < 2:
+        raise reader.fail("path_rad", f"a list of at least 2 waypoints, got {raw!r:.80}")
+    for i, _ in enumerate(raw):
+        row = TableReader(reader.source, reader.prefix, {f"path_rad[{i}]": raw[i]})
+        row.vector(f"path_rad[{i}]", robot.dof)
+
+
+def _continuum(reader: TableReader, obstacle_names: list[str]) -> None:
+    reader.unknown_keys(("collision_points_m", "guide_obstacles", "note"))
+    raw = reader.raw("collision_points_m", [])
+    if not isinstance(raw, list):
+        raise reader.fail("collision_points_m", f"a list of [x, y] points [m], got {raw!r:.80}")
+    for i, p in enumerate(raw):
+        ok = (
+            isinstance(p, list)
+            and len(p) in (2, 3)
+            and all(
+                isinstance(v, int | float) and not isinstance(v, bool) and math.isfinite(v)
+                for v in p
+            )
+        )
+        if not ok:
+            raise reader.fail(
+                f"collision_points_m[{i}]",
+                f"two or three finite numbers (x, y[, z]) [m], got {p!r}",
+            )
+    guides = reader.raw("guide_obstacles", [])
+    if not isinstance(guides, list) or not all(isinstance(n, str) for n in guides):
+        raise reader.fail("guide_obstacles", f"a list of obstacle names, got {guides!r}")
+    for n in guides:
+        if n not in obstacle_names:
+            raise reader.fail(
+                "guide_obstacles",
+                f"names of obstacles in this problem ({', '.join(obstacle_names) or 'none'}); "
+                f"unknown: {n};{did_you_mean(n, obstacle_names)}",
+            )
+
+
+def _simulation(top: TableReader, robot: Robot) -> SimSettings:
+    if not top.has("simulation"):
+        if robot.kind == "armz":
+            # Under gravity a 16-m Arm-Z bent sideways needs far more torque than its
+            # joints have and collapses in PyBullet; every bundled Arm-Z problem turns
+            # gravity off (see the comment in problems/armz_pocket.toml).
+            return SimSettings(
+                (0.0, 0.0, 0.0),
+                origin="gravity off: the Arm-Z default when [simulation] is absent "
+                "(as in every bundled Arm-Z problem); set gravity_mps2 to change it",
+            )
+        return SimSettings(origin="gravity -9.81 m/s² along -z: the default")
+    sim = TableReader(top.source, "simulation", top.raw("simulation"))
+    sim.unknown_keys(("gravity_mps2", "max_track_err_rad", "note"))
+    if not sim.has("gravity_mps2"):
+        default = _simulation(TableReader(top.source, "", {}), robot)
+        g = np.array(default.gravity_mps2)
+        origin = default.origin
+    else:
+        g = sim.vector("gravity_mps2", 3)
+        origin = f"gravity {g.tolist()} m/s² from [simulation]"
+    return SimSettings(
+        gravity_mps2=(float(g[0]), float(g[1]), float(g[2])),
+        max_track_err_rad=sim.number("max_track_err_rad", 0.05, positive=True),
+        origin=origin,
+    )
+
+
 def problem_from_dict(data: Mapping[str, Any], source: str) -> Problem:
     """Build a problem from a parsed TOML document; ``source`` names it in errors."""
     top = TableReader(source, "", dict(data))
+    _check_tables(top)
     meta = TableReader(source, "problem", top.raw("problem"))
+    meta.unknown_keys(("name", "description", "note"))
     name = meta.string("name")
     description = meta.string("description", "")
     robot_reader = TableReader(source, "robot", top.raw("robot"))
@@ -319,26 +443,53 @@ def problem_from_dict(data: Mapping[str, Any], source: str) -> Problem:
     if not isinstance(raw_goals, list) or not raw_goals:
         raise top.fail("goals", "a non-empty array of tables [[goals]] (one per leg)")
     goals = tuple(_goal(TableReader(source, f"goals[{i}]", g)) for i, g in enumerate(raw_goals))
+    goal_names = [g.name for g in goals]
+    for i, n in enumerate(goal_names):
+        if goal_names.index(n) != i:
+            raise ProblemError(
+                source,
+                f"goals[{i}].name",
+                f"a unique name (legs are chosen by name); {n!r} is also goals"
+                f"[{goal_names.index(n)}]",
+            )
+        if n.isdigit():
+            raise ProblemError(
+                source,
+                f"goals[{i}].name",
+                f"a name that is not a number (--legs {n} means leg {n})",
+            )
 
     b = TableReader(source, "budget", top.raw("budget", {}))
-    b.unknown_keys(("max_iterations", "max_collision_checks", "time_limit_s"))
+    b.unknown_keys(("max_iterations", "max_collision_checks", "time_limit_s", "note"))
     budget = Budget(
         max_iterations=b.optional_integer("max_iterations", minimum=1),
         max_collision_checks=b.optional_integer("max_collision_checks", minimum=1),
         time_limit_s=b.optional_number("time_limit_s", positive=True),
     )
     c = TableReader(source, "checking", top.raw("checking", {}))
-    c.unknown_keys(("joint_step",))
+    c.unknown_keys(("joint_step", "note"))
     joint_step = c.number("joint_step", 0.05, positive=True)
+    if joint_step < MIN_JOINT_STEP_RAD:
+        raise c.fail(
+            "joint_step",
+            f"a step >= {MIN_JOINT_STEP_RAD:g} rad, got {joint_step:g}: every edge is checked "
+            f"every joint_step and re-checked every joint_step/4, so one radian of motion "
+            f"would cost {4.0 / joint_step:.3g} collision checks",
+        )
+    if joint_step > math.pi:
+        raise c.fail(
+            "joint_step", f"a step <= pi rad, got {joint_step:g} (edges would go unchecked)"
+        )
 
-    sim = TableReader(source, "simulation", top.raw("simulation", {}))
-    sim.unknown_keys(("gravity_mps2", "max_track_err_rad", "note"))
-    simulation = SimSettings(
-        gravity_mps2=tuple(float(v) for v in sim.vector("gravity_mps2", 3, (0.0, 0.0, -9.81))),
-        max_track_err_rad=sim.number("max_track_err_rad", 0.05, positive=True),
-    )
+    simulation = _simulation(top, robot)
 
-    extras = {k: v for k, v in data.items() if k not in KNOWN_TABLES}
+    extras = {k: v for k, v in data.items() if k in EXTRA_TABLES}
+    if "witness" in extras:
+        _witness(TableReader(source, "witness", extras["witness"]), robot)
+    if "continuum" in extras:
+        _continuum(TableReader(source, "continuum", extras["continuum"]), names)
+    if "ik_expected" in extras:
+        TableReader(source, "ik_expected", extras["ik_expected"])  # a table, free-form
     return Problem(
         name=name,
         robot=robot,
@@ -358,10 +509,24 @@ def parse_problem(path: str | Path) -> Problem:
     """Read and validate a problem file (no collision checks; see ``catalog.load_problem``)."""
     path = Path(path)
     source = str(path)
+    if path.is_dir():
+        raise ProblemError(source, "<file>", "a problem file (.toml), got a directory")
     try:
-        text = path.read_text(encoding="utf-8")
+        raw = path.read_bytes()
     except FileNotFoundError:
         raise ProblemError(source, "<file>", "an existing problem file") from None
+    except OSError as exc:
+        raise ProblemError(source, "<file>", f"a readable problem file: {exc.strerror}") from None
+    try:
+        text = raw.decode("utf-8")
+    except UnicodeDecodeError as exc:
+        line = raw[: exc.start].count(b"\n") + 1
+        raise ProblemError(
+            source,
+            "<encoding>",
+            f"UTF-8 text (TOML); byte 0x{raw[exc.start]:02x} on line {line} is not UTF-8 "
+            "(a binary file, or text saved as Latin-1: save it as UTF-8)",
+        ) from None
     try:
         data = tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:

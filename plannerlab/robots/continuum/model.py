@@ -492,6 +492,10 @@ class ContinuumChain:
         return "".join(parts)
 
 
+#: largest ``n_links`` a problem file may ask for (the bundled problems use 40)
+MAX_LINKS = 400
+
+
 def from_table(reader: Any) -> ContinuumChain:
     """Build a chain from a problem file's ``[robot]`` table (a ``problem.TableReader``)."""
     reader.unknown_keys(
@@ -507,12 +511,18 @@ def from_table(reader: Any) -> ContinuumChain:
             "note",
         )
     )
-    T = reader.pose("base_xyz_m", "base_rpy_deg") if reader.has("base_xyz_m") else np.eye(4)
+    T = reader.pose("base_xyz_m", "base_rpy_deg")  # identity when both are absent
     rpy = matrix_to_rpy(T[:3, :3])
     if abs(rpy[0]) > 1e-9 or abs(rpy[1]) > 1e-9:
         raise reader.fail("base_rpy_deg", "roll = pitch = 0 (the continuum chain is planar)")
     return ContinuumChain(
-        n_links=reader.integer("n_links", 40, minimum=1),
+        n_links=reader.integer(
+            "n_links",
+            40,
+            minimum=1,
+            maximum=MAX_LINKS,
+            why_maximum="collision checking and simulation grow with the link count",
+        ),
         length_m=reader.number("length_m", 0.5, positive=True),
         link_radius_m=reader.number("link_radius_m", 0.002, positive=True),
         max_joint_rad=float(np.deg2rad(reader.number("max_joint_deg", 90.0, positive=True))),

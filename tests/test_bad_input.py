@@ -1,0 +1,440 @@
+"""Bad input of every kind gets a clear answer: exit code 2, no traceback, and a message
+that names the file and the key (or the flag) that is wrong.
+
+Problem files are a small valid Arm-Z problem with one thing broken; plan files a valid
+plan (written here, not planned) with one thing broken; command lines one bad flag each.
+Every case runs ``plannerlab`` in-process (an escaped exception would fail the test);
+a few run it as a subprocess to see exactly what a user sees.
+"""
+
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+from conftest import PROBLEMS, ROOT
+
+from plannerlab.cli.main import main
+from plannerlab.planners.base import PlanResult, Status
+from plannerlab.problem.load import parse_problem
+
+VALID = """\
+[problem]
+name = "tiny"
+description = "a short Arm-Z and one box"
+
+[robot]
+type = "armz"
+n_modules = 6
+
+[start]
+fill_deg = 180.0
+
+[[obstacles]]
+name = "wall"
+type = "box"
+center_m = [3.0, 0.0, 2.0]
+size_m = [0.4, 4.0, 4.0]
+
+[[goals]]
+name = "up"
+p_m = [0.5, 0.0, 3.0]
+n = [0.0, 0.0, 1.0]
+pos_tol_m = 0.1
+angle_tol_deg = 10.0
+
+[budget]
+max_iterations = 50
+
+[checking]
+joint_step = 0.05
+"""
+
+
+def run(capsys, *argv: str) -> tuple[int, str, str]:
+    """``plannerlab ARGV`` in-process: exit code, stdout, stderr (argparse exits too)."""
+    try:
+        code = main(list(argv))
+    except SystemExit as exc:
+        code = int(exc.code or 0)
+    out, err = capsys.readouterr()
+    return code, out, err
+
+
+def assert_clean_error(code: int, err: str, *names: str) -> None:
+    assert code == 2, err
+    assert "Traceback" not in err
+    for name in names:
+        assert name in err, f"{name!r} not in {err!r}"
+
+
+def write(tmp_path: Path, text: str | bytes, name: str = "p.toml") -> Path:
+    p = tmp_path / name
+    if isinstance(text, bytes):
+        p.write_bytes(text)
+    else:
+        p.write_text(text, encoding="utf-8")
+    return p
+
+
+def test_the_valid_problem_is_valid(tmp_path):
+    problem = parse_problem(write(tmp_path, VALID))
+    assert problem.name == "tiny" and problem.robot.dof == 5
+
+
+# --------------------------------------------------------------- problem files
+def replace(old: str, new: str) -> str:
+    assert old in VALID, old
+    return VALID.replace(old, new)
+
+
+PROBLEM_CASES = {
+    # name: (file text, key that must be named)
+    "misspelled_table": (VALID + "\n[simulaton]\ngravity_mps2 = [0, 0, 0]\n", "simulaton"),
+    "unknown_table": (VALID + "\n[extra_stuff]\na = 1\n", "extra_stuff"),
+    "unknown_problem_key": (replace('name = "tiny"', 'name = "tiny"\ntitel = "x"'), "titel"),
+    "missing_problem_name": (replace('name = "tiny"\n', ""), "problem.name"),
+    "unknown_robot_type": (replace('type = "armz"', 'type = "armzz"'), "robot.type"),
+    "huge_n_modules": (replace("n_modules = 6", "n_modules = 10000"), "robot.n_modules"),
+    "n_modules_float": (replace("n_modules = 6", "n_modules = 6.5"), "robot.n_modules"),
+    "unknown_robot_key": (replace("n_modules = 6", "n_modules = 6\nmodules = 3"), "robot.modules"),
+    "two_starts": (replace("fill_deg = 180.0", "fill_deg = 180.0\nfill = 3.0"), "start"),
+    "start_wrong_length": (replace("fill_deg = 180.0", "q = [1.0, 2.0]"), "start.q"),
+    "obstacle_bad_type": (replace('type = "box"', 'type = "cube"'), "obstacles[0].type"),
+    "obstacle_negative_size": (
+        replace("size_m = [0.4, 4.0, 4.0]", "size_m = [0.4, -4.0, 4.0]"),
+        "obstacles[0].size_m",
+    ),
+    "obstacle_nan_center": (
+        replace("center_m = [3.0, 0.0, 2.0]", "center_m = [nan, 0.0, 2.0]"),
+        "obstacles[0].center_m",
+    ),
+    "duplicate_obstacle": (
+        VALID + '\n[[obstacles]]\nname = "wall"\ntype = "sphere"\ncenter_m = [9, 9, 9]\n'
+        "radius_m = 0.5\n",
+        "obstacles[1].name",
+    ),
+    "no_goals": (VALID.split("[[goals]]")[0] + "[budget]\nmax_iterations = 5\n", "goals"),
+    "duplicate_goal_names": (
+        VALID + '\n[[goals]]\nname = "up"\np_m = [1, 0, 3]\nn = [0, 0, 1]\npos_tol_m = 0.1\n'
+        "angle_tol_deg = 10\n",
+        "goals[1].name",
+    ),
+    "numeric_goal_name": (replace('name = "up"', 'name = "3"'), "goals[0].name"),
+    "empty_goal_name": (replace('name = "up"', 'name = " "'), "goals[0].name"),
+    "angle_tol_270": (replace("angle_tol_deg = 10.0", "angle_tol_deg = 270"), "angle_tol_deg"),
+    "negative_pos_tol": (replace("pos_tol_m = 0.1", "pos_tol_m = -0.1"), "goals[0].pos_tol_m"),
+    "zero_normal": (replace("n = [0.0, 0.0, 1.0]", "n = [0.0, 0.0, 0.0]"), "goals[0].n"),
+    "unknown_goal_key": (replace("pos_tol_m = 0.1", "pos_tol_m = 0.1\ntol = 1"), "goals[0].tol"),
+    "zero_check_budget": (
+        replace("max_iterations = 50", "max_collision_checks = 0"),
+        "budget.max_collision_checks",
+    ),
+    "unknown_budget_key": (replace("max_iterations = 50", "max_checks = 50"), "budget.max_checks"),
+    "tiny_joint_step": (replace("joint_step = 0.05", "joint_step = 1e-9"), "checking.joint_step"),
+    "huge_joint_step": (replace("joint_step = 0.05", "joint_step = 10.0"), "checking.joint_step"),
+    "gravity_two_numbers": (
+        VALID + "\n[simulation]\ngravity_mps2 = [0, -9.81]\n",
+        "simulation.gravity_mps2",
+    ),
+    "witness_wrong_joint_count": (
+        VALID + "\n[witness]\npath_rad = [[3.14, 3.14, 3.14, 3.14, 3.14], [1.0, 2.0]]\n",
+        "witness.path_rad[1]",
+    ),
+    "witness_one_waypoint": (
+        VALID + "\n[witness]\npath_rad = [[3.14, 3.14, 3.14, 3.14, 3.14]]\n",
+        "witness.path_rad",
+    ),
+    "continuum_nan_point": (
+        VALID + "\n[continuum]\ncollision_points_m = [[0.1, 0.2], [nan, 0.2]]\n",
+        "continuum.collision_points_m[1]",
+    ),
+    "continuum_unknown_guide": (
+        VALID + '\n[continuum]\nguide_obstacles = ["sleeve"]\n',
+        "continuum.guide_obstacles",
+    ),
+    "continuum_unknown_key": (
+        VALID + "\n[continuum]\ncollision_point_m = [[0.1, 0.2]]\n",
+        "continuum.collision_point_m",
+    ),
+    "toml_syntax": (VALID + "\n[goals\n", "<syntax>"),
+    "latin1_text": (VALID.replace("a short", "café, a short").encode("latin-1"), "<encoding>"),
+    "binary_file": (bytes(range(256)) * 4, "<encoding>"),
+}
+
+
+@pytest.mark.parametrize("case", sorted(PROBLEM_CASES))
+def test_bad_problem_file(capsys, tmp_path, case):
+    text, key = PROBLEM_CASES[case]
+    path = write(tmp_path, text)
+    code, _, err = run(capsys, "solve", str(path), "--planner", "gradient")
+    assert_clean_error(code, err, str(path), key)
+
+
+def test_misspelled_table_suggests_the_right_one(capsys, tmp_path):
+    path = write(tmp_path, PROBLEM_CASES["misspelled_table"][0])
+    code, _, err = run(capsys, "solve", str(path), "--planner", "gradient")
+    assert_clean_error(code, err, "did you mean 'simulation'")
+
+
+def test_huge_robot_is_refused_with_the_cost(capsys, tmp_path):
+    path = write(tmp_path, PROBLEM_CASES["huge_n_modules"][0])
+    code, _, err = run(capsys, "solve", str(path), "--planner", "gradient")
+    assert_clean_error(code, err, "<= 100", "10000")
+
+
+def test_tiny_joint_step_is_refused_with_the_cost(capsys, tmp_path):
+    path = write(tmp_path, PROBLEM_CASES["tiny_joint_step"][0])
+    code, _, err = run(capsys, "solve", str(path), "--planner", "gradient")
+    assert_clean_error(code, err, "collision checks")
+
+
+def test_directory_as_problem_file(capsys, tmp_path):
+    code, _, err = run(capsys, "solve", str(tmp_path), "--planner", "gradient")
+    assert_clean_error(code, err, str(tmp_path), "directory")
+
+
+def test_missing_problem_file(capsys, tmp_path):
+    path = tmp_path / "nope.toml"
+    code, _, err = run(capsys, "solve", str(path), "--planner", "gradient")
+    assert_clean_error(code, err, str(path), "<file>")
+
+
+def test_unknown_problem_name(capsys):
+    code, _, err = run(capsys, "solve", "armz_pockt", "--planner", "gradient")
+    assert_clean_error(code, err, "armz_pockt", "did you mean 'armz_pocket'")
+
+
+# --------------------------------------------------------------- command lines
+POCKET = str(PROBLEMS / "armz_pocket.toml")
+
+CLI_CASES = {
+    "seed_negative": (["--seed", "-1"], "--seed"),
+    "seed_not_a_number": (["--seed", "abc"], "--seed"),
+    "max_checks_zero": (["--max-checks", "0"], "--max-checks"),
+    "max_checks_negative": (["--max-checks", "-5"], "--max-checks"),
+    "max_checks_float": (["--max-checks", "2.5"], "--max-checks"),
+    "max_iterations_zero": (["--max-iterations", "0"], "--max-iterations"),
+    "time_limit_negative": (["--time-limit", "-1"], "--time-limit"),
+    "time_limit_nan": (["--time-limit", "nan"], "--time-limit"),
+    "time_limit_inf": (["--time-limit", "inf"], "--time-limit"),
+    "time_limit_zero": (["--time-limit", "0"], "--time-limit"),
+    "legs_empty": (["--legs", ""], "--legs"),
+    "legs_empty_item": (["--legs", "0,,1"], "--legs"),
+    "legs_out_of_range": (["--legs", "5"], "--legs"),
+    "legs_unknown_name": (["--legs", "pockett"], "--legs"),
+    "legs_twice": (["--legs", "0,pocket"], "--legs"),
+    "unknown_planner": (["--planner", "ompl.rrtconect"], "ompl.rrtconnect"),
+    "unknown_setting": (["--set", "no_such_setting=3"], "no_such_setting"),
+    "set_without_equals": (["--set", "alpha"], "--set"),
+}
+
+
+@pytest.mark.parametrize("case", sorted(CLI_CASES))
+def test_bad_command_line(capsys, case):
+    extra, name = CLI_CASES[case]
+    argv = ["solve", POCKET, *(["--planner", "gradient"] if "--planner" not in extra else [])]
+    code, _, err = run(capsys, *argv, *extra)
+    assert_clean_error(code, err, name)
+
+
+@pytest.mark.parametrize(
+    "extra,name",
+    [
+        (["--jobs", "0"], "--jobs"),
+        (["--max-checks", "0"], "--max-checks"),
+        (["--time-limit", "nan"], "--time-limit"),
+        (["--legs", "7"], "--legs"),
+        (["--seeds", "x"], "--seeds"),
+    ],
+    ids=["jobs", "max_checks", "time_limit", "legs", "seeds"],
+)
+def test_bad_compare_command_line(capsys, tmp_path, extra, name):
+    code, _, err = run(
+        capsys, "compare", POCKET, "--planners", "gradient", "--out", str(tmp_path), *extra
+    )
+    assert_clean_error(code, err, name)
+
+
+def test_out_into_an_impossible_path_fails_before_planning(capsys, tmp_path):
+    blocker = tmp_path / "a_file"
+    blocker.write_text("x")
+    out = blocker / "sub" / "plan.json"
+    code, _, err = run(capsys, "solve", POCKET, "--planner", "gradient", "--out", str(out))
+    assert_clean_error(code, err, str(blocker))
+
+
+# --------------------------------------------------------------- plan files
+def _valid_plan(tmp_path: Path) -> dict:
+    """A plan of armz_pocket (23 joints) with a short straight path, written by hand."""
+    problem = parse_problem(PROBLEMS / "armz_pocket.toml")
+    q0 = problem.q_start
+    path = np.array([q0, q0 + 0.01, q0 + 0.02])
+    r = PlanResult("gradient", problem.name, 0, "pocket", Status.FAILED, "hand-made", path)
+    return {
+        "format": "plannerlab.plan/1",
+        "problem": problem.name,
+        "problem_file": str(PROBLEMS / "armz_pocket.toml"),
+        "planner": "gradient",
+        "seed": 0,
+        "budget": {},
+        "legs": [r.to_dict()],
+        "executions": [],
+    }
+
+
+def _plan_file(tmp_path: Path, data: dict | str | bytes) -> Path:
+    p = tmp_path / "plan.json"
+    if isinstance(data, bytes):
+        p.write_bytes(data)
+    else:
+        p.write_text(data if isinstance(data, str) else json.dumps(data), encoding="utf-8")
+    return p
+
+
+def _broken(tmp_path: Path, how: str) -> dict | str | bytes:
+    d = _valid_plan(tmp_path)
+    if how == "no_legs":
+        d["legs"] = []
+    elif how == "legs_not_a_list":
+        d["legs"] = 3
+    elif how == "wrong_joint_count":
+        d["legs"][0]["path"] = [[3.14] * 5, [3.0] * 5]
+    elif how == "nan_in_path":
+        d["legs"][0]["path"][1][4] = float("nan")
+    elif how == "leg_out_of_range":
+        d["legs"][0]["leg"] = 4
+    elif how == "wrong_format":
+        d["format"] = "something/9"
+    elif how == "missing_planner":
+        del d["planner"]
+    elif how == "not_json":
+        return "{not json"
+    elif how == "binary":
+        return bytes(range(256))
+    return d
+
+
+PLAN_CASES = {
+    "no_legs": "legs",
+    "legs_not_a_list": "legs",
+    "wrong_joint_count": "legs[0].path",
+    "nan_in_path": "legs[0].path[1]",
+    "leg_out_of_range": "legs[0].leg",
+    "wrong_format": "format",
+    "missing_planner": "planner",
+    "not_json": "JSON",
+    "binary": "<encoding>",
+}
+
+
+@pytest.mark.parametrize("command", ["plot", "execute"])
+@pytest.mark.parametrize("case", sorted(PLAN_CASES))
+def test_bad_plan_file(capsys, tmp_path, case, command):
+    path = _plan_file(tmp_path, _broken(tmp_path, case))
+    code, _, err = run(capsys, command, str(path), "--out", str(tmp_path / "o"))
+    assert_clean_error(code, err, str(path), PLAN_CASES[case])
+
+
+def test_directory_as_plan_file(capsys, tmp_path):
+    d = tmp_path / "x.json"
+    d.mkdir()
+    code, _, err = run(capsys, "plot", str(d))
+    assert_clean_error(code, err, str(d), "directory")
+
+
+# --------------------------------------------------------------- as a user sees it
+def test_subprocess_shows_one_error_line_and_no_traceback(tmp_path):
+    path = write(tmp_path, PROBLEM_CASES["latin1_text"][0])
+    proc = subprocess.run(
+        [sys.executable, "-m", "plannerlab", "solve", str(path), "--planner", "gradient"],
+        capture_output=True,
+        text=True,
+        cwd=ROOT,
+        timeout=120,
+    )
+    assert proc.returncode == 2
+    assert "Traceback" not in proc.stderr
+    assert proc.stderr.startswith("error:") and "<encoding>" in proc.stderr
+    assert proc.stdout == ""
+
+
+# --------------------------------------------------------------- right diagnoses
+def test_goal_beyond_the_arm_is_unreachable_before_planning(capsys, tmp_path):
+    far = replace("p_m = [0.5, 0.0, 3.0]", "p_m = [100.0, 0.0, 3.0]")
+    path = write(tmp_path, far)
+    code, out, _ = run(
+        capsys,
+        "solve",
+        str(path),
+        "--planner",
+        "ompl.rrtconnect",
+        "--json",
+        "--out",
+        str(tmp_path / "plan.json"),
+    )
+    assert code == 0
+    leg = json.loads(out)["legs"][0]
+    assert leg["status"] == "unreachable"
+    assert leg["collision_checks"] == 0 and "reaches at most" in leg["reason"]
+
+
+def test_irb6_goal_off_the_track_is_unreachable(tmp_path):
+    from plannerlab.problem.goals import unreachable_reason
+
+    problem = parse_problem(PROBLEMS / "irb6_case1.toml")
+    goal = problem.goals[0]
+    assert unreachable_reason(problem.robot, goal) is None
+    T = problem.robot.T_world_base
+    far = type(goal)(
+        "far", T[:3, :3] @ [0.3, 0.9, 25.0] + T[:3, 3], goal.n_world, goal.pos_tol_m, 10.0
+    )
+    why = unreachable_reason(problem.robot, far)
+    assert why is not None and "track" in why
+
+
+def test_every_bundled_goal_passes_the_reach_check():
+    from plannerlab.problem.catalog import list_problems
+    from plannerlab.problem.goals import unreachable_reason
+
+    for f in list_problems():
+        p = parse_problem(f)
+        for g in p.goals:
+            assert unreachable_reason(p.robot, g) is None, (f, g.name)
+
+
+def test_reach_bound_holds_for_random_armz_states():
+    """The bound is a bound: no random state's tip lies beyond it."""
+    from plannerlab.problem.goals import GoalRegion, unreachable_reason
+
+    problem = parse_problem(PROBLEMS / "armz_pocket.toml")
+    rng = np.random.default_rng(0)
+    for q in rng.uniform(-np.pi, np.pi, (200, problem.robot.dof)):
+        p, n = problem.robot.tip(q)
+        assert unreachable_reason(problem.robot, GoalRegion("g", p, n, 1e-6, 1.0)) is None
+
+
+def test_armz_without_simulation_table_runs_gravity_free_and_says_so(tmp_path):
+    problem = parse_problem(write(tmp_path, VALID))
+    assert problem.simulation.gravity_mps2 == (0.0, 0.0, 0.0)
+    assert "gravity off" in problem.simulation.origin
+
+
+def test_base_rpy_without_base_xyz_is_honoured(tmp_path):
+    text = replace("n_modules = 6", "n_modules = 6\nbase_rpy_deg = [0.0, 0.0, 90.0]")
+    problem = parse_problem(write(tmp_path, text))
+    assert np.allclose(problem.robot.T_world_base[:3, 3], 0.0)
+    assert np.allclose(problem.robot.T_world_base[:3, 0], [0.0, 1.0, 0.0], atol=1e-12)
+
+
+def test_problem_names_resolve_from_the_working_directory_first(tmp_path, monkeypatch):
+    from plannerlab.problem.catalog import resolve_problem_path
+
+    (tmp_path / "problems").mkdir()
+    mine = write(tmp_path / "problems", VALID, "armz_pocket.toml")
+    monkeypatch.chdir(tmp_path)
+    assert resolve_problem_path("armz_pocket").resolve() == mine.resolve()
