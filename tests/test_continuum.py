@@ -6,7 +6,6 @@ Paper: ``003_d410ec97f064abf9.txt`` (``docs/papers.md`` §3).
 from __future__ import annotations
 
 import math
-import tomllib
 from pathlib import Path
 
 import numpy as np
@@ -22,7 +21,6 @@ from plannerlab.planners.chord_arc_search import (
     ConvexPolygon,
     MotionStep,
     prepare,
-    query_from_toml_data,
     search_chord_arc,
     solve_chord_arc,
 )
@@ -41,9 +39,18 @@ PROBLEMS = Path(__file__).resolve().parents[1] / "problems"
 T0 = planar_frame([0.0, 0.0], [0.0, 1.0])  # section frame = world: tangent along +y
 
 
-def _load(case: int) -> dict:
-    with open(PROBLEMS / f"continuum_case{case}.toml", "rb") as f:
-        return tomllib.load(f)
+def _problem(case: int):
+    from plannerlab.problem.catalog import load_problem
+
+    return load_problem(f"continuum_case{case}")
+
+
+def _query(case: int) -> ChordArcQuery:
+    """The paper's query of a case (the problem's own obstacles and collision points,
+    zero thickness), built by the planner from the one problem loader."""
+    from plannerlab.planners import make_planner
+
+    return make_planner("chord_arc").query(_problem(case), 0)
 
 
 # --------------------------------------------------------------------------- section math
@@ -326,7 +333,7 @@ def test_forward_constrained_contact_holds_when_bending_further() -> None:
 
 
 def test_motion_sequence_follows_the_final_shape() -> None:
-    q = tomllib_query(2)
+    q = _query(2)
     res = solve_chord_arc(q)
     geo = prepare(q, ChordArcSettings()).geometry
     for plan in res.plans:
@@ -344,10 +351,6 @@ def test_motion_sequence_follows_the_final_shape() -> None:
                 assert t1 / t0 == pytest.approx(1 + (l1 - l0) / l0)
             for a in np.linspace(0, 1, 6):
                 assert not geo.inside_any(_shape_points(s.shape_at(float(a))), 1e-6).any()
-
-
-def tomllib_query(case: int) -> ChordArcQuery:
-    return query_from_toml_data(_load(case))
 
 
 def _shape_points(shape: tuple[tuple[float, float], ...]) -> np.ndarray:
@@ -397,9 +400,10 @@ EXPECTED = {
 
 @pytest.mark.parametrize("case", [1, 2, 3], ids=lambda c: f"case{c}")
 def test_paper_cases_regression(case: int) -> None:
-    data = _load(case)
-    assert data["robot"]["type"] == "continuum_chain"
-    q = query_from_toml_data(data)
+    problem = _problem(case)
+    chain = problem.robot
+    assert isinstance(chain, ContinuumChain)
+    q = _query(case)
     exp = EXPECTED[case]
     assert len(q.collision_points_m) == exp["points"]
     res = solve_chord_arc(q)
@@ -414,20 +418,74 @@ def test_paper_cases_regression(case: int) -> None:
     # unsolvable for a single section without contact
     assert all(s.contact_indices for s in res.search.solutions)
     # every plan fits the robot and maps onto the chain within its joint bounds
-    chain = ContinuumChain(
-        n_links=data["robot"]["n_links"],
-        length_m=data["robot"]["length_m"],
-        T_world_base=pose_matrix(
-            data["robot"]["base_xyz_m"], np.deg2rad(data["robot"]["base_rpy_deg"])
-        ),
-    )
-    goal = np.array(data["goals"][0]["p_m"])
+    goal = problem.goal(0)
     for p in res.plans:
-        assert p.solution.total_length_m <= data["robot"]["length_m"]
+        assert p.solution.total_length_m <= chain.length_m
         qj = chain.q_from_arcs(p.solution.shape)
         assert np.all(qj >= chain.lower) and np.all(qj <= chain.upper)
         tip, _ = chain.tip(qj)
-        assert np.linalg.norm(tip - goal) < data["goals"][0]["pos_tol_m"]
+        assert np.linalg.norm(tip - goal.p_world_m) < goal.pos_tol_m
+
+
+def test_one_contact_solutions_are_the_two_arc_geometry() -> None:
+    """Golden values from geometry, not from a run: a one-contact solution is the arc
+    from the port (tangent +y) through the corner, then the arc tangent to it from the
+    corner to the target; :func:`_two_arcs` computes both bends in closed form."""
+    for case, key in ((1, (0,)), (1, (1,)), (2, (0,)), (3, (1,))):
+        q = _query(case)
+        corner = q.collision_points_m[key[0]]
+        np.testing.assert_allclose(
+            EXPECTED[case]["plans"][key], _two_arcs(corner, q.target_xy_m), atol=1e-9
+        )
+
+
+def test_the_planner_has_one_settings_class() -> None:
+    from plannerlab.planners import chord_arc, chord_arc_search
+
+    assert chord_arc.ChordArcSettings is chord_arc_search.ChordArcSettings
+    with pytest.raises(ChordArcInputError, match="choose must be one of"):
+        ChordArcSettings(choose="best")
+    assert ChordArcSettings().inflate_by_radius  # the robot's radius by default
+
+
+def test_batched_arcs_to_joints_equal_the_single_version() -> None:
+    chain = _problem(2).robot
+    rng = np.random.default_rng(3)
+    th = rng.uniform(-2.0, 2.0, (20, 3))
+    ln = rng.uniform(0.01, 0.15, (20, 3))
+    ref = np.array(
+        [chain.q_from_arcs(list(zip(a, b, strict=True))) for a, b in zip(th, ln, strict=True)]
+    )
+    np.testing.assert_allclose(chain.q_from_arcs_batch(th, ln), ref, atol=1e-12)
+    # a zero-length arc adds nothing
+    z = chain.q_from_arcs_batch([[0.7, 1.3, -0.2]], [[0.1, 0.0, 0.05]])
+    np.testing.assert_allclose(z[0], chain.q_from_arcs([(0.7, 0.1), (-0.2, 0.05)]), atol=1e-12)
+
+
+@pytest.mark.parametrize("case", [1, 2, 3], ids=lambda c: f"case{c}")
+def test_batched_capsule_contacts_equal_fcl(case: int) -> None:
+    """The planner's one-call planar contact test gives, state by state, exactly the
+    (link, obstacle) pairs python-fcl reports for the 3-D capsules and boxes."""
+    from plannerlab.collision.fcl_checker import CollisionChecker
+    from plannerlab.planners import make_planner
+    from plannerlab.planners.chord_arc import capsule_distances
+
+    problem = _problem(case)
+    chain = problem.robot
+    planner = make_planner("chord_arc", {"inflate_by_radius": False})
+    r = planner.solve(problem, 0, problem.budget, np.random.default_rng(0))
+    path = r.path[::3]
+    q = planner.query(problem, 0)
+    names = [o.name for o in q.obstacles]
+    dist = capsule_distances(chain.link_segments(path)[..., :2], q.obstacles, chain.link_radius_m)
+    checker = CollisionChecker(chain, problem.scene)
+    pairs_fcl, pairs_planar = set(), set()
+    for k, state in enumerate(path):
+        pairs_fcl |= {(k, link, other) for link, other in checker.colliding_pairs(state)}
+        for li, o in zip(*np.nonzero(dist[k] < chain.link_radius_m), strict=True):
+            pairs_planar.add((k, chain.link_names[li], names[o]))
+    assert pairs_planar  # the path touches its corners by design
+    assert pairs_planar == pairs_fcl
 
 
 # --------------------------------------------------------------------------- bad input
@@ -497,9 +555,37 @@ def test_problem_files_load_as_continuum_chains(case: int) -> None:
     np.testing.assert_allclose(robot.T_world_base[:3, 0], [0.0, 1.0, 0.0], atol=1e-15)
 
 
-def test_draw_case_writes_a_png(tmp_path: Path) -> None:
-    from plannerlab.plot.continuum import draw_case
+def test_case_figure_draws_the_query_and_the_solutions(tmp_path: Path) -> None:
+    from matplotlib.patches import Polygon
+
+    from plannerlab.plot.continuum import case_figure, draw_case, solution_xy
 
     q = _wall_query()
-    out = draw_case(q, solve_chord_arc(q), tmp_path / "fig" / "wall.png")
+    res = solve_chord_arc(q)
+    fig = case_figure(q, res)
+    (ax,) = fig.axes
+    polys = [p for p in ax.patches if isinstance(p, Polygon)]
+    assert len(polys) == len(q.obstacles)
+    np.testing.assert_allclose(polys[0].get_xy()[:4], np.array(q.obstacles[0].vertices_m))
+    lines = {ln.get_label(): ln for ln in ax.get_lines()}
+    np.testing.assert_allclose(lines["collision points"].get_xydata(), q.collision_points_m)
+    np.testing.assert_allclose(lines["target"].get_xydata(), [q.target_xy_m])
+    red = [ln for ln in ax.get_lines() if ln.get_color() == "tab:red"]
+    assert len(red) == len(res.plans)
+    for ln, p in zip(red, res.plans, strict=True):
+        np.testing.assert_allclose(ln.get_xydata(), solution_xy(p.solution))
+    out = draw_case(q, res, tmp_path / "fig" / "wall.png")
     assert out.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+
+
+def test_plot_module_leaves_the_backend_alone() -> None:
+    import subprocess
+    import sys
+
+    code = (
+        "import matplotlib; b = matplotlib.get_backend(); "
+        "import plannerlab.plot.continuum; "
+        "assert matplotlib.get_backend() == b, (b, matplotlib.get_backend()); "
+        "assert 'matplotlib.pyplot' not in __import__('sys').modules"
+    )
+    subprocess.run([sys.executable, "-c", code], check=True, env={"MPLBACKEND": "svg"})

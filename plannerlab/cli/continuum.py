@@ -21,6 +21,7 @@ from __future__ import annotations
 
 import argparse
 import contextlib
+import dataclasses
 import json
 import os
 import statistics
@@ -29,16 +30,10 @@ from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
 
+import numpy as np
 from rich.console import Console
 from rich.markup import escape
 from rich.table import Table
-
-#: the paper's Table I by problem name: (time [s], collision points, solutions)
-PAPER: dict[str, tuple[float, int, int]] = {
-    "continuum_case1": (0.07, 8, 2),
-    "continuum_case2": (0.06, 6, 2),
-    "continuum_case3": (0.04, 5, 1),
-}
 
 
 def add_continuum_parser(subparsers: Any) -> argparse.ArgumentParser:
@@ -97,6 +92,39 @@ def _case_name(case: str) -> str:
     return f"continuum_case{case}" if case.isdigit() else case
 
 
+def _thickness_figure(planner: Any, problem: Any, out: Path) -> Path:
+    """Where the paper's zero-thickness curves and the robot of the problem's radius part."""
+    from plannerlab.planners.chord_arc import thickness_cuts
+    from plannerlab.plot.continuum import save, thickness_figure
+
+    thin_planner = planner.with_settings(inflate_by_radius=False)
+    thick_planner = planner.with_settings(inflate_by_radius=True)
+    query, thin = thin_planner.search(problem, 0)
+    grown = thick_planner.planning_query(problem, query)
+    _, thick = thick_planner.search(problem, 0)
+    r = problem.robot.link_radius_m
+    cuts = [thickness_cuts(query, p.solution, r) for p in thin.plans]
+    kept = {p.solution.contact_indices for p in thick.plans}
+    lost = [
+        p.solution.contact_indices for p in thin.plans if p.solution.contact_indices not in kept
+    ]
+    title = (
+        f"{problem.name}: {len(thin.plans)} zero-thickness solution(s) (paper), "
+        f"{len(thick.plans)} for r = {r * 1e3:g} mm"
+        + (f"; lost: {', '.join(str(list(c)) for c in lost)}" if lost else "")
+    )
+    fig = thickness_figure(
+        query,
+        grown,
+        [p.solution for p in thin.plans],
+        [p.solution for p in thick.plans],
+        r,
+        np.vstack(cuts) if cuts else np.zeros((0, 2)),
+        title=title,
+    )
+    return save(fig, out / f"{problem.name}_thickness.png")
+
+
 def _figure(planner: Any, problem: Any, result: Any, out: Path) -> Path:
     """Fig. 4: the search's curves, split into the planner's kept and dropped ones."""
     from plannerlab.planners.chord_arc_search import ChordArcResult, DroppedSolution
@@ -124,6 +152,7 @@ def run_case(
     """One row of the table as data (JSON-able)."""
     from plannerlab.bench.task import leg_rng
     from plannerlab.planners import make_planner
+    from plannerlab.planners.chord_arc import PAPER_TABLE, guide_obstacles
     from plannerlab.problem.catalog import load_problem
 
     problem = load_problem(_case_name(case))
@@ -136,7 +165,9 @@ def run_case(
         solve_s.append(r.time_s)
         search_s.append(r.extra.get("search", {}).get("time_s", float("nan")))
         counts.add((r.status.value, len(r.extra["solutions"]), len(r.extra["dropped"])))
-    paper = PAPER.get(problem.name)
+    paper = PAPER_TABLE.get(problem.name)
+    thin = make_planner("chord_arc", {**overrides, "inflate_by_radius": False})
+    thin_r = thin.solve(problem, 0, budget, leg_rng(0, 0))
     sol = first.extra["solutions"]
     chosen = first.extra["chosen"]
     row: dict[str, Any] = {
@@ -148,24 +179,28 @@ def run_case(
         "solve_median_s": statistics.median(solve_s) if runs else None,
         "collision_points": len(first.extra["collision_points_m"]),
         "solutions": len(sol),
+        "inflated": bool(first.settings.get("inflate_by_radius")),
+        "solutions_zero_thickness": len(thin_r.extra["solutions"]),
         "dropped": len(first.extra["dropped"]),
         "dropped_reasons": [d["reason"] for d in first.extra["dropped"]],
         "chosen": chosen,
         "chosen_contacts": sol[chosen]["contact_indices"] if chosen is not None else None,
         "expansions": first.iterations,
         "same_every_run": len(counts) <= 1,
-        "paper": None
-        if paper is None
-        else {"time_s": paper[0], "collision_points": paper[1], "solutions": paper[2]},
+        "paper": None if paper is None else dataclasses.asdict(paper),
         "solutions_data": sol,
         "settings": dict(first.settings),
     }
     if figures is not None and sol:
         row["figure"] = str(_figure(planner, problem, first, figures))
+        row["thickness_figure"] = str(_thickness_figure(planner, problem, figures))
     if do_execute and first.extra.get("chosen") is not None:
         from plannerlab.sim.continuum import execute_chord_arc
 
-        row["execution"] = execute_chord_arc(problem, first).to_dict()
+        guide_obstacles(problem)  # validated (the plan's extra carries the names)
+        row["execution"] = execute_chord_arc(
+            problem, first.path, first.extra, leg=first.leg
+        ).to_dict()
     return row
 
 
@@ -202,6 +237,7 @@ def cmd_continuum(args: argparse.Namespace, console: Console) -> int:
         "paper ms",
         "points (paper)",
         "solutions (paper)",
+        "zero-thickness",
         "dropped",
         "chosen: points",
         "same",
@@ -225,6 +261,7 @@ def cmd_continuum(args: argparse.Namespace, console: Console) -> int:
             p_ms,
             f"{r['collision_points']}{p_pts}",
             f"{r['solutions']}{p_sol}",
+            str(r["solutions_zero_thickness"]),
             str(r["dropped"]),
             "-" if r["chosen"] is None else f"#{r['chosen']}: {r['chosen_contacts']}",
             "yes" if r["same_every_run"] else "[red]no[/red]",
@@ -245,14 +282,15 @@ def cmd_continuum(args: argparse.Namespace, console: Console) -> int:
         for d in r["dropped_reasons"]:
             notes.append(f"{r['problem']} dropped: {d}")
         if "figure" in r:
-            notes.append(f"{r['problem']} figure: {r['figure']}")
+            notes.append(f"{r['problem']} figures: {r['figure']}, {r['thickness_figure']}")
     t.caption = escape(
         "\n".join(
             [
                 "search ms: search + contact-type check (what the paper times); solve ms: the "
-                "planner's whole solve (joint paths, FCL contact classification); same: every "
-                "run gave the same status and counts; expected / unexpected: contact pairs in "
-                "PyBullet"
+                "planner's whole solve (joint paths, capsule contact classification); "
+                "solutions: for the robot's radius (inflate_by_radius) unless set false; "
+                "zero-thickness: the paper's model; same: every run gave the same status and "
+                "counts; expected / unexpected: contact pairs in PyBullet"
             ]
             + notes
         )
@@ -261,4 +299,4 @@ def cmd_continuum(args: argparse.Namespace, console: Console) -> int:
     return 0
 
 
-__all__ = ["PAPER", "add_continuum_parser", "cmd_continuum", "run_case"]
+__all__ = ["add_continuum_parser", "cmd_continuum", "run_case"]

@@ -27,7 +27,7 @@ Solutions are dropped, with the reason kept (``extra["dropped"]``), when
 2. the chain cannot follow the motion: a joint of the rigid-link chain would leave its
    bounds (the curve is too sharp for ``n_links`` links of ±``max_joint_rad``), or
 3. the robot's thickness (the search treats it as a curve) makes it touch an obstacle
-   away from the solution's collision points somewhere along the motion (FCL, below).
+   away from the solution's collision points somewhere along the motion (below).
 
 **The path** is the joint path (m, dof) of the chosen solution's motion sequence: each
 :class:`~plannerlab.planners.chord_arc_search.MotionStep` is sampled so that neither the
@@ -37,15 +37,15 @@ it would), and every shape is mapped to joints by ``ContinuumChain.q_from_arcs``
 leftover length stays straight behind the port). The path starts at the retracted,
 straight robot (insertion 0, every joint 0): ``q_start`` must be that state.
 
-**Robot thickness.** By default (``inflate_by_radius = False``) the search is the
-paper's: the robot is a curve, the obstacles and collision points are the problem's.
-With ``inflate_by_radius = True`` it plans the chain's *axis* instead: obstacles grown by
-the link radius r (:func:`grow_query`), collision points moved out of their obstacle by
-r, so the capsules touch the corners rather than cut them. Measured in PyBullet
-(:mod:`plannerlab.sim.continuum`): the paper's model deflects the chain at the corners
-(case 2's chosen solution ended 95 mm off with contacts away from the collision points),
-the grown model ended 1.5-7 mm off with contact only at the collision points; but it
-finds fewer solutions (case 2: 1 instead of the paper's 2).
+**Robot thickness.** By default (``inflate_by_radius = True``) the search plans the
+chain's *axis*: obstacles grown by the link radius r (:func:`grow_query`), collision
+points moved out of their obstacle by r, so that the capsules graze the corners instead
+of cutting them, and a returned solution is one the 2 mm robot can execute. With
+``inflate_by_radius = False`` the search is the paper's: the robot is a curve through
+the corners. The two differ on the paper's case 2 only: 1 solution instead of the
+paper's 2, because the lost one's curve meets the wall's lower right corner and the
+post's lower left corner at shallow angles, where a 2 mm robot along it would overlap
+their edges for several millimetres (:func:`thickness_cuts`; ``results/continuum.md``).
 
 **Contact is allowed by design.** The curve passes *through* each collision point (an
 obstacle corner; with ``inflate_by_radius``, r from it), so the chain's capsules
@@ -54,18 +54,20 @@ past it. The FCL re-check of this path (e.g.
 :func:`plannerlab.sim.execute.execute`'s ``path_valid``, or the shared planner check's
 "every edge collision-free") therefore reports collisions at those points. This planner
 is the one contact-permitting planner: :attr:`ChordArcPlanner.allows_contact` is True.
-During ``solve`` every state of every surviving solution's path is checked with FCL
-(:class:`~plannerlab.collision.fcl_checker.CollisionChecker`); a colliding (link, obstacle) pair is
-*expected* when the link's axis passes within ``contact_tolerance_m`` (= 2·r +
-``contact_margin_m``) of one of the solution's collision points on that obstacle;
-``extra["expected_contacts"]`` lists the chosen solution's expected pairs. Any other
-colliding pair drops the solution (3. above). These checks count in
-``collision_checks``.
+During ``solve`` every state of every surviving solution's path is checked in one
+batched call (:func:`capsule_distances`: every state × link × obstacle; the robot and
+the obstacles' cuts lie in one plane, so a capsule touches an obstacle exactly when its
+axis comes closer than r to the cut; it gives the same pairs as python-fcl state by
+state, 30-40 times faster); a touching (link, obstacle) pair is *expected* when the
+link's axis passes within ``contact_tolerance_m`` (= 2·r + ``contact_margin_m``) of one
+of the solution's collision points on that obstacle; ``extra["expected_contacts"]``
+lists the chosen solution's expected pairs. Any other touching pair drops the solution
+(3. above). Every state checked counts as one of ``collision_checks``.
 
 **Budget.** ``iterations`` = bases expanded by the search; ``budget.max_iterations`` caps
 ``max_expansions``. The search (milliseconds) is not interruptible: a ``time_limit_s``
 is compared with the search time afterwards (status ``budget_exhausted`` if it was
-exceeded), and the FCL contact classification stops at ``max_collision_checks`` (status
+exceeded), and the contact classification stops at ``max_collision_checks`` (status
 ``budget_exhausted``). The method is deterministic: ``rng`` is unused.
 
 ``trace``: the distance from the tip to the target [m] at each waypoint of the returned
@@ -74,6 +76,7 @@ path (it falls as the robot advances; flat stretches are the pushes and re-bends
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import time
 from collections.abc import Sequence
@@ -82,7 +85,6 @@ from typing import Any
 
 import numpy as np
 
-from plannerlab.collision.fcl_checker import CollisionChecker
 from plannerlab.errors import PlannerlabError, ProblemError
 from plannerlab.planners.base import (
     Deadline,
@@ -93,10 +95,12 @@ from plannerlab.planners.base import (
     with_overrides,
 )
 from plannerlab.planners.chord_arc_search import (
+    CHOICES,
     ChordArcInputError,
     ChordArcPlan,
     ChordArcQuery,
     ChordArcResult,
+    ChordArcSettings,
     ChordArcSolution,
     Circle,
     ConvexPolygon,
@@ -104,93 +108,27 @@ from plannerlab.planners.chord_arc_search import (
     PlanarObstacle,
     solve_chord_arc,
 )
-from plannerlab.planners.chord_arc_search import ChordArcSettings as SearchSettings
 from plannerlab.planners.chord_arc_search import prepare as prepare_check
 from plannerlab.problem.scene import Box, Cylinder, Scene, Sphere
 from plannerlab.robots.base import Array
 from plannerlab.robots.continuum.model import ContinuumChain
 
-#: values of :attr:`ChordArcSettings.choose`
-CHOICES: tuple[str, ...] = ("shortest", "fewest_contacts", "first")
-
 
 @dataclass(frozen=True)
-class ChordArcSettings:
-    """Settings of the ``chord_arc`` planner.
+class PaperCase:
+    """One row of the continuum paper's Table I (MATLAB 2019a on an i7-4790K)."""
 
-    Attributes:
-        max_expansions: most bases the search expands (the port counts as one).
-        max_depth: most arcs in a solution (contacts + 1); 0 = collision points + 1.
-        arc_step_m: largest spacing of the samples along an arc in the search [m].
-        inside_tol_m: an arc sample counts as inside an obstacle only deeper than this [m].
-        boundary_tol_m: how far a collision point may lie from an obstacle boundary [m].
-        max_bend_rad: largest |θ| of one arc [rad].
-        push_length_m: initial push l at each contact [m] (capped at half the next arc).
-        choose: which surviving solution to execute: "shortest" (least arc length),
-            "fewest_contacts" (ties: shorter), "first" (breadth-first order).
-        path_step_m: largest change of inserted length and of the last arc's length
-            between path waypoints [m].
-        path_joint_step_rad: largest change of any bend joint between waypoints [rad].
-        check_contacts: FCL-check every state of every surviving solution's path and drop
-            solutions touching obstacles away from their collision points.
-        contact_margin_m: a contact is expected within 2·link radius + this of one of
-            the solution's collision points [m].
-        inflate_by_radius: plan the robot's axis among obstacles grown by the link
-            radius, through collision points moved out of their obstacle by the radius
-            (the chain then touches the corners instead of cutting them); False: the
-            paper's zero-thickness curve.
-    """
+    time_s: float
+    collision_points: int
+    solutions: int
 
-    max_expansions: int = 100_000
-    max_depth: int = 0
-    arc_step_m: float = 1e-3
-    inside_tol_m: float = 1e-6
-    boundary_tol_m: float = 1e-6
-    max_bend_rad: float = math.pi
-    push_length_m: float = 0.005
-    choose: str = "shortest"
-    path_step_m: float = 0.002
-    path_joint_step_rad: float = 0.02
-    check_contacts: bool = True
-    contact_margin_m: float = 0.01
-    inflate_by_radius: bool = False
 
-    def __post_init__(self) -> None:
-        if self.choose not in CHOICES:
-            raise PlannerlabError(
-                f"choose must be one of {', '.join(CHOICES)}, got {self.choose!r}"
-            )
-        if self.max_expansions < 1:
-            raise PlannerlabError(f"max_expansions must be >= 1, got {self.max_expansions}")
-        if self.max_depth < 0:
-            raise PlannerlabError(f"max_depth must be >= 0 (0: no limit), got {self.max_depth}")
-        for name in (
-            "arc_step_m",
-            "max_bend_rad",
-            "push_length_m",
-            "path_step_m",
-            "path_joint_step_rad",
-        ):
-            if not getattr(self, name) > 0:
-                raise PlannerlabError(f"{name} must be > 0, got {getattr(self, name)}")
-        for name in ("inside_tol_m", "boundary_tol_m", "contact_margin_m"):
-            if not getattr(self, name) >= 0:
-                raise PlannerlabError(f"{name} must be >= 0, got {getattr(self, name)}")
-
-    def search_settings(self, max_iterations: int | None = None) -> SearchSettings:
-        """The search module's settings; ``max_iterations`` (a budget) caps the expansions."""
-        expansions = self.max_expansions
-        if max_iterations is not None:
-            expansions = max(1, min(expansions, int(max_iterations)))
-        return SearchSettings(
-            max_depth=self.max_depth or None,
-            max_expansions=expansions,
-            arc_step_m=self.arc_step_m,
-            inside_tol_m=self.inside_tol_m,
-            boundary_tol_m=self.boundary_tol_m,
-            max_bend_rad=self.max_bend_rad,
-            push_length_m=self.push_length_m,
-        )
+#: the paper's Table I by problem name (``docs/papers.md`` §3): the one copy of it
+PAPER_TABLE: dict[str, PaperCase] = {
+    "continuum_case1": PaperCase(0.07, 8, 2),
+    "continuum_case2": PaperCase(0.06, 6, 2),
+    "continuum_case3": PaperCase(0.04, 5, 1),
+}
 
 
 # --------------------------------------------------------------------------- building
@@ -256,7 +194,7 @@ def grow_query(
     against the direction into the obstacle (a corner's bisector, an edge's normal, a
     circle's radius), which puts a corner's point on the middle of its chamfer.
     """
-    prep = prepare_check(query, SearchSettings(boundary_tol_m=boundary_tol_m))
+    prep = prepare_check(query, ChordArcSettings(boundary_tol_m=boundary_tol_m))
     obstacles: list[PlanarObstacle] = []
     for o in query.obstacles:
         if isinstance(o, Circle):
@@ -275,6 +213,35 @@ def grow_query(
         points,
         query.target_xy_m,
     )
+
+
+def thickness_cuts(
+    query: ChordArcQuery,
+    solution: ChordArcSolution,
+    radius_m: float,
+    near_m: float | None = None,
+    step_m: float = 5e-4,
+) -> Array:
+    """Points (k, 2) of a zero-thickness solution where a robot of radius ``radius_m``
+    following it would cut an obstacle: the curve comes closer than the radius to an
+    obstacle farther than ``near_m`` (default 2·radius) from the solution's collision
+    points (at those points the curve passes through the corner by design).
+    """
+    near = 2.0 * radius_m if near_m is None else near_m
+    geo = prepare_check(query, ChordArcSettings()).geometry
+    pts = np.vstack(
+        [
+            a.points(np.linspace(0.0, 1.0, max(2, math.ceil(a.length_m / step_m))))
+            for a in solution.arcs
+        ]
+    )
+    sd = geo.signed_distance(pts).min(axis=1)
+    corners = np.asarray(solution.contact_points_m, dtype=float).reshape(-1, 2)
+    if len(corners):
+        d = np.linalg.norm(pts[:, None, :] - corners[None], axis=-1).min(axis=1)
+    else:
+        d = np.full(len(pts), math.inf)
+    return pts[(sd < radius_m - 1e-9) & (d > near)]
 
 
 def collision_points(problem: Any) -> tuple[tuple[float, float], ...]:
@@ -354,6 +321,14 @@ def _shape_dict(sol: ChordArcSolution, real: ChordArcQuery) -> dict[str, Any]:
     }
 
 
+def _capped(settings: ChordArcSettings, max_iterations: int | None) -> ChordArcSettings:
+    """``settings`` with ``max_expansions`` capped by a budget's ``max_iterations``."""
+    if max_iterations is None:
+        return settings
+    cap = max(1, min(settings.max_expansions, int(max_iterations)))
+    return dataclasses.replace(settings, max_expansions=cap)
+
+
 def _steps(a: float, b: float, step: float) -> int:
     return max(1, math.ceil(abs(b - a) / step - 1e-12))
 
@@ -370,6 +345,86 @@ class _Candidate:
     unexpected: tuple[dict[str, Any], ...]
 
 
+def _point_segment_distance(p: Array, a: Array, b: Array) -> Array:
+    """Distance (...) from points ``p`` to segments ``a``-``b`` (..., 2), broadcasting."""
+    dx, dy = b[..., 0] - a[..., 0], b[..., 1] - a[..., 1]
+    px, py = p[..., 0] - a[..., 0], p[..., 1] - a[..., 1]
+    t = np.clip((px * dx + py * dy) / np.maximum(dx * dx + dy * dy, 1e-300), 0.0, 1.0)
+    ex, ey = px - t * dx, py - t * dy
+    return np.sqrt(ex * ex + ey * ey)
+
+
+def _cross(u: Array, v: Array) -> Array:
+    return u[..., 0] * v[..., 1] - u[..., 1] * v[..., 0]
+
+
+def _segment_polygon_distance(a: Array, b: Array, vertices_m: Array) -> Array:
+    """Distance (k,) from segments ``a``-``b`` (k, 2) to a convex polygon (n, 2) CCW."""
+    v0 = vertices_m
+    v1 = np.roll(v0, -1, axis=0)
+    e = v1 - v0
+    A, B = a[:, None, :], b[:, None, :]  # (k, 1, 2) against the n edges
+    inside_a = np.all(_cross(e, A - v0) > 0.0, axis=-1)
+    inside_b = np.all(_cross(e, B - v0) > 0.0, axis=-1)
+    o1, o2 = _cross(B - A, v0 - A), _cross(B - A, v1 - A)
+    o3, o4 = _cross(e, A - v0), _cross(e, B - v0)
+    crosses = np.any((o1 * o2 <= 0.0) & (o3 * o4 <= 0.0), axis=-1)
+    d = np.minimum(
+        np.minimum(_point_segment_distance(A, v0, v1), _point_segment_distance(B, v0, v1)),
+        _point_segment_distance(v0, A, B),
+    ).min(axis=-1)
+    return np.where(inside_a | inside_b | crosses, 0.0, d)
+
+
+def capsule_distances(
+    seg_m: Array, obstacles: Sequence[PlanarObstacle], reach_m: float = math.inf
+) -> Array:
+    """Distance from link axes to planar obstacles, for a whole path at once.
+
+    The robot lies in the plane and every obstacle is its cut by that plane (upright boxes
+    and vertical cylinders reach across it), so a capsule of radius r touches an obstacle
+    exactly when its axis segment comes closer than r to the obstacle's cut.
+
+    Args:
+        seg_m: (..., 2, 2) axis segments (start, end) in the plane [m], e.g. (states,
+            links, 2, 2).
+        obstacles: convex polygons and circles (:func:`_planar_obstacles`).
+        reach_m: only distances up to this are computed exactly; segments whose bounding
+            box stays farther than this from an obstacle's bounding box get ``inf``.
+
+    Returns:
+        (..., O) distance from each segment to each obstacle [m]; 0 when the segment
+        meets the obstacle.
+    """
+    flat = np.asarray(seg_m, dtype=float).reshape(-1, 2, 2)
+    a, b = flat[:, 0], flat[:, 1]
+    lo, hi = np.minimum(a, b), np.maximum(a, b)
+    out = np.full((len(flat), len(obstacles)), math.inf)
+    for o, obs in enumerate(obstacles):
+        if isinstance(obs, Circle):
+            c = np.asarray(obs.center_m)
+            o_lo, o_hi = c - obs.radius_m, c + obs.radius_m
+        else:
+            v = np.asarray(obs.vertices_m)
+            o_lo, o_hi = v.min(axis=0), v.max(axis=0)
+        near = np.flatnonzero(np.all((lo <= o_hi + reach_m) & (hi >= o_lo - reach_m), axis=1))
+        if not len(near):
+            continue
+        if isinstance(obs, Circle):
+            d = np.maximum(_point_segment_distance(c, a[near], b[near]) - obs.radius_m, 0.0)
+        else:
+            d = _segment_polygon_distance(a[near], b[near], v)
+        out[near, o] = d
+    return out.reshape(np.shape(seg_m)[:-2] + (len(obstacles),))
+
+
+class _CheckCounter:
+    """Counts the states checked (``checks``), as :class:`Deadline` expects."""
+
+    def __init__(self) -> None:
+        self.checks = 0
+
+
 # --------------------------------------------------------------------------- planner
 
 
@@ -383,6 +438,10 @@ class ChordArcPlanner:
     def __init__(self, name: str, settings: ChordArcSettings) -> None:
         self.name = name
         self.settings = settings
+
+    def with_settings(self, **changes: Any) -> ChordArcPlanner:
+        """The same planner with some settings changed."""
+        return ChordArcPlanner(self.name, dataclasses.replace(self.settings, **changes))
 
     # ------------------------------------------------------------------ build
     def query(self, problem: Any, leg: int) -> ChordArcQuery:
@@ -423,7 +482,7 @@ class ChordArcPlanner:
         module's result (search + motion check) on the planning query, e.g. for figures."""
         query = self.query(problem, leg)
         plan_q = self.planning_query(problem, query)
-        return query, solve_chord_arc(plan_q, self.settings.search_settings(max_iterations))
+        return query, solve_chord_arc(plan_q, _capped(self.settings, max_iterations))
 
     def motion_path(
         self, robot: ContinuumChain, motion: Sequence[MotionStep]
@@ -437,12 +496,18 @@ class ChordArcPlanner:
         states = [robot.q_from_arcs([], insertion_m=0.0)]
         owner = [-1]
         for k, step in enumerate(motion):
-            l0, l1 = step.start_shape[-1][1], step.end_shape[-1][1]
+            (t0, l0), (t1, l1) = step.start_shape[-1], step.end_shape[-1]
+            fixed = np.array(step.start_shape[:-1], dtype=float).reshape(-1, 2)
             n = _steps(l0, l1, s.path_step_m)
             for _ in range(4):  # refine until no joint jumps more than path_joint_step_rad
-                Q = np.array(
-                    [robot.q_from_arcs(step.shape_at(a)) for a in np.linspace(0.0, 1.0, n + 1)]
+                a = np.linspace(0.0, 1.0, n + 1)[:, None]
+                th = np.hstack(
+                    [np.broadcast_to(fixed[:, 0], (n + 1, len(fixed))), t0 + a * (t1 - t0)]
                 )
+                ln = np.hstack(
+                    [np.broadcast_to(fixed[:, 1], (n + 1, len(fixed))), l0 + a * (l1 - l0)]
+                )
+                Q = robot.q_from_arcs_batch(th, ln)
                 jump = float(np.max(np.abs(np.diff(Q[:, 1:], axis=0)), initial=0.0))
                 if jump <= s.path_joint_step_rad * (1.0 + 1e-9):
                     break
@@ -460,64 +525,60 @@ class ChordArcPlanner:
     def _classify(
         self,
         robot: ContinuumChain,
-        checker: CollisionChecker,
-        deadline: Deadline,
+        counter: _CheckCounter,
         budget: Any,
         plan: ChordArcPlan,
         query: ChordArcQuery,
         path: Array,
         tol: float,
     ) -> tuple[list[dict[str, Any]], list[dict[str, Any]], bool]:
-        """FCL contacts along a path, split into expected and unexpected (link, obstacle).
+        """Contacts of the chain's capsules along a path, split into expected and
+        unexpected (link, obstacle) pairs, in one batched planar test
+        (:func:`capsule_distances`: every state × link × obstacle at once).
+
+        A colliding pair is expected while the link's axis passes within ``tol`` of one
+        of the solution's collision points on that obstacle; once it collides anywhere
+        else it is unexpected. Every state counts as one collision check.
 
         Returns (expected, unexpected, cut short by the check budget).
         """
         limit = budget.max_collision_checks
-        if limit is not None:
-            left = limit - deadline.checks_used
-            if left < len(path):
-                return [], [], True
-        bad = np.flatnonzero(~checker.valid_batch(path))
-        pts = {i: np.asarray(query.collision_points_m[i]) for i in plan.solution.contact_indices}
-        owner = {
-            i: c.obstacle for i, c in zip(plan.solution.contact_indices, plan.contacts, strict=True)
-        }
-        link_index = {n: i for i, n in enumerate(robot.link_names)}
-        expected: dict[tuple[str, str], dict[str, Any]] = {}
-        unexpected: dict[tuple[str, str], dict[str, Any]] = {}
-        for k in bad:
-            if limit is not None and deadline.checks_used >= limit:
-                return list(expected.values()), list(unexpected.values()), True
-            seg = robot.link_segments(path[k])[:, :, :2]
-            for link, other in checker.colliding_pairs(path[k]):
-                key = (link, other)
-                if key in unexpected:
-                    continue
-                li = link_index.get(link)
-                best: tuple[float, int | None] = (math.inf, None)
-                if li is not None:
-                    a, b = seg[li]
-                    for i, p in pts.items():
-                        if owner[i] != other:
-                            continue
-                        d = b - a
-                        t = float(np.clip(np.dot(p - a, d) / max(np.dot(d, d), 1e-300), 0, 1))
-                        dist = float(np.linalg.norm(a + t * d - p))
-                        if dist < best[0]:
-                            best = (dist, i)
-                rec = {
-                    "link": link,
-                    "obstacle": other,
-                    "first_state": int(k),
-                    "collision_point": best[1],
-                    "distance_m": None if best[1] is None else best[0],
-                }
-                if best[0] > tol:  # once anywhere else: unexpected
-                    expected.pop(key, None)
-                    unexpected[key] = rec
-                elif key not in expected:
-                    expected[key] = rec
-        return list(expected.values()), list(unexpected.values()), False
+        if limit is not None and limit - counter.checks < len(path):
+            return [], [], True
+        counter.checks += len(path)
+        seg = robot.link_segments(path)[..., :2]  # (S, L, 2, 2)
+        dist = capsule_distances(seg, query.obstacles, robot.link_radius_m)  # (S, L, O)
+        touching = dist < robot.link_radius_m
+        if not touching.any():
+            return [], [], False
+        names = [o.name for o in query.obstacles]
+        near = np.full(touching.shape, math.inf)  # axis distance to an own collision point
+        nearest = np.full(touching.shape, -1, dtype=int)
+        for i, ck in zip(plan.solution.contact_indices, plan.contacts, strict=True):
+            o = names.index(ck.obstacle)
+            p = np.asarray(query.collision_points_m[i], dtype=float)
+            d = _point_segment_distance(p, seg[..., 0, :], seg[..., 1, :])  # (S, L)
+            better = d < near[..., o]
+            near[..., o] = np.where(better, d, near[..., o])
+            nearest[..., o] = np.where(better, i, nearest[..., o])
+        expected: list[dict[str, Any]] = []
+        unexpected: list[dict[str, Any]] = []
+        for li, o in zip(*np.nonzero(touching.any(axis=0)), strict=True):
+            states = np.flatnonzero(touching[:, li, o])
+            away = states[near[states, li, o] > tol]
+            k = int(away[0]) if len(away) else int(states[0])
+            ci = int(nearest[k, li, o])
+            rec = {
+                "link": robot.link_names[li],
+                "obstacle": names[o],
+                "first_state": k,
+                "collision_point": None if ci < 0 else ci,
+                "distance_m": None if ci < 0 else float(near[k, li, o]),
+            }
+            (unexpected if len(away) else expected).append(rec)
+        expected.sort(key=lambda r: r["first_state"])
+        unexpected.sort(key=lambda r: r["first_state"])
+        return expected, unexpected, False
 
     # ------------------------------------------------------------------ solve
     def solve(
@@ -549,21 +610,10 @@ class ChordArcPlanner:
         s = self.settings
         robot = problem.robot
         goal = problem.goal(leg)
-        query_error = ""
-        query: ChordArcQuery | None = None
         real = self.query(problem, leg)
-        try:
-            query = self.planning_query(problem, real)
-            prepare_check(query, s.search_settings())
-        except ChordArcInputError as exc:  # only the target can be wrong per leg
-            if "target" not in str(exc):
-                raise
-            query_error = str(exc) + (
-                " (obstacles grown by the link radius)" if s.inflate_by_radius else ""
-            )
-            query = None
-        checker = CollisionChecker(robot, problem.scene)
-        deadline = Deadline(budget, checker)
+        query = self.planning_query(problem, real)
+        counter = _CheckCounter()
+        deadline = Deadline(budget, counter)
         q0 = np.asarray(problem.q_start if q_start is None else q_start, dtype=float)
         q0 = q0.reshape(robot.dof)
         tol = 2.0 * robot.link_radius_m + s.contact_margin_m
@@ -576,6 +626,7 @@ class ChordArcPlanner:
             "chosen": None,
             "expected_contacts": [],
             "allows_contact": True,
+            "guide_obstacles": sorted(guide_obstacles(problem)),
         }
 
         def result(
@@ -623,11 +674,14 @@ class ChordArcPlanner:
                 "m off the robot's plane",
                 q0[None],
             )
-        if query is None:
-            return result(Status.INVALID_GOAL, query_error, q0[None])
-
         t_search = time.perf_counter()
-        res = solve_chord_arc(query, s.search_settings(budget.max_iterations))
+        try:
+            res = solve_chord_arc(query, _capped(s, budget.max_iterations))
+        except ChordArcInputError as exc:  # only the target can be wrong per leg
+            if "target" not in str(exc):
+                raise
+            grown = " (obstacles grown by the link radius)" if s.inflate_by_radius else ""
+            return result(Status.INVALID_GOAL, str(exc) + grown, q0[None])
         search_s = time.perf_counter() - t_search
         srch = res.search
         base_extra["search"] = {
@@ -676,7 +730,7 @@ class ChordArcPlanner:
             unexp: list[dict[str, Any]] = []
             if not reason and s.check_contacts and not cut_short:
                 exp, unexp, cut_short = self._classify(
-                    robot, checker, deadline, budget, plan, real, path, tol
+                    robot, counter, budget, plan, real, path, tol
                 )
                 if unexp:
                     u = unexp[0]
@@ -793,4 +847,16 @@ def make(name: str, overrides: dict[str, Any]) -> ChordArcPlanner:
     return ChordArcPlanner(name, with_overrides(ChordArcSettings(), overrides, name))
 
 
-__all__ = ["CHOICES", "ChordArcPlanner", "ChordArcSettings", "collision_points", "make"]
+__all__ = [
+    "CHOICES",
+    "PAPER_TABLE",
+    "ChordArcPlanner",
+    "ChordArcSettings",
+    "PaperCase",
+    "capsule_distances",
+    "collision_points",
+    "grow_query",
+    "guide_obstacles",
+    "make",
+    "thickness_cuts",
+]

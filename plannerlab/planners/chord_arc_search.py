@@ -66,7 +66,7 @@ file's boxes (yaw only), vertical cylinders and spheres onto the plane z = 0.
 from __future__ import annotations
 
 import math
-from collections.abc import Mapping, Sequence
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 from typing import Any, Literal
 
@@ -322,12 +322,19 @@ class ChordArcQuery:
         object.__setattr__(self, "target_xy_m", _point(self.target_xy_m, "target_xy_m"))
 
 
+#: values of :attr:`ChordArcSettings.choose`
+CHOICES: tuple[str, ...] = ("shortest", "fewest_contacts", "first")
+
+
 @dataclass(frozen=True)
 class ChordArcSettings:
-    """Search and motion-check settings.
+    """Settings of the ``chord_arc`` planner: its search, motion check and joint path.
 
-    Args:
-        max_depth: most arcs in a solution (contacts + 1); None = collision points + 1.
+    The search functions of this module read the first group; the planner
+    (:mod:`plannerlab.planners.chord_arc`) reads the second.
+
+    Search and motion check:
+        max_depth: most arcs in a solution (contacts + 1); 0 = collision points + 1.
         max_expansions: most bases expanded (the port counts as one).
         arc_step_m: largest spacing of the samples along an arc [m].
         inside_tol_m: a sample counts as inside an obstacle only deeper than this [m].
@@ -339,9 +346,25 @@ class ChordArcSettings:
         coarse_factor: a first pass samples arcs this many times more sparsely to drop
             blocked arcs early (1 = off).
         chunk_samples: arc samples per numpy batch (bounds memory).
+
+    Planner:
+        inflate_by_radius: plan the robot's axis among obstacles grown by the link
+            radius, through collision points moved out of their obstacle by the radius, so
+            that the chain's capsules touch the corners instead of cutting them (default);
+            False: the paper's zero-thickness curve.
+        choose: which surviving solution to execute: "shortest" (least arc length),
+            "fewest_contacts" (ties: shorter), "first" (breadth-first order).
+        path_step_m: largest change of inserted length and of the last arc's length
+            between path waypoints [m].
+        path_joint_step_rad: largest change of any bend joint between waypoints [rad].
+        check_contacts: check every state of every surviving solution's path for the
+            chain's capsules touching obstacles away from its collision points, and drop
+            such solutions.
+        contact_margin_m: a contact is expected within 2·link radius + this of one of
+            the solution's collision points [m].
     """
 
-    max_depth: int | None = None
+    max_depth: int = 0
     max_expansions: int = 100_000
     arc_step_m: float = 1e-3
     inside_tol_m: float = 1e-6
@@ -352,18 +375,35 @@ class ChordArcSettings:
     min_kappa_change_per_m: float = 1e-9
     coarse_factor: int = 8
     chunk_samples: int = 65536
+    inflate_by_radius: bool = True
+    choose: str = "shortest"
+    path_step_m: float = 0.002
+    path_joint_step_rad: float = 0.02
+    check_contacts: bool = True
+    contact_margin_m: float = 0.01
 
     def __post_init__(self) -> None:
-        if self.max_depth is not None and self.max_depth < 1:
-            raise ChordArcInputError(f"max_depth must be >= 1, got {self.max_depth}")
-        if self.max_expansions < 1:
-            raise ChordArcInputError(f"max_expansions must be >= 1, got {self.max_expansions}")
-        for name in ("arc_step_m", "max_bend_rad", "push_length_m"):
+        if self.max_depth < 0:
+            raise ChordArcInputError(f"max_depth must be >= 0 (0: no limit), got {self.max_depth}")
+        for name in ("max_expansions", "rebend_steps", "coarse_factor", "chunk_samples"):
+            if getattr(self, name) < 1:
+                raise ChordArcInputError(f"{name} must be >= 1, got {getattr(self, name)}")
+        for name in (
+            "arc_step_m",
+            "max_bend_rad",
+            "push_length_m",
+            "path_step_m",
+            "path_joint_step_rad",
+        ):
             if not getattr(self, name) > 0:
                 raise ChordArcInputError(f"{name} must be > 0, got {getattr(self, name)}")
-        for name in ("inside_tol_m", "boundary_tol_m"):
+        for name in ("inside_tol_m", "boundary_tol_m", "contact_margin_m"):
             if not getattr(self, name) >= 0:
                 raise ChordArcInputError(f"{name} must be >= 0, got {getattr(self, name)}")
+        if self.choose not in CHOICES:
+            raise ChordArcInputError(
+                f"choose must be one of {', '.join(CHOICES)}, got {self.choose!r}"
+            )
 
 
 @dataclass(frozen=True)
@@ -660,7 +700,7 @@ class _Level:
 def _search(query: ChordArcQuery, prep: _Prepared, settings: ChordArcSettings) -> SearchResult:
     m = len(prep.points)
     goals = np.vstack([prep.points, prep.target[None]])  # (m + 1, 2); column m = target
-    max_depth = settings.max_depth if settings.max_depth is not None else m + 1
+    max_depth = settings.max_depth or m + 1
     total = query.total_length_m
     root = _Level(
         parent=np.array([-1]),
@@ -961,59 +1001,8 @@ def solve_chord_arc(
     return ChordArcResult(search, tuple(plans), tuple(dropped))
 
 
-# --------------------------------------------------------------------------- problem files
-
-
-def query_from_toml_data(data: Mapping[str, Any]) -> ChordArcQuery:
-    """A query from a parsed problem file (``tomllib.load``) with a ``[continuum]`` table.
-
-    A stop-gap until the problem loader wraps this planner. Obstacles are cut by the plane
-    z = 0: a box (yaw only) gives a rectangle, a cylinder with a vertical axis a circle, a
-    sphere the circle of its cross-section; shapes that miss the plane are left out. The
-    base tangent is the base frame's x axis; the target is the first goal's position.
-
-    Raises:
-        ChordArcInputError: a tilted box or cylinder, a missing key.
-    """
-    try:
-        robot = data["robot"]
-        base = robot.get("base_xyz_m", [0.0, 0.0, 0.0])
-        yaw = math.radians(robot.get("base_rpy_deg", [0.0, 0.0, 0.0])[2])
-        obstacles: list[PlanarObstacle] = []
-        for o in data.get("obstacles", []):
-            cx, cy, cz = o["center_m"]
-            roll, pitch, oyaw = (math.radians(v) for v in o.get("rpy_deg", [0.0, 0.0, 0.0]))
-            if o["type"] in ("box", "cylinder") and (abs(roll) > 1e-12 or abs(pitch) > 1e-12):
-                raise ChordArcInputError(
-                    f"obstacle {o['name']!r}: only yaw is supported in the plane"
-                )
-            if o["type"] == "box":
-                sx, sy, sz = o["size_m"]
-                if abs(cz) < sz / 2:
-                    obstacles.append(ConvexPolygon.rectangle((cx, cy), (sx, sy), oyaw, o["name"]))
-            elif o["type"] == "cylinder":
-                if abs(cz) < o["length_m"] / 2:
-                    obstacles.append(Circle((cx, cy), o["radius_m"], o["name"]))
-            elif o["type"] == "sphere":
-                if abs(cz) < o["radius_m"]:
-                    obstacles.append(
-                        Circle((cx, cy), math.sqrt(o["radius_m"] ** 2 - cz**2), o["name"])
-                    )
-            else:
-                raise ChordArcInputError(f"obstacle {o['name']!r}: unknown type {o['type']!r}")
-        return ChordArcQuery(
-            base_xy_m=(base[0], base[1]),
-            base_tangent=(math.cos(yaw), math.sin(yaw)),
-            total_length_m=robot["length_m"],
-            obstacles=tuple(obstacles),
-            collision_points_m=tuple(tuple(p) for p in data["continuum"]["collision_points_m"]),
-            target_xy_m=tuple(data["goals"][0]["p_m"][:2]),
-        )
-    except KeyError as e:
-        raise ChordArcInputError(f"problem data is missing the key {e.args[0]!r}") from None
-
-
 __all__ = [
+    "CHOICES",
     "Arc",
     "ChordArcInputError",
     "ChordArcPlan",
@@ -1030,7 +1019,6 @@ __all__ = [
     "SearchResult",
     "check_motion",
     "prepare",
-    "query_from_toml_data",
     "search_chord_arc",
     "solve_chord_arc",
 ]

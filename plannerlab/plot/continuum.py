@@ -1,33 +1,204 @@
-"""Figures of the chord-arc search in the style of the paper's Fig. 4.
+"""Figures of the chord-arc search in the style of the paper's Fig. 4, and of the robot's
+thickness.
 
 Blue lines: obstacle boundaries; red curves: solutions that hold (dropped solutions
 dashed grey); green dots: the user's collision points; black dot: the target.
-Matplotlib with the Agg backend, written to a file; nothing is shown.
+Figures are built as :class:`matplotlib.figure.Figure` objects without pyplot (no
+backend is chosen or changed here) and written to a file; nothing is shown.
 """
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from pathlib import Path
 
-import matplotlib
+import numpy as np
+from matplotlib.axes import Axes
+from matplotlib.figure import Figure
+from matplotlib.patches import Circle as CirclePatch
+from matplotlib.patches import Polygon as PolygonPatch
 
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
-import numpy as np  # noqa: E402
-from matplotlib.patches import Circle as CirclePatch  # noqa: E402
-from matplotlib.patches import Polygon as PolygonPatch  # noqa: E402
-
-from plannerlab.planners.chord_arc_search import (  # noqa: E402
+from plannerlab.planners.chord_arc_search import (
     ChordArcQuery,
     ChordArcResult,
     ChordArcSolution,
     Circle,
+    PlanarObstacle,
 )
 
 
-def _solution_xy(sol: ChordArcSolution, n: int = 100) -> np.ndarray:
+def solution_xy(sol: ChordArcSolution, n: int = 100) -> np.ndarray:
+    """Points (k, 2) along a solution's arcs [m], ``n`` per arc."""
     a = np.linspace(0.0, 1.0, n)
     return np.vstack([arc.points(a) for arc in sol.arcs])
+
+
+def _obstacles(ax: Axes, obstacles: Sequence[PlanarObstacle], **style: object) -> None:
+    for o in obstacles:
+        if isinstance(o, Circle):
+            ax.add_patch(CirclePatch(o.center_m, o.radius_m, fill=False, **style))
+        else:
+            ax.add_patch(PolygonPatch(np.array(o.vertices_m), closed=True, fill=False, **style))
+
+
+def _port_and_target(ax: Axes, query: ChordArcQuery) -> None:
+    if query.collision_points_m:
+        cp = np.array(query.collision_points_m)
+        ax.plot(cp[:, 0], cp[:, 1], "o", color="tab:green", ms=5, label="collision points")
+    ax.plot(*query.target_xy_m, "o", color="black", ms=6, label="target")
+    bx, by = query.base_xy_m
+    tx, ty = query.base_tangent
+    ax.annotate(
+        "",
+        xy=(bx + 0.03 * tx, by + 0.03 * ty),
+        xytext=(bx, by),
+        arrowprops={"arrowstyle": "->", "color": "black"},
+    )
+
+
+def _finish(ax: Axes, title: str, legend: bool = True) -> None:
+    ax.set_aspect("equal")
+    if ax.get_autoscale_on():
+        ax.autoscale_view()
+    ax.set_xlabel("x [m]")
+    ax.set_ylabel("y [m]")
+    ax.set_title(title, fontsize=9)
+    if legend:
+        ax.legend(loc="lower right", fontsize=7)
+    ax.grid(alpha=0.3)
+
+
+def case_figure(
+    query: ChordArcQuery, result: ChordArcResult, title: str = "", show_dropped: bool = True
+) -> Figure:
+    """Fig. 4 of a case: obstacles, collision points, every solution, target, port.
+
+    Args:
+        query: the search input (obstacles and collision points drawn).
+        result: :func:`~plannerlab.planners.chord_arc_search.solve_chord_arc` output.
+        title: figure title (default: the counts).
+        show_dropped: also draw the dropped solutions (dashed grey).
+    """
+    fig = Figure(figsize=(5.0, 5.0), dpi=120)
+    ax = fig.add_subplot()
+    _obstacles(ax, query.obstacles, color="tab:blue")
+    if show_dropped:
+        for i, d in enumerate(result.dropped):
+            xy = solution_xy(d.solution)
+            ax.plot(
+                xy[:, 0],
+                xy[:, 1],
+                "--",
+                color="0.6",
+                lw=1.0,
+                label="dropped" if i == 0 else None,
+            )
+    for i, p in enumerate(result.plans):
+        xy = solution_xy(p.solution)
+        ax.plot(
+            xy[:, 0], xy[:, 1], "-", color="tab:red", lw=1.8, label="solutions" if i == 0 else None
+        )
+    _port_and_target(ax, query)
+    _finish(
+        ax,
+        title
+        or f"{len(result.plans)} solution(s), {len(query.collision_points_m)} collision points",
+    )
+    fig.tight_layout()
+    return fig
+
+
+def thickness_figure(
+    query: ChordArcQuery,
+    grown: ChordArcQuery,
+    thin: Sequence[ChordArcSolution],
+    thick: Sequence[ChordArcSolution],
+    radius_m: float,
+    cuts_xy_m: np.ndarray,
+    title: str = "",
+) -> Figure:
+    """Where the zero-thickness curve and the real robot part.
+
+    Args:
+        query: the problem's obstacles and collision points.
+        grown: the same obstacles grown by ``radius_m`` (what the robot's axis must avoid).
+        thin: the paper's zero-thickness solutions (drawn thin red, with the robot's
+            width around them shaded).
+        thick: the solutions for the robot of radius ``radius_m`` (drawn dark blue).
+        radius_m: link radius [m].
+        cuts_xy_m: (k, 2) points of the thin solutions closer than ``radius_m`` to an
+            obstacle away from their collision points (drawn as crosses).
+        title: figure title.
+    """
+    cuts = np.asarray(cuts_xy_m, dtype=float).reshape(-1, 2)
+    clusters: list[np.ndarray] = []  # cuts 2 cm apart or more: one zoom each (at most 2)
+    left = cuts
+    while len(left) and len(clusters) < 2:
+        near = np.linalg.norm(left - left[0], axis=1) < 0.02
+        clusters.append(left[near])
+        left = left[~near]
+    fig = Figure(figsize=(5.0 + 4.0 * len(clusters), 5.5), dpi=120)
+    axes = [fig.add_subplot(1, 1 + len(clusters), i + 1) for i in range(1 + len(clusters))]
+    full, zooms = axes[0], axes[1:]
+    for ax in axes:
+        _obstacles(ax, query.obstacles, color="tab:blue", lw=1.2)
+        _obstacles(ax, grown.obstacles, color="tab:blue", lw=0.8, ls=":")
+        ax.plot([], [], ":", color="tab:blue", lw=0.8, label=f"grown by r = {radius_m * 1e3:g} mm")
+        for i, s in enumerate(thin):
+            xy = solution_xy(s, 400)
+            t = np.gradient(xy, axis=0)
+            nrm = np.stack([-t[:, 1], t[:, 0]], axis=1) / np.linalg.norm(t, axis=1)[:, None]
+            band = np.vstack([xy + radius_m * nrm, (xy - radius_m * nrm)[::-1]])
+            ax.add_patch(PolygonPatch(band, closed=True, color="tab:red", alpha=0.25, lw=0))
+            ax.plot(
+                xy[:, 0],
+                xy[:, 1],
+                "-",
+                color="tab:red",
+                lw=0.8,
+                label="zero-thickness (paper), robot's width shaded" if i == 0 else None,
+            )
+        for i, s in enumerate(thick):
+            xy = solution_xy(s, 400)
+            ax.plot(
+                xy[:, 0],
+                xy[:, 1],
+                "-",
+                color="navy",
+                lw=1.4,
+                label=f"axis of the {radius_m * 1e3:g} mm robot" if i == 0 else None,
+            )
+        if len(cuts):
+            ax.plot(cuts[:, 0], cuts[:, 1], "x", color="black", ms=4, label="robot would cut")
+        _port_and_target(ax, query)
+    # the working area (not the sleeve behind the port), and a zoom on the cuts
+    pts = [np.array([query.base_xy_m, query.target_xy_m])]
+    pts += [solution_xy(s) for s in (*thin, *thick)]
+    if query.collision_points_m:
+        pts.append(np.array(query.collision_points_m))
+    xy = np.vstack(pts)
+    lo, hi = xy.min(axis=0) - 0.02, xy.max(axis=0) + 0.02
+    full.set_xlim(lo[0], hi[0])
+    full.set_ylim(lo[1], hi[1])
+    _finish(full, "the working area")
+    fig.suptitle(title, fontsize=10)
+    for zoom, c in zip(zooms, clusters, strict=True):
+        mid = (c.min(axis=0) + c.max(axis=0)) / 2.0
+        zoom.set_xlim(mid[0] - 0.012, mid[0] + 0.012)
+        zoom.set_ylim(mid[1] - 0.012, mid[1] + 0.012)
+        _finish(zoom, f"where they part near ({mid[0]:.3f}, {mid[1]:.3f}) m", legend=False)
+    for ax in axes:
+        ax.set_autoscale_on(False)
+    fig.tight_layout()
+    return fig
+
+
+def save(fig: Figure, png_path: str | Path) -> Path:
+    """Write a figure to a PNG (parent folders are created); returns the path."""
+    path = Path(png_path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fig.savefig(path)
+    return path
 
 
 def draw_case(
@@ -37,77 +208,8 @@ def draw_case(
     title: str = "",
     show_dropped: bool = True,
 ) -> Path:
-    """Draw a case (obstacles, collision points, every solution, target) to a PNG.
-
-    Args:
-        query: the search input.
-        result: :func:`~plannerlab.planners.chord_arc_search.solve_chord_arc` output.
-        png_path: file to write (parent folders are created).
-        title: figure title.
-        show_dropped: also draw solutions the motion check dropped (dashed grey).
-
-    Returns:
-        The path written.
-    """
-    path = Path(png_path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fig, ax = plt.subplots(figsize=(5.0, 5.0), dpi=120)
-    try:
-        for o in query.obstacles:
-            if isinstance(o, Circle):
-                ax.add_patch(CirclePatch(o.center_m, o.radius_m, fill=False, color="tab:blue"))
-            else:
-                ax.add_patch(
-                    PolygonPatch(np.array(o.vertices_m), closed=True, fill=False, color="tab:blue")
-                )
-        if show_dropped:
-            for i, d in enumerate(result.dropped):
-                xy = _solution_xy(d.solution)
-                ax.plot(
-                    xy[:, 0],
-                    xy[:, 1],
-                    "--",
-                    color="0.6",
-                    lw=1.0,
-                    label="dropped by the motion check" if i == 0 else None,
-                )
-        for i, p in enumerate(result.plans):
-            xy = _solution_xy(p.solution)
-            ax.plot(
-                xy[:, 0],
-                xy[:, 1],
-                "-",
-                color="tab:red",
-                lw=1.8,
-                label="solutions" if i == 0 else None,
-            )
-        if query.collision_points_m:
-            cp = np.array(query.collision_points_m)
-            ax.plot(cp[:, 0], cp[:, 1], "o", color="tab:green", ms=5, label="collision points")
-        ax.plot(*query.target_xy_m, "o", color="black", ms=6, label="target")
-        bx, by = query.base_xy_m
-        tx, ty = query.base_tangent
-        ax.annotate(
-            "",
-            xy=(bx + 0.03 * tx, by + 0.03 * ty),
-            xytext=(bx, by),
-            arrowprops={"arrowstyle": "->", "color": "black"},
-        )
-        ax.set_aspect("equal")
-        ax.autoscale_view()
-        ax.set_xlabel("x [m]")
-        ax.set_ylabel("y [m]")
-        ax.set_title(
-            title
-            or f"{len(result.plans)} solution(s), {len(query.collision_points_m)} collision points"
-        )
-        ax.legend(loc="lower right", fontsize=7)
-        ax.grid(alpha=0.3)
-        fig.tight_layout()
-        fig.savefig(path)
-    finally:
-        plt.close(fig)
-    return path
+    """:func:`case_figure` written to ``png_path``; returns the path."""
+    return save(case_figure(query, result, title, show_dropped), png_path)
 
 
-__all__ = ["draw_case"]
+__all__ = ["case_figure", "draw_case", "save", "solution_xy", "thickness_figure"]

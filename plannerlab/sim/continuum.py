@@ -25,14 +25,28 @@ Every point is classified (not only the deepest per pair); per (link, other, ver
 the deepest point is kept. Points count from a penetration depth above ``min_depth_m``
 (0: touching, as :mod:`plannerlab.sim.execute`).
 
-**Time step.** The chain's links are light (10 g, 12.5 mm: rotational inertia ~1e-7
-kg·m²). At PyBullet's 1/240 s step, position control of this chain does not settle: on
-case 3 *without any obstacle* the joints still oscillated by 0.04-0.08 rad after 2 s of
-holding the final waypoint and the tip ended 61 mm off; at 1/960 s it ended 17 mm off,
-at 1/2400 s 0.9 mm. :data:`DT_S` = 1/2400 s is used here (same simulated time per
-waypoint as 12 steps of 1/240 s: 0.05 s), with PyBullet's default gains and the URDF's
-effort limits. :func:`plannerlab.sim.execute.execute` has no time-step parameter, hence
-the loop here.
+**Constraint solver (what fixed the tip error).** The chain's links are light (10 g,
+12.5 mm: rotational inertia ~1e-7 kg·m²) while the first joint carries the whole chain,
+and 41 position motors act in series. PyBullet's default iterative solver (projected
+Gauss-Seidel, 50 iterations) does not converge on such a chain: the motors' constraint
+rows are solved only approximately every step, the chain never comes to rest and its
+joints wander by ~0.01 rad each, which put the tip 5-10 mm off the target *with every
+obstacle removed* (case 1: 10.0 mm, case 2: 10.4 mm after a 1 s hold at 1/2400 s; the
+error grew while holding). Higher gains, more iterations, a finer time step or a closing
+correction on the joints' error only moved that around (``results/continuum.md``). A
+direct solver of the mixed LCP (:data:`SOLVER` = "dantzig") solves the motors exactly:
+the chain follows the joint path to 0.8 mm at the waypoints and comes to rest on the
+last one, so the executed tip error is the planned one (0.04-0.13 mm from the 40-link
+discretisation of the arcs) at PyBullet's usual 1/240 s step (:data:`DT_S`), 0.05 s per
+waypoint, 1 s hold, PyBullet's default gains and the URDF's 100 N·m / 100 N efforts.
+:func:`plannerlab.sim.execute.execute` has no solver or time-step parameter, hence the
+loop here (on :class:`plannerlab.sim.world.SimWorld`).
+
+**Contact.** The position-controlled joints impose the planned shape; contact with a
+corner carries no load in this simulation. Planned for the robot's radius (the
+planner's default), the capsules graze the corner: their axes pass 1.87-1.90 mm from it
+on the paper's cases (the links are chords of the arcs), and PyBullet reports no
+penetrating contact there.
 
 The tip error is the final tip's distance to the leg's target (the goals of the paper's
 cases constrain position only). :attr:`ContinuumExecution.success` = the tip ends inside
@@ -40,7 +54,8 @@ the goal region and no contact is unexpected. An FCL re-check of the path is not
 here: it reports the collision-point contacts by design; the planner's
 ``extra["expected_contacts"]`` holds its classification.
 
-No pybullet import here (``docs/architecture.md``); nothing is printed.
+Takes plain data (the path and the plan's ``extra``), imports no planner; nothing is
+printed.
 """
 
 from __future__ import annotations
@@ -52,19 +67,32 @@ from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
+import pybullet
 
 from plannerlab.errors import PlannerlabError
-from plannerlab.planners.base import PlanResult
-from plannerlab.planners.chord_arc import guide_obstacles
 from plannerlab.problem.load import Problem
 from plannerlab.sim.world import Contact, SimWorld
 
-#: physics time step [s] (see the module docstring)
-DT_S: float = 1.0 / 2400.0
+#: physics time step [s] (PyBullet's and the Arm-Z paper's; see the module docstring)
+DT_S: float = 1.0 / 240.0
 #: physics steps per commanded waypoint (0.05 s; a waypoint moves at most 2 mm / 0.02 rad)
-STEPS_PER_WAYPOINT: int = 120
+STEPS_PER_WAYPOINT: int = 12
 #: physics steps holding the last waypoint (1 s)
-SETTLE_STEPS: int = 2400
+SETTLE_STEPS: int = 240
+#: PyBullet position-control gains (None: PyBullet's defaults 0.1 and 1.0)
+POSITION_GAIN: float | None = None
+VELOCITY_GAIN: float | None = None
+#: closest approaches to the obstacles are recorded up to this distance [m]
+APPROACH_M: float = 1e-3
+#: PyBullet constraint solver: "dantzig" (a direct MLCP solver) or "pgs" (PyBullet's
+#: default iterative projected Gauss-Seidel); see the module docstring
+SOLVER: str = "dantzig"
+SOLVERS: dict[str, int] = {
+    "pgs": pybullet.CONSTRAINT_SOLVER_LCP_SI,
+    "dantzig": pybullet.CONSTRAINT_SOLVER_LCP_DANTZIG,
+}
+#: PyBullet constraint-solver iterations per step (None: PyBullet's default, 50)
+SOLVER_ITERATIONS: int | None = None
 
 
 @dataclass(frozen=True)
@@ -126,7 +154,15 @@ class ContinuumExecution:
         goal_reached: final tip inside the goal region.
         max_tip_track_err_m: largest commanded-vs-actual tip distance at the waypoints [m].
         final_track_err: largest |q_cmd − q| after settling [rad; m for the insertion].
+        q_final: the state reached at the end.
         contacts: every (link, other, verdict) seen, deepest point each.
+        approaches: per obstacle (guides excepted) that the chain came within
+            ``approach_m`` of, the closest approach over the waypoints: ``obstacle``,
+            ``distance_m`` (negative: penetration), ``link``, ``p_world_m`` (on the
+            link), ``collision_point`` (nearest chosen one on that obstacle, or None) and
+            ``point_distance_m``, and ``at_collision_point`` (within ``tolerance_m``).
+            With position-controlled joints contact carries no load, so a plan for the
+            robot's radius grazes its corners: this shows where.
         waypoints, dt_s, steps_per_waypoint, settle_steps: how it was run.
         sim_time_s, wall_time_s: duration.
         reason: the verdict in words.
@@ -142,7 +178,9 @@ class ContinuumExecution:
     goal_reached: bool
     max_tip_track_err_m: float
     final_track_err: float
+    q_final: tuple[float, ...]
     contacts: tuple[ClassifiedContact, ...]
+    approaches: tuple[dict[str, Any], ...]
     waypoints: int
     dt_s: float
     steps_per_waypoint: int
@@ -177,7 +215,9 @@ class ContinuumExecution:
             "goal_reached": self.goal_reached,
             "max_tip_track_err_m": _num(self.max_tip_track_err_m),
             "final_track_err": _num(self.final_track_err),
+            "q_final": list(self.q_final),
             "contacts": [c.to_dict() for c in self.contacts],
+            "approaches": [dict(a) for a in self.approaches],
             "expected": len(self.expected_contacts),
             "unexpected": len(self.unexpected_contacts),
             "success": self.success,
@@ -220,53 +260,79 @@ def classify_point(
 
 def execute_chord_arc(
     problem: Problem,
-    plan_result: PlanResult,
+    path: Any,
+    extra: Mapping[str, Any],
     *,
+    leg: int = 0,
     tolerance_m: float | None = None,
     dt_s: float = DT_S,
     steps_per_waypoint: int = STEPS_PER_WAYPOINT,
     settle_steps: int = SETTLE_STEPS,
+    position_gain: float | None = POSITION_GAIN,
+    velocity_gain: float | None = VELOCITY_GAIN,
+    solver: str = SOLVER,
+    solver_iterations: int | None = SOLVER_ITERATIONS,
     min_depth_m: float = 0.0,
+    approach_m: float = APPROACH_M,
     gravity_mps2: tuple[float, float, float] | None = None,
     gui: bool = False,
 ) -> ContinuumExecution:
-    """Execute a solved ``chord_arc`` result's path in PyBullet and classify its contacts.
+    """Execute a ``chord_arc`` plan's joint path in PyBullet and classify its contacts.
 
-    The world is reset to the path's first state (the retracted robot); each waypoint is
-    commanded for ``steps_per_waypoint`` steps of ``dt_s``, the last one held for
-    ``settle_steps``. The path is not densified further (it moves at most the planner's
-    ``path_step_m`` / ``path_joint_step_rad`` per waypoint).
+    Plain data in (no planner import): the path and the plan's ``extra`` (a
+    :attr:`plannerlab.planners.base.PlanResult.extra` of the ``chord_arc`` planner, or
+    the same mapping read back from a plan file). The world is reset to the path's first
+    state (the retracted robot); each waypoint is commanded for ``steps_per_waypoint``
+    steps of ``dt_s``, the last one held for ``settle_steps``. The path is not densified
+    further (it moves at most the planner's ``path_step_m`` / ``path_joint_step_rad`` per
+    waypoint).
 
     Args:
         problem: the problem the plan was made for.
-        plan_result: a :class:`PlanResult` of the ``chord_arc`` planner with a chosen
-            solution (status solved or approximate).
-        tolerance_m: expected-contact radius [m]; default the plan's
-            ``extra["contact_tolerance_m"]``.
+        path: (m, dof) joint path of the chosen solution.
+        extra: the plan's extra data: ``chosen``, ``solutions`` (its
+            ``contact_indices``, ``contact_points_m``, ``contact_obstacles``),
+            ``contact_tolerance_m`` and ``guide_obstacles`` (names; optional).
+        leg: the leg the path was planned for (its goal gives the tip error).
+        tolerance_m: expected-contact radius [m]; default ``extra["contact_tolerance_m"]``.
         dt_s: physics time step [s].
         steps_per_waypoint: physics steps per waypoint.
         settle_steps: physics steps holding the last waypoint.
+        position_gain, velocity_gain: PyBullet's position-control gains (see
+            :data:`POSITION_GAIN`); None keeps PyBullet's defaults (0.1, 1.0).
+        solver: the constraint solver (:data:`SOLVERS`).
+        solver_iterations: PyBullet's constraint-solver iterations per step (None: its
+            default).
         min_depth_m: penetration depth above which a contact point counts [m].
+        approach_m: after every waypoint, the chain's closest points to every obstacle
+            but the guides are read up to this distance [m] (see
+            :attr:`ContinuumExecution.approaches`).
         gravity_mps2: default: the problem's ``[simulation] gravity_mps2``.
         gui: PyBullet's GUI instead of DIRECT.
 
     Raises:
-        PlannerlabError: the result has no chosen solution (not a chord_arc result, or
-            nothing was solved), or a bad parameter.
+        PlannerlabError: no chosen solution in ``extra`` (not a chord_arc plan, or
+            nothing was solved), a path of the wrong shape, or a bad parameter.
     """
     t0 = time.perf_counter()
-    extra = plan_result.extra
     chosen = extra.get("chosen") if isinstance(extra, Mapping) else None
     if chosen is None or "solutions" not in extra:
         raise PlannerlabError(
-            f"execute_chord_arc needs a chord_arc result with a chosen solution; got "
-            f"{plan_result.planner!r} with status {plan_result.status.value} "
-            f"({plan_result.reason})"
+            "execute_chord_arc needs a chord_arc plan with a chosen solution "
+            "(extra['chosen'] and extra['solutions'])"
         )
+    if solver not in SOLVERS:
+        raise PlannerlabError(f"solver must be one of {', '.join(SOLVERS)}, got {solver!r}")
     if steps_per_waypoint < 1 or settle_steps < 0 or not dt_s > 0:
         raise PlannerlabError(
             f"need dt_s > 0, steps_per_waypoint >= 1, settle_steps >= 0; "
             f"got {dt_s}, {steps_per_waypoint}, {settle_steps}"
+        )
+    robot = problem.robot
+    path = np.asarray(path, dtype=float)
+    if path.ndim != 2 or path.shape[1] != robot.dof or len(path) < 1:
+        raise PlannerlabError(
+            f"path must be (m >= 1, {robot.dof}) for {problem.name}, got {path.shape}"
         )
     sol = extra["solutions"][int(chosen)]
     tol = float(extra["contact_tolerance_m"] if tolerance_m is None else tolerance_m)
@@ -275,16 +341,23 @@ def execute_chord_arc(
         i: (float(p[0]), float(p[1])) for i, p in zip(idx, sol["contact_points_m"], strict=True)
     }
     owners = dict(zip(idx, sol["contact_obstacles"], strict=True))
-    robot = problem.robot
-    goal = problem.goal(plan_result.leg)
-    path = np.asarray(plan_result.path, dtype=float)
+    goal = problem.goal(leg)
     gravity = problem.simulation.gravity_mps2 if gravity_mps2 is None else gravity_mps2
-    guides = guide_obstacles(problem)
+    guides = frozenset(str(n) for n in extra.get("guide_obstacles", ()))
 
     seen: dict[tuple[str, str, bool, bool], list[Any]] = {}
+    closest: dict[str, dict[str, Any]] = {}
     tips_cmd = robot.tip(path)[0]
     tip_track = np.empty(len(path))
-    with SimWorld(robot, problem.scene, gui=gui, dt_s=dt_s, gravity_mps2=gravity) as world:
+    with SimWorld(
+        robot,
+        problem.scene,
+        gui=gui,
+        dt_s=dt_s,
+        gravity_mps2=gravity,
+        position_gain=position_gain,
+        velocity_gain=velocity_gain,
+    ) as world:
 
         def run(n: int) -> None:
             for _ in range(n):
@@ -304,10 +377,42 @@ def execute_chord_arc(
                         if c.depth_m > rec[0]:
                             rec[0], rec[2], rec[4], rec[5] = c.depth_m, c.p_world_m, near, dist
 
+        world.client.setPhysicsEngineParameter(constraintSolverType=SOLVERS[solver])
+        if solver_iterations is not None:
+            world.client.setPhysicsEngineParameter(numSolverIterations=int(solver_iterations))
+        watched = {uid: n for uid, n in world.obstacle_names.items() if n not in guides}
+
+        def approach() -> None:
+            for uid, name in watched.items():
+                for pt in world.client.getClosestPoints(world.body, uid, approach_m):
+                    d = float(pt[8])
+                    rec = closest.get(name)
+                    if rec is not None and d >= rec["distance_m"]:
+                        continue
+                    p = tuple(float(v) for v in pt[5])
+                    best = min(
+                        (
+                            (float(np.hypot(p[0] - xy[0], p[1] - xy[1])), i)
+                            for i, xy in points.items()
+                            if owners[i] == name
+                        ),
+                        default=(math.inf, None),
+                    )
+                    closest[name] = {
+                        "obstacle": name,
+                        "distance_m": d,
+                        "link": world._link_name(pt[3])[0],
+                        "p_world_m": list(p),
+                        "collision_point": best[1],
+                        "point_distance_m": None if best[1] is None else best[0],
+                        "at_collision_point": best[0] <= tol,
+                    }
+
         world.reset(path[0])
         for k, q in enumerate(path):
             world.command(q)
             run(steps_per_waypoint)
+            approach()
             tip_track[k] = np.linalg.norm(robot.tip(world.state())[0] - tips_cmd[k])
         run(settle_steps)
         q_final = world.state()
@@ -353,10 +458,18 @@ def execute_chord_arc(
         )
     else:
         words.append("no unexpected contact")
+    for name in sorted(closest):
+        a = closest[name]
+        where = (
+            f"at collision point {a['collision_point']}"
+            if a["at_collision_point"]
+            else "AWAY from the collision points"
+        )
+        words.append(f"closest to {name}: {a['distance_m'] * 1e3:.2f} mm, {where}")
     return ContinuumExecution(
         problem=problem.name,
-        leg=plan_result.leg,
-        goal=plan_result.goal,
+        leg=leg,
+        goal=goal.name,
         chosen=int(chosen),
         collision_points_used=tuple(idx),
         tolerance_m=tol,
@@ -364,7 +477,9 @@ def execute_chord_arc(
         goal_reached=reached,
         max_tip_track_err_m=float(np.max(tip_track, initial=0.0)),
         final_track_err=float(np.max(np.abs(q_final - path[-1]), initial=0.0)),
+        q_final=tuple(float(v) for v in q_final),
         contacts=contacts,
+        approaches=tuple(closest[n] for n in sorted(closest)),
         waypoints=len(path),
         dt_s=float(dt_s),
         steps_per_waypoint=int(steps_per_waypoint),

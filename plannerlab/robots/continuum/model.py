@@ -397,6 +397,36 @@ class ContinuumChain:
         q[1:] = np.diff(np.concatenate([[0.0], psi_rel]))
         return q
 
+    def q_from_arcs_batch(self, theta_rad: Array, length_m: Array) -> Array:
+        """:meth:`q_from_arcs` for many shapes at once (insertion = each shape's length).
+
+        Args:
+            theta_rad, length_m: (N, K) bend and length of the K arcs of N shapes (an arc
+                of length 0 is allowed and adds nothing).
+
+        Returns:
+            (N, dof) joint vectors, equal to ``q_from_arcs(list(zip(θ_n, L_n)))`` per row.
+        """
+        th = np.atleast_2d(np.asarray(theta_rad, dtype=float))
+        ln = np.atleast_2d(np.asarray(length_m, dtype=float))
+        if th.shape != ln.shape:
+            raise ValueError(f"theta_rad {th.shape} and length_m {ln.shape} differ in shape")
+        d = ln.sum(axis=1)  # (N,)
+        if np.any(d > self.length_m * (1.0 + 1e-9)) or np.any(d < 0.0) or np.any(ln < 0.0):
+            raise ValueError(f"insertions {d.min()}..{d.max()} m outside [0, {self.length_m}] m")
+        ell = self.link_length_m
+        u_mid = (np.arange(self.n_links) + 0.5) * ell
+        s_mid = np.clip(u_mid[None, :] - (self.length_m - d)[:, None], 0.0, None)  # (N, n)
+        starts = np.cumsum(ln, axis=1) - ln  # (N, K)
+        rel = s_mid[:, :, None] - starts[:, None, :]  # (N, n, K)
+        safe = np.where(ln > 0.0, ln, 1.0)[:, None, :]
+        frac = np.where(ln[:, None, :] > 0.0, np.clip(rel / safe, 0.0, 1.0), 0.0)
+        phi = np.einsum("nik,nk->ni", frac, th)  # right-positive turning at the midpoints
+        q = np.empty((len(th), self.dof))
+        q[:, 0] = np.minimum(d, self.length_m)
+        q[:, 1:] = np.diff(-phi, axis=1, prepend=0.0)
+        return q
+
     # ------------------------------------------------------------------ URDF
     def urdf(self) -> str:
         """URDF of the chain in its base frame (load it at ``T_world_base``, fixed base).
