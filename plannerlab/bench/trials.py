@@ -252,6 +252,8 @@ def _execution_record(executions: Sequence[Any]) -> dict[str, Any]:
             "path_valid": bool(e.path_valid),
             "max_track_err_rad": _num(e.max_track_err_rad),
             "track_err_limit_rad": _num(e.track_err_limit_rad),
+            "timing": e.timing,
+            "duration_s": _num(e.duration_s),
             "max_tip_track_err_m": _num(e.max_tip_track_err_m),
             "contacts": len(e.contacts),
             "final_pos_err_m": _num(e.final_pos_err_m),

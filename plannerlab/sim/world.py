@@ -228,6 +228,17 @@ class SimWorld:
             )
         self.max_force = forces
         self.max_force.setflags(write=False)
+        #: the URDF joints' velocity limits (dof,) [rad/s or m/s] (inf where none is set)
+        vel = np.array([infos[j][11] for j in self._joints], dtype=float)
+        self.max_velocity = np.where(vel > 0, vel, np.inf)
+        self.max_velocity.setflags(write=False)
+        # PyBullet's inverse dynamics takes every movable joint in index order.
+        movable = [j for j, info in enumerate(infos) if info[2] != pybullet.JOINT_FIXED]
+        self._dyn_order: list[int] | None = (
+            [movable.index(j) for j in self._joints]
+            if sorted(movable) == sorted(self._joints)
+            else None
+        )
 
         # Self-collision filters: the pairs the FCL checker never checks.
         for i, j in robot.excluded_pairs:
@@ -302,6 +313,14 @@ class SimWorld:
         return self.steps_taken * self.dt_s
 
     # ------------------------------------------------------------------ state
+    def to_urdf(self, q: Array) -> Array:
+        """q (..., dof) -> the URDF's joint values (..., dof) (the identity for Arm-Z)."""
+        return self._to_urdf(q)
+
+    def from_urdf(self, q_urdf: Array) -> Array:
+        """Inverse of :meth:`to_urdf`."""
+        return self._from_urdf(q_urdf)
+
     def _to_urdf(self, q: Array) -> Array:
         """q -> the URDF's joint values. A robot whose URDF joints are not q itself (the
         IRb-6 keeps absolute angles in q) provides ``urdf_joint_positions``."""
@@ -368,6 +387,59 @@ class SimWorld:
         )
         self._command(sent)
         return sent
+
+    def state_urdf(self) -> tuple[Array, Array]:
+        """Positions and velocities (dof,) of the URDF's joints."""
+        states = self.client.getJointStates(self.body, self._joints)
+        return (
+            np.array([s[0] for s in states], dtype=float),
+            np.array([s[1] for s in states], dtype=float),
+        )
+
+    def command_urdf(
+        self, q_urdf: Array, qd_urdf: Array, *, position_gain: float | None = None
+    ) -> None:
+        """Position and velocity targets (dof,) for the URDF's joints, without stepping
+        (no wrapping: continuous joints go to the value given).
+
+        PyBullet's motor asks for velocity ``qd_urdf + position_gain × (q_urdf − q)/dt``
+        (velocity gain 1), within the effort limits. ``position_gain`` overrides the
+        world's gain for this command.
+        """
+        gains = dict(self._gains)
+        if position_gain is not None:
+            gains["positionGains"] = [float(position_gain)] * self.robot.dof
+        self.client.setJointMotorControlArray(
+            self.body,
+            self._joints,
+            pybullet.POSITION_CONTROL,
+            targetPositions=[float(v) for v in q_urdf],
+            targetVelocities=[float(v) for v in qd_urdf],
+            forces=self.max_force.tolist(),
+            **gains,
+        )
+
+    def inverse_dynamics(self, q_urdf: Array, qd_urdf: Array, qdd_urdf: Array) -> Array:
+        """Joint torques/forces (dof,) that give accelerations ``qdd_urdf`` at positions
+        ``q_urdf`` and velocities ``qd_urdf`` (URDF joints), under the world's gravity.
+
+        Raises:
+            PlannerlabError: the URDF has movable joints the robot does not drive.
+        """
+        if self._dyn_order is None:
+            raise PlannerlabError(
+                f"the {self.robot.kind} URDF has movable joints outside robot.joint_names; "
+                "no inverse dynamics"
+            )
+        n = len(self._dyn_order)
+        args = []
+        for v in (q_urdf, qd_urdf, qdd_urdf):
+            full = [0.0] * n
+            for i, k in enumerate(self._dyn_order):
+                full[k] = float(v[i])
+            args.append(full)
+        tau = self.client.calculateInverseDynamics(self.body, *args)
+        return np.array([tau[k] for k in self._dyn_order], dtype=float)
 
     def step(self, steps: int = 1) -> None:
         """Advance the physics ``steps`` time steps of ``dt_s``."""
