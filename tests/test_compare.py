@@ -236,6 +236,158 @@ def test_same_seed_same_results_in_fresh_processes(comparison: dict, tmp_path: P
         assert _deterministic(rec) == _deterministic(old), rec["key"]
 
 
+def test_same_seeds_same_table_whatever_jobs(comparison: dict, tmp_path: Path) -> None:
+    """The module comparison ran with --jobs 2 in children forked from the fork server;
+    one job at a time gives the same per-trial results and the same table, and OMPL's
+    seed took effect in every child (different seeds, different paths)."""
+    first = {r["key"]: r for r in _lines(comparison["store"])}
+    run = run_comparison(_trials(), tmp_path / "one.jsonl", jobs=1)
+    assert run.ran == len(first)
+    for rec in run.records:
+        assert _deterministic(rec) == _deterministic(first[rec["key"]]), rec["key"]
+        assert rec["startup_s"] >= 0.0
+
+    def table(records: list[dict]) -> list[dict]:
+        return [
+            {k: v for k, v in row.items() if not k.startswith("time_")}
+            for row in summarise(records)
+        ]
+
+    assert table(run.records) == table([first[r["key"]] for r in run.records])
+    if HAVE_OMPL:
+        hashes = {
+            r["seed"]: r["legs_run"][0]["path_sha256"]
+            for r in run.records
+            if r["planner"] == "ompl.rrtconnect"
+        }
+        assert len(set(hashes.values())) == len(SEEDS), hashes
+
+
+def test_fork_server_children_match_spawned_interpreters(comparison: dict, tmp_path: Path) -> None:
+    """A child forked from the warm fork server gives what a fresh interpreter gives."""
+    from plannerlab.bench.local import LocalBackend
+
+    first = {r["key"]: r for r in _lines(comparison["store"])}
+    pick = [t for t in _trials() if t.seed == 2]
+    backend = LocalBackend(tmp_path / "running", start_method="spawn")
+    try:
+        run = run_comparison(pick, tmp_path / "spawned.jsonl", jobs=2, backend=backend)
+    finally:
+        backend.close()
+    assert run.ran == len(pick)
+    for rec in run.records:
+        assert _deterministic(rec) == _deterministic(first[rec["key"]]), rec["key"]
+
+
+def test_a_trial_past_its_time_limit_is_killed_and_recorded(tmp_path: Path) -> None:
+    """A planner that overruns the per-trial limit is killed, recorded as timeout, and the
+    comparison goes on with the next trial."""
+    from plannerlab.bench.trials import TIMEOUT_STATUS
+
+    path = resolve_problem_path(PROBLEM).resolve()
+    slow = Trial.make(PROBLEM, path, "gradient", 0)  # default budget: seconds
+    quick = Trial.make(PROBLEM, path, "gradient.analytic", 0, budget={"max_collision_checks": 100})
+    t0 = time.monotonic()
+    run = run_comparison(
+        [slow, quick],
+        tmp_path / "s.jsonl",
+        jobs=1,
+        poll_s=0.05,
+        trial_timeout_s=lambda t: 0.2 if t.key == slow.key else None,
+    )
+    assert time.monotonic() - t0 < 60
+    recs = {r["key"]: r for r in run.records}
+    assert recs[slow.key]["status"] == TIMEOUT_STATUS and not recs[slow.key]["success"]
+    assert "per-trial limit of 0.2 s" in recs[slow.key]["error"]
+    assert recs[quick.key]["status"] not in (TIMEOUT_STATUS, ERROR_STATUS)
+    rows = {r["planner"]: r for r in summarise(run.records)}
+    assert rows["gradient"]["errors"] == 1 and rows["gradient"]["successes"] == 0
+    # a timeout is finished for resuming
+    again = run_comparison([slow, quick], tmp_path / "s.jsonl", jobs=1)
+    assert again.ran == 0 and again.skipped == 2
+
+
+def test_cli_trial_timeout_records_timeouts(tmp_path: Path) -> None:
+    import contextlib
+    import io
+
+    buf = io.StringIO()
+    with contextlib.redirect_stdout(buf):
+        code = main(
+            [
+                "compare",
+                PROBLEM,
+                "--planners",
+                "gradient",
+                "--seeds",
+                "0",
+                "--trial-timeout",
+                "0.2",
+                "--out",
+                str(tmp_path),
+                "--name",
+                "to",
+                "--json",
+            ]
+        )
+    assert code == 0
+    (rec,) = _lines(tmp_path / "to" / "trials.jsonl")
+    assert rec["status"] == "timeout"
+    assert json.loads(buf.getvalue())["errors"] == 1
+
+
+RAY_PLANNERS = PLANNERS[1:]  # a gradient planner and, with the adapter, RRT-Connect
+
+
+def test_ray_backend_gives_the_same_records(comparison: dict, tmp_path: Path) -> None:
+    """--backend ray on a small local Ray instance started here: each trial a Ray task in
+    a fresh worker (max_calls=1), the same store and reports, the same results."""
+    ray = pytest.importorskip("ray")
+    import contextlib
+    import io
+
+    ray.init(num_cpus=2, include_dashboard=False, log_to_driver=False)
+    try:
+        buf = io.StringIO()
+        with contextlib.redirect_stdout(buf):
+            code = main(
+                [
+                    "compare",
+                    PROBLEM,
+                    "--planners",
+                    ",".join(RAY_PLANNERS),
+                    "--seeds",
+                    "1",
+                    "--max-checks",
+                    str(MAX_CHECKS),
+                    "--jobs",
+                    "2",
+                    "--backend",
+                    "ray",
+                    "--out",
+                    str(tmp_path),
+                    "--name",
+                    NAME,
+                    "--json",
+                ]
+            )
+        assert code == 0
+        assert ray.is_initialized()  # joined the running instance, left it running
+    finally:
+        ray.shutdown()
+    summary = json.loads(buf.getvalue())
+    assert summary["ran"] == len(RAY_PLANNERS)
+    first = {r["key"]: r for r in _lines(comparison["store"])}
+    recs = _lines(tmp_path / NAME / "trials.jsonl")
+    assert len({r["pid"] for r in recs}) == len(recs)  # a fresh worker per trial
+    for rec in recs:
+        assert _deterministic(rec) == _deterministic(first[rec["key"]]), rec["key"]
+    meta = json.loads((tmp_path / NAME / "meta.json").read_text())
+    assert meta["backend"] == "ray"
+    summary_csv = (tmp_path / NAME / "summary.csv").read_text()
+    assert all(p in summary_csv for p in RAY_PLANNERS)
+
+
 # ---------------------------------------------------------------------- failures
 def test_a_raising_trial_is_recorded_and_execution_summarised(tmp_path: Path) -> None:
     path = resolve_problem_path(PROBLEM).resolve()

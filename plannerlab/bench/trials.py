@@ -12,13 +12,15 @@ and an interrupted run loses only the trials that were still running.
 
 Decisions:
 
-* **One spawned process per trial** (``multiprocessing`` "spawn" context, at most ``jobs``
-  alive). This is what ``ProcessPoolExecutor(mp_context=spawn, max_tasks_per_child=1)``
-  gives, managed by hand so that (a) a trial whose process dies (a segfault in a native
-  library) is recorded as an ``error`` for *that* trial instead of breaking a whole pool
-  and every trial running beside it, and (b) on Ctrl-C the running trials are terminated
-  at once. Children ignore SIGINT: the parent decides. A record is appended by the parent
-  only, when a child has sent it, so there is a single writer.
+* **One fresh process per trial**, at most ``jobs`` running, on a *backend*:
+  :mod:`plannerlab.bench.local` (default: children forked from a fork server that has
+  imported numpy, FCL, PyBullet and OMPL's modules but created no OMPL object) or
+  :mod:`plannerlab.bench.ray_backend` (Ray tasks, one fresh worker process each). A
+  trial whose process dies is recorded as an ``error`` for *that* trial; a trial past
+  its wall-clock limit (``trial_timeout_s``; :func:`default_trial_timeout_s` derives one
+  from the budget) is killed and recorded as ``timeout``; on Ctrl-C the running trials
+  are stopped at once. A record is appended by the parent only, so there is a single
+  writer, and the store, resuming and ``on_done`` are the same whatever the backend.
 * **Seeding.** The child seeds OMPL (``seed_ompl(seed)``) before anything else whenever
   :mod:`plannerlab.planners.ompl` imports, whatever the planner (a planner may use OMPL
   inside); numpy generators come from :func:`plannerlab.bench.task.leg_rng`.
@@ -26,11 +28,13 @@ Decisions:
   the budget and settings overrides, the legs and the execute flag, so one store can hold
   runs of the same grid under different budgets without mixing them.
 * **Errors.** A trial that raises is recorded with status ``error`` and the exception's
-  last line (never kills the run); it is "finished" for resuming unless ``retry_errors``.
+  last line (never kills the run); it and a ``timeout`` are "finished" for resuming
+  unless ``retry_errors``.
 * **Statistics** (:func:`summarise`): success = every leg SOLVED; a trial with status
-  ``error`` counts in ``n`` as a failure. Times (sum over legs of ``time_s``) and final
-  tip errors are over every trial that did not error; path length over successful trials
-  only; 95 % Wilson score interval for the success rate.
+  ``error`` or ``timeout`` counts in ``n`` as a failure and in ``errors``. Times (sum
+  over legs of ``time_s``) and final tip errors are over every trial that did not error
+  or time out; path length over successful trials only; 95 % Wilson score interval for
+  the success rate.
 """
 
 from __future__ import annotations
@@ -40,15 +44,12 @@ import hashlib
 import json
 import logging
 import math
-import multiprocessing
 import os
-import signal
 import time
 import traceback
 from collections.abc import Callable, Iterable, Iterator, Mapping, Sequence
 from dataclasses import dataclass, field
 from datetime import UTC, datetime
-from multiprocessing.connection import Connection, wait
 from pathlib import Path
 from typing import Any
 
@@ -63,6 +64,8 @@ RECORD_FORMAT = "plannerlab.trial/1"
 Z95 = 1.959963984540054
 #: statuses of a trial record: the planner statuses plus "error" (the trial raised)
 ERROR_STATUS = "error"
+#: status of a trial killed for running past its wall-clock limit
+TIMEOUT_STATUS = "timeout"
 
 Scalar = int | float | str | bool | None
 
@@ -392,61 +395,6 @@ def _error_record(trial: Trial, error: str) -> dict[str, Any]:
     }
 
 
-#: characters of a trial process's captured output kept in its record
-OUTPUT_TAIL_CHARS = 2000
-
-
-def _tail(path: Path, chars: int = OUTPUT_TAIL_CHARS) -> str:
-    try:
-        text = path.read_text(encoding="utf-8", errors="replace")
-    except OSError:
-        return ""
-    return text[-chars:]
-
-
-@contextlib.contextmanager
-def _sigint_ignored() -> Iterator[None]:
-    """Ignore SIGINT while starting a child, so that the child starts with SIGINT ignored
-    (a terminal's Ctrl-C goes to the whole process group; the parent stops the children).
-    A no-op outside the main thread, where handlers cannot be changed."""
-    import threading
-
-    if threading.current_thread() is not threading.main_thread():
-        yield
-        return
-    previous = signal.signal(signal.SIGINT, signal.SIG_IGN)
-    try:
-        yield
-    finally:
-        signal.signal(signal.SIGINT, previous)
-
-
-def _child_main(trial: Trial, conn: Connection, out_path: str) -> None:
-    """Entry point of a trial's process: run it and send the record to the parent.
-
-    The process's stdout and stderr (file descriptors 1 and 2: Python warnings, log
-    records without a handler, native libraries' own prints) go to ``out_path``, so they
-    cannot garble the parent's progress display; their tail is kept in the record.
-    """
-    import sys
-
-    signal.signal(signal.SIGINT, signal.SIG_IGN)  # the parent handles Ctrl-C
-    fd = os.open(out_path, os.O_WRONLY | os.O_CREAT | os.O_TRUNC, 0o644)
-    os.dup2(fd, 1)
-    os.dup2(fd, 2)
-    os.close(fd)
-    try:
-        rec = run_trial(trial)
-        sys.stdout.flush()
-        sys.stderr.flush()
-        output = _tail(Path(out_path))
-        if output:
-            rec["output"] = output
-        conn.send(rec)
-    finally:
-        conn.close()
-
-
 # ---------------------------------------------------------------------- the store
 class TrialStore:
     """Append-only JSON-lines file of finished trial records (one line per trial).
@@ -561,6 +509,56 @@ class ComparisonRun:
     missing: list[Trial] = field(default_factory=list)
 
 
+#: the backends :func:`run_comparison` knows by name
+BACKENDS = ("local", "ray")
+#: wall-clock allowance per leg when the budget has no time limit [s]
+LEG_ALLOWANCE_S = 600.0
+#: wall-clock allowance per executed leg [s]
+EXECUTE_ALLOWANCE_S = 120.0
+#: start-up allowance per trial [s]
+STARTUP_ALLOWANCE_S = 60.0
+
+
+def default_trial_timeout_s(time_limit_s: float | None, n_legs: int, execute: bool) -> float:
+    """A trial's wall-clock limit derived from its budget: per leg twice the time limit
+    plus 30 s (or :data:`LEG_ALLOWANCE_S` when only checks or iterations are budgeted, which
+    have no clock), plus :data:`EXECUTE_ALLOWANCE_S` per executed leg, plus
+    :data:`STARTUP_ALLOWANCE_S`."""
+    per_leg = 2.0 * float(time_limit_s) + 30.0 if time_limit_s else LEG_ALLOWANCE_S
+    if execute:
+        per_leg += EXECUTE_ALLOWANCE_S
+    return STARTUP_ALLOWANCE_S + max(1, int(n_legs)) * per_leg
+
+
+def _timeout_record(trial: Trial, limit_s: float, elapsed_s: float) -> dict[str, Any]:
+    rec = _error_record(
+        trial, f"killed after {elapsed_s:.1f} s: past the per-trial limit of {limit_s:g} s"
+    )
+    rec["status"] = TIMEOUT_STATUS
+    rec["wall_s"] = elapsed_s
+    return rec
+
+
+def make_backend(name: str, work_dir: str | Path, *, address: str | None = None) -> Any:
+    """A trial backend by name: ``"local"`` (:class:`plannerlab.bench.local.LocalBackend`,
+    fork server) or ``"ray"`` (:class:`plannerlab.bench.ray_backend.RayBackend`).
+
+    Raises:
+        PlannerlabError: unknown name, ``address`` without Ray, or Ray not installed.
+    """
+    if name == "local":
+        if address is not None:
+            raise PlannerlabError("--address is for --backend ray")
+        from plannerlab.bench.local import LocalBackend
+
+        return LocalBackend(work_dir)
+    if name == "ray":
+        from plannerlab.bench.ray_backend import RayBackend
+
+        return RayBackend(address=address)
+    raise PlannerlabError(f"backend: expected one of {', '.join(BACKENDS)}, got {name!r}")
+
+
 def run_comparison(
     trials: Sequence[Trial],
     store: TrialStore | str | Path,
@@ -569,23 +567,33 @@ def run_comparison(
     *,
     retry_errors: bool = False,
     poll_s: float = 0.5,
+    trial_timeout_s: float | Callable[[Trial], float | None] | None = None,
+    backend: Any = None,
 ) -> ComparisonRun:
     """Run the trials not yet in ``store``, ``jobs`` at a time, each in its own process.
 
     Args:
         trials: the grid; duplicates (same key) run once.
         store: where finished records are appended (a :class:`TrialStore` or its path).
-        jobs: processes alive at once (>= 1).
+        jobs: trials running at once (>= 1).
         on_done: called in this process as ``on_done(record, skipped)`` for every trial
             already in the store (``skipped=True``, first) and every trial as it finishes.
-        retry_errors: rerun trials whose stored record has status ``error``.
-        poll_s: how often to look at the children [s] (only matters for responsiveness).
+        retry_errors: rerun trials whose stored record has status ``error`` or
+            ``timeout``.
+        poll_s: how often to look at the running trials [s] (responsiveness, and the
+            resolution of the time limit).
+        trial_timeout_s: wall-clock limit per trial [s], or a function of the trial
+            (None: no limit). A trial past it is killed and recorded with status
+            ``timeout``; the comparison goes on.
+        backend: where trials run: a backend object (see :mod:`plannerlab.bench.local`,
+            :mod:`plannerlab.bench.ray_backend`), or None for the local fork-server
+            backend. A backend made here is closed here.
 
     Returns:
         the records of every requested trial (see :class:`ComparisonRun`).
 
     Raises:
-        KeyboardInterrupt: after terminating the running trials; every trial finished
+        KeyboardInterrupt: after stopping the running trials; every trial finished
             before is in the store, so rerunning resumes.
     """
     if jobs < 1:
@@ -597,9 +605,10 @@ def run_comparison(
     stored = store.load()
     results: dict[str, dict[str, Any]] = {}
     todo: list[Trial] = []
+    retry = (ERROR_STATUS, TIMEOUT_STATUS)
     for key, t in unique.items():
         rec = stored.get(key)
-        if rec is not None and not (retry_errors and rec.get("status") == ERROR_STATUS):
+        if rec is not None and not (retry_errors and rec.get("status") in retry):
             results[key] = rec
         else:
             todo.append(t)
@@ -608,16 +617,20 @@ def run_comparison(
         for key in unique:
             if key in results:
                 on_done(results[key], True)
+
+    def limit_of(trial: Trial) -> float | None:
+        if trial_timeout_s is None:
+            return None
+        v = trial_timeout_s(trial) if callable(trial_timeout_s) else trial_timeout_s
+        return None if v is None else float(v)
+
     ran = 0
     if todo:
-        ctx = multiprocessing.get_context("spawn")
         queue = list(reversed(todo))
-        running: dict[Connection, tuple[Trial, Any, Path]] = {}  # pipe -> trial, proc, output
-        out_dir = store.path.parent / ".running"
+        own_backend = backend is None
         with store.writer() as append:
-            out_dir.mkdir(parents=True, exist_ok=True)
-            for stale in out_dir.glob("*.out"):  # left by a run that was killed
-                stale.unlink(missing_ok=True)
+            if own_backend:
+                backend = make_backend("local", store.path.parent / ".running")
 
             def finish(rec: dict[str, Any]) -> None:
                 nonlocal ran
@@ -627,72 +640,34 @@ def run_comparison(
                 if on_done is not None:
                     on_done(rec, False)
 
+            running: dict[Any, tuple[Trial, float, float | None]] = {}
             try:
                 while queue or running:
                     while queue and len(running) < jobs:
                         trial = queue.pop()
-                        recv, send = ctx.Pipe(duplex=False)
-                        out = out_dir / (
-                            hashlib.sha256(trial.key.encode()).hexdigest()[:16] + ".out"
-                        )
-                        proc = ctx.Process(
-                            target=_child_main,
-                            args=(trial, send, str(out)),
-                            name=f"trial {trial.key}",
-                            daemon=True,
-                        )
-                        running[recv] = (trial, proc, out)  # before start: see the cleanup
-                        with _sigint_ignored():  # inherited: Ctrl-C is the parent's to handle
-                            proc.start()
-                        send.close()  # the child holds the only write end now
-                    for conn in wait(list(running), timeout=poll_s):
-                        # stays in `running` until handled, so an interrupt cleans it up
-                        trial, proc, out = running[conn]  # type: ignore[index]
-                        try:
-                            rec = conn.recv()  # type: ignore[union-attr]
-                        except (EOFError, OSError):
-                            rec = None
-                        conn.close()  # type: ignore[union-attr]
-                        if rec is not None:
-                            finish(rec)  # stored first: nothing below can lose it
-                            proc.join(timeout=30)
-                        else:
-                            proc.join(timeout=30)
-                            rec = _error_record(
-                                trial,
-                                f"trial process died (exit code {proc.exitcode}) "
-                                "before reporting a result",
-                            )
-                            output = _tail(out)
-                            if output:
-                                rec["output"] = output
-                            finish(rec)
-                        out.unlink(missing_ok=True)
-                        del running[conn]  # type: ignore[arg-type]
-            except BaseException as exc:
-                started = [(c, p, o) for c, (_t, p, o) in running.items() if p.pid is not None]
-                for _conn, proc, _out in started:
-                    proc.terminate()
-                for _conn, proc, _out in started:
-                    proc.join(timeout=10)
-                    if proc.is_alive():
-                        proc.kill()
-                        proc.join(timeout=5)
-                if isinstance(exc, KeyboardInterrupt):
-                    # keep the results that were sent but not yet read
-                    for conn, _proc, _out in started:
-                        with contextlib.suppress(Exception):
-                            if conn.poll(0):
-                                rec = conn.recv()
-                                if isinstance(rec, dict) and "key" in rec:
-                                    finish(rec)
-                for conn, (_trial, _proc, out) in running.items():
-                    conn.close()
-                    out.unlink(missing_ok=True)
+                        started = time.monotonic()
+                        handle = backend.start(trial)
+                        running[handle] = (trial, started, limit_of(trial))
+                    for handle, rec, why in backend.wait(list(running), poll_s):
+                        trial, _started, _limit = running.pop(handle)
+                        finish(rec if rec is not None else _error_record(trial, why))
+                    now = time.monotonic()
+                    for handle, (trial, started, limit) in list(running.items()):
+                        if limit is not None and now - started > limit:
+                            backend.kill(handle)
+                            del running[handle]
+                            finish(_timeout_record(trial, limit, now - started))
+            except KeyboardInterrupt:
+                for rec in backend.salvage():  # sent but not yet read
+                    if rec.get("key") in unique and rec["key"] not in results:
+                        finish(rec)
                 raise
             finally:
-                with contextlib.suppress(OSError):
-                    out_dir.rmdir()  # only when empty
+                if own_backend:
+                    backend.close()
+                else:
+                    for handle in list(running):
+                        backend.kill(handle)
     records = [results[k] for k in unique if k in results]
     missing = [t for k, t in unique.items() if k not in results]
     return ComparisonRun(records=records, ran=ran, skipped=skipped, missing=missing)
@@ -764,7 +739,7 @@ def summarise(records: Iterable[Mapping[str, Any]]) -> list[dict[str, Any]]:
     for (problem, planner), recs in groups.items():
         n = len(recs)
         ok = [r for r in recs if r.get("success")]
-        ran = [r for r in recs if r.get("status") != ERROR_STATUS]
+        ran = [r for r in recs if r.get("status") not in (ERROR_STATUS, TIMEOUT_STATUS)]
         lo, hi = wilson_interval(len(ok), n)
         t = _vals(r["totals"].get("time_s") for r in ran)
         ex = [r["execution"] for r in recs if r.get("execution")]
@@ -803,12 +778,16 @@ def summarise(records: Iterable[Mapping[str, Any]]) -> list[dict[str, Any]]:
 
 
 __all__ = [
+    "BACKENDS",
     "ERROR_STATUS",
+    "TIMEOUT_STATUS",
     "SUMMARY_COLUMNS",
     "ComparisonRun",
     "Trial",
     "TrialStore",
     "default_name",
+    "default_trial_timeout_s",
+    "make_backend",
     "parse_seeds",
     "run_comparison",
     "run_trial",

@@ -4,9 +4,13 @@
                        [--time-limit S | --max-checks N | --max-iterations N]
                        [--legs L1,L2] [--set PLANNER:KEY=VALUE ...] [--execute]
                        [--jobs J] [--name NAME] [--out DIR] [--retry-errors] [--json]
+                       [--trial-timeout S] [--backend local|ray [--address ADDR]]
 
 Every (problem, planner, seed) is a trial run in a fresh process (OMPL's generator is
-process-global and must be seeded before any OMPL object exists). Finished trials are
+process-global and must be seeded before any OMPL object exists): forked from a warm
+fork server on this machine (``--backend local``, the default), or a Ray task in a fresh
+worker (``--backend ray``, on a local instance or a cluster at ``--address``). A trial
+past ``--trial-timeout`` is killed and recorded as ``timeout``. Finished trials are
 appended to ``DIR/NAME/trials.jsonl`` as they finish, so rerunning the same command skips
 them and an interrupted comparison resumes where it stopped. At the end: a table per
 problem (success rate with a 95 % Wilson interval, time median/p75/p95, path length,
@@ -44,7 +48,13 @@ from rich.progress import (
 )
 from rich.table import Table
 
-from plannerlab.cli.common import add_budget_args, leg_spec, legs_from_spec, positive_int
+from plannerlab.cli.common import (
+    add_budget_args,
+    leg_spec,
+    legs_from_spec,
+    positive_int,
+    positive_seconds,
+)
 from plannerlab.errors import PlannerlabError
 
 DEFAULT_OUT = Path("results") / "compare"
@@ -81,6 +91,26 @@ def add_compare_parser(subparsers: Any) -> argparse.ArgumentParser:
         help="also execute every plan in PyBullet (success, tracking error)",
     )
     p.add_argument("--jobs", type=positive_int, default=1, help="trials run at once (default 1)")
+    p.add_argument(
+        "--trial-timeout",
+        type=positive_seconds,
+        metavar="S",
+        help="wall-clock limit per trial [s]; a trial past it is killed and recorded as "
+        "timeout (default: from the budget: 60 s + per leg 2 x the time limit + 30 s, or "
+        "600 s without a time limit, + 120 s with --execute)",
+    )
+    p.add_argument(
+        "--backend",
+        choices=("local", "ray"),
+        default="local",
+        help="where trials run: local processes (default) or Ray tasks (pip install .[ray])",
+    )
+    p.add_argument(
+        "--address",
+        metavar="ADDR",
+        help="Ray cluster address for --backend ray (e.g. HOST:6379 or auto; default: a "
+        "running local instance, else a private one)",
+    )
     p.add_argument("--name", help="comparison name (default: from problems and planners)")
     p.add_argument(
         "--out",
@@ -143,6 +173,12 @@ def _command(args: argparse.Namespace) -> str:
     if args.execute:
         parts.append("--execute")
     parts += ["--jobs", str(args.jobs)]
+    if args.trial_timeout is not None:
+        parts += ["--trial-timeout", f"{args.trial_timeout:g}"]
+    if args.backend != "local":
+        parts += ["--backend", args.backend]
+    if args.address:
+        parts += ["--address", args.address]
     if args.name:
         parts += ["--name", args.name]
     if Path(args.out) != DEFAULT_OUT:
@@ -165,9 +201,12 @@ def cmd_compare(args: argparse.Namespace, console: Console) -> int:
     from plannerlab.bench.report import machine_info, write_reports
     from plannerlab.bench.trials import (
         ERROR_STATUS,
+        TIMEOUT_STATUS,
         Trial,
         TrialStore,
         default_name,
+        default_trial_timeout_s,
+        make_backend,
         parse_seeds,
         run_comparison,
         store_path,
@@ -180,6 +219,12 @@ def cmd_compare(args: argparse.Namespace, console: Console) -> int:
     # -- validate everything before the first process starts
     if args.jobs < 1:
         raise PlannerlabError(f"--jobs: expected >= 1, got {args.jobs}")
+    if args.trial_timeout is not None and not (
+        math.isfinite(args.trial_timeout) and args.trial_timeout > 0
+    ):
+        raise PlannerlabError(f"--trial-timeout: expected a number > 0, got {args.trial_timeout}")
+    if args.address is not None and args.backend != "ray":
+        raise PlannerlabError("--address is for --backend ray")
     for flag, v in (
         ("--max-checks", args.max_checks),
         ("--max-iterations", args.max_iterations),
@@ -264,7 +309,7 @@ def cmd_compare(args: argparse.Namespace, console: Console) -> int:
 
     def on_done(rec: dict[str, Any], skipped: bool) -> None:
         counts["skipped" if skipped else "ran"] += 1
-        if rec.get("status") == ERROR_STATUS:
+        if rec.get("status") in (ERROR_STATUS, TIMEOUT_STATUS):
             counts["errors"] += 1
         last = (
             ""
@@ -273,10 +318,27 @@ def cmd_compare(args: argparse.Namespace, console: Console) -> int:
         )
         progress.update(task, advance=1, detail=detail() + last)
 
+    budgets_used = {p.name: p.budget.replace(**budget) for p, _ in problems}
+    n_legs = {p.name: len(legs_by_problem[p.name] or range(p.legs)) for p, _ in problems}
+
+    def trial_timeout(trial: Trial) -> float:
+        if args.trial_timeout is not None:
+            return float(args.trial_timeout)
+        return default_trial_timeout_s(
+            budgets_used[trial.problem].time_limit_s, n_legs[trial.problem], trial.execute
+        )
+
+    backend = make_backend(args.backend, store.path.parent / ".running", address=args.address)
     try:
         with progress:
             run = run_comparison(
-                trials, store, jobs=args.jobs, on_done=on_done, retry_errors=args.retry_errors
+                trials,
+                store,
+                jobs=args.jobs,
+                on_done=on_done,
+                retry_errors=args.retry_errors,
+                trial_timeout_s=trial_timeout,
+                backend=backend,
             )
     except KeyboardInterrupt:
         done = counts["ran"] + counts["skipped"]
@@ -287,6 +349,8 @@ def cmd_compare(args: argparse.Namespace, console: Console) -> int:
             highlight=False,
         )
         return 130
+    finally:
+        backend.close()
     wall_s = time.perf_counter() - t0
 
     # -- report
@@ -314,10 +378,12 @@ def cmd_compare(args: argparse.Namespace, console: Console) -> int:
         "legs": args.legs,
         "execute": bool(args.execute),
         "jobs": args.jobs,
+        "backend": args.backend,
+        "trial_timeout_s": args.trial_timeout,
         "trials": len(trials),
         "ran": run.ran,
         "skipped": run.skipped,
-        "errors": sum(1 for r in records if r.get("status") == ERROR_STATUS),
+        "errors": sum(1 for r in records if r.get("status") in (ERROR_STATUS, TIMEOUT_STATUS)),
         "started_at": started.isoformat(timespec="seconds"),
         "wall_s": wall_s,
         "store": str(store.path),
