@@ -56,6 +56,7 @@ PRELOAD_MODULES: tuple[str, ...] = (
     "plannerlab.bench.trials",
     "plannerlab.sim.execute",
     "plannerlab.record.files",
+    "toppra",  # imported by retiming on first use; itself imports scipy.interpolate
 )
 #: what a child imports before it is "started" (free when preloaded)
 _TRIAL_MODULES = PRELOAD_MODULES[2:]
