@@ -58,8 +58,9 @@ PRELOAD_MODULES: tuple[str, ...] = (
     "plannerlab.record.files",
     "toppra",  # imported by retiming on first use; itself imports scipy.interpolate
 )
-#: what a child imports before it is "started" (free when preloaded)
-_TRIAL_MODULES = PRELOAD_MODULES[2:]
+#: what a child imports before it is "started" (free when preloaded): plannerlab's
+#: trial modules, which import numpy, FCL, PyBullet and OMPL (toppra only when executing)
+_TRIAL_MODULES = tuple(m for m in PRELOAD_MODULES if m.startswith("plannerlab."))
 START_METHODS = ("forkserver", "spawn")
 #: characters of a trial process's captured output kept in its record
 OUTPUT_TAIL_CHARS = 2000
