@@ -345,4 +345,4 @@ def test_retiming_that_is_infeasible_falls_back_to_waypoints_and_says_so() -> No
     problem = make_problem(robot, Scene(), q1)
     ex = execute(problem, np.stack([q0, q1]), settle_steps=24, steps_per_waypoint=2)
     assert ex.timing == "waypoints"
-    assert "not retimed" in ex.reason and "toppra" in ex.reason
+    assert "not retimed" in ex.reason and "to hold against gravity" in ex.reason

@@ -422,7 +422,7 @@ def _run(
                 knot_step=recheck_step,
             )
             timing_used = "toppra"
-        except PlannerlabError as exc:
+        except Exception as exc:  # toppra or the simulator's inverse dynamics
             notes.append(f"not retimed ({exc}); executed along densified waypoints")
     elif timing != "waypoints":
         raise PlannerlabError(f"timing: expected 'toppra' or 'waypoints', got {timing!r}")

@@ -6,7 +6,9 @@ spline through knots laid along the polyline, time-parameterised by TOPP-RA
 (``toppra``, Pham & Pham 2018) so that every joint stays within
 
 * its **velocity limit** (the URDF's ``velocity``; Arm-Z 10 rad/s), and
-* a **torque budget** ``|τ_i(q, q̇, q̈)| ≤ torque_fraction × effort_i``, where τ is the
+* a **torque budget** ``|τ_i(q, q̇, q̈) − g_i(q)| ≤ torque_fraction × (effort_i −
+  |g_i(q)|)``: of the torque left after holding the pose against gravity g(q), the
+  trajectory may use a fraction. τ is the
   inverse dynamics of the robot's URDF (masses, inertias, the world's gravity; Arm-Z:
   1 kg modules of inertia diag(0.25, 0.25, 0.5) kg·m², 100 N·m motors) evaluated along
   the path. This is the principled bound from the torque limit and the module inertia.
@@ -19,8 +21,11 @@ spline through knots laid along the polyline, time-parameterised by TOPP-RA
 
 Decisions:
 
-* **Half the torque** (:data:`TORQUE_FRACTION` = 0.5) goes to the trajectory, half is kept
-  for the feedback that corrects tracking errors (the motors saturate at the URDF effort).
+* **Half the torque** (:data:`TORQUE_FRACTION` = 0.5) left after gravity goes to the
+  trajectory, half is kept for the feedback that corrects tracking errors (the motors
+  saturate at the URDF effort). Without gravity (the bundled Arm-Z problems) this is
+  |τ| ≤ 0.5 × effort. A pose whose gravity torque exceeds the effort cannot be held at
+  all: :func:`retime` raises, and the execution says so.
 * **Knots** are the path's states densified to ``knot_step`` (the execution uses the FCL
   re-check resolution, ``joint_step / 4``), so every planned waypoint is a knot and the
   spline cannot stray far from the checked polyline; knots closer than ``knot_step / 4``
@@ -157,11 +162,13 @@ def retime(
     path = np.atleast_2d(np.asarray(path, dtype=float))
     dof = path.shape[1]
     v = np.broadcast_to(np.asarray(velocity_limit, dtype=float), (dof,))
-    tau = np.broadcast_to(np.asarray(effort_limit, dtype=float), (dof,)) * float(torque_fraction)
+    tau = np.broadcast_to(np.asarray(effort_limit, dtype=float), (dof,))
+    if not 0.0 < torque_fraction <= 1.0:
+        raise PlannerlabError(f"torque_fraction must be in (0, 1], got {torque_fraction}")
     if not (np.all(v > 0) and np.all(np.isfinite(v))):
         raise PlannerlabError(f"velocity limits must be positive and finite, got {v}")
     if not (np.all(tau > 0) and np.all(np.isfinite(tau))):
-        raise PlannerlabError(f"torque budgets must be positive and finite, got {tau}")
+        raise PlannerlabError(f"effort limits must be positive and finite, got {tau}")
     if not knot_step > 0:
         raise PlannerlabError(f"knot_step must be positive, got {knot_step}")
     knots = _knots(path, float(knot_step))
@@ -173,14 +180,36 @@ def retime(
     mid = 0.5 * (ss[1:] + ss[:-1])
     max_dev = float(np.max(np.abs(spline(mid) - 0.5 * (knots[1:] + knots[:-1]))))
 
+    # The budget: of the torque left after holding the pose against gravity, g(q), the
+    # trajectory may use ``torque_fraction``: |τ − g(q)| ≤ f·(effort − |g(q)|). Dividing
+    # by the per-pose headroom keeps the constraint affine in (s̈, ṡ²) at every s.
+    zeros = np.zeros(dof)
+    effort = np.broadcast_to(np.asarray(effort_limit, dtype=float), (dof,))
+    held: dict[bytes, tuple[Array, Array]] = {}
+
+    def gravity_and_room(q: Array) -> tuple[Array, Array]:
+        key = np.asarray(q, dtype=float).tobytes()
+        if key not in held:
+            g = np.asarray(inverse_dynamics(q, zeros, zeros), dtype=float)
+            room = effort - np.abs(g)
+            if np.any(room <= 1e-9 * effort):
+                j = int(np.argmin(room / effort))
+                raise PlannerlabError(
+                    f"a pose on the path needs {abs(g[j]):.3g} N·m (or N) at joint {j} to "
+                    f"hold against gravity; the motor has {effort[j]:.3g}"
+                )
+            held[key] = (g, room)
+        return held[key]
+
     def inv_dyn(q: Array, qd: Array, qdd: Array) -> Array:
-        return np.asarray(inverse_dynamics(q, qd, qdd), dtype=float)
+        g, room = gravity_and_room(q)
+        return (np.asarray(inverse_dynamics(q, qd, qdd), dtype=float) - g) / room
 
     constraints = [
         constraint.JointVelocityConstraint(np.stack([-v, v], axis=1)),
         constraint.JointTorqueConstraint(
             inv_dyn,
-            np.stack([-tau, tau], axis=1),
+            np.tile([-float(torque_fraction), float(torque_fraction)], (dof, 1)),
             np.zeros(dof),
             discretization_scheme=constraint.DiscretizationType.Interpolation,
         ),
@@ -190,8 +219,7 @@ def retime(
     if traj is None:
         raise PlannerlabError(
             "toppra found no time parameterisation within the velocity limits and "
-            f"{torque_fraction:g} x the effort limits (a pose on the path needs more torque "
-            "than that, e.g. to hold it against gravity)"
+            f"{torque_fraction:g} x the torque left after gravity"
         )
     return Trajectory(float(traj.duration), knots, max_dev, len(ss), traj)
 
