@@ -129,6 +129,11 @@ def main(argv: Sequence[str] | None = None) -> int:
     stream = sys.stderr if to_stderr else sys.stdout
     # In a log or a pipe rich would wrap at 80 columns: tables read better wider.
     console = Console(stderr=to_stderr, width=None if stream.isatty() else 150)
+    # OMPL's own log lines (forwarded to this logger) reach the terminal only with -v
+    ompl_logger = logging.getLogger("plannerlab.ompl")
+    ompl_level = ompl_logger.level
+    if not args.verbose:
+        ompl_logger.setLevel(logging.ERROR)
     try:
         with engine_output_kept_off_stdout(args.verbose):
             return int(args.func(args, console) or 0)
@@ -147,6 +152,8 @@ def main(argv: Sequence[str] | None = None) -> int:
     except KeyboardInterrupt:
         Console(stderr=True).print("interrupted")
         return 130
+    finally:
+        ompl_logger.setLevel(ompl_level)
 
 
 if __name__ == "__main__":

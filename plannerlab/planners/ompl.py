@@ -44,8 +44,12 @@ Design (measured on ``armz_inspection``, 23 continuous joints):
   connect step). Iterations: the planner's own count where the wheel exposes it
   (``numIterations`` of the RRT* family and BIT*, ``milestoneCount`` of PRM), else the
   number of termination-condition polls (one per loop iteration of RRT, RRT-Connect,
-  KPIECE, …). Slack: checks used by the final fine re-validation of a found path are not
-  part of the planning budget (reported as ``extra["validation_checks"]``).
+  KPIECE, …). The final fine re-validation of a found path (below) is part of the
+  budget: once a path exists, planning and simplification stop when the checks left are
+  just enough to re-check it (recomputed every few polls while an optimizing planner
+  improves it); if they are not, the leg is BUDGET_EXHAUSTED with the numbers, and the
+  path is not trusted. Slack: the re-check may end at most 1 % over
+  ``max_collision_checks`` (its cost is known exactly only once the path is final).
 * **PRM / PRM\\***: OMPL's ``PRM::solve`` checks for a solution in a second thread; with
   Python callbacks the wheel deadlocks there (the caller keeps the GIL while joining).
   These two are therefore driven single-threaded: ``growRoadmap``/``expandRoadmap`` in
@@ -265,6 +269,12 @@ _SETTERS: Mapping[str, str] = {
 _KPIECE = frozenset({"KPIECE1", "BKPIECE1", "LBKPIECE1"})
 _ROADMAP = frozenset({"PRM", "PRMstar"})
 #: planners whose informed samplers need a RealVector space (see ``_Space``)
+#: how often (termination polls) the check reserve for re-checking the best path so far
+#: is recomputed while an optimizing planner improves it
+_RESERVE_EVERY_POLLS = 8
+#: the reserve is this many times the re-check's cost: planners and the simplifier poll
+#: their termination condition between steps that use checks, so they stop a little late
+_RESERVE_FACTOR = 1.25
 _LIFTED = frozenset({"InformedRRTstar", "SORRTstar", "BITstar", "AORRTC"})
 _MOTION_CHECKS = ("batched", "ompl")
 #: OMPL's GoalRegion is satisfied when distanceGoal < threshold (strict)
@@ -343,6 +353,17 @@ def _ompl_logging(logger: logging.Logger) -> Iterator[None]:
 
 
 # ---------------------------------------------------------------------------- helpers
+def _recheck_cost(path: Array, joint_step: float, continuous: Array) -> int:
+    """Collision checks ``checker.check_path(path, joint_step)`` will make (all states of
+    the densified path), computed without checking anything."""
+    path = np.atleast_2d(np.asarray(path, dtype=float))
+    if len(path) < 2:
+        return len(path)
+    d = np.abs(joint_difference(path[1:], path[:-1], continuous))
+    steps = np.maximum(1, np.ceil(np.max(d, axis=1) / joint_step - 1e-12))
+    return int(1 + np.sum(steps))
+
+
 def _reach_m(robot: Robot, q: Array) -> float:
     """An upper bound of the tip's distance from the base [m]: the sum of link lengths."""
     seg = robot.link_segments(np.asarray(q, dtype=float))
@@ -780,7 +801,42 @@ class OMPLPlanner:
         planner.setProblemDefinition(pdef)
         planner.setup()
 
-        ptc = ob.PlannerTerminationCondition(bud.poll)
+        recheck_step = problem.joint_step / 4.0
+
+        def recheck_cost(ompl_path: Any) -> int:
+            if s.interpolate:  # the path that will be re-checked is the interpolated one
+                ompl_path = og.PathGeometric(ompl_path)
+                ompl_path.interpolate()
+            n = ompl_path.getStateCount()
+            Q = np.array([space.to_q(ompl_path.getState(i)) for i in range(n)])
+            return _recheck_cost(Q, recheck_step, robot.continuous)
+
+        reserve = [0]
+
+        def planning_done() -> bool:
+            """Any limit reached, or a path was found and the checks left are just enough
+            to re-check it (asymptotically optimal planners would otherwise spend the
+            whole budget improving it and leave nothing for its re-check)."""
+            if bud.poll():
+                return True
+            if bud.max_checks is None:
+                return False
+            if hasattr(planner, "bestCost"):
+                # RRT*, Informed RRT*, BIT* add their path to the problem definition only
+                # when they stop; their best cost is a path length L in the planning space
+                # (L2 or a sum over joints, either >= the largest joint motion), so the
+                # re-check needs at most L / (joint_step/4) + L / joint_step (interpolated
+                # waypoints) + a few checks
+                best = float(planner.bestCost().value())
+                if math.isfinite(best):
+                    reserve[0] = int(5.0 * best / problem.joint_step) + 16
+            elif pdef.hasSolution() and (reserve[0] == 0 or bud.polls % _RESERVE_EVERY_POLLS == 0):
+                reserve[0] = recheck_cost(og.PathGeometric(pdef.getSolutionPath()))
+            if reserve[0] == 0:
+                return False
+            return bud.deadline.checks_used + _RESERVE_FACTOR * reserve[0] >= bud.max_checks
+
+        ptc = ob.PlannerTerminationCondition(planning_done)
         if self.ompl_class in _ROADMAP:
             ompl_path, exact, status_text = self._roadmap_solve(
                 planner, si, space, guard, pool, q0, goal, robot, bud, problem.joint_step
@@ -818,10 +874,29 @@ class OMPLPlanner:
 
         extra["length_raw"] = float(ompl_path.length())
         extra["waypoints_raw"] = int(ompl_path.getStateCount())
+        fits = [False]
+
+        def simplify_done() -> bool:
+            """Stop simplifying at any limit, or once the checks left are just enough to
+            re-check the path (a path too long to re-check is simplified until it fits or
+            the budget is spent)."""
+            if bud.poll():
+                return True
+            if bud.max_checks is None:
+                return False
+            margin = (
+                bud.max_checks
+                - bud.deadline.checks_used
+                - _RESERVE_FACTOR * recheck_cost(ompl_path)
+            )
+            if margin > 0:
+                fits[0] = True
+            return fits[0] and margin <= 0
+
         if s.simplify and bud.exhausted() is None:
             simplifier = og.PathSimplifier(si, goal_obj)
             c0 = checker.checks
-            simplifier.simplify(ompl_path, ob.PlannerTerminationCondition(bud.poll))
+            simplifier.simplify(ompl_path, ob.PlannerTerminationCondition(simplify_done))
             extra["simplify_checks"] = checker.checks - c0
         extra["length_simplified"] = float(ompl_path.length())
         extra["waypoints_simplified"] = int(ompl_path.getStateCount())
@@ -842,8 +917,22 @@ class OMPLPlanner:
         path[0] = q0  # exact copy (removes float noise of the OMPL round trip)
         extra["path_length_rad"] = path_length(path, robot.continuous)
 
+        cost = _recheck_cost(path, recheck_step, robot.continuous)
+        if bud.max_checks is not None:
+            left = bud.max_checks + bud.max_checks // 100 - bud.deadline.checks_used
+            if cost > left:
+                extra["validation_checks"] = 0
+                return result(
+                    Status.BUDGET_EXHAUSTED,
+                    f"{self.ompl_class} found a path ({status_text}) but re-checking it at "
+                    f"joint_step/4 needs {cost} collision checks and the budget of "
+                    f"{bud.max_checks} (+1 %) leaves {max(left, 0)}: the path is not "
+                    "trusted; give a larger --max-checks",
+                    path,
+                    iterations,
+                )
         c0 = checker.checks
-        check = checker.check_path(path, problem.joint_step / 4.0)
+        check = checker.check_path(path, recheck_step)
         extra["validation_checks"] = checker.checks - c0
         if not check.valid:
             return result(

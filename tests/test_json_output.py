@@ -1,0 +1,107 @@
+"""``--json`` output is exactly one JSON document on stdout, whatever the engines print
+(PyBullet writes ``argv[0]=`` and its banner to file descriptor 1, OMPL logs there).
+
+Runs the real command in a subprocess (file-descriptor-level output is what matters),
+for each kind of planner: gradient, gradient.closed_loop (PyBullet in the loop), ompl.*.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+from conftest import PROBLEMS, ROOT
+
+POCKET = str(PROBLEMS / "armz_pocket.toml")
+
+
+def plannerlab(*argv: str, cwd: Path = ROOT) -> subprocess.CompletedProcess[str]:
+    env = dict(os.environ, MPLBACKEND="Agg", PYTHONPATH=str(ROOT))
+    return subprocess.run(
+        [sys.executable, "-m", "plannerlab", *argv],
+        capture_output=True,
+        text=True,
+        cwd=cwd,
+        env=env,
+        timeout=600,
+    )
+
+
+def one_json_document(stdout: str):
+    return json.loads(stdout)  # raises on anything before or after the document
+
+
+BUDGETS = {
+    "gradient": ["--max-iterations", "3"],
+    "gradient.closed_loop": ["--max-iterations", "3"],
+    "ompl.rrtconnect": ["--max-checks", "300"],
+}
+
+
+@pytest.fixture(scope="module")
+def plans(tmp_path_factory) -> dict[str, Path]:
+    out = tmp_path_factory.mktemp("plans")
+    paths = {}
+    for planner, budget in BUDGETS.items():
+        path = out / f"{planner}.json"
+        proc = plannerlab(
+            "solve", POCKET, "--planner", planner, "--out", str(path), "--json", *budget
+        )
+        assert proc.returncode == 0, proc.stderr
+        plan = one_json_document(proc.stdout)
+        assert plan["planner"] == planner and len(plan["legs"]) == 1
+        paths[planner] = path
+    return paths
+
+
+@pytest.mark.parametrize("planner", sorted(BUDGETS))
+def test_solve_json_is_one_document(plans, planner):
+    assert json.loads(plans[planner].read_text())["planner"] == planner
+
+
+@pytest.mark.parametrize("planner", ["gradient", "ompl.rrtconnect"])
+def test_execute_json_is_one_document(plans, tmp_path, planner):
+    proc = plannerlab("execute", str(plans[planner]), "--json")
+    assert proc.returncode == 0, proc.stderr
+    doc = one_json_document(proc.stdout)
+    assert len(doc["executions"]) == 1
+
+
+def test_plot_json_is_one_document(plans, tmp_path):
+    proc = plannerlab("plot", str(plans["gradient"]), "--out", str(tmp_path), "--json")
+    assert proc.returncode == 0, proc.stderr
+    files = one_json_document(proc.stdout)
+    assert files and all(Path(f).exists() for f in files)
+
+
+def test_compare_json_is_one_document(tmp_path):
+    proc = plannerlab(
+        "compare",
+        POCKET,
+        "--planners",
+        "gradient,ompl.rrtconnect",
+        "--seeds",
+        "0",
+        "--max-checks",
+        "300",
+        "--max-iterations",
+        "3",
+        "--out",
+        str(tmp_path),
+        "--json",
+    )
+    assert proc.returncode == 0, proc.stderr
+    one_json_document(proc.stdout)
+
+
+def test_pybullet_banner_stays_off_a_normal_terminal_unless_verbose(plans):
+    quiet = plannerlab("execute", str(plans["gradient"]))
+    assert quiet.returncode == 0, quiet.stderr
+    assert "argv[0]" not in quiet.stdout and "argv[0]" not in quiet.stderr
+    loud = plannerlab("-v", "execute", str(plans["gradient"]))
+    assert loud.returncode == 0, loud.stderr
+    assert "argv[0]" not in loud.stdout and "argv[0]" in loud.stderr
