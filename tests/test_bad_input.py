@@ -438,3 +438,41 @@ def test_problem_names_resolve_from_the_working_directory_first(tmp_path, monkey
     mine = write(tmp_path / "problems", VALID, "armz_pocket.toml")
     monkeypatch.chdir(tmp_path)
     assert resolve_problem_path("armz_pocket").resolve() == mine.resolve()
+
+
+SUBCOMMANDS = ("problems", "planners", "solve", "execute", "plot", "ik", "compare", "continuum")
+
+
+def test_help_lists_every_subcommand_and_has_no_markup(capsys):
+    code, out, _ = run(capsys, "--help")
+    assert code == 0
+    for name in SUBCOMMANDS:
+        assert f"    {name} " in out, name
+    for name in SUBCOMMANDS:
+        code, out, _ = run(capsys, name, "--help")
+        assert code == 0 and "``" not in out and ":func:" not in out, name
+        assert "usage: plannerlab " + name in out
+
+
+def test_help_shows_defaults(capsys):
+    _, out, _ = run(capsys, "solve", "--help")
+    text = " ".join(out.split())
+    assert "(default: 0)" in text  # --seed
+    assert "[budget]" in text  # budget flags: the problem file's budget
+    _, out, _ = run(capsys, "compare", "--help")
+    assert "(default 1)" in " ".join(out.split())  # --jobs
+
+
+def test_too_small_a_budget_is_reported_as_the_budget():
+    """Not as an invalid goal: the budget ran out before IK could find a goal state."""
+    from conftest import small_armz_problem
+
+    from plannerlab.planners import make_planner
+    from plannerlab.problem.load import Budget
+
+    problem = small_armz_problem()
+    r = make_planner("ompl.rrtconnect").solve(
+        problem, 0, Budget(max_collision_checks=2), np.random.default_rng(0)
+    )
+    assert r.status is Status.BUDGET_EXHAUSTED, r.reason
+    assert "collision-check budget of 2" in r.reason and r.collision_checks <= 2

@@ -7,6 +7,7 @@ import contextlib
 import io
 import logging
 import os
+import re
 import sys
 from collections.abc import Iterator, Sequence
 
@@ -36,9 +37,18 @@ file, the key or flag, and what was expected), 130 interrupted.
 """
 
 
+def _plain(text: str) -> str:
+    """Help text without reStructuredText markup (docstrings double as descriptions)."""
+    text = re.sub(r":[a-z]+:`~?([^`]+)`", r"\1", text)
+    return text.replace("``", "'")
+
+
 class HelpFormatter(argparse.RawDescriptionHelpFormatter):
     """Keeps the descriptions' line breaks and appends each flag's default to its help
     (unless the help already states it, or there is no default)."""
+
+    def _format_text(self, text: str) -> str:
+        return super()._format_text(_plain(text))
 
     def _get_help_string(self, action: argparse.Action) -> str:
         text = action.help or ""

@@ -723,8 +723,10 @@ class OMPLPlanner:
         pool: list[Array] = []
         c_pool = checker.checks
         per_slot = max(1, s.max_goal_attempts // max(s.goal_samples, 1))
+        pool_cut_short = ""
         for _ in range(s.goal_samples):
             if bud.exhausted() is not None:
+                pool_cut_short = bud.exhausted() or ""
                 break
             if s.goal_selection == "near":
                 q_goal = _near_goal(problem, leg, q0, checker, bud)
@@ -856,6 +858,14 @@ class OMPLPlanner:
         why_stopped = bud.exhausted()
 
         if ompl_path is None:
+            if not pool and pool_cut_short:
+                return result(
+                    Status.BUDGET_EXHAUSTED,
+                    f"the budget ran out while sampling goal states by IK ({pool_cut_short}) "
+                    f"and {self.ompl_class} reached no goal: give a larger budget",
+                    q0[None],
+                    iterations,
+                )
             if not pool:
                 return result(
                     Status.INVALID_GOAL,
