@@ -40,10 +40,11 @@ PAPER_SOLUTIONS = {c: PAPER_TABLE[f"continuum_case{c}"].solutions for c in CASES
 #: whose thin curve meets the wall's lower right corner and the post's lower left corner
 #: at shallow angles (see test_the_solutions_lost_to_thickness_are_those_that_cut)
 THICK_SOLUTIONS = {1: 2, 2: 1, 3: 1}
-#: the chosen (shortest) solution's collision points per case, from the paper's Fig. 4:
-#: case 1 passes the wall's lower left corner (the mirror image via point 1 is as long;
-#: the first in breadth-first order is kept), case 2 the wall's lower left corner, case 3
-#: the slab's lower right corner
+#: the chosen ("shortest") solution's collision points, from the geometry: cases 2 and 3
+#: have one solution for the robot's radius (case 2: round the wall's lower left corner,
+#: case 3: the slab's corner 1); case 1's two are mirror images about the port's axis
+#: (equal length, bends ±0.836 / ∓2.600 rad), and the tie goes to the first in
+#: breadth-first order, point 0
 CHOSEN_POINTS = {1: (0,), 2: (0,), 3: (1,)}
 RRT_CHECKS = 30_000  # collision-check budget of RRT-Connect (generous: without the sleeve
 #                      it solved case 3 in a few hundred)

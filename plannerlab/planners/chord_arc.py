@@ -398,22 +398,35 @@ def capsule_distances(
     """
     flat = np.asarray(seg_m, dtype=float).reshape(-1, 2, 2)
     a, b = flat[:, 0], flat[:, 1]
-    lo, hi = np.minimum(a, b), np.maximum(a, b)
     out = np.full((len(flat), len(obstacles)), math.inf)
+    if not len(obstacles) or not len(flat):
+        return out.reshape(np.shape(seg_m)[:-2] + (len(obstacles),))
+    o_lo = np.empty((len(obstacles), 2))
+    o_hi = np.empty((len(obstacles), 2))
     for o, obs in enumerate(obstacles):
         if isinstance(obs, Circle):
             c = np.asarray(obs.center_m)
-            o_lo, o_hi = c - obs.radius_m, c + obs.radius_m
+            o_lo[o], o_hi[o] = c - obs.radius_m, c + obs.radius_m
         else:
             v = np.asarray(obs.vertices_m)
-            o_lo, o_hi = v.min(axis=0), v.max(axis=0)
-        near = np.flatnonzero(np.all((lo <= o_hi + reach_m) & (hi >= o_lo - reach_m), axis=1))
-        if not len(near):
-            continue
+            o_lo[o], o_hi[o] = v.min(axis=0), v.max(axis=0)
+    o_lo -= reach_m
+    o_hi += reach_m
+    lo, hi = np.minimum(a, b), np.maximum(a, b)
+    near_all = (
+        (lo[:, None, 0] <= o_hi[None, :, 0])
+        & (hi[:, None, 0] >= o_lo[None, :, 0])
+        & (lo[:, None, 1] <= o_hi[None, :, 1])
+        & (hi[:, None, 1] >= o_lo[None, :, 1])
+    )  # (N, O)
+    for o in np.flatnonzero(near_all.any(axis=0)):
+        obs = obstacles[o]
+        near = np.flatnonzero(near_all[:, o])
         if isinstance(obs, Circle):
+            c = np.asarray(obs.center_m)
             d = np.maximum(_point_segment_distance(c, a[near], b[near]) - obs.radius_m, 0.0)
         else:
-            d = _segment_polygon_distance(a[near], b[near], v)
+            d = _segment_polygon_distance(a[near], b[near], np.asarray(obs.vertices_m))
         out[near, o] = d
     return out.reshape(np.shape(seg_m)[:-2] + (len(obstacles),))
 
@@ -552,30 +565,39 @@ class ChordArcPlanner:
         if not touching.any():
             return [], [], False
         names = [o.name for o in query.obstacles]
-        near = np.full(touching.shape, math.inf)  # axis distance to an own collision point
-        nearest = np.full(touching.shape, -1, dtype=int)
+        st, li, ob = np.nonzero(touching)  # every touching (state, link, obstacle)
+        near = np.full(len(st), math.inf)  # link axis to the nearest own collision point
+        nearest = np.full(len(st), -1, dtype=int)
         for i, ck in zip(plan.solution.contact_indices, plan.contacts, strict=True):
-            o = names.index(ck.obstacle)
+            m = np.flatnonzero(ob == names.index(ck.obstacle))
             p = np.asarray(query.collision_points_m[i], dtype=float)
-            d = _point_segment_distance(p, seg[..., 0, :], seg[..., 1, :])  # (S, L)
-            better = d < near[..., o]
-            near[..., o] = np.where(better, d, near[..., o])
-            nearest[..., o] = np.where(better, i, nearest[..., o])
+            d = _point_segment_distance(p, seg[st[m], li[m], 0], seg[st[m], li[m], 1])
+            better = d < near[m]
+            near[m[better]] = d[better]
+            nearest[m[better]] = i
+        away = near > tol
+        # per (link, obstacle) pair, in order of states: the first state, and the first
+        # state away from the collision points (if any)
+        key = li * len(names) + ob
+        order = np.lexsort((~away, st, key))  # by pair, then state; away first on ties
+        key, st, li, ob = key[order], st[order], li[order], ob[order]
+        near, nearest, away = near[order], nearest[order], away[order]
+        starts = np.flatnonzero(np.r_[True, key[1:] != key[:-1]])
+        ends = np.r_[starts[1:], len(key)]
         expected: list[dict[str, Any]] = []
         unexpected: list[dict[str, Any]] = []
-        for li, o in zip(*np.nonzero(touching.any(axis=0)), strict=True):
-            states = np.flatnonzero(touching[:, li, o])
-            away = states[near[states, li, o] > tol]
-            k = int(away[0]) if len(away) else int(states[0])
-            ci = int(nearest[k, li, o])
+        for a0, a1 in zip(starts, ends, strict=True):
+            hits = np.flatnonzero(away[a0:a1])
+            k = a0 + (int(hits[0]) if len(hits) else 0)
+            ci = int(nearest[k])
             rec = {
-                "link": robot.link_names[li],
-                "obstacle": names[o],
-                "first_state": k,
+                "link": robot.link_names[int(li[k])],
+                "obstacle": names[int(ob[k])],
+                "first_state": int(st[k]),
                 "collision_point": None if ci < 0 else ci,
-                "distance_m": None if ci < 0 else float(near[k, li, o]),
+                "distance_m": None if ci < 0 else float(near[k]),
             }
-            (unexpected if len(away) else expected).append(rec)
+            (unexpected if len(hits) else expected).append(rec)
         expected.sort(key=lambda r: r["first_state"])
         unexpected.sort(key=lambda r: r["first_state"])
         return expected, unexpected, False
