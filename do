@@ -23,9 +23,11 @@ job=${1:-main}
 shift || true
 case "$job" in
   main)
-    exec "$VENV/bin/plannerlab" compare armz_inspection --legs enter \
-      --planners gradient,gradient+rrtconnect,gradient.multistart,ompl.rrtconnect \
-      --seeds 0-2 --max-checks 50000 --execute --jobs 2 --out results/runs --name main "$@" ;;
+    # the paper's whole experiment: enter, A-E, leave; each trial stops at its first
+    # failed leg, solved legs are executed in PyBullet
+    exec "$VENV/bin/plannerlab" compare armz_inspection \
+      --planners gradient.clearance+detour,gradient.clearance,gradient \
+      --seeds 0-1 --max-checks 100000 --execute --jobs 2 --out results/runs --name main "$@" ;;
   test)
     exec "$VENV/bin/python" -m pytest -q "$@" ;;
   bench)
