@@ -63,8 +63,14 @@ def _lines(path: Path) -> list[dict]:
 
 
 def _deterministic(rec: dict) -> list[dict]:
-    """A record's per-leg results without the clocks."""
-    return [{k: v for k, v in leg.items() if k != "time_s"} for leg in rec["legs_run"]]
+    """A record's per-leg results without the clocks (progress rows without their time)."""
+    return [
+        {
+            **{k: v for k, v in leg.items() if k not in ("time_s", "progress")},
+            "progress": [row[1:] for row in leg.get("progress", [])],
+        }
+        for leg in rec["legs_run"]
+    ]
 
 
 @pytest.fixture(scope="module")
@@ -222,6 +228,51 @@ def test_ompl_log_loads_into_sqlite(comparison: dict, tmp_path: Path) -> None:
     assert seeds == SEEDS
     assert rows == {pl: (len(SEEDS), expected[pl]) for pl in PLANNERS}
     assert statuses == sum(expected.values())
+
+
+def test_planner_arena_shows_progress(comparison: dict, tmp_path: Path) -> None:
+    """The OMPL log's progress properties reach Planner Arena's progress table: per run,
+    times increasing from 0 and the best goal distance never growing, and 0 at the end of
+    every solved run."""
+    database = pytest.importorskip("plannerarena.database")
+    script = BIN / "ompl_benchmark_statistics"
+    if not script.exists():
+        pytest.skip("ompl_benchmark_statistics is not installed")
+    db = tmp_path / "arena.db"
+    log = comparison["folder"] / f"{NAME}.log"
+    proc = subprocess.run(
+        [str(script), str(log), "-d", str(db)], capture_output=True, text=True, timeout=120
+    )
+    assert proc.returncode == 0, proc.stderr
+    data = database.load_database(db)
+    progress = data["progress"]
+    assert not progress.is_empty()
+    # Planner Arena shows the SQL columns with spaces again
+    assert {"time", "best goal distance", "best cost", "collision checks", "leg"} <= set(
+        progress.columns
+    )
+    con = sqlite3.connect(db)
+    try:
+        runs = con.execute(
+            "SELECT r.id, p.name, r.solved, r.collision_checks FROM runs r "
+            "JOIN plannerConfigs p ON p.id = r.plannerid"
+        ).fetchall()
+        for run_id, planner, solved, checks in runs:
+            rows = con.execute(
+                "SELECT time, best_goal_distance, collision_checks FROM progress "
+                "WHERE runid = ? ORDER BY time",
+                (run_id,),
+            ).fetchall()
+            assert rows, (planner, run_id)
+            times = [t for t, _, _ in rows]
+            dists = [d for _, d, _ in rows]
+            assert times[0] >= 0 and all(b > a for a, b in zip(times, times[1:], strict=False))
+            assert all(b <= a for a, b in zip(dists, dists[1:], strict=False)), planner
+            assert 0 < rows[-1][2] <= checks  # the run's checks, counted from its start
+            if solved:
+                assert dists[-1] == 0.0, planner
+    finally:
+        con.close()
 
 
 # ---------------------------------------------------------------------- determinism

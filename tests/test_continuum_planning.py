@@ -155,6 +155,7 @@ def test_chord_arc_is_the_same_every_run(case: int) -> None:
         d["extra"].pop("search")  # holds the search's wall time
         d.pop("time_s")
         d.pop("seed")
+        d["progress"] = [row[1:] for row in d["progress"]]  # without the clock
     assert da == db
 
 

@@ -11,6 +11,7 @@ from plannerlab.planners import make_planner
 from plannerlab.planners.base import Status
 from plannerlab.problem.catalog import load_problem
 from plannerlab.robots.base import joint_difference
+from plannerlab.robots.paths import path_length
 from plannerlab.sim.execute import execute
 
 
@@ -25,6 +26,18 @@ def test_gradient_rrtconnect_escapes_from_the_stall_itself():
     assert record["start_from_stall_rad"] == 0.0
     assert record["start_from_leg_start_rad"] == pytest.approx(record["descent_before_stall_rad"])
     assert record["left_stall"]
+    # the escape shows in the progress rows as a drop of the best goal distance: a plateau
+    # at the stall (> 0, the descent's best), then 0 once RRT-Connect reached the region
+    stall = make_planner("gradient").solve(
+        problem, 0, problem.budget.replace(max_collision_checks=50_000), np.random.default_rng(0)
+    )
+    assert stall.status is Status.LOCAL_MINIMUM
+    t, checks, dist, cost = r.progress.T
+    drop = int(np.flatnonzero(dist == 0.0)[0])
+    assert drop > 0 and dist[drop - 1] > 1.0  # outside the region by its tolerances
+    assert dist[drop - 1] == pytest.approx(stall.progress[-1, 2], rel=0.05)
+    assert checks[drop] > checks[drop - 1] and t[drop] > t[drop - 1]
+    assert cost[-1] == pytest.approx(path_length(r.path, problem.robot.continuous))
     assert (
         CollisionChecker(problem.robot, problem.scene)
         .check_path(r.path, problem.joint_step / 4)

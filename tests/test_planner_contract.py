@@ -38,6 +38,7 @@ from plannerlab.problem.load import Budget, Problem
 from plannerlab.problem.scene import Scene, Sphere
 from plannerlab.robots.armz.model import ArmZ
 from plannerlab.robots.base import joint_difference, trans
+from plannerlab.robots.paths import path_length
 
 SEED = 7
 #: planning budget of the contract solve [collision checks]; asymptotically optimal
@@ -244,3 +245,22 @@ def test_result_survives_json_round_trip(name: str) -> None:
     assert back.status is r.status
     assert np.array_equal(back.path, r.path)
     assert back.planner == r.planner and back.collision_checks == r.collision_checks
+    assert np.array_equal(back.progress, r.progress, equal_nan=True)
+    json.dumps(r.to_dict(), allow_nan=False)  # strict JSON: NaN travels as null
+
+
+@pytest.mark.parametrize("name", PARAMS)
+def test_progress_rows_tell_how_the_planner_got_there(name: str) -> None:
+    r = _result(name)
+    problem = problem_for(name)
+    t, checks, dist, cost = r.progress.T
+    assert r.progress.shape[1] == 4 and len(r.progress) >= 1
+    assert np.all(np.diff(t) > 0) and t[0] >= 0 and t[-1] <= r.time_s
+    assert np.all(np.diff(checks) >= 0) and checks[-1] <= r.collision_checks
+    assert np.all(np.diff(dist) <= 0)  # the best goal distance never grows
+    # the first row is no better than the start, the last is where the path ends
+    goal = problem.goals[0]
+    assert dist[0] <= float(goal.distance(problem.robot, r.path[0])) + 1e-12
+    if r.solved:
+        assert dist[-1] == 0.0
+        assert cost[-1] == pytest.approx(path_length(r.path, problem.robot.continuous))

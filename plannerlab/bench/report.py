@@ -38,6 +38,14 @@ Run properties: ``seed``, ``time`` (planning time summed over legs [s]), ``solve
 [deg], ``local minima``, ``escapes``, ``wall time`` (the trial's process [s]) and, for
 executed comparisons, ``execution success``, ``execution max tracking error`` [rad] and
 ``execution contacts`` (empty otherwise).
+
+Progress properties (OMPL's ``N progress properties`` block after the runs, one line of
+``v1,v2,…,;`` samples per run; Planner Arena's "Progress" tab plots them): ``time`` [s],
+``best goal distance`` (normalised, 0 inside the goal region), ``best cost`` (joint-space
+length of the best solution [rad], empty until one), ``collision checks`` and ``leg``,
+from each leg's :attr:`~plannerlab.planners.base.PlanResult.progress`; legs follow one
+another, times and checks counted from the trial's start. An escape from a local minimum
+shows as a drop of the best goal distance.
 """
 
 from __future__ import annotations
@@ -430,6 +438,39 @@ _RUN_PROPERTIES: tuple[tuple[str, str], ...] = (
 )
 
 
+#: progress properties of a run: its legs one after another, times and checks counted
+#: from the trial's start; the best goal distance is the current leg's
+_PROGRESS_PROPERTIES: tuple[tuple[str, str], ...] = (
+    ("time", "REAL"),
+    ("best goal distance", "REAL"),
+    ("best cost", "REAL"),
+    ("collision checks", "INTEGER"),
+    ("leg", "INTEGER"),
+)
+
+
+def _run_progress(r: Mapping[str, Any]) -> list[list[Any]]:
+    """A trial's progress rows (see :data:`_PROGRESS_PROPERTIES`), times strictly
+    increasing (OMPL's table keys progress on (run, time))."""
+    rows: list[list[Any]] = []
+    t_off = 0.0
+    c_off = 0
+    for leg in r.get("legs_run") or []:
+        for t, checks, dist, cost in leg.get("progress") or []:
+            if t is None:
+                continue
+            time_s = t_off + float(t)
+            c = None if checks is None else c_off + int(checks)
+            row = [time_s, dist, cost, c, int(leg["leg"])]
+            if rows and time_s <= rows[-1][0]:
+                rows[-1] = [rows[-1][0], *row[1:]]  # same instant: the later values
+            else:
+                rows.append(row)
+        t_off += float(leg.get("time_s") or 0.0)
+        c_off += int(leg.get("collision_checks") or 0)
+    return rows
+
+
 def _log_value(v: Any) -> str:
     if v is None:
         return ""
@@ -533,6 +574,13 @@ def ompl_log(problem: str, records: Sequence[Mapping[str, Any]], meta: Mapping[s
         lines += [f"{n} {t}" for n, t in _RUN_PROPERTIES]
         lines.append(f"{len(runs)} runs")
         lines += ["".join(f"{v}; " for v in _run_values(r)) for r in runs]
+        lines.append(f"{len(_PROGRESS_PROPERTIES)} progress properties")
+        lines += [f"{n} {t}" for n, t in _PROGRESS_PROPERTIES]
+        lines.append(f"{len(runs)} runs")
+        lines += [
+            "".join("".join(f"{_log_value(v)}," for v in row) + ";" for row in _run_progress(r))
+            for r in runs
+        ]
         lines.append(".")
     return "\n".join(lines) + "\n"
 

@@ -60,8 +60,6 @@ from plannerlab.errors import PlannerlabError
 LOGGER = logging.getLogger(__name__)
 
 RECORD_FORMAT = "plannerlab.trial/1"
-#: two-sided 95 % normal quantile
-Z95 = 1.959963984540054
 #: statuses of a trial record: the planner statuses plus "error" (the trial raised)
 ERROR_STATUS = "error"
 #: status of a trial killed for running past its wall-clock limit
@@ -218,6 +216,17 @@ def _seed_ompl(seed: int) -> bool:
     return True
 
 
+#: most progress rows a leg record keeps (evenly picked, the first and last always)
+MAX_PROGRESS_ROWS = 200
+
+
+def _thinned(rows: np.ndarray, most: int = MAX_PROGRESS_ROWS) -> np.ndarray:
+    rows = np.asarray(rows, dtype=float).reshape(-1, 4)
+    if len(rows) <= most:
+        return rows
+    return rows[np.unique(np.linspace(0, len(rows) - 1, most).round().astype(int))]
+
+
 def _leg_record(r: Any, continuous: np.ndarray) -> dict[str, Any]:
     from plannerlab.robots.paths import path_length
 
@@ -244,6 +253,7 @@ def _leg_record(r: Any, continuous: np.ndarray) -> dict[str, Any]:
         "path_points": int(len(path)),
         "path_sha256": hashlib.sha256(path.tobytes()).hexdigest()[:16],
         "extra_lengths": extra_lengths,
+        "progress": [[_num(float(v)) for v in row] for row in _thinned(r.progress)],
     }
 
 
@@ -674,8 +684,9 @@ def run_comparison(
 
 
 # ---------------------------------------------------------------------- statistics
-def wilson_interval(successes: int, n: int, z: float = Z95) -> tuple[float, float]:
-    """Wilson score interval of a binomial proportion (95 % by default).
+def wilson_interval(successes: int, n: int, confidence: float = 0.95) -> tuple[float, float]:
+    """Wilson score interval of a binomial proportion (95 % by default), from
+    ``scipy.stats.binomtest(k, n).proportion_ci(method="wilson")``.
 
     ``(nan, nan)`` for ``n == 0``. 0/20 gives (0, 0.161); 20/20 gives (0.839, 1).
     """
@@ -683,14 +694,12 @@ def wilson_interval(successes: int, n: int, z: float = Z95) -> tuple[float, floa
         return (math.nan, math.nan)
     if not 0 <= successes <= n:
         raise ValueError(f"successes must be in [0, {n}], got {successes}")
-    p = successes / n
-    z2 = z * z
-    denom = 1.0 + z2 / n
-    center = (p + z2 / (2 * n)) / denom
-    half = z * math.sqrt(p * (1 - p) / n + z2 / (4 * n * n)) / denom
-    lo = 0.0 if successes == 0 else max(0.0, center - half)
-    hi = 1.0 if successes == n else min(1.0, center + half)
-    return (lo, hi)
+    from scipy.stats import binomtest  # here: scipy.stats takes a while to import
+
+    ci = binomtest(int(successes), int(n)).proportion_ci(
+        confidence_level=confidence, method="wilson"
+    )
+    return (float(ci.low), float(ci.high))
 
 
 def _vals(xs: Iterable[Any]) -> np.ndarray:

@@ -50,6 +50,8 @@ class Stepper(Protocol):
 
 def _jsonable(value: Any) -> Any:
     if isinstance(value, np.ndarray):
+        if value.dtype.kind == "f" and not np.all(np.isfinite(value)):
+            return _jsonable(value.tolist())  # NaN/inf are not JSON
         return value.tolist()
     if isinstance(value, np.generic):
         return value.item()
@@ -69,6 +71,99 @@ def settings_dict(settings: Any) -> dict[str, Any]:
     return _jsonable(dataclasses.asdict(settings)) if dataclasses.is_dataclass(settings) else {}
 
 
+#: the columns of :attr:`PlanResult.progress`, in order
+PROGRESS_COLUMNS = ("time_s", "collision_checks", "best_goal_dist", "best_cost")
+
+
+class Progress:
+    """Records a planner's progress: a row ``(time_s, collision_checks, best_goal_dist,
+    best_cost)`` whenever the best normalised goal distance
+    (:meth:`~plannerlab.problem.goals.GoalRegion.distance`, 0 inside the region) or the
+    best cost (joint-space length of the best solution [rad], NaN until one is found)
+    improves, and one at the end. Times are strictly increasing: a row at the same time as
+    the last one replaces it. The shared helper behind :attr:`PlanResult.progress`.
+
+    Args:
+        clock: seconds since the solve started (e.g. ``Deadline.elapsed_s``).
+        checks: collision checks used so far in this solve.
+    """
+
+    def __init__(self, clock: Any, checks: Any) -> None:
+        self._clock = clock
+        self._checks = checks
+        self.best_goal_dist = math.inf
+        self.best_cost = math.inf
+        self._rows: list[list[float]] = []
+
+    def _row(self, time_s: float, checks: int) -> None:
+        d, c = self.best_goal_dist, self.best_cost
+        row = [
+            float(time_s),
+            float(checks),
+            d if d < math.inf else math.nan,
+            c if c < math.inf else math.nan,
+        ]
+        if self._rows and row[0] <= self._rows[-1][0]:
+            row[0] = self._rows[-1][0]
+            self._rows[-1] = row
+        else:
+            self._rows.append(row)
+
+    def note(
+        self,
+        goal_dist: float = math.nan,
+        cost: float = math.nan,
+        time_s: float | None = None,
+        checks: int | None = None,
+    ) -> bool:
+        """Take a state's goal distance and/or a solution's cost; a row when either best
+        improves (True then)."""
+        better = False
+        if goal_dist < self.best_goal_dist:  # False for NaN
+            self.best_goal_dist = float(goal_dist)
+            better = True
+        if cost < self.best_cost:
+            self.best_cost = float(cost)
+            better = True
+        if better:
+            self._row(
+                self._clock() if time_s is None else time_s,
+                self._checks() if checks is None else checks,
+            )
+        return better
+
+    def extend(self, rows: Array, time_offset_s: float, checks_offset: int) -> None:
+        """Take a sub-solve's progress rows (a hybrid's descent or escape), shifted by when
+        it started; its costs are of a part of the path, so only goal distances count."""
+        for t, c, d, _cost in np.asarray(rows, dtype=float).reshape(-1, 4):
+            self.note(goal_dist=d, time_s=time_offset_s + t, checks=int(checks_offset + c))
+
+    def finish(self, goal_dist: float = math.nan, cost: float = math.nan) -> Array:
+        """The rows, closed by one at the end (the last state's distance, the path's cost)."""
+        if not self.note(goal_dist, cost):
+            self._row(self._clock(), self._checks())
+        return self.rows()
+
+    def rows(self) -> Array:
+        return np.array(self._rows, dtype=float).reshape(-1, len(PROGRESS_COLUMNS)).copy()
+
+    @staticmethod
+    def of_series(
+        times_s: Any, checks: Any, goal_dists: Any, final_cost: float = math.nan
+    ) -> Array:
+        """Rows from per-iteration series (a descent's), keeping the improvements and the
+        last iteration; ``final_cost`` is the path's cost when it solved."""
+        times_s = np.asarray(times_s, dtype=float)
+        series = list(zip(times_s, checks, goal_dists, strict=True))
+        if not series:
+            return np.zeros((0, len(PROGRESS_COLUMNS)))
+        last = series[-1]
+        p = Progress(lambda: last[0], lambda: last[1])
+        for t, c, d in series:
+            p.note(goal_dist=float(d), time_s=float(t), checks=int(c))
+        return p.finish(cost=final_cost)
+
+
 @dataclass(frozen=True, eq=False)
 class PlanResult:
     """What a planner returns for one leg.
@@ -85,6 +180,10 @@ class PlanResult:
         fk_calls: forward-kinematics evaluations (states), where the planner counts them.
         pos_err_m, angle_err_deg: tip errors of the path's last state.
         trace: objective (or best goal distance) per iteration, for plots.
+        progress: (k, 4) rows ``(time_s, collision_checks, best_goal_dist, best_cost)``
+            (:data:`PROGRESS_COLUMNS`), one whenever the best goal distance or the best
+            cost improved, plus one at the end: how the planner got there over time
+            (OMPL's benchmark "progress properties"; see :class:`Progress`).
         local_minima, escapes: local minima met, and how many of them were left.
         seed: the trial's seed (None if not seeded by a trial).
         settings: the planner's settings as data.
@@ -105,6 +204,7 @@ class PlanResult:
     pos_err_m: float = math.nan
     angle_err_deg: float = math.nan
     trace: Array = field(default_factory=lambda: np.zeros(0))
+    progress: Array = field(default_factory=lambda: np.zeros((0, 4)))
     local_minima: int = 0
     escapes: int = 0
     seed: int | None = None
@@ -119,6 +219,9 @@ class PlanResult:
         trace = np.array(self.trace, dtype=float).reshape(-1)
         trace.setflags(write=False)
         object.__setattr__(self, "trace", trace)
+        progress = np.array(self.progress, dtype=float).reshape(-1, len(PROGRESS_COLUMNS))
+        progress.setflags(write=False)
+        object.__setattr__(self, "progress", progress)
 
     @property
     def solved(self) -> bool:
@@ -139,6 +242,10 @@ class PlanResult:
             for k in ("pos_err_m", "angle_err_deg", "time_s"):
                 if values.get(k) is None:
                     values[k] = math.nan
+            if values.get("progress") is not None:  # JSON has no NaN: None stands for it
+                values["progress"] = [
+                    [math.nan if v is None else v for v in row] for row in values["progress"]
+                ]
             return cls(**values)
         except (TypeError, ValueError) as exc:
             raise PlanFileError(f"not a plan result: {exc}") from None

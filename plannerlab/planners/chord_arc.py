@@ -89,6 +89,7 @@ from plannerlab.errors import PlannerlabError, ProblemError
 from plannerlab.planners.base import (
     Deadline,
     PlanResult,
+    Progress,
     Status,
     Stepper,
     settings_dict,
@@ -112,6 +113,7 @@ from plannerlab.planners.chord_arc_search import prepare as prepare_check
 from plannerlab.problem.scene import Box, Cylinder, Scene, Sphere
 from plannerlab.robots.base import Array
 from plannerlab.robots.continuum.model import ContinuumChain
+from plannerlab.robots.paths import path_length
 
 
 @dataclass(frozen=True)
@@ -660,6 +662,13 @@ class ChordArcPlanner:
             extra: dict[str, Any] | None = None,
         ) -> PlanResult:
             pe, ae = goal.errors(robot, path[-1])
+            progress = Progress(lambda: time.perf_counter() - t0, lambda: deadline.checks_used)
+            progress.note(float(goal.distance(robot, q0)), time_s=0.0, checks=0)
+            solved = status is Status.SOLVED
+            rows = progress.finish(
+                float(goal.distance(robot, path[-1])),
+                path_length(path, robot.continuous) if solved else math.nan,
+            )
             return PlanResult(
                 planner=self.name,
                 problem=problem.name,
@@ -675,6 +684,7 @@ class ChordArcPlanner:
                 pos_err_m=float(pe),
                 angle_err_deg=float(ae),
                 trace=np.zeros(0) if trace is None else trace,
+                progress=rows,
                 settings=settings_dict(s),
                 extra={**base_extra, **(extra or {})},
             )

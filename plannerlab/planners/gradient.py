@@ -34,6 +34,7 @@ region). A **stall** is declared when the best f has not improved by more than
 
 from __future__ import annotations
 
+import math
 import time
 from dataclasses import dataclass
 
@@ -45,6 +46,7 @@ from plannerlab.errors import PlannerlabError
 from plannerlab.planners.base import (
     Deadline,
     PlanResult,
+    Progress,
     Status,
     Stepper,
     settings_dict,
@@ -52,7 +54,7 @@ from plannerlab.planners.base import (
 )
 from plannerlab.planners.objective import Objective
 from plannerlab.robots.base import Array, wrap_to_pi
-from plannerlab.robots.paths import interpolate_edge
+from plannerlab.robots.paths import interpolate_edge, path_length
 
 
 @dataclass(frozen=True)
@@ -178,6 +180,9 @@ class GradientPlanner:
                 )
             stepper.reset(q)
 
+        clock: list[float] = []  # per state of the path: when it was reached [s]
+        checks: list[int] = []  # … and the collision checks used by then
+
         def result(
             status: Status,
             reason: str,
@@ -188,6 +193,15 @@ class GradientPlanner:
             extra: dict | None = None,
         ) -> PlanResult:
             pos_err, ang_err = goal.errors(robot, path[-1])
+            # progress from the descent's states (bookkeeping: these FK calls are not counted)
+            cost = (
+                path_length(np.array(path), robot.continuous)
+                if status is Status.SOLVED
+                else math.nan
+            )
+            n = min(len(path), len(clock))  # 0 when the start is refused
+            dists = goal.distance(robot, np.array(path[:n])) if n else []
+            progress = Progress.of_series(clock[:n], checks[:n], dists, cost)
             return PlanResult(
                 planner=self.name,
                 problem=problem.name,
@@ -203,6 +217,7 @@ class GradientPlanner:
                 pos_err_m=float(pos_err),
                 angle_err_deg=float(ang_err),
                 trace=np.array(trace),
+                progress=progress,
                 local_minima=minima,
                 escapes=0,
                 settings=settings_dict(s),
@@ -216,6 +231,8 @@ class GradientPlanner:
         path = [q.copy()]
         value = f(q)
         trace = [value]
+        clock.append(time.perf_counter() - t0)
+        checks.append(checker.checks)
         best, best_iter = value, 0
         blocked_steps = 0
         iteration = 0
@@ -286,6 +303,8 @@ class GradientPlanner:
             value = f(q) if closed else float(f.smooth(q))
             path.append(q.copy())
             trace.append(value)
+            clock.append(time.perf_counter() - t0)
+            checks.append(checker.checks)
             if value < best - s.stall_min_decrease:
                 best, best_iter = value, iteration
 

@@ -24,6 +24,7 @@ and whether it left the stall. Both planners report ``local_minima`` and ``escap
 
 from __future__ import annotations
 
+import math
 import time
 from dataclasses import dataclass
 from typing import Any
@@ -32,7 +33,13 @@ import numpy as np
 
 from plannerlab.collision.fcl_checker import CollisionChecker
 from plannerlab.errors import PlannerlabError
-from plannerlab.planners.base import PlanResult, Status, settings_dict, with_overrides
+from plannerlab.planners.base import (
+    PlanResult,
+    Progress,
+    Status,
+    settings_dict,
+    with_overrides,
+)
 from plannerlab.planners.gradient import GradientPlanner, GradientSettings
 from plannerlab.problem.load import Budget
 from plannerlab.robots.base import Array, joint_difference, wrap_to_pi
@@ -157,10 +164,13 @@ class HybridPlanner:
         minima = escapes = 0
         notes: list[str] = []
         noise = s.restart_noise_rad
+        progress = Progress(lambda: time.perf_counter() - t0, lambda: ledger.checks)
 
         def done(status: Status, reason: str) -> PlanResult:
             p = np.array(path)
             pos_err, ang_err = goal.errors(robot, p[-1])
+            cost = path_length(p, robot.continuous) if status is Status.SOLVED else math.nan
+            rows = progress.finish(float(goal.distance(robot, p[-1])), cost)
             return PlanResult(
                 planner=self.name,
                 problem=problem.name,
@@ -176,6 +186,7 @@ class HybridPlanner:
                 pos_err_m=float(pos_err),
                 angle_err_deg=float(ang_err),
                 trace=np.array(trace),
+                progress=rows,
                 local_minima=minima,
                 escapes=escapes,
                 settings=settings_dict(s),
@@ -192,8 +203,10 @@ class HybridPlanner:
             sub = ledger.remaining()
             if sub is None:
                 return done(Status.BUDGET_EXHAUSTED, ledger.exhausted_reason())
+            t_sub, c_sub = time.perf_counter() - t0, ledger.checks
             r = self._descent.solve(problem, leg, sub, rng, q_start=q)
             ledger.add(r)
+            progress.extend(r.progress, t_sub, c_sub)
             path.extend(r.path[1:])
             trace.extend(r.trace.tolist())
             descent_rad.append(path_length(r.path, robot.continuous))
@@ -223,9 +236,11 @@ class HybridPlanner:
             }
             escapes_log.append(record)
             if s.escape == "rrtconnect":
+                t_sub, c_sub = time.perf_counter() - t0, ledger.checks
                 rrt = self._rrt_escape(problem, leg, ledger, rng, q)
                 if rrt is None:
                     return done(Status.BUDGET_EXHAUSTED, ledger.exhausted_reason())
+                progress.extend(rrt.progress, t_sub, c_sub)  # an escape: a drop to 0
                 notes.append(f"rrtconnect from stall {minima}: {rrt.status.value}")
                 if rrt.solved:
                     path.extend(rrt.path[1:])

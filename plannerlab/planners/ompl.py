@@ -94,7 +94,14 @@ import ompl.util as ou
 
 from plannerlab.collision.fcl_checker import CollisionChecker
 from plannerlab.errors import PlannerlabError, UnknownNameError
-from plannerlab.planners.base import Deadline, PlanResult, Status, settings_dict, with_overrides
+from plannerlab.planners.base import (
+    Deadline,
+    PlanResult,
+    Progress,
+    Status,
+    settings_dict,
+    with_overrides,
+)
 from plannerlab.problem.goals import GoalRegion
 from plannerlab.problem.ik import sample_goal_state
 from plannerlab.robots.base import Array, Robot, joint_difference, wrap_to_pi
@@ -691,11 +698,17 @@ class OMPLPlanner:
         )
         fk = [0]
         trace: list[float] = []
+        progress = Progress(lambda: bud.deadline.elapsed_s, lambda: checker.checks)
         extra: dict[str, Any] = {"ompl_class": self.ompl_class, "ompl_seed": ompl_seed}
 
         def result(status: Status, reason: str, path: Array, iterations: int) -> PlanResult:
             pos_err, ang_err = (float(v) for v in goal.errors(robot, path[-1]))
             extra["refused_checks"] = bud.refused
+            solved = status is Status.SOLVED
+            rows = progress.finish(
+                float(goal.distance(robot, path[-1])),
+                path_length(path, robot.continuous) if solved else math.nan,
+            )
             return PlanResult(
                 planner=self.name,
                 problem=problem.name,
@@ -711,6 +724,7 @@ class OMPLPlanner:
                 pos_err_m=pos_err,
                 angle_err_deg=ang_err,
                 trace=np.array(trace),
+                progress=rows,
                 settings=settings_dict(s),
                 extra=dict(extra),
             )
@@ -718,6 +732,8 @@ class OMPLPlanner:
         if not checker.is_valid(q0):
             pairs = ", ".join(f"{a} x {b}" for a, b in checker.colliding_pairs(q0))
             return result(Status.INVALID_START, f"the start state collides: {pairs}", q0[None], 0)
+        fk[0] += 1
+        progress.note(float(goal.distance(robot, q0)))  # where the search starts from
 
         # Goal pool (IK), within the budget.
         pool: list[Array] = []
@@ -772,6 +788,7 @@ class OMPLPlanner:
             if d < best[0]:
                 best[0] = d
                 trace.append(d)
+                progress.note(d)
             return d
 
         def fill(state: Any, i: int) -> None:
