@@ -5,6 +5,7 @@
                        [--legs L1,L2] [--set PLANNER:KEY=VALUE ...] [--execute]
                        [--jobs J] [--name NAME] [--out DIR] [--retry-errors] [--json]
                        [--trial-timeout S] [--backend local|ray [--address ADDR]]
+                       [--wide | --columns A,B,C]
 
 Every (problem, planner, seed) is a trial run in a fresh process (OMPL's generator is
 process-global and must be seeded before any OMPL object exists): forked from a warm
@@ -46,7 +47,6 @@ from rich.progress import (
     TimeElapsedColumn,
     TimeRemainingColumn,
 )
-from rich.table import Table
 
 from plannerlab.cli.common import (
     add_budget_args,
@@ -54,6 +54,12 @@ from plannerlab.cli.common import (
     legs_from_spec,
     positive_int,
     positive_seconds,
+)
+from plannerlab.cli.tables import (
+    SUMMARY_COLUMNS,
+    column_notes,
+    pick_columns,
+    print_summary_tables,
 )
 from plannerlab.errors import PlannerlabError
 
@@ -122,6 +128,17 @@ def add_compare_parser(subparsers: Any) -> argparse.ArgumentParser:
     )
     p.add_argument(
         "--json", action="store_true", help="print the summary rows and file paths as JSON"
+    )
+    p.add_argument(
+        "--wide",
+        action="store_true",
+        help="every column (percentiles, path length, tip errors, tracking error); "
+        "the default is a compact table that fits 80 columns",
+    )
+    p.add_argument(
+        "--columns",
+        metavar="A,B,C",
+        help="the table's columns, in order: " + ", ".join(SUMMARY_COLUMNS),
     )
     p.set_defaults(func=cmd_compare)
     return p
@@ -217,6 +234,7 @@ def cmd_compare(args: argparse.Namespace, console: Console) -> int:
     from plannerlab.record.files import versions
 
     # -- validate everything before the first process starts
+    columns = pick_columns(args.columns, args.wide, args.execute)
     if args.jobs < 1:
         raise PlannerlabError(f"--jobs: expected >= 1, got {args.jobs}")
     if args.trial_timeout is not None and not (
@@ -411,7 +429,7 @@ def cmd_compare(args: argparse.Namespace, console: Console) -> int:
             )
         )
         return 0
-    _print_tables(console, rows, args.execute)
+    _print_tables(console, rows, columns)
     errors = [r for r in records if r.get("status") == ERROR_STATUS]
     if errors:
         console.print(
@@ -425,28 +443,19 @@ def cmd_compare(args: argparse.Namespace, console: Console) -> int:
         f"store; {wall_s:.1f} s",
         highlight=False,
     )
-    console.print(f"trial store: {store.path}", highlight=False)
+    console.print(f"trial store: {store.path}", highlight=False, soft_wrap=True)
     for f in files:
-        console.print(f"wrote {f}", highlight=False)
+        console.print(f"wrote {f}", highlight=False, soft_wrap=True)
     return 0
 
 
-def _print_tables(console: Console, rows: list[dict[str, Any]], executed: bool) -> None:
-    from plannerlab.bench.report import EXEC_HEADERS, TABLE_HEADERS, TABLE_NOTES, summary_cells
-
-    headers = TABLE_HEADERS + (EXEC_HEADERS if executed else ())
+def _print_tables(console: Console, rows: list[dict[str, Any]], columns: list[str]) -> None:
     for problem in dict.fromkeys(r["problem"] for r in rows):
-        t = Table(title=f"{problem}", title_justify="left")
-        for h in headers:
-            t.add_column(h, overflow="fold", no_wrap=(h == "planner"))
-        for r in rows:
-            if r["problem"] != problem:
-                continue
-            cells = [escape(c) for c in summary_cells(r, executed)]
-            style = (
-                "green" if r["success_rate"] >= 0.95 else "red" if r["successes"] == 0 else "yellow"
-            )
-            cells[1] = f"[{style}]{cells[1]}[/{style}]"
-            t.add_row(*cells)
-        console.print(t)
-    console.print(f"[dim]{TABLE_NOTES}[/dim]", highlight=False)
+        print_summary_tables(
+            console, problem, [r for r in rows if r["problem"] == problem], columns
+        )
+    console.print(
+        f"[dim]{escape(column_notes(columns))}. Medians over the trials that ran; times and "
+        "checks summed over legs. All columns: --wide, report.md, summary.csv.[/dim]",
+        highlight=False,
+    )

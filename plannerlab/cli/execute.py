@@ -8,11 +8,61 @@ from pathlib import Path
 from typing import Any
 
 from rich.console import Console
+from rich.markup import escape
 from rich.table import Table
 
 from plannerlab.cli.common import fmt
 from plannerlab.cli.solve import add_plan_arguments, leg_table, solve_and_save
+from plannerlab.cli.tables import table
 from plannerlab.errors import PlannerlabError
+
+
+def execution_table(legs: Any, executions: Any) -> Table:
+    """One row per executed leg: FCL re-check, tip errors, tracking, the trajectory's
+    duration, contacts, wall time, verdict; which pairs collided or touched goes in the
+    caption (names never cut)."""
+    t = table(
+        "execution in PyBullet",
+        [
+            ("leg", "num"),
+            ("goal", "name"),
+            ("FCL", "name"),
+            ("pos err\nm", "num"),
+            ("ang err\n°", "num"),
+            ("track\nerr rad", "num"),
+            ("motion\ns", "num"),
+            ("con-\ntacts", "num"),
+            ("wall s", "num"),
+            ("ok", "name"),
+        ],
+        compact=True,
+    )
+    notes = []
+    for r, e in zip(legs, executions, strict=True):
+        names = [f"{c.link_name} x {c.other_name}" for c in e.contacts]
+        if names:
+            notes.append(f"leg {r.leg} {r.goal}: contacts " + ", ".join(names))
+        if not e.path_valid:
+            pairs = ", ".join(f"{a} x {b}" for a, b in e.recheck_pairs)
+            notes.append(
+                f"leg {r.leg} {r.goal}: FCL re-check collides on edge "
+                f"{e.recheck_first_invalid_edge}: {pairs}"
+            )
+        t.add_row(
+            str(r.leg),
+            escape(str(r.goal)),
+            "valid" if e.path_valid else "[red]collides[/red]",
+            fmt(e.final_pos_err_m),
+            fmt(e.final_angle_err_deg),
+            fmt(e.max_track_err_rad),
+            fmt(e.duration_s),
+            str(len(names)),
+            fmt(e.wall_time_s),
+            "[green]yes[/green]" if e.success else "[red]no[/red]",
+        )
+    if notes:
+        t.caption = escape("\n".join(notes))
+    return t
 
 
 def cmd_execute(args: argparse.Namespace, console: Console) -> int:
@@ -43,45 +93,7 @@ def cmd_execute(args: argparse.Namespace, console: Console) -> int:
         print(json.dumps(plan.to_dict()))
         return 1 if args.strict and not all(e.success for e in executions) else 0
     console.print(leg_table(plan, f"{plan.planner} on {plan.problem}, seed {plan.seed}: plan"))
-    t = Table(title="execution in PyBullet")
-    for col in (
-        "leg",
-        "goal",
-        "FCL re-check",
-        "pos err m",
-        "ang err °",
-        "max track err rad",
-        "motion s",
-        "contacts",
-        "sim s",
-        "wall s",
-        "ok",
-    ):
-        t.add_column(col, overflow="fold")
-    for r, e in zip(plan.legs, executions, strict=True):
-        names = [f"{c.link_name} x {c.other_name}" for c in e.contacts]
-        contacts = ", ".join(names[:2]) + (f" +{len(names) - 2} more" if len(names) > 2 else "")
-        contacts = contacts or "none"
-        recheck = (
-            "valid"
-            if e.path_valid
-            else f"collides on edge {e.recheck_first_invalid_edge}: "
-            + ", ".join(f"{a} x {b}" for a, b in e.recheck_pairs)
-        )
-        t.add_row(
-            str(r.leg),
-            r.goal,
-            recheck,
-            fmt(e.final_pos_err_m),
-            fmt(e.final_angle_err_deg),
-            fmt(e.max_track_err_rad),
-            fmt(e.duration_s),
-            contacts,
-            fmt(e.sim_time_s),
-            fmt(e.wall_time_s),
-            "[green]yes[/green]" if e.success else "[red]no[/red]",
-        )
-    console.print(t)
+    console.print(execution_table(plan.legs, executions))
     console.print(f"plan and execution written to {out}")
     return 1 if args.strict and not all(e.success for e in executions) else 0
 

@@ -15,6 +15,7 @@ from rich.console import Console
 from rich.markup import escape
 
 from plannerlab.cli import execute, planners, plot, problems, solve
+from plannerlab.cli.tables import make_console
 from plannerlab.errors import PlannerlabError
 
 DESCRIPTION = """\
@@ -136,9 +137,8 @@ def main(argv: Sequence[str] | None = None) -> int:
         format="%(levelname)s %(name)s: %(message)s",
     )
     to_stderr = bool(getattr(args, "json", False))
-    stream = sys.stderr if to_stderr else sys.stdout
-    # In a log or a pipe rich would wrap at 80 columns: tables read better wider.
-    console = Console(stderr=to_stderr, width=None if stream.isatty() else 150)
+    # the terminal's width; piped: COLUMNS, the terminal's, or 100 (cli.tables)
+    console = make_console(stderr=to_stderr)
     # OMPL's own log lines (forwarded to this logger) reach the terminal only with -v
     ompl_logger = logging.getLogger("plannerlab.ompl")
     ompl_level = ompl_logger.level

@@ -7,7 +7,8 @@ import json
 from typing import Any
 
 from rich.console import Console
-from rich.table import Table
+
+from plannerlab.cli.tables import table
 
 
 def cmd_planners(args: argparse.Namespace, console: Console) -> int:
@@ -25,9 +26,7 @@ def cmd_planners(args: argparse.Namespace, console: Console) -> int:
     if args.json:
         print(json.dumps(rows, indent=1))
         return 0
-    t = Table(title="planners")
-    for col in ("name", "robots", "summary"):
-        t.add_column(col)
+    t = table("planners", [("name", "name"), ("robots", "text"), ("summary", "text")])
     for r in rows:
         robots = r["robots"] if isinstance(r["robots"], str) else ", ".join(r["robots"])
         t.add_row(r["name"], robots, r["summary"])

@@ -23,7 +23,7 @@ def cmd_plot(args: argparse.Namespace, console: Console) -> int:
         print(json.dumps([str(f) for f in files]))
     else:
         for f in files:
-            console.print(f"wrote {f}")
+            console.print(f"wrote {f}", soft_wrap=True)
     return 0
 
 

@@ -7,7 +7,12 @@ import json
 from typing import Any
 
 from rich.console import Console
-from rich.table import Table
+from rich.markup import escape
+
+from plannerlab.cli.tables import Kind, table
+
+#: console width from which descriptions get a column
+WIDE = 120
 
 
 def cmd_problems(args: argparse.Namespace, console: Console) -> int:
@@ -31,19 +36,23 @@ def cmd_problems(args: argparse.Namespace, console: Console) -> int:
     if args.json:
         print(json.dumps(rows, indent=1))
         return 0
-    t = Table(title="problems")
-    for col in ("name", "robot", "dof", "legs", "obstacles", "description"):
-        t.add_column(col)
+    # descriptions are long: a column of their own only where they have room
+    beside = console.width >= WIDE
+    cols: list[tuple[str, Kind]] = [
+        ("name", "name"),
+        ("robot", "name"),
+        ("dof", "num"),
+        ("obstacles", "num"),
+        ("legs", "text"),
+    ]
+    t = table("problems", cols + ([("description", "text")] if beside else []), compact=True)
     for r in rows:
-        t.add_row(
-            r["name"],
-            r["robot"],
-            str(r["dof"]),
-            ", ".join(r["legs"]),
-            str(r["obstacles"]),
-            r["description"],
-        )
+        cells = [r["name"], r["robot"], str(r["dof"]), str(r["obstacles"]), ", ".join(r["legs"])]
+        t.add_row(*[escape(c) for c in cells], *([escape(r["description"])] if beside else []))
     console.print(t)
+    if not beside:
+        for r in rows:
+            console.print(f"[bold]{escape(r['name'])}[/bold]: {escape(r['description'])}")
     return 0
 
 

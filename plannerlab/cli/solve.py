@@ -20,12 +20,24 @@ from plannerlab.cli.common import (
     parse_overrides,
     seed_int,
 )
+from plannerlab.cli.tables import table
 
 
 def leg_table(plan: Any, title: str) -> Table:
-    t = Table(title=title, caption_justify="left")
-    for col in ("leg", "goal", "status", "iters", "time s", "checks", "pos err m", "ang err °"):
-        t.add_column(col, no_wrap=(col == "status"))
+    t = table(
+        title,
+        [
+            ("leg", "num"),
+            ("goal", "name"),
+            ("status", "name"),
+            ("iters", "num"),
+            ("time s", "num"),
+            ("checks", "num"),
+            ("pos err m", "num"),
+            ("ang err °", "num"),
+        ],
+        compact=True,
+    )
     reasons = []
     for r in plan.legs:
         style = "green" if r.solved else ("yellow" if r.status == "local_minimum" else "red")
