@@ -22,4 +22,6 @@ def test_compare_notebook_runs_headless(tmp_path, monkeypatch):
     assert "local_minimum" in outputs  # the paper's method stalls on the pocket
     assert "gradient+rrtconnect" in outputs
     images = [o for c in nb.cells for o in c.get("outputs", []) if "image/png" in o.get("data", {})]
-    assert len(images) >= 2  # the arm snapshot and the objective trace
+    assert len(images) >= 2  # the arm snapshot and the progress plot
+    gifs = [o for c in nb.cells for o in c.get("outputs", []) if "image/gif" in o.get("data", {})]
+    assert len(gifs) == 1  # the motion, planned and executed, inline

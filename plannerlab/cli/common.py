@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import argparse
 import math
+import os
+import sys
 from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
@@ -124,3 +126,13 @@ def legs_from_spec(problem: Any, spec: str | None) -> list[int] | None:
     if len(set(legs)) != len(legs):
         raise PlannerlabError(f"--legs: {spec!r} names a leg twice")
     return legs
+
+
+def require_display(gui: bool) -> None:
+    """``--gui`` opens PyBullet's window: on Linux that needs an X display."""
+    if gui and sys.platform.startswith("linux") and not os.environ.get("DISPLAY"):
+        raise PlannerlabError(
+            "--gui opens PyBullet's window and needs a display, but DISPLAY is not set: "
+            "run under a desktop session or `xvfb-run -a plannerlab ...`, or drop --gui "
+            "(`plannerlab animate PLAN.json` shows the motion without a display)"
+        )

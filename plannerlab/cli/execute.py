@@ -11,7 +11,7 @@ from rich.console import Console
 from rich.markup import escape
 from rich.table import Table
 
-from plannerlab.cli.common import fmt
+from plannerlab.cli.common import fmt, require_display
 from plannerlab.cli.solve import add_plan_arguments, leg_table, solve_and_save
 from plannerlab.cli.tables import table
 from plannerlab.errors import PlannerlabError
@@ -71,6 +71,7 @@ def cmd_execute(args: argparse.Namespace, console: Console) -> int:
     from plannerlab.bench.plan_check import check_plan, read_plan
     from plannerlab.sim.execute import execute_legs
 
+    require_display(args.gui)
     if args.problem.endswith(".json"):
         out = Path(args.problem)
         plan = read_plan(out)

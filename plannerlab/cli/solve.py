@@ -18,6 +18,7 @@ from plannerlab.cli.common import (
     leg_spec,
     legs_from_spec,
     parse_overrides,
+    require_display,
     seed_int,
 )
 from plannerlab.cli.tables import table
@@ -99,6 +100,7 @@ def solve_and_save(args: argparse.Namespace, console: Console) -> Any:
 
 
 def cmd_solve(args: argparse.Namespace, console: Console) -> int:
+    require_display(args.gui)
     plan, out = solve_and_save(args, console)
     if args.json:
         print(json.dumps(plan.to_dict()))
@@ -139,7 +141,9 @@ def add_plan_arguments(p: argparse.ArgumentParser, name: str) -> None:
     )
     p.add_argument("--out", help="plan file to write (default results/plans/...)")
     p.add_argument("--json", action="store_true", help="machine-readable output")
-    p.add_argument("--gui", action="store_true", help="PyBullet window instead of DIRECT")
+    p.add_argument(
+        "--gui", action="store_true", help="PyBullet window instead of DIRECT (needs a display)"
+    )
     p.add_argument(
         "--strict",
         action="store_true",
