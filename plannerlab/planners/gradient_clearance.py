@@ -30,6 +30,7 @@ with ``extra["q_stall"]`` and ``extra["descent_rad"]`` (joint-space distance tra
 
 from __future__ import annotations
 
+import math
 import time
 from dataclasses import dataclass
 
@@ -37,7 +38,14 @@ import numpy as np
 
 from plannerlab.collision.fcl_checker import CollisionChecker
 from plannerlab.errors import PlannerlabError
-from plannerlab.planners.base import Deadline, PlanResult, Status, settings_dict, with_overrides
+from plannerlab.planners.base import (
+    Deadline,
+    PlanResult,
+    Progress,
+    Status,
+    settings_dict,
+    with_overrides,
+)
 from plannerlab.planners.clearance import ClearanceField
 from plannerlab.robots.base import Array, joint_difference, wrap_to_pi
 
@@ -480,6 +488,12 @@ class ClearanceDescent:
         iterations = 0
         minima = escapes = 0
         descent_rad: list[float] = []
+        progress = Progress(lambda: time.perf_counter() - t0, lambda: checker.checks)
+
+        def note(states: list[Array]) -> None:
+            """Progress after a descent or an escape: the best goal distance it reached."""
+            if states:
+                progress.note(float(np.min(goal.distance(robot, np.asarray(states)))))
 
         def length(seg: list[Array]) -> float:
             if len(seg) < 2:
@@ -501,6 +515,10 @@ class ClearanceDescent:
             }
             if status is Status.LOCAL_MINIMUM:
                 extra["q_stall"] = P[-1].tolist()
+            rows = progress.finish(
+                float(goal.distance(robot, P[-1])),
+                length(path) if status is Status.SOLVED else math.nan,
+            )
             return PlanResult(
                 planner=self.name,
                 problem=problem.name,
@@ -515,6 +533,7 @@ class ClearanceDescent:
                 pos_err_m=float(pos_err),
                 angle_err_deg=float(ang_err),
                 trace=np.array(trace),
+                progress=rows,
                 local_minima=minima,
                 escapes=escapes,
                 settings=settings_dict(s),
@@ -524,6 +543,7 @@ class ClearanceDescent:
         if not checker.is_valid(q0):
             pairs = ", ".join(f"{a} x {b}" for a, b in checker.colliding_pairs(q0))
             return done(Status.INVALID_START, f"start in collision: {pairs}")
+        note([q0])
         q = q0
         while True:
             st, reason, seg, tr, it = self.leg_descent(
@@ -531,6 +551,7 @@ class ClearanceDescent:
             )
             iterations += it
             trace.extend(tr)
+            note(list(seg))
             path.extend(seg[1:])
             descent_rad.append(length(seg))
             if st is Status.SOLVED:
@@ -568,6 +589,7 @@ class ClearanceDescent:
                     Status.LOCAL_MINIMUM,
                     f"{reason}; the {s.escape} escape from stall {minima} failed ({how})",
                 )
+            note(list(esc))
             path.extend(esc[1:])
             q = np.array(path[-1])
             if goal.contains(robot, q):
