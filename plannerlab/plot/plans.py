@@ -218,8 +218,8 @@ def _width_ratios(bounds: Array) -> list[float]:
     """Panel widths for equal panel heights: each view as wide as its scene (clipped)."""
     span = np.maximum(bounds[1] - bounds[0], 1e-3)
     flat = float(np.sqrt(max(span[0], span[1]) / span[2]))
-    return [float(np.clip(1.2 * flat, 0.55, 1.6))] + [
-        float(np.clip(span[i] / span[j], 0.45, 3.0)) for i, j in VIEWS.values()
+    return [float(np.clip(1.1 * flat, 0.45, 1.6))] + [
+        float(np.clip(span[i] / span[j], 0.25, 3.0)) for i, j in VIEWS.values()
     ]
 
 
