@@ -23,7 +23,7 @@ from pathlib import Path
 
 def main(argv: list[str]) -> int:
     from plannerlab.bench.local import LocalBackend
-    from plannerlab.bench.trials import Trial, run_comparison
+    from plannerlab.bench.trials import Trial, run_comparison, run_trial
     from plannerlab.problem.catalog import resolve_problem_path
     from plannerlab.record.files import versions
 
@@ -38,7 +38,7 @@ def main(argv: list[str]) -> int:
     paths = {}
     with tempfile.TemporaryDirectory() as tmp:
         for method in ("spawn", "forkserver"):
-            backend = LocalBackend(Path(tmp) / f"run-{method}", start_method=method)
+            backend = LocalBackend(Path(tmp) / f"run-{method}", run_trial, start_method=method)
             try:
                 run = run_comparison(trials, Path(tmp) / f"{method}.jsonl", backend=backend)
             finally:

@@ -34,7 +34,7 @@ import multiprocessing
 import os
 import signal
 import time
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from dataclasses import dataclass
 from multiprocessing.connection import Connection, wait
 from pathlib import Path
@@ -75,20 +75,22 @@ def _tail(path: Path, chars: int = OUTPUT_TAIL_CHARS) -> str:
 
 
 @contextlib.contextmanager
-def _sigint_ignored() -> Iterator[None]:
-    """Ignore SIGINT while starting a child (or the fork server), so that it starts with
-    SIGINT ignored (a terminal's Ctrl-C goes to the whole process group; the parent stops
-    the children). A no-op outside the main thread, where handlers cannot be changed."""
+def _sigint_held() -> Iterator[None]:
+    """Block SIGINT while starting a child (or the fork server), so that it starts with
+    SIGINT blocked (a terminal's Ctrl-C goes to the whole process group; the parent stops
+    the children; a child then ignores it for good). Blocked, not ignored, in the parent:
+    a Ctrl-C that arrives meanwhile stays pending and interrupts the parent as soon as the
+    child has started, instead of being lost. A no-op outside the main thread."""
     import threading
 
     if threading.current_thread() is not threading.main_thread():
         yield
         return
-    previous = signal.signal(signal.SIGINT, signal.SIG_IGN)
+    previous = signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT})
     try:
         yield
     finally:
-        signal.signal(signal.SIGINT, previous)
+        signal.pthread_sigmask(signal.SIG_SETMASK, previous)
 
 
 def _start_fork_server() -> None:
@@ -105,7 +107,7 @@ def _start_fork_server() -> None:
     try:
         os.dup2(null, 1)
         os.dup2(null, 2)
-        with _sigint_ignored():
+        with _sigint_held():
             forkserver.ensure_running()
     finally:
         os.dup2(saved[0], 1)
@@ -122,8 +124,14 @@ def _import_trial_modules() -> None:
             importlib.import_module(name)
 
 
-def _child_main(trial: Any, conn: Connection, out_path: str, launched_at: float) -> None:
-    """Entry point of a trial's process: run it and send the record to the parent."""
+def _child_main(
+    trial: Any,
+    conn: Connection,
+    out_path: str,
+    launched_at: float,
+    run: Callable[[Any], dict[str, Any]],
+) -> None:
+    """Entry point of a trial's process: ``run(trial)`` and send the record to the parent."""
     import sys
 
     signal.signal(signal.SIGINT, signal.SIG_IGN)  # the parent handles Ctrl-C
@@ -134,9 +142,7 @@ def _child_main(trial: Any, conn: Connection, out_path: str, launched_at: float)
     try:
         _import_trial_modules()
         startup_s = time.time() - launched_at
-        from plannerlab.bench.trials import run_trial
-
-        rec = run_trial(trial)
+        rec = run(trial)
         rec["startup_s"] = startup_s
         sys.stdout.flush()
         sys.stderr.flush()
@@ -162,12 +168,21 @@ class LocalBackend:
     Args:
         work_dir: folder for the children's captured output (created; emptied of stale
             files; removed by :meth:`close` when empty).
+        run: what a trial's process calls with the trial, returning its record
+            (:func:`plannerlab.bench.trials.run_trial`; passed in, pickled by reference,
+            so that this module does not import the runner that imports it).
         start_method: ``"forkserver"`` (default) or ``"spawn"``.
     """
 
     name = "local"
 
-    def __init__(self, work_dir: str | Path, start_method: str = "forkserver") -> None:
+    def __init__(
+        self,
+        work_dir: str | Path,
+        run: Callable[[Any], dict[str, Any]],
+        start_method: str = "forkserver",
+    ) -> None:
+        self._run = run
         if start_method not in START_METHODS:
             raise PlannerlabError(
                 f"start_method: expected one of {', '.join(START_METHODS)}, got {start_method!r}"
@@ -189,12 +204,12 @@ class LocalBackend:
         out = self.work_dir / (hashlib.sha256(trial.key.encode()).hexdigest()[:16] + ".out")
         proc = self._ctx.Process(
             target=_child_main,
-            args=(trial, send, str(out), time.time()),
+            args=(trial, send, str(out), time.time(), self._run),
             name=f"trial {trial.key}",
             daemon=True,
         )
         self._running[recv] = _Running(trial, proc, recv, out)  # before start: cleanup
-        with _sigint_ignored():  # inherited: Ctrl-C is the parent's to handle
+        with _sigint_held():  # inherited: Ctrl-C is the parent's to handle
             proc.start()
         send.close()  # the child holds the only write end now
         return recv

@@ -27,20 +27,19 @@ from __future__ import annotations
 
 import time
 import traceback
+from collections.abc import Callable
 from typing import Any
 
 from plannerlab.errors import PlannerlabError
 
 
-def _ray_trial(trial: Any, launched_at: float) -> dict:
-    """The Ray task: run one trial in this (fresh) worker process."""
+def _ray_trial(trial: Any, launched_at: float, run: Callable[[Any], dict[str, Any]]) -> dict:
+    """The Ray task: ``run(trial)`` in this (fresh) worker process."""
     from plannerlab.bench.local import _import_trial_modules
 
     _import_trial_modules()
     startup_s = time.time() - launched_at
-    from plannerlab.bench.trials import run_trial
-
-    rec = run_trial(trial)
+    rec = run(trial)
     rec["startup_s"] = startup_s
     return rec
 
@@ -49,6 +48,8 @@ class RayBackend:
     """Trials as Ray tasks (see the module docstring).
 
     Args:
+        run: what a task calls with the trial (:func:`plannerlab.bench.trials.run_trial`,
+            passed in so that this module does not import the runner that imports it).
         address: a Ray cluster's address, or None for a local instance.
         num_cpus: CPUs of a private local instance (None: Ray's default, all of them).
 
@@ -58,7 +59,13 @@ class RayBackend:
 
     name = "ray"
 
-    def __init__(self, address: str | None = None, num_cpus: int | None = None) -> None:
+    def __init__(
+        self,
+        run: Callable[[Any], dict[str, Any]],
+        address: str | None = None,
+        num_cpus: int | None = None,
+    ) -> None:
+        self._run = run
         try:
             import ray
         except ImportError:
@@ -85,7 +92,7 @@ class RayBackend:
 
     def start(self, trial: Any) -> Any:
         """Submit a trial; returns its handle (an object reference)."""
-        ref = self._task.remote(trial, time.time())
+        ref = self._task.remote(trial, time.time(), self._run)
         self._trials[ref] = trial
         return ref
 

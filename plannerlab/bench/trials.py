@@ -561,11 +561,11 @@ def make_backend(name: str, work_dir: str | Path, *, address: str | None = None)
             raise PlannerlabError("--address is for --backend ray")
         from plannerlab.bench.local import LocalBackend
 
-        return LocalBackend(work_dir)
+        return LocalBackend(work_dir, run_trial)
     if name == "ray":
         from plannerlab.bench.ray_backend import RayBackend
 
-        return RayBackend(address=address)
+        return RayBackend(run_trial, address=address)
     raise PlannerlabError(f"backend: expected one of {', '.join(BACKENDS)}, got {name!r}")
 
 
