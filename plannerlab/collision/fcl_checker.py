@@ -1,10 +1,17 @@
-"""Collision checking with python-fcl: the only module that imports ``fcl``.
+"""Collision checking: the compiled core, with python-fcl as its reference and fallback.
 
 The robot's links are capsules (see :class:`plannerlab.robots.base.Robot`); obstacles are
-FCL boxes, cylinders and spheres. FCL objects are built once; each query only updates the
-link transforms. A vectorised pre-test (world-aligned bounding boxes of every link against
-every obstacle and every other link, over a whole batch of states) settles most pairs, so
-FCL is asked only about pairs whose boxes overlap.
+boxes, cylinders and spheres. Two backends answer the same questions with the same meaning:
+
+* ``"core"`` (:mod:`plannerlab.collision.core`): numba-compiled kinematics, broad phase and
+  exact capsule tests over whole batches; the default whenever every obstacle is a shape it
+  covers.
+* ``"fcl"``: FCL objects built once, each query updating the link transforms after a
+  vectorised bounding-box pre-test. It answers what the core does not cover, and it is the
+  reference the core is compared with (``bench/core_agreement.py``). This is the only module
+  that imports ``fcl``.
+
+:attr:`CollisionChecker.backend` says which one answers; :class:`PathCheck` carries it.
 
 Pairs that are never checked: a fixed link against the scene (the base stands on its
 pedestal by design) and the robot's ``excluded_pairs`` (neighbours that always touch).
@@ -17,6 +24,8 @@ from dataclasses import dataclass
 import fcl
 import numpy as np
 
+from plannerlab.collision.core import Core, PairDistances
+from plannerlab.collision.core import supports as core_supports
 from plannerlab.problem.scene import Box, Cylinder, Scene, Sphere
 from plannerlab.robots.base import Array, Robot
 from plannerlab.robots.paths import densify
@@ -39,6 +48,7 @@ class PathCheck:
     first_invalid_edge: int | None = None
     first_invalid_state: Array | None = None
     pairs: tuple[tuple[str, str], ...] = ()
+    backend: str = "fcl"
 
 
 def _rotations_z_to(d: Array) -> Array:
@@ -54,10 +64,24 @@ class CollisionChecker:
     """Validity, colliding pairs and distances for one robot in one scene.
 
     Holds its own FCL objects and a count of the states it has checked
-    (``checks``); it is not thread-safe and not shared between trials.
+    (``checks``: one per state, whichever backend answers); it is not thread-safe and not
+    shared between trials.
+
+    Args:
+        backend: ``"auto"`` (the core when it covers the scene, else FCL), ``"core"`` or
+            ``"fcl"``.
     """
 
-    def __init__(self, robot: Robot, scene: Scene) -> None:
+    def __init__(self, robot: Robot, scene: Scene, backend: str = "auto") -> None:
+        if backend not in ("auto", "core", "fcl"):
+            raise ValueError(f"backend must be 'auto', 'core' or 'fcl', got {backend!r}")
+        if backend == "core" and not core_supports(scene):
+            raise ValueError("backend 'core' covers boxes, cylinders and spheres only")
+        self._core: Core | None = None
+        if backend == "core" or (backend == "auto" and core_supports(scene)):
+            self._core = Core(robot, scene)
+        #: which backend answers the queries: "core" or "fcl"
+        self.backend = "core" if self._core is not None else "fcl"
         self.robot = robot
         self.scene = scene
         self.checks = 0
@@ -172,6 +196,9 @@ class CollisionChecker:
     def valid_batch(self, Q: Array) -> np.ndarray:
         """Validity of every state in Q (k, dof) -> (k,) bool. Counts k checks."""
         Q = np.atleast_2d(np.asarray(Q, dtype=float))
+        if self._core is not None:
+            self.checks += len(Q)
+            return self._core.valid(Q)
         segs = self.robot.link_segments(Q)
         scene, selfc = self._candidates(segs)
         valid = np.ones(len(Q), dtype=bool)
@@ -191,6 +218,10 @@ class CollisionChecker:
         Counts only the states it had to look at.
         """
         Q = np.atleast_2d(np.asarray(Q, dtype=float))
+        if self._core is not None:
+            bad = self._core.first_invalid(Q)
+            self.checks += len(Q) if bad < 0 else bad + 1
+            return None if bad < 0 else bad
         segs = self.robot.link_segments(Q)
         scene, selfc = self._candidates(segs)
         undecided = np.flatnonzero(scene.any(axis=(1, 2)) | selfc.any(axis=1))
@@ -203,9 +234,12 @@ class CollisionChecker:
 
     def colliding_pairs(self, q: Array) -> tuple[tuple[str, str], ...]:
         """Every colliding pair at q: (link name, obstacle name) or (link name, link name)."""
-        seg = self.robot.link_segments(np.asarray(q, dtype=float))
-        scene, selfc = self._candidates(seg[None])
-        hits = self._state_pairs(seg, scene[0], selfc[0], first_only=False)
+        if self._core is not None:
+            hits = [(int(a), int(b), bool(c)) for a, b, c in self._core.hits(q)]
+        else:
+            seg = self.robot.link_segments(np.asarray(q, dtype=float))
+            scene, selfc = self._candidates(seg[None])
+            hits = self._state_pairs(seg, scene[0], selfc[0], first_only=False)
         self.checks += 1
         names = self.scene.names
         return tuple(
@@ -216,8 +250,13 @@ class CollisionChecker:
     def clearance(self, q: Array, include_self: bool = True) -> float:
         """Smallest signed distance [m] over every checked pair; negative = penetration.
 
-        Exact for every pair (no pre-test), so slower than :meth:`is_valid`.
+        Exact for every pair (no pre-test), so slower than :meth:`is_valid`. Penetration
+        depths follow FCL only approximately on the core (see
+        :mod:`plannerlab.collision.geometry`).
         """
+        if self._core is not None:
+            self.checks += 1
+            return self._core.clearance(q, include_self)
         seg = self.robot.link_segments(np.asarray(q, dtype=float))
         self._place(seg)
         best = np.inf
@@ -232,6 +271,28 @@ class CollisionChecker:
         self.checks += 1
         return float(best)
 
+    def pair_distances(self, q: Array, margin_m: float) -> PairDistances:
+        """Every checked pair at q (dof,) whose signed distance is below ``margin_m`` [m].
+
+        See :class:`plannerlab.collision.core.PairDistances`. Counts one check. Answered by
+        the core; with the FCL backend it raises (FCL gives no axis parameters here).
+        """
+        if self._core is None:
+            raise NotImplementedError("pair_distances needs the core backend")
+        self.checks += 1
+        return self._core.pair_distances(q, margin_m)
+
+    def fcl_pair_distances(
+        self, q: Array, link: Array, other: Array, other_is_link: Array
+    ) -> np.ndarray:
+        """FCL's signed distance [m] of the listed pairs at q (the reference; no count)."""
+        self._place(self.robot.link_segments(np.asarray(q, dtype=float)))
+        out = np.empty(len(link))
+        for k, (a, b, is_link) in enumerate(zip(link, other, other_is_link, strict=True)):
+            o2 = self._links[b] if is_link else self._obstacles[b]
+            out[k] = self._signed_distance(self._links[a], o2)
+        return out
+
     def _signed_distance(self, o1: fcl.CollisionObject, o2: fcl.CollisionObject) -> float:
         res = fcl.CollisionResult()
         if fcl.collide(o1, o2, self._contact_request, res) > 0:
@@ -243,7 +304,7 @@ class CollisionChecker:
         states, owners = densify(path, joint_step, self.robot.continuous)
         bad = self.first_invalid(states)
         if bad is None:
-            return PathCheck(valid=True, states_checked=len(states))
+            return PathCheck(valid=True, states_checked=len(states), backend=self.backend)
         q_bad = states[bad]
         return PathCheck(
             valid=False,
@@ -251,4 +312,5 @@ class CollisionChecker:
             first_invalid_edge=int(owners[bad]),
             first_invalid_state=q_bad,
             pairs=self.colliding_pairs(q_bad),
+            backend=self.backend,
         )

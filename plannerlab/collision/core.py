@@ -1,0 +1,497 @@
+"""The compiled collision and kinematics core: batched, exact, FCL's equal on capsules.
+
+:class:`Core` answers, for one robot in one scene, the questions the planners ask millions
+of times: is a batch of states valid, which state of an edge is the first invalid one, and
+how far is every pair of shapes (:meth:`Core.pair_distances`, for clearance-aware
+optimisation). Everything on the hot path is one numba call over the whole batch (``cache=
+True``: compiled once per machine into ``__pycache__``, loaded in later processes):
+
+* **Kinematics.** Arm-Z's chain ``H_i = RotZ(θ_i) · Trans(0, δy, δz) · RotX(ζ)`` is compiled
+  (:func:`armz_frames`, :func:`armz_segments`); other robots give their segments through
+  their own numpy ``link_segments``.
+* **Broad phase.** Per state, world-aligned boxes of every capsule; links against
+  obstacles are tested box-against-box, link pairs by sort-and-sweep along the axis of
+  largest spread, so the cost grows as ``L log L`` with the number of links, not ``L²``.
+* **Narrow phase.** Exact capsule tests (:mod:`plannerlab.collision.geometry`).
+
+The pairs checked are the checker's: moving links against every obstacle, and the robot's
+link pairs except ``excluded_pairs`` and pairs of two fixed links.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+from numba import njit
+
+from plannerlab.collision.geometry import (
+    BOX,
+    CYLINDER,
+    SPHERE,
+    capsule_obstacle,
+    capsule_obstacle_hit,
+    seg_seg,
+)
+from plannerlab.problem.scene import Box, Cylinder, Scene, Sphere
+from plannerlab.robots.base import Array, Robot
+
+# ---------------------------------------------------------------------- kinematics
+
+
+@njit(cache=True, nogil=True)
+def armz_frames(Q, T0, T1, M, out):
+    """Arm-Z frames for a batch: Q (k, dof) → out (k, dof + 2, 4, 4) (see ``ArmZ.fk``)."""
+    k, dof = Q.shape
+    for s in range(k):
+        for i in range(4):
+            for j in range(4):
+                out[s, 0, i, j] = T0[i, j]
+                out[s, 1, i, j] = T1[i, j]
+        for f in range(dof):
+            c = math.cos(Q[s, f])
+            sn = math.sin(Q[s, f])
+            for i in range(3):
+                # row i of F · RotZ(θ): columns 0 and 1 turn, 2 and 3 stay
+                f0 = out[s, f + 1, i, 0]
+                f1 = out[s, f + 1, i, 1]
+                f2 = out[s, f + 1, i, 2]
+                f3 = out[s, f + 1, i, 3]
+                g0 = c * f0 + sn * f1
+                g1 = -sn * f0 + c * f1
+                for j in range(4):
+                    out[s, f + 2, i, j] = g0 * M[0, j] + g1 * M[1, j] + f2 * M[2, j]
+                out[s, f + 2, i, 3] += f3
+            out[s, f + 2, 3, 0] = 0.0
+            out[s, f + 2, 3, 1] = 0.0
+            out[s, f + 2, 3, 2] = 0.0
+            out[s, f + 2, 3, 3] = 1.0
+    return out
+
+
+@njit(cache=True, nogil=True)
+def armz_segments(Q, T0, T1, M, out):
+    """Arm-Z capsule axes for a batch: Q (k, dof) → out (k, dof + 1, 2, 3)."""
+    k, dof = Q.shape
+    R = np.empty((3, 3))
+    p = np.empty(3)
+    for s in range(k):
+        for i in range(3):
+            out[s, 0, 0, i] = T0[i, 3]
+            p[i] = T1[i, 3]
+            for j in range(3):
+                R[i, j] = T1[i, j]
+        for f in range(dof):
+            c = math.cos(Q[s, f])
+            sn = math.sin(Q[s, f])
+            for i in range(3):
+                out[s, f, 1, i] = p[i]
+                out[s, f + 1, 0, i] = p[i]
+            for i in range(3):
+                g0 = c * R[i, 0] + sn * R[i, 1]
+                g1 = -sn * R[i, 0] + c * R[i, 1]
+                g2 = R[i, 2]
+                p[i] += g0 * M[0, 3] + g1 * M[1, 3] + g2 * M[2, 3]
+                R[i, 0] = g0 * M[0, 0] + g1 * M[1, 0] + g2 * M[2, 0]
+                R[i, 1] = g0 * M[0, 1] + g1 * M[1, 1] + g2 * M[2, 1]
+                R[i, 2] = g0 * M[0, 2] + g1 * M[1, 2] + g2 * M[2, 2]
+        for i in range(3):
+            out[s, dof, 1, i] = p[i]
+    return out
+
+
+# ---------------------------------------------------------------------- broad + narrow phase
+
+
+@njit(cache=True, nogil=True)
+def _link_boxes(seg, radii, lo, hi):
+    L = seg.shape[0]
+    for li in range(L):
+        r = radii[li]
+        for i in range(3):
+            a = seg[li, 0, i]
+            b = seg[li, 1, i]
+            lo[li, i] = min(a, b) - r
+            hi[li, i] = max(a, b) + r
+
+
+@njit(cache=True, nogil=True)
+def _overlap(lo, hi, i, olo, ohi, j, pad):
+    return (
+        lo[i, 0] <= ohi[j, 0] + pad
+        and hi[i, 0] >= olo[j, 0] - pad
+        and lo[i, 1] <= ohi[j, 1] + pad
+        and hi[i, 1] >= olo[j, 1] - pad
+        and lo[i, 2] <= ohi[j, 2] + pad
+        and hi[i, 2] >= olo[j, 2] - pad
+    )
+
+
+@njit(cache=True, nogil=True)
+def _sweep_order(lo, hi):
+    """Axis of largest spread of the link boxes and the links sorted along it."""
+    L = lo.shape[0]
+    best_ax = 0
+    best = -1.0
+    for ax in range(3):
+        mn = np.inf
+        mx = -np.inf
+        for li in range(L):
+            c = lo[li, ax] + hi[li, ax]
+            mn = min(mn, c)
+            mx = max(mx, c)
+        if mx - mn > best:
+            best = mx - mn
+            best_ax = ax
+    keys = np.empty(L)
+    for li in range(L):
+        keys[li] = lo[li, best_ax]
+    return best_ax, np.argsort(keys)
+
+
+@njit(cache=True, nogil=True)
+def _state_hits(
+    seg, radii, moving, allowed, kinds, Rs, cs, hs, olo, ohi, lo, hi, first_only, out_pairs
+):
+    """Colliding pairs of one state; returns how many were written to out_pairs (m, 3).
+
+    Row = (link, other, other_is_link). With ``first_only`` stops at the first.
+    """
+    L = seg.shape[0]
+    n_obs = kinds.shape[0]
+    _link_boxes(seg, radii, lo, hi)
+    m = 0
+    for li in range(L):
+        if not moving[li]:
+            continue
+        for oi in range(n_obs):
+            if not _overlap(lo, hi, li, olo, ohi, oi, 0.0):
+                continue
+            if capsule_obstacle_hit(
+                kinds[oi], Rs[oi], cs[oi], hs[oi], seg[li, 0], seg[li, 1], radii[li]
+            ):
+                out_pairs[m, 0] = li
+                out_pairs[m, 1] = oi
+                out_pairs[m, 2] = 0
+                m += 1
+                if first_only:
+                    return m
+    ax, order = _sweep_order(lo, hi)
+    for a in range(L):
+        i = order[a]
+        for b in range(a + 1, L):
+            j = order[b]
+            if lo[j, ax] > hi[i, ax]:
+                break
+            p = min(i, j)
+            q = max(i, j)
+            if not allowed[p, q]:
+                continue
+            if not _overlap(lo, hi, i, lo, hi, j, 0.0):
+                continue
+            d2, _, _ = seg_seg(seg[p, 0], seg[p, 1], seg[q, 0], seg[q, 1])
+            rr = radii[p] + radii[q]
+            if d2 <= rr * rr:
+                out_pairs[m, 0] = p
+                out_pairs[m, 1] = q
+                out_pairs[m, 2] = 1
+                m += 1
+                if first_only:
+                    return m
+    return m
+
+
+@njit(cache=True, nogil=True)
+def valid_batch(segs, radii, moving, allowed, kinds, Rs, cs, hs, olo, ohi, out):
+    """Validity of every state: segs (k, L, 2, 3) → out (k,) bool."""
+    k, L = segs.shape[0], segs.shape[1]
+    lo = np.empty((L, 3))
+    hi = np.empty((L, 3))
+    pairs = np.empty((1, 3), dtype=np.int64)
+    for s in range(k):
+        m = _state_hits(
+            segs[s], radii, moving, allowed, kinds, Rs, cs, hs, olo, ohi, lo, hi, True, pairs
+        )
+        out[s] = m == 0
+    return out
+
+
+@njit(cache=True, nogil=True)
+def first_invalid(segs, radii, moving, allowed, kinds, Rs, cs, hs, olo, ohi):
+    """Index of the first invalid state of segs (k, L, 2, 3), or -1."""
+    k, L = segs.shape[0], segs.shape[1]
+    lo = np.empty((L, 3))
+    hi = np.empty((L, 3))
+    pairs = np.empty((1, 3), dtype=np.int64)
+    for s in range(k):
+        if _state_hits(
+            segs[s], radii, moving, allowed, kinds, Rs, cs, hs, olo, ohi, lo, hi, True, pairs
+        ):
+            return s
+    return -1
+
+
+@njit(cache=True, nogil=True)
+def armz_first_invalid(Q, T0, T1, M, radii, moving, allowed, kinds, Rs, cs, hs, olo, ohi):
+    """As :func:`first_invalid` with Arm-Z kinematics fused in: no FK past the first hit."""
+    k, dof = Q.shape
+    L = dof + 1
+    seg = np.empty((1, L, 2, 3))
+    lo = np.empty((L, 3))
+    hi = np.empty((L, 3))
+    pairs = np.empty((1, 3), dtype=np.int64)
+    for s in range(k):
+        armz_segments(Q[s : s + 1], T0, T1, M, seg)
+        if _state_hits(
+            seg[0], radii, moving, allowed, kinds, Rs, cs, hs, olo, ohi, lo, hi, True, pairs
+        ):
+            return s
+    return -1
+
+
+@njit(cache=True, nogil=True)
+def all_hits(seg, radii, moving, allowed, kinds, Rs, cs, hs, olo, ohi):
+    """Every colliding pair of one state (L, 2, 3): (m, 3) rows (link, other, other_is_link)."""
+    L = seg.shape[0]
+    lo = np.empty((L, 3))
+    hi = np.empty((L, 3))
+    out = np.empty((L * kinds.shape[0] + L * L, 3), dtype=np.int64)
+    m = _state_hits(seg, radii, moving, allowed, kinds, Rs, cs, hs, olo, ohi, lo, hi, False, out)
+    return out[:m].copy()
+
+
+@njit(cache=True, nogil=True)
+def pair_distances_kernel(seg, radii, moving, allowed, kinds, Rs, cs, hs, olo, ohi, margin):
+    """Every checked pair of one state whose signed distance is below ``margin`` [m].
+
+    Returns (idx (m, 3) int: link, other, other_is_link; d (m,); t_link (m,);
+    t_other (m,); n (m, 3)).
+    """
+    L = seg.shape[0]
+    n_obs = kinds.shape[0]
+    lo = np.empty((L, 3))
+    hi = np.empty((L, 3))
+    _link_boxes(seg, radii, lo, hi)
+    cap = L * n_obs + L * L
+    idx = np.empty((cap, 3), dtype=np.int64)
+    d = np.empty(cap)
+    tl = np.empty(cap)
+    to = np.empty(cap)
+    n = np.empty((cap, 3))
+    pad = margin if margin < 1e300 else 1e300
+    m = 0
+    nv = np.empty(3)
+    for li in range(L):
+        if not moving[li]:
+            continue
+        for oi in range(n_obs):
+            if not _overlap(lo, hi, li, olo, ohi, oi, pad):
+                continue
+            dist, t = capsule_obstacle(
+                kinds[oi], Rs[oi], cs[oi], hs[oi], seg[li, 0], seg[li, 1], radii[li], True, nv
+            )
+            if dist < margin:
+                idx[m, 0] = li
+                idx[m, 1] = oi
+                idx[m, 2] = 0
+                d[m] = dist
+                tl[m] = t
+                to[m] = 0.0
+                n[m, 0], n[m, 1], n[m, 2] = nv[0], nv[1], nv[2]
+                m += 1
+    for i in range(L):
+        for j in range(i + 1, L):
+            if not allowed[i, j]:
+                continue
+            if not _overlap(lo, hi, i, lo, hi, j, pad):
+                continue
+            d2, s, t = seg_seg(seg[i, 0], seg[i, 1], seg[j, 0], seg[j, 1])
+            dist_axis = math.sqrt(d2)
+            dist = dist_axis - radii[i] - radii[j]
+            if dist < margin:
+                idx[m, 0] = i
+                idx[m, 1] = j
+                idx[m, 2] = 1
+                d[m] = dist
+                tl[m] = s
+                to[m] = t
+                for c in range(3):
+                    nv[c] = (seg[i, 0, c] + s * (seg[i, 1, c] - seg[i, 0, c])) - (
+                        seg[j, 0, c] + t * (seg[j, 1, c] - seg[j, 0, c])
+                    )
+                if dist_axis > 0.0:
+                    for c in range(3):
+                        nv[c] /= dist_axis
+                else:  # crossing axes: the common normal of the two segments
+                    u = seg[i, 1] - seg[i, 0]
+                    v = seg[j, 1] - seg[j, 0]
+                    nv[0] = u[1] * v[2] - u[2] * v[1]
+                    nv[1] = u[2] * v[0] - u[0] * v[2]
+                    nv[2] = u[0] * v[1] - u[1] * v[0]
+                    nn = math.sqrt(nv[0] ** 2 + nv[1] ** 2 + nv[2] ** 2)
+                    if nn > 0.0:
+                        for c in range(3):
+                            nv[c] /= nn
+                    else:
+                        nv[0], nv[1], nv[2] = 0.0, 0.0, 1.0
+                n[m, 0], n[m, 1], n[m, 2] = nv[0], nv[1], nv[2]
+                m += 1
+    return idx[:m].copy(), d[:m].copy(), tl[:m].copy(), to[:m].copy(), n[:m].copy()
+
+
+# ---------------------------------------------------------------------- Python front
+
+
+@dataclass(frozen=True)
+class PairDistances:
+    """Signed distances of the checked pairs of one state below a margin.
+
+    Attributes:
+        link: (m,) link index.
+        other: (m,) obstacle index (``other_is_link`` False) or link index (True).
+        other_is_link: (m,) bool.
+        d_m: (m,) signed distance [m]; negative = penetration depth (exact while the
+            capsule axes stay outside the other shape, a lower bound on it otherwise).
+        t_link: (m,) parameter in [0, 1] of the closest point on the link's axis
+            ``p = a + t (b − a)``.
+        t_other: (m,) the same on the other link's axis (0 for obstacles).
+        n_world: (m, 3) unit direction that increases the distance when the link's
+            closest point moves along it.
+    """
+
+    link: np.ndarray
+    other: np.ndarray
+    other_is_link: np.ndarray
+    d_m: np.ndarray
+    t_link: np.ndarray
+    t_other: np.ndarray
+    n_world: np.ndarray
+
+
+def supports(scene: Scene) -> bool:
+    """True when every obstacle of the scene is a shape the core tests exactly."""
+    return all(isinstance(o, Box | Cylinder | Sphere) for o in scene.obstacles)
+
+
+class Core:
+    """Compiled validity and distances for one robot in one scene (no check counter:
+    :class:`~plannerlab.collision.fcl_checker.CollisionChecker` counts)."""
+
+    def __init__(self, robot: Robot, scene: Scene) -> None:
+        if not supports(scene):
+            raise ValueError("the core tests boxes, cylinders and spheres only")
+        self.robot = robot
+        self.scene = scene
+        self.radii = np.ascontiguousarray(robot.link_radii_m, dtype=float)
+        L = len(self.radii)
+        self.n_links = L
+        self.moving = np.array([i not in robot.fixed_links for i in range(L)])
+        allowed = np.zeros((L, L), dtype=bool)
+        for i in range(L):
+            for j in range(i + 1, L):
+                allowed[i, j] = (i, j) not in robot.excluded_pairs and not (
+                    i in robot.fixed_links and j in robot.fixed_links
+                )
+        self.allowed = allowed
+        n = len(scene.obstacles)
+        self.kinds = np.zeros(n, dtype=np.int64)
+        self.Rs = np.zeros((n, 3, 3))
+        self.cs = np.zeros((n, 3))
+        self.hs = np.zeros((n, 3))
+        for k, o in enumerate(scene.obstacles):
+            T = o.T_world_obstacle
+            self.Rs[k] = T[:3, :3]
+            self.cs[k] = T[:3, 3]
+            if isinstance(o, Box):
+                self.kinds[k] = BOX
+                self.hs[k] = np.asarray(o.size_m, dtype=float) / 2.0
+            elif isinstance(o, Cylinder):
+                self.kinds[k] = CYLINDER
+                self.hs[k] = (o.radius_m, o.length_m / 2.0, 0.0)
+            else:
+                self.kinds[k] = SPHERE
+                self.hs[k] = (o.radius_m, 0.0, 0.0)
+        lo, hi = scene.aabbs()
+        self.olo = np.ascontiguousarray(lo, dtype=float).reshape(n, 3)
+        self.ohi = np.ascontiguousarray(hi, dtype=float).reshape(n, 3)
+        self._geo = (
+            self.radii,
+            self.moving,
+            self.allowed,
+            self.kinds,
+            self.Rs,
+            self.cs,
+            self.hs,
+            self.olo,
+            self.ohi,
+        )
+        self._armz = getattr(robot, "kind", "") == "armz"
+        if self._armz:
+            T0 = np.ascontiguousarray(robot.T_world_base, dtype=float)
+            self._T0 = T0
+            self._T1 = T0 @ robot._T_base_j1
+            self._M = np.ascontiguousarray(robot._M, dtype=float)
+
+    # ------------------------------------------------------------------ kinematics
+    def _Q(self, Q: Array) -> np.ndarray:
+        Q = np.ascontiguousarray(np.atleast_2d(np.asarray(Q, dtype=float)))
+        if Q.shape[1] != self.robot.dof:
+            raise ValueError(f"q must have {self.robot.dof} joints, got shape {Q.shape}")
+        return Q
+
+    def fk(self, Q: Array) -> np.ndarray:
+        """Frames (k, F, 4, 4) for Q (k, dof), or (F, 4, 4) for one q (compiled for Arm-Z)."""
+        single = np.ndim(Q) == 1
+        if not self._armz:
+            return self.robot.fk(Q)
+        Qc = self._Q(Q)
+        out = np.empty((len(Qc), self.robot.dof + 2, 4, 4))
+        armz_frames(Qc, self._T0, self._T1, self._M, out)
+        return out[0] if single else out
+
+    def segments(self, Q: Array) -> np.ndarray:
+        """Capsule axes (k, L, 2, 3) for Q (k, dof)."""
+        Qc = self._Q(Q)
+        if self._armz:
+            out = np.empty((len(Qc), self.n_links, 2, 3))
+            return armz_segments(Qc, self._T0, self._T1, self._M, out)
+        return np.ascontiguousarray(self.robot.link_segments(Qc), dtype=float)
+
+    # ------------------------------------------------------------------ queries
+    def valid(self, Q: Array) -> np.ndarray:
+        """(k,) bool validity of Q (k, dof)."""
+        segs = self.segments(Q)
+        out = np.empty(len(segs), dtype=bool)
+        return valid_batch(segs, *self._geo, out)
+
+    def first_invalid(self, Q: Array) -> int:
+        """Index of the first invalid state of Q (k, dof) in order, -1 if all are valid."""
+        Qc = self._Q(Q)
+        if self._armz:
+            return int(armz_first_invalid(Qc, self._T0, self._T1, self._M, *self._geo))
+        return int(first_invalid(self.segments(Qc), *self._geo))
+
+    def hits(self, q: Array) -> np.ndarray:
+        """Every colliding pair at q: (m, 3) rows (link, other, other_is_link)."""
+        return all_hits(self.segments(q)[0], *self._geo)
+
+    def pair_distances(self, q: Array, margin_m: float) -> PairDistances:
+        """Every checked pair at q (dof,) whose signed distance is below ``margin_m``."""
+        seg = self.segments(q)[0]
+        idx, d, tl, to, n = pair_distances_kernel(seg, *self._geo, float(margin_m))
+        return PairDistances(
+            link=idx[:, 0].copy(),
+            other=idx[:, 1].copy(),
+            other_is_link=idx[:, 2].astype(bool),
+            d_m=d,
+            t_link=tl,
+            t_other=to,
+            n_world=n,
+        )
+
+    def clearance(self, q: Array, include_self: bool = True) -> float:
+        """Smallest signed distance [m] over every checked pair (inf when none)."""
+        pd = self.pair_distances(q, np.inf)
+        d = pd.d_m if include_self else pd.d_m[~pd.other_is_link]
+        return float(d.min()) if len(d) else float("inf")

@@ -1,0 +1,161 @@
+"""The compiled core: kinematics, verdicts and distances against FCL and independent routes."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from plannerlab.collision.agreement import KINDS, compare, sample_states
+from plannerlab.collision.core import Core
+from plannerlab.collision.fcl_checker import CollisionChecker
+from plannerlab.problem.catalog import load_problem
+from plannerlab.problem.scene import Box, Cylinder, Scene, Sphere
+from plannerlab.robots.armz.model import ArmZ
+from plannerlab.robots.base import pose_matrix
+
+SCENES = ("armz_inspection", "armz_pocket", "irb6_track_obstacle", "continuum_case3")
+
+
+@pytest.mark.parametrize("n_modules", [12, 24, 96])
+def test_armz_kinematics_match_the_numpy_model_to_1e12(n_modules):
+    robot = ArmZ(n_modules=n_modules, T_world_base=pose_matrix([1.0, -2.0, 0.5], [0.1, -0.2, 0.3]))
+    core = Core(robot, Scene())
+    Q = np.random.default_rng(3).uniform(-np.pi, np.pi, (50, robot.dof))
+    assert np.abs(core.fk(Q) - robot.fk(Q)).max() < 1e-12
+    assert np.abs(core.fk(Q[7]) - robot.fk(Q[7])).max() < 1e-12
+    assert np.abs(core.segments(Q) - robot.link_segments(Q)).max() < 1e-12
+
+
+@pytest.mark.parametrize("name", SCENES)
+@pytest.mark.parametrize("kind", KINDS)
+def test_core_agrees_with_fcl_and_with_an_independent_minimisation(name, kind):
+    p = load_problem(name)
+    core = Core(p.robot, p.scene)
+    ref = CollisionChecker(p.robot, p.scene, backend="fcl")
+    rng = np.random.default_rng(11)
+    Q = sample_states(core, kind, 300, rng)
+    a = compare(core, ref, Q, distance_states=60, reference_pairs=30, rng=rng)
+    # FCL's GJK decides states within its tolerance of contact either way: any verdict that
+    # differs must belong to a state that close to contact.
+    bad = np.flatnonzero(core.valid(Q) != ref.valid_batch(Q))
+    assert len(bad) == a.verdict_mismatches
+    for s in bad:
+        assert abs(core.clearance(Q[s])) < 1e-6
+    assert a.verdict_mismatches <= 2
+    if a.pairs_compared:
+        assert a.max_err_ref_m < 1e-9
+
+
+def test_contact_states_lie_within_a_millimetre_of_contact():
+    p = load_problem("armz_inspection")
+    core = Core(p.robot, p.scene)
+    Q = sample_states(core, "contact", 100, np.random.default_rng(0))
+    c = np.array([core.clearance(q) for q in Q])
+    assert np.all(np.abs(c) <= 1.5e-3)
+    assert 0.1 < np.mean(c > 0) < 0.9
+
+
+def test_shapes_at_hand_worked_distances():
+    robot = ArmZ()
+    column = np.full(robot.dof, np.pi)  # straight up along x = 0, y = δy
+    r = robot.collision_radius_m
+    y = robot.delta_y_m
+    tip = robot.fk(column)[-1, :3, 3]
+    scene = Scene(
+        (
+            Box("box", pose_matrix([r + 0.3 + 0.5, y, 5.0], [0.4, 0, 0]), [1.0, 1.0, 1.0]),
+            Cylinder("post", pose_matrix([-(r + 0.2 + 0.25), y, 6.0], [0, 0, 0]), 0.25, 2.0),
+            # a ball straight above the tip: the tip is the capsule axis's nearest point
+            Sphere("ball", pose_matrix(tip + [0.0, 0.0, r + 0.7 + 0.1], [0, 0, 0]), 0.1),
+            # a cylinder lying across above the top, its rim 0.4 m over the tip's capsule
+            Cylinder("bar", pose_matrix([0.0, y, 40.0], [0, np.pi / 2, 0]), 0.5, 40.0),
+        )
+    )
+    core = Core(robot, scene)
+    pd = core.pair_distances(column, np.inf)
+    tip_z = robot.fk(column)[-1, 2, 3]
+    best = {}
+    for k in range(len(pd.d_m)):
+        if not pd.other_is_link[k]:
+            name = scene.names[pd.other[k]]
+            best[name] = min(best.get(name, np.inf), pd.d_m[k])
+    # the box is tilted about x: its face towards the column stays the plane x = r + 0.3
+    assert best["box"] == pytest.approx(0.3, abs=1e-12)
+    assert best["post"] == pytest.approx(0.2, abs=1e-12)
+    assert best["ball"] == pytest.approx(0.7, abs=1e-12)
+    assert best["bar"] == pytest.approx(40.0 - 0.5 - tip_z - r, abs=1e-9)
+
+
+def _same_pair(pds, ref, k):
+    """Distance in ``pds`` of the pair ``k`` of ``ref``."""
+    m = (
+        (pds.link == ref.link[k])
+        & (pds.other == ref.other[k])
+        & (pds.other_is_link == ref.other_is_link[k])
+    )
+    return pds.d_m[m][0]
+
+
+def test_pair_distance_gradient_matches_finite_differences():
+    p = load_problem("armz_inspection")
+    core = Core(p.robot, p.scene)
+    rng = np.random.default_rng(5)
+    Q = sample_states(core, "coiled", 15, rng)
+    h = 1e-7
+    checked = 0
+    for q in Q:
+        pd = core.pair_distances(q, 0.5)
+        for k in np.flatnonzero(pd.d_m > 0.01)[:3]:
+            seg = core.segments(q)[0]
+            grad = np.empty(len(q))
+            for j in range(len(q)):
+                dq = np.zeros(len(q))
+                dq[j] = h
+                sp = core.segments(q + dq)[0]
+                dl = (1 - pd.t_link[k]) * (sp[pd.link[k], 0] - seg[pd.link[k], 0]) + pd.t_link[
+                    k
+                ] * (sp[pd.link[k], 1] - seg[pd.link[k], 1])
+                g = pd.n_world[k] @ dl
+                if pd.other_is_link[k]:
+                    o = pd.other[k]
+                    do = (1 - pd.t_other[k]) * (sp[o, 0] - seg[o, 0]) + pd.t_other[k] * (
+                        sp[o, 1] - seg[o, 1]
+                    )
+                    g -= pd.n_world[k] @ do
+                grad[j] = g / h
+            fd = np.empty(len(q))
+            for j in range(len(q)):
+                dq = np.zeros(len(q))
+                dq[j] = h
+                pp = core.pair_distances(q + dq, 1.0)
+                pm = core.pair_distances(q - dq, 1.0)
+
+                fd[j] = (_same_pair(pp, pd, k) - _same_pair(pm, pd, k)) / (2 * h)
+            assert np.allclose(grad, fd, atol=1e-5)
+            checked += 1
+    assert checked >= 5
+
+
+def test_checker_counts_one_check_per_state_on_both_backends():
+    p = load_problem("armz_inspection")
+    Q = np.random.default_rng(2).uniform(p.robot.lower, p.robot.upper, (200, p.robot.dof))
+    results = {}
+    for backend in ("core", "fcl"):
+        c = CollisionChecker(p.robot, p.scene, backend=backend)
+        assert c.backend == backend
+        v = c.valid_batch(Q)
+        assert c.checks == 200
+        first = c.first_invalid(Q)
+        assert c.checks == 200 + first + 1
+        check = c.check_path(Q[:3], 0.05)
+        assert check.backend == backend
+        results[backend] = (v, first, check.states_checked, check.pairs)
+    assert np.array_equal(results["core"][0], results["fcl"][0])
+    assert results["core"][1:] == results["fcl"][1:]
+
+
+def test_checker_picks_the_core_by_default_and_refuses_unknown_backends():
+    p = load_problem("armz_inspection")
+    assert CollisionChecker(p.robot, p.scene).backend == "core"
+    with pytest.raises(ValueError, match="backend"):
+        CollisionChecker(p.robot, p.scene, backend="gpu")
