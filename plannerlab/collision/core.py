@@ -118,19 +118,27 @@ def _link_boxes(seg, radii, lo, hi):
 
 @njit(cache=True, nogil=True)
 def _overlap(lo, hi, i, olo, ohi, j, pad):
+    """Boxes i of (lo, hi) and j of (olo, ohi), grown by ``pad``, overlap.
+
+    Bitwise ``&`` on purpose: without branches this is ten times faster than ``and``.
+    """
     return (
-        lo[i, 0] <= ohi[j, 0] + pad
-        and hi[i, 0] >= olo[j, 0] - pad
-        and lo[i, 1] <= ohi[j, 1] + pad
-        and hi[i, 1] >= olo[j, 1] - pad
-        and lo[i, 2] <= ohi[j, 2] + pad
-        and hi[i, 2] >= olo[j, 2] - pad
+        (lo[i, 0] <= ohi[j, 0] + pad)
+        & (hi[i, 0] >= olo[j, 0] - pad)
+        & (lo[i, 1] <= ohi[j, 1] + pad)
+        & (hi[i, 1] >= olo[j, 1] - pad)
+        & (lo[i, 2] <= ohi[j, 2] + pad)
+        & (hi[i, 2] >= olo[j, 2] - pad)
     )
 
 
 @njit(cache=True, nogil=True)
-def _sweep_order(lo, hi):
-    """Axis of largest spread of the link boxes and the links sorted along it."""
+def _sweep_order(lo, hi, order):
+    """Axis of largest spread of the link boxes; ``order`` re-sorted along it in place.
+
+    Insertion sort from the previous state's order: states of one batch (an edge) are
+    alike, so the order is nearly sorted and the sort is linear in the number of links.
+    """
     L = lo.shape[0]
     best_ax = 0
     best = -1.0
@@ -144,20 +152,27 @@ def _sweep_order(lo, hi):
         if mx - mn > best:
             best = mx - mn
             best_ax = ax
-    keys = np.empty(L)
-    for li in range(L):
-        keys[li] = lo[li, best_ax]
-    return best_ax, np.argsort(keys)
+    for a in range(1, L):
+        v = order[a]
+        key = lo[v, best_ax]
+        b = a - 1
+        while b >= 0 and lo[order[b], best_ax] > key:
+            order[b + 1] = order[b]
+            b -= 1
+        order[b + 1] = v
+    return best_ax
 
 
 @njit(cache=True, nogil=True)
 def _state_hits(
-    seg, radii, moving, allowed, kinds, Rs, cs, hs, olo, ohi, lo, hi, first_only, out_pairs
+    seg, radii, moving, allowed, kinds, Rs, cs, hs, olo, ohi, buf, first_only, out_pairs
 ):
     """Colliding pairs of one state; returns how many were written to out_pairs (m, 3).
 
-    Row = (link, other, other_is_link). With ``first_only`` stops at the first.
+    Row = (link, other, other_is_link). With ``first_only`` stops at the first. ``buf``:
+    scratch from :func:`_scratch`.
     """
+    lo, hi, order, w = buf
     L = seg.shape[0]
     n_obs = kinds.shape[0]
     _link_boxes(seg, radii, lo, hi)
@@ -169,7 +184,7 @@ def _state_hits(
             if not _overlap(lo, hi, li, olo, ohi, oi, 0.0):
                 continue
             if capsule_obstacle_hit(
-                kinds[oi], Rs[oi], cs[oi], hs[oi], seg[li, 0], seg[li, 1], radii[li]
+                kinds[oi], Rs[oi], cs[oi], hs[oi], seg[li, 0], seg[li, 1], radii[li], w
             ):
                 out_pairs[m, 0] = li
                 out_pairs[m, 1] = oi
@@ -177,7 +192,7 @@ def _state_hits(
                 m += 1
                 if first_only:
                     return m
-    ax, order = _sweep_order(lo, hi)
+    ax = _sweep_order(lo, hi, order)
     for a in range(L):
         i = order[a]
         for b in range(a + 1, L):
@@ -203,15 +218,20 @@ def _state_hits(
 
 
 @njit(cache=True, nogil=True)
+def _scratch(L):
+    """Per-call scratch of the narrow and broad phase: (lo, hi, order, w)."""
+    return np.empty((L, 3)), np.empty((L, 3)), np.arange(L), np.zeros(32)
+
+
+@njit(cache=True, nogil=True)
 def valid_batch(segs, radii, moving, allowed, kinds, Rs, cs, hs, olo, ohi, out):
     """Validity of every state: segs (k, L, 2, 3) → out (k,) bool."""
     k, L = segs.shape[0], segs.shape[1]
-    lo = np.empty((L, 3))
-    hi = np.empty((L, 3))
+    buf = _scratch(L)
     pairs = np.empty((1, 3), dtype=np.int64)
     for s in range(k):
         m = _state_hits(
-            segs[s], radii, moving, allowed, kinds, Rs, cs, hs, olo, ohi, lo, hi, True, pairs
+            segs[s], radii, moving, allowed, kinds, Rs, cs, hs, olo, ohi, buf, True, pairs
         )
         out[s] = m == 0
     return out
@@ -221,12 +241,11 @@ def valid_batch(segs, radii, moving, allowed, kinds, Rs, cs, hs, olo, ohi, out):
 def first_invalid(segs, radii, moving, allowed, kinds, Rs, cs, hs, olo, ohi):
     """Index of the first invalid state of segs (k, L, 2, 3), or -1."""
     k, L = segs.shape[0], segs.shape[1]
-    lo = np.empty((L, 3))
-    hi = np.empty((L, 3))
+    buf = _scratch(L)
     pairs = np.empty((1, 3), dtype=np.int64)
     for s in range(k):
         if _state_hits(
-            segs[s], radii, moving, allowed, kinds, Rs, cs, hs, olo, ohi, lo, hi, True, pairs
+            segs[s], radii, moving, allowed, kinds, Rs, cs, hs, olo, ohi, buf, True, pairs
         ):
             return s
     return -1
@@ -238,13 +257,12 @@ def armz_first_invalid(Q, T0, T1, M, radii, moving, allowed, kinds, Rs, cs, hs, 
     k, dof = Q.shape
     L = dof + 1
     seg = np.empty((1, L, 2, 3))
-    lo = np.empty((L, 3))
-    hi = np.empty((L, 3))
+    buf = _scratch(L)
     pairs = np.empty((1, 3), dtype=np.int64)
     for s in range(k):
         armz_segments(Q[s : s + 1], T0, T1, M, seg)
         if _state_hits(
-            seg[0], radii, moving, allowed, kinds, Rs, cs, hs, olo, ohi, lo, hi, True, pairs
+            seg[0], radii, moving, allowed, kinds, Rs, cs, hs, olo, ohi, buf, True, pairs
         ):
             return s
     return -1
@@ -254,10 +272,10 @@ def armz_first_invalid(Q, T0, T1, M, radii, moving, allowed, kinds, Rs, cs, hs, 
 def all_hits(seg, radii, moving, allowed, kinds, Rs, cs, hs, olo, ohi):
     """Every colliding pair of one state (L, 2, 3): (m, 3) rows (link, other, other_is_link)."""
     L = seg.shape[0]
-    lo = np.empty((L, 3))
-    hi = np.empty((L, 3))
     out = np.empty((L * kinds.shape[0] + L * L, 3), dtype=np.int64)
-    m = _state_hits(seg, radii, moving, allowed, kinds, Rs, cs, hs, olo, ohi, lo, hi, False, out)
+    m = _state_hits(
+        seg, radii, moving, allowed, kinds, Rs, cs, hs, olo, ohi, _scratch(L), False, out
+    )
     return out[:m].copy()
 
 
@@ -282,6 +300,7 @@ def pair_distances_kernel(seg, radii, moving, allowed, kinds, Rs, cs, hs, olo, o
     pad = margin if margin < 1e300 else 1e300
     m = 0
     nv = np.empty(3)
+    w = np.zeros(32)
     for li in range(L):
         if not moving[li]:
             continue
@@ -289,7 +308,7 @@ def pair_distances_kernel(seg, radii, moving, allowed, kinds, Rs, cs, hs, olo, o
             if not _overlap(lo, hi, li, olo, ohi, oi, pad):
                 continue
             dist, t = capsule_obstacle(
-                kinds[oi], Rs[oi], cs[oi], hs[oi], seg[li, 0], seg[li, 1], radii[li], True, nv
+                kinds[oi], Rs[oi], cs[oi], hs[oi], seg[li, 0], seg[li, 1], radii[li], True, nv, w
             )
             if dist < margin:
                 idx[m, 0] = li

@@ -119,15 +119,16 @@ def _box_dist2_at(p0, d, h, t):
 
 
 @njit(cache=True, nogil=True)
-def seg_box_local(p0, p1, h):
+def seg_box_local(p0, p1, h, w):
     """Exact squared distance from segment p0→p1 (box frame) to the box of half sizes h.
 
-    Returns (squared distance, t of the closest point on the segment).
+    ``w`` is scratch space (≥ 11 floats). Returns (squared distance, t of the closest point
+    on the segment).
     """
-    d = np.empty(3)
+    d = w[0:3]
     for i in range(3):
         d[i] = p1[i] - p0[i]
-    ts = np.empty(8)
+    ts = w[3:11]
     n = 0
     ts[n] = 0.0
     n += 1
@@ -253,12 +254,13 @@ def seg_sd_min(kind, p0, p1, h, stop_below):
 
 
 @njit(cache=True, nogil=True)
-def capsule_obstacle(kind, R, c, h, a, b, r, want_normal, n_out):
+def capsule_obstacle(kind, R, c, h, a, b, r, want_normal, n_out, w):
     """Signed distance [m] of capsule (a→b, r) to one obstacle, and t on the capsule axis.
 
     ``kind``: 0 box (h = half sizes), 1 cylinder (h = radius, half length), 2 sphere
     (h[0] = radius). With ``want_normal`` the unit direction (world) that increases the
     distance when the capsule's closest point moves along it is written to ``n_out``.
+    ``w``: scratch space (≥ 32 floats).
     """
     if kind == 2:
         d2, t = seg_point(a, b, c)
@@ -272,12 +274,12 @@ def capsule_obstacle(kind, R, c, h, a, b, r, want_normal, n_out):
             else:
                 n_out[0], n_out[1], n_out[2] = 0.0, 0.0, 1.0
         return dist - r - h[0], t
-    p0 = np.empty(3)
-    p1 = np.empty(3)
+    p0 = w[0:3]
+    p1 = w[3:6]
     _to_local(R, c, a, p0)
     _to_local(R, c, b, p1)
     if kind == 0:
-        d2, t = seg_box_local(p0, p1, h)
+        d2, t = seg_box_local(p0, p1, h, w[6:])
         if d2 > 0.0:
             sd = math.sqrt(d2)
         else:
@@ -288,7 +290,8 @@ def capsule_obstacle(kind, R, c, h, a, b, r, want_normal, n_out):
         x = p0[0] + t * (p1[0] - p0[0])
         y = p0[1] + t * (p1[1] - p0[1])
         z = p0[2] + t * (p1[2] - p0[2])
-        nl = np.zeros(3)
+        nl = w[20:23]
+        nl[:] = 0.0
         if kind == 0:
             if sd > 0.0:
                 nl[0] = x - min(max(x, -h[0]), h[0])
@@ -324,22 +327,26 @@ def capsule_obstacle(kind, R, c, h, a, b, r, want_normal, n_out):
 
 
 @njit(cache=True, nogil=True)
-def capsule_obstacle_hit(kind, R, c, h, a, b, r):
-    """True when capsule (a→b, r) touches or overlaps the obstacle (distance ≤ 0)."""
+def capsule_obstacle_hit(kind, R, c, h, a, b, r, w):
+    """True when capsule (a→b, r) touches or overlaps the obstacle (distance ≤ 0).
+
+    ``w``: scratch space (≥ 32 floats), so the hot path allocates nothing.
+    """
     if kind == 2:
         d2, _ = seg_point(a, b, c)
         rr = r + h[0]
         return d2 <= rr * rr
-    p0 = np.empty(3)
-    p1 = np.empty(3)
+    p0 = w[0:3]
+    p1 = w[3:6]
     _to_local(R, c, a, p0)
     _to_local(R, c, b, p1)
     if kind == 0:
-        d2, _ = seg_box_local(p0, p1, h)
+        d2, _ = seg_box_local(p0, p1, h, w[6:])
         return d2 <= r * r
     # cylinder: reject with the enclosing capsule around its axis, else search
-    ax0 = np.zeros(3)
-    ax1 = np.zeros(3)
+    ax0 = w[20:23]
+    ax1 = w[23:26]
+    ax0[0], ax0[1], ax1[0], ax1[1] = 0.0, 0.0, 0.0, 0.0
     ax0[2] = -h[1]
     ax1[2] = h[1]
     d2, _, _ = seg_seg(p0, p1, ax0, ax1)
