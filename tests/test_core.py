@@ -6,12 +6,13 @@ import numpy as np
 import pytest
 
 from plannerlab.collision.agreement import KINDS, compare, sample_states
-from plannerlab.collision.core import Core
+from plannerlab.collision.core import Core, edge_states
 from plannerlab.collision.fcl_checker import CollisionChecker
 from plannerlab.problem.catalog import load_problem
 from plannerlab.problem.scene import Box, Cylinder, Scene, Sphere
 from plannerlab.robots.armz.model import ArmZ
 from plannerlab.robots.base import pose_matrix
+from plannerlab.robots.paths import densify, interpolate_edge
 
 SCENES = ("armz_inspection", "armz_pocket", "irb6_track_obstacle", "continuum_case3")
 
@@ -159,3 +160,60 @@ def test_checker_picks_the_core_by_default_and_refuses_unknown_backends():
     assert CollisionChecker(p.robot, p.scene).backend == "core"
     with pytest.raises(ValueError, match="backend"):
         CollisionChecker(p.robot, p.scene, backend="gpu")
+
+
+@pytest.mark.parametrize("name", ["armz_inspection", "irb6_track_obstacle", "continuum_case3"])
+def test_one_call_edge_check_equals_interpolating_then_checking(name):
+    p = load_problem(name)
+    r = p.robot
+    core = CollisionChecker(r, p.scene, backend="core")
+    ref = CollisionChecker(r, p.scene, backend="fcl")
+    rng = np.random.default_rng(4)
+    bad_seen = 0
+    for k in range(30):
+        a = rng.uniform(r.lower, r.upper)
+        b = np.clip(a + rng.normal(0.0, 0.4, r.dof), r.lower - 1.0, r.upper + 1.0)
+        limit = (None, 0, 2, 10**6)[k % 4]
+        states = interpolate_edge(a, b, 0.05, r.continuous)[1:]
+        n, bad = core.check_edge(a, b, 0.05, limit)
+        assert n == len(states)
+        m = len(states) if limit is None else min(limit, len(states))
+        expect = ref.first_invalid(states[:m]) if m else None
+        assert bad == expect
+        c0, f0 = core.checks, ref.checks
+        assert ref.check_edge(a, b, 0.05, limit) == (n, bad)
+        core.check_edge(a, b, 0.05, limit)
+        assert core.checks - c0 == ref.checks - f0 == (m if bad is None else bad + 1)
+        bad_seen += bad is not None
+    assert bad_seen > 0
+
+
+def test_edge_states_are_bit_identical_to_interpolate_edge():
+    rng = np.random.default_rng(8)
+    for _ in range(300):
+        dof = int(rng.integers(1, 9))
+        a, b = rng.uniform(-4.0, 4.0, (2, dof))
+        cont = rng.random(dof) < 0.5
+        step = float(rng.choice([0.05, 0.3, 2.0]))
+        n, Q = edge_states(a, b, step, cont, 2**62)
+        ref = interpolate_edge(a, b, step, cont)[1:]
+        assert n == len(ref) and np.array_equal(Q, ref)
+
+
+def test_densify_is_edge_by_edge_interpolation_bit_for_bit():
+    rng = np.random.default_rng(9)
+    for _ in range(200):
+        dof, m = int(rng.integers(1, 8)), int(rng.integers(1, 7))
+        path = rng.uniform(-4.0, 4.0, (m, dof))
+        if m > 2:
+            path[2] = path[1]  # a zero-length edge still yields one state
+        cont = rng.random(dof) < 0.5
+        step = float(rng.choice([0.05, 0.3, 2.0]))
+        states, owners = densify(path, step, cont)
+        chunks, own = [path[:1]], [np.zeros(1, dtype=int)]
+        for i in range(m - 1):
+            pts = interpolate_edge(path[i], path[i + 1], step, cont)[1:]
+            chunks.append(pts)
+            own.append(np.full(len(pts), i))
+        assert np.array_equal(states, np.concatenate(chunks))
+        assert np.array_equal(owners, np.concatenate(own))

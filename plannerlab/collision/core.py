@@ -37,6 +37,8 @@ from plannerlab.collision.geometry import (
 from plannerlab.problem.scene import Box, Cylinder, Scene, Sphere
 from plannerlab.robots.base import Array, Robot
 
+_NO_LIMIT = 2**62  # "check every state of the edge"
+
 # ---------------------------------------------------------------------- kinematics
 
 
@@ -269,6 +271,57 @@ def armz_first_invalid(Q, T0, T1, M, radii, moving, allowed, kinds, Rs, cs, hs, 
 
 
 @njit(cache=True, nogil=True)
+def edge_states(q_a, q_b, joint_step, continuous, limit):
+    """The states of ``interpolate_edge(q_a, q_b, joint_step)[1:]``, bit for bit, at most
+    ``limit`` of them: (n, Q (min(n, limit), dof)), n the edge's full count."""
+    dof = q_a.shape[0]
+    d = np.empty(dof)
+    span = 0.0
+    for i in range(dof):
+        x = q_b[i] - q_a[i]
+        if continuous[i]:
+            x = (x + np.pi) % (2.0 * np.pi) - np.pi
+        d[i] = x
+        span = max(span, abs(x))
+    n = max(1, int(math.ceil(span / joint_step - 1e-12)))
+    m = min(n, limit)
+    Q = np.empty((m, dof))
+    inv = 1.0 / n
+    for j in range(1, m + 1):
+        t = 1.0 if j == n else j * inv
+        for i in range(dof):
+            Q[j - 1, i] = q_a[i] + t * d[i]
+    return n, Q
+
+
+@njit(cache=True, nogil=True)
+def armz_edge_first_invalid(
+    q_a,
+    q_b,
+    joint_step,
+    continuous,
+    limit,
+    T0,
+    T1,
+    M,
+    radii,
+    moving,
+    allowed,
+    kinds,
+    Rs,
+    cs,
+    hs,
+    olo,
+    ohi,
+):
+    """An Arm-Z edge checked in order, interpolation and kinematics fused in: (n, first bad
+    index among the first min(n, limit) states or -1)."""
+    n, Q = edge_states(q_a, q_b, joint_step, continuous, limit)
+    bad = armz_first_invalid(Q, T0, T1, M, radii, moving, allowed, kinds, Rs, cs, hs, olo, ohi)
+    return n, bad
+
+
+@njit(cache=True, nogil=True)
 def all_hits(seg, radii, moving, allowed, kinds, Rs, cs, hs, olo, ohi):
     """Every colliding pair of one state (L, 2, 3): (m, 3) rows (link, other, other_is_link)."""
     L = seg.shape[0]
@@ -445,6 +498,7 @@ class Core:
             self.olo,
             self.ohi,
         )
+        self._continuous = np.ascontiguousarray(robot.continuous, dtype=np.bool_)
         self._armz = getattr(robot, "kind", "") == "armz"
         if self._armz:
             T0 = np.ascontiguousarray(robot.T_world_base, dtype=float)
@@ -484,12 +538,50 @@ class Core:
         out = np.empty(len(segs), dtype=bool)
         return valid_batch(segs, *self._geo, out)
 
+    def is_valid(self, q: Array) -> bool:
+        """Validity of one state q (dof,): one compiled call for Arm-Z."""
+        Qc = self._Q(q)
+        if len(Qc) != 1:
+            raise ValueError(f"q must be one state ({self.robot.dof},), got shape {np.shape(q)}")
+        if self._armz:
+            return armz_first_invalid(Qc, self._T0, self._T1, self._M, *self._geo) < 0
+        return bool(self.valid(Qc)[0])
+
     def first_invalid(self, Q: Array) -> int:
         """Index of the first invalid state of Q (k, dof) in order, -1 if all are valid."""
         Qc = self._Q(Q)
         if self._armz:
             return int(armz_first_invalid(Qc, self._T0, self._T1, self._M, *self._geo))
         return int(first_invalid(self.segments(Qc), *self._geo))
+
+    def edge_first_invalid(
+        self, q_a: Array, q_b: Array, joint_step: float, limit: int | None = None
+    ) -> tuple[int, int]:
+        """Check the states of ``interpolate_edge(q_a, q_b, joint_step)[1:]`` in order.
+
+        Only the first ``limit`` states are looked at (all when None). Returns (n, bad):
+        n the edge's number of states, bad the index of the first invalid one, -1 if none.
+        """
+        qa = np.ascontiguousarray(q_a, dtype=float)
+        qb = np.ascontiguousarray(q_b, dtype=float)
+        lim = _NO_LIMIT if limit is None else max(int(limit), 0)
+        if self._armz:
+            n, bad = armz_edge_first_invalid(
+                qa,
+                qb,
+                float(joint_step),
+                self._continuous,
+                lim,
+                self._T0,
+                self._T1,
+                self._M,
+                *self._geo,
+            )
+            return int(n), int(bad)
+        n, Q = edge_states(qa, qb, float(joint_step), self._continuous, lim)
+        if len(Q) == 0:
+            return int(n), -1
+        return int(n), int(first_invalid(self.segments(Q), *self._geo))
 
     def hits(self, q: Array) -> np.ndarray:
         """Every colliding pair at q: (m, 3) rows (link, other, other_is_link)."""

@@ -28,7 +28,7 @@ from plannerlab.collision.core import Core, PairDistances
 from plannerlab.collision.core import supports as core_supports
 from plannerlab.problem.scene import Box, Cylinder, Scene, Sphere
 from plannerlab.robots.base import Array, Robot
-from plannerlab.robots.paths import densify
+from plannerlab.robots.paths import densify, interpolate_edge
 
 
 @dataclass(frozen=True)
@@ -210,6 +210,9 @@ class CollisionChecker:
 
     def is_valid(self, q: Array) -> bool:
         """True when q (dof,) collides neither with the scene nor with itself."""
+        if self._core is not None:
+            self.checks += 1
+            return bool(self._core.is_valid(q))
         return bool(self.valid_batch(np.asarray(q, dtype=float)[None, :])[0])
 
     def first_invalid(self, Q: Array) -> int | None:
@@ -231,6 +234,26 @@ class CollisionChecker:
                 return int(s)
         self.checks += len(Q)
         return None
+
+    def check_edge(
+        self, q_a: Array, q_b: Array, joint_step: float, max_states: int | None = None
+    ) -> tuple[int, int | None]:
+        """Check the edge q_a → q_b as :func:`~plannerlab.robots.paths.interpolate_edge`
+        densifies it (q_a itself excluded), in order, at most ``max_states`` states.
+
+        Returns (n, bad): the edge's number of states and the index of the first invalid
+        one among those checked (None if none). Counts the states looked at, as
+        :meth:`first_invalid` does. On the core, interpolation, kinematics and checks are
+        one compiled call.
+        """
+        if self._core is not None:
+            n, bad = self._core.edge_first_invalid(q_a, q_b, joint_step, max_states)
+            m = n if max_states is None else min(n, max(int(max_states), 0))
+            self.checks += m if bad < 0 else bad + 1
+            return n, (None if bad < 0 else bad)
+        states = interpolate_edge(q_a, q_b, joint_step, self.robot.continuous)[1:]
+        m = len(states) if max_states is None else min(len(states), max(int(max_states), 0))
+        return len(states), (self.first_invalid(states[:m]) if m > 0 else None)
 
     def colliding_pairs(self, q: Array) -> tuple[tuple[str, str], ...]:
         """Every colliding pair at q: (link name, obstacle name) or (link name, link name)."""

@@ -20,8 +20,9 @@ Design (measured on ``armz_inspection``, 23 continuous joints):
   Motions are checked by default by a Python ``MotionValidator`` (``motion_check =
   "batched"``) that interpolates the edge exactly as :func:`plannerlab.robots.paths.densify` does
   (no joint moves more than ``problem.joint_step`` between checked states) and asks
-  ``checker.first_invalid`` for the whole edge at once (vectorised FK and bounding-box
-  pre-test: ~50 µs per state instead of ~150). ``motion_check = "ompl"`` uses OMPL's
+  ``checker.check_edge`` for the whole edge at once: on the compiled core
+  (:mod:`plannerlab.collision.core`) interpolation, kinematics and checks of the edge are
+  one call, a few µs per state. ``motion_check = "ompl"`` uses OMPL's
   discrete validator with the longest-valid-segment fraction set to ``joint_step /
   max_extent``: because the compound metric is L1, that is ``joint_step`` in the *sum*
   of joint changes, conservative and ~several times more states per edge. Limitation of
@@ -105,7 +106,7 @@ from plannerlab.planners.base import (
 from plannerlab.problem.goals import GoalRegion
 from plannerlab.problem.ik import sample_goal_state
 from plannerlab.robots.base import Array, Robot, joint_difference, wrap_to_pi
-from plannerlab.robots.paths import interpolate_edge, path_length
+from plannerlab.robots.paths import path_length
 
 LOGGER = logging.getLogger("plannerlab.ompl")
 
@@ -512,16 +513,17 @@ class _GuardedChecker:
         return self.checker.is_valid(q)
 
     def edge_valid(self, q_a: Array, q_b: Array, joint_step: float) -> bool:
-        """Every state of the edge after q_a (q_b included) is valid, checked in order."""
-        states = interpolate_edge(q_a, q_b, joint_step, self.checker.robot.continuous)[1:]
+        """Every state of the edge after q_a (q_b included) is valid, checked in order.
+
+        One call to the checker for the whole edge (interpolation included); with too
+        little budget left for the whole edge, checks what it may, then refuses.
+        """
         left = self.budget.checks_left()
-        if left is not None and left < len(states):
-            # not enough budget to check the whole edge: check what we may, then refuse
+        n, bad = self.checker.check_edge(q_a, q_b, joint_step, left)
+        if left is not None and left < n:
             self.budget.refused += 1
-            if left > 0:
-                self.checker.first_invalid(states[:left])
             return False
-        return self.checker.first_invalid(states) is None
+        return bad is None
 
 
 def _goal_class() -> type:
