@@ -96,22 +96,23 @@ class PyBulletChecker:
 
 _COMPILE_SNIPPET = """
 import time
-t0 = time.perf_counter()
+t0, c0 = time.perf_counter(), time.process_time()
 import numpy as np
 from plannerlab.collision.core import Core
 from plannerlab.problem.catalog import load_problem
-t1 = time.perf_counter()
+t1, c1 = time.perf_counter(), time.process_time()
 p = load_problem({problem!r})
 core = Core(p.robot, p.scene)
 Q = np.random.default_rng(0).uniform(p.robot.lower, p.robot.upper, (10, p.robot.dof))
 core.valid(Q); core.first_invalid(Q); core.pair_distances(Q[0], 0.1); core.fk(Q[0])
-t2 = time.perf_counter()
-print(t1 - t0, t2 - t1)
+core.is_valid(Q[0]); core.edge_first_invalid(Q[0], Q[1], 0.05)
+t2, c2 = time.perf_counter(), time.process_time()
+print(t1 - t0, t2 - t1, c1 - c0, c2 - c1)
 """
 
 
-def compile_cost(problem: str) -> tuple[tuple[float, float], tuple[float, float]]:
-    """(import s, first calls s) with an empty numba cache, then with the cache warm."""
+def compile_cost(problem: str) -> list[tuple[float, float, float, float]]:
+    """(import, first calls) wall and CPU seconds in fresh processes: empty cache, then warm."""
     code = _COMPILE_SNIPPET.format(problem=problem)
     out = []
     with tempfile.TemporaryDirectory(prefix="plannerlab_numba_") as tmp:
@@ -120,9 +121,9 @@ def compile_cost(problem: str) -> tuple[tuple[float, float], tuple[float, float]
             res = subprocess.run(
                 [sys.executable, "-c", code], env=env, capture_output=True, text=True, check=True
             )
-            a, b = (float(v) for v in res.stdout.split())
-            out.append((a, b))
-    return out[0], out[1]
+            a, b, c, d = (float(v) for v in res.stdout.split())
+            out.append((a, b, c, d))
+    return out
 
 
 def main() -> None:
@@ -223,7 +224,7 @@ def main() -> None:
         )
     if pb:
         pb.close()
-    (imp0, first0), (imp1, first1) = compile_cost(args.problem)
+    cold, warm = compile_cost(args.problem)
 
     table = Table(
         title=f"core vs FCL checker vs PyBullet on {problem.name} ({robot.dof} joints, "
@@ -266,10 +267,11 @@ def main() -> None:
                 f"{b / a:.2f}x",
             )
         con.print(t)
-    con.print(
-        f"numba compile: import {imp0:.2f} s + first calls {first0:.2f} s with an empty cache; "
-        f"import {imp1:.2f} s + first calls {first1:.2f} s with the cache warm"
-    )
+    for label, (ti, tf, ci, cf) in (("empty cache", cold), ("warm cache", warm)):
+        con.print(
+            f"numba, fresh process, {label}: import {ti:.2f} s wall / {ci:.2f} s CPU, "
+            f"first calls (compile or load) {tf:.2f} s wall / {cf:.2f} s CPU"
+        )
     con.print(f"machine: {machine()}")
 
 
