@@ -8,6 +8,7 @@ import pytest
 from plannerlab.collision.agreement import KINDS, compare, sample_states
 from plannerlab.collision.core import Core, edge_states
 from plannerlab.collision.fcl_checker import CollisionChecker
+from plannerlab.errors import PlannerlabError
 from plannerlab.problem.catalog import load_problem
 from plannerlab.problem.scene import Box, Cylinder, Scene, Sphere
 from plannerlab.robots.armz.model import ArmZ
@@ -195,7 +196,7 @@ def test_edge_states_are_bit_identical_to_interpolate_edge():
         a, b = rng.uniform(-4.0, 4.0, (2, dof))
         cont = rng.random(dof) < 0.5
         step = float(rng.choice([0.05, 0.3, 2.0]))
-        n, Q = edge_states(a, b, step, cont, 2**62)
+        n, Q = edge_states(a, b, step, cont, 2**62, 2**62)
         ref = interpolate_edge(a, b, step, cont)[1:]
         assert n == len(ref) and np.array_equal(Q, ref)
 
@@ -217,3 +218,18 @@ def test_densify_is_edge_by_edge_interpolation_bit_for_bit():
             own.append(np.full(len(pts), i))
         assert np.array_equal(states, np.concatenate(chunks))
         assert np.array_equal(owners, np.concatenate(own))
+
+
+@pytest.mark.parametrize("backend", ["core", "fcl"])
+def test_edge_checks_refuse_what_interpolate_edge_refuses(backend):
+    p = load_problem("armz_inspection")
+    c = CollisionChecker(p.robot, p.scene, backend=backend)
+    a = np.zeros(p.robot.dof)
+    b = np.full(p.robot.dof, 1.0)
+    with pytest.raises(PlannerlabError, match="more than the limit"):
+        c.check_edge(a, b, 1e-6)
+    with pytest.raises(PlannerlabError, match="joint_step must be a positive"):
+        c.check_edge(a, b, 0.0)
+    with pytest.raises(PlannerlabError, match="more than the limit"):
+        densify(np.stack([a, b]), 1e-6, p.robot.continuous)
+    assert c.checks == 0

@@ -35,7 +35,13 @@ from plannerlab.collision.geometry import (
     seg_seg,
 )
 from plannerlab.problem.scene import Box, Cylinder, Scene, Sphere
-from plannerlab.robots.base import Array, Robot
+from plannerlab.robots.base import Array, Robot, joint_difference
+from plannerlab.robots.paths import (
+    MAX_EDGE_STATES,
+    edge_steps,
+    edge_too_long,
+    require_joint_step,
+)
 
 _NO_LIMIT = 2**62  # "check every state of the edge"
 
@@ -271,9 +277,10 @@ def armz_first_invalid(Q, T0, T1, M, radii, moving, allowed, kinds, Rs, cs, hs, 
 
 
 @njit(cache=True, nogil=True)
-def edge_states(q_a, q_b, joint_step, continuous, limit):
+def edge_states(q_a, q_b, joint_step, continuous, limit, cap):
     """The states of ``interpolate_edge(q_a, q_b, joint_step)[1:]``, bit for bit, at most
-    ``limit`` of them: (n, Q (min(n, limit), dof)), n the edge's full count."""
+    ``limit`` of them: (n, Q (min(n, limit), dof)), n the edge's full count; an edge of
+    more than ``cap`` states gives (cap + 1, no states)."""
     dof = q_a.shape[0]
     d = np.empty(dof)
     span = 0.0
@@ -283,7 +290,10 @@ def edge_states(q_a, q_b, joint_step, continuous, limit):
             x = (x + np.pi) % (2.0 * np.pi) - np.pi
         d[i] = x
         span = max(span, abs(x))
-    n = max(1, int(math.ceil(span / joint_step - 1e-12)))
+    n_f = max(1.0, math.ceil(span / joint_step - 1e-12))
+    if n_f > cap:  # refused: the caller raises
+        return cap + 1, np.empty((0, dof))
+    n = int(n_f)
     m = min(n, limit)
     Q = np.empty((m, dof))
     inv = 1.0 / n
@@ -301,6 +311,7 @@ def armz_edge_first_invalid(
     joint_step,
     continuous,
     limit,
+    cap,
     T0,
     T1,
     M,
@@ -316,7 +327,9 @@ def armz_edge_first_invalid(
 ):
     """An Arm-Z edge checked in order, interpolation and kinematics fused in: (n, first bad
     index among the first min(n, limit) states or -1)."""
-    n, Q = edge_states(q_a, q_b, joint_step, continuous, limit)
+    n, Q = edge_states(q_a, q_b, joint_step, continuous, limit, cap)
+    if n > cap:
+        return n, -1
     bad = armz_first_invalid(Q, T0, T1, M, radii, moving, allowed, kinds, Rs, cs, hs, olo, ohi)
     return n, bad
 
@@ -561,27 +574,40 @@ class Core:
 
         Only the first ``limit`` states are looked at (all when None). Returns (n, bad):
         n the edge's number of states, bad the index of the first invalid one, -1 if none.
+
+        Raises:
+            PlannerlabError: as ``interpolate_edge`` (bad ``joint_step``, or more than
+                ``MAX_EDGE_STATES`` states).
         """
         qa = np.ascontiguousarray(q_a, dtype=float)
         qb = np.ascontiguousarray(q_b, dtype=float)
+        step = float(joint_step)
+        require_joint_step(step)
         lim = _NO_LIMIT if limit is None else max(int(limit), 0)
         if self._armz:
             n, bad = armz_edge_first_invalid(
                 qa,
                 qb,
-                float(joint_step),
+                step,
                 self._continuous,
                 lim,
+                MAX_EDGE_STATES,
                 self._T0,
                 self._T1,
                 self._M,
                 *self._geo,
             )
-            return int(n), int(bad)
-        n, Q = edge_states(qa, qb, float(joint_step), self._continuous, lim)
-        if len(Q) == 0:
-            return int(n), -1
-        return int(n), int(first_invalid(self.segments(Q), *self._geo))
+        else:
+            n, Q = edge_states(qa, qb, step, self._continuous, lim, MAX_EDGE_STATES)
+            bad = (
+                -1
+                if n > MAX_EDGE_STATES or len(Q) == 0
+                else first_invalid(self.segments(Q), *self._geo)
+            )
+        if n > MAX_EDGE_STATES:
+            span = float(np.max(np.abs(joint_difference(qb, qa, self._continuous))))
+            raise edge_too_long(span, step, edge_steps(qa, qb, step, self._continuous))
+        return int(n), int(bad)
 
     def hits(self, q: Array) -> np.ndarray:
         """Every colliding pair at q: (m, 3) rows (link, other, other_is_link)."""

@@ -21,6 +21,21 @@ def edge_steps(q_a: Array, q_b: Array, joint_step: float, continuous: np.ndarray
 MAX_EDGE_STATES = 100_000
 
 
+def require_joint_step(joint_step: float) -> None:
+    """Raise unless ``joint_step`` is a positive finite number."""
+    if not (joint_step > 0.0 and math.isfinite(joint_step)):
+        raise PlannerlabError(f"joint_step must be a positive finite number, got {joint_step!r}")
+
+
+def edge_too_long(span_rad: float, joint_step: float, n: int) -> PlannerlabError:
+    """The error for an edge that needs more than :data:`MAX_EDGE_STATES` states."""
+    return PlannerlabError(
+        f"an edge of {span_rad:.3g} rad checked every joint_step = {joint_step:.3g} rad needs "
+        f"{n} states, more than the limit of {MAX_EDGE_STATES}: use a larger "
+        "[checking] joint_step"
+    )
+
+
 def interpolate_edge(q_a: Array, q_b: Array, joint_step: float, continuous: np.ndarray) -> Array:
     """States from q_a to q_b inclusive, at most ``joint_step`` apart per joint: (m, dof).
 
@@ -30,16 +45,11 @@ def interpolate_edge(q_a: Array, q_b: Array, joint_step: float, continuous: np.n
     Raises:
         PlannerlabError: the edge would need more than :data:`MAX_EDGE_STATES` states.
     """
-    if not (joint_step > 0.0 and math.isfinite(joint_step)):
-        raise PlannerlabError(f"joint_step must be a positive finite number, got {joint_step!r}")
+    require_joint_step(joint_step)
     n = edge_steps(q_a, q_b, joint_step, continuous)
     if n > MAX_EDGE_STATES:
         span = float(np.max(np.abs(joint_difference(q_b, q_a, continuous))))
-        raise PlannerlabError(
-            f"an edge of {span:.3g} rad checked every joint_step = {joint_step:.3g} rad needs "
-            f"{n} states, more than the limit of {MAX_EDGE_STATES}: use a larger "
-            "[checking] joint_step"
-        )
+        raise edge_too_long(span, joint_step, n)
     d = joint_difference(q_b, q_a, continuous)
     t = np.linspace(0.0, 1.0, n + 1)[:, None]
     return np.asarray(q_a, dtype=float)[None, :] + t * d[None, :]
@@ -53,13 +63,21 @@ def densify(path: Array, joint_step: float, continuous: np.ndarray) -> tuple[Arr
 
     Returns:
         states (M, dof) and, for each, the index of the waypoint edge it belongs to.
+
+    Raises:
+        PlannerlabError: an edge would need more than :data:`MAX_EDGE_STATES` states.
     """
     path = np.atleast_2d(np.asarray(path, dtype=float))
     if len(path) == 1:
         return path.copy(), np.zeros(1, dtype=int)
+    require_joint_step(joint_step)
     d = joint_difference(path[1:], path[:-1], continuous)  # (m - 1, dof)
     span = np.max(np.abs(d), axis=1, initial=0.0)
-    n = np.maximum(1, np.ceil(span / joint_step - 1e-12).astype(int))  # steps per edge
+    n_f = np.maximum(1.0, np.ceil(span / joint_step - 1e-12))  # steps per edge
+    worst = int(np.argmax(n_f))
+    if n_f[worst] > MAX_EDGE_STATES:
+        raise edge_too_long(float(span[worst]), joint_step, int(min(n_f[worst], 2**62)))
+    n = n_f.astype(int)
     owners = np.repeat(np.arange(len(d)), n)
     j = np.arange(len(owners)) - np.repeat(np.cumsum(n) - n, n) + 1  # 1 .. n_i
     n_of = n[owners]
