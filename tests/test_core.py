@@ -35,8 +35,8 @@ def test_core_agrees_with_fcl_and_with_an_independent_minimisation(name, kind):
     core = Core(p.robot, p.scene)
     ref = CollisionChecker(p.robot, p.scene, backend="fcl")
     rng = np.random.default_rng(11)
-    Q = sample_states(core, kind, 300, rng)
-    a = compare(core, ref, Q, distance_states=60, reference_pairs=30, rng=rng)
+    Q = sample_states(core, kind, 150, rng)
+    a = compare(core, ref, Q, distance_states=30, reference_pairs=20, rng=rng)
     # FCL's GJK decides states within its tolerance of contact either way: any verdict that
     # differs must belong to a state that close to contact.
     bad = np.flatnonzero(core.valid(Q) != ref.valid_batch(Q))
@@ -233,3 +233,20 @@ def test_edge_checks_refuse_what_interpolate_edge_refuses(backend):
     with pytest.raises(PlannerlabError, match="more than the limit"):
         densify(np.stack([a, b]), 1e-6, p.robot.continuous)
     assert c.checks == 0
+
+
+@pytest.mark.parametrize("n_modules", [24, 60])
+def test_every_colliding_pair_is_found_in_the_checkers_order(n_modules):
+    # coiled Arm-Z states collide with themselves in many places at once: the tree
+    # traversal must find every pair the FCL checker finds, reported in the same order
+    p = load_problem("armz_inspection")
+    robot = ArmZ(n_modules=n_modules)
+    core = CollisionChecker(robot, p.scene, backend="core")
+    ref = CollisionChecker(robot, p.scene, backend="fcl")
+    Q = sample_states(core._core, "coiled", 40, np.random.default_rng(6))
+    many = 0
+    for q in Q:
+        pairs = core.colliding_pairs(q)
+        assert pairs == ref.colliding_pairs(q)
+        many += len(pairs) >= 5
+    assert many >= 10

@@ -9,9 +9,11 @@ True``: compiled once per machine into ``__pycache__``, loaded in later processe
 * **Kinematics.** Arm-Z's chain ``H_i = RotZ(θ_i) · Trans(0, δy, δz) · RotX(ζ)`` is compiled
   (:func:`armz_frames`, :func:`armz_segments`); other robots give their segments through
   their own numpy ``link_segments``.
-* **Broad phase.** Per state, world-aligned boxes of every capsule; links against
-  obstacles are tested box-against-box, link pairs by sort-and-sweep along the axis of
-  largest spread, so the cost grows as ``L log L`` with the number of links, not ``L²``.
+* **Broad phase.** Per state, world-aligned boxes of every capsule and a bounding-box tree
+  over the chain's consecutive links (:func:`chain_tree`: topology built once, boxes
+  refit per state), traversed against each obstacle and against itself; node pairs that
+  are apart or hold no checked pair are pruned, so the cost grows as ``L log L`` with the
+  number of links, not ``L²``.
 * **Narrow phase.** Exact capsule tests (:mod:`plannerlab.collision.geometry`).
 
 The pairs checked are the checker's: moving links against every obstacle, and the robot's
@@ -140,58 +142,101 @@ def _overlap(lo, hi, i, olo, ohi, j, pad):
     )
 
 
-@njit(cache=True, nogil=True)
-def _sweep_order(lo, hi, order):
-    """Axis of largest spread of the link boxes; ``order`` re-sorted along it in place.
+def chain_tree(allowed: np.ndarray) -> tuple[np.ndarray, ...]:
+    """A balanced binary tree over consecutive link ranges, and allowed-pair counts.
 
-    Insertion sort from the previous state's order: states of one batch (an edge) are
-    alike, so the order is nearly sorted and the sort is linear in the number of links.
+    Returns ``(start, end, left, right, prefix)``: node ``k`` covers links
+    ``start[k]:end[k]``, children ``left[k]``, ``right[k]`` (-1 for a leaf), nodes in
+    preorder (children after parents, root 0); ``prefix`` (L+1, L+1) the 2-D prefix sums of
+    the symmetric allowed-pair matrix, so "does any allowed pair join ranges A and B" is
+    four lookups. The topology depends only on the links, so it is built once per robot.
     """
-    L = lo.shape[0]
-    best_ax = 0
-    best = -1.0
-    for ax in range(3):
-        mn = np.inf
-        mx = -np.inf
-        for li in range(L):
-            c = lo[li, ax] + hi[li, ax]
-            mn = min(mn, c)
-            mx = max(mx, c)
-        if mx - mn > best:
-            best = mx - mn
-            best_ax = ax
-    for a in range(1, L):
-        v = order[a]
-        key = lo[v, best_ax]
-        b = a - 1
-        while b >= 0 and lo[order[b], best_ax] > key:
-            order[b + 1] = order[b]
-            b -= 1
-        order[b + 1] = v
-    return best_ax
+    L = allowed.shape[0]
+    start: list[int] = []
+    end: list[int] = []
+    left: list[int] = []
+    right: list[int] = []
+
+    def build(a: int, b: int) -> int:
+        k = len(start)
+        start.append(a)
+        end.append(b)
+        left.append(-1)
+        right.append(-1)
+        if b - a > 1:
+            mid = (a + b) // 2
+            left[k] = build(a, mid)
+            right[k] = build(mid, b)
+        return k
+
+    build(0, L)
+    sym = allowed | allowed.T
+    prefix = np.zeros((L + 1, L + 1), dtype=np.int64)
+    prefix[1:, 1:] = np.cumsum(np.cumsum(sym.astype(np.int64), axis=0), axis=1)
+    return (
+        np.array(start, dtype=np.int64),
+        np.array(end, dtype=np.int64),
+        np.array(left, dtype=np.int64),
+        np.array(right, dtype=np.int64),
+        prefix,
+    )
+
+
+@njit(cache=True, nogil=True)
+def _any_allowed(prefix, a0, a1, b0, b1):
+    return prefix[a1, b1] - prefix[a0, b1] - prefix[a1, b0] + prefix[a0, b0] > 0
+
+
+@njit(cache=True, nogil=True)
+def _node_boxes(tree, lo, hi, nlo, nhi):
+    start, end, left, right, prefix = tree
+    for k in range(start.shape[0] - 1, -1, -1):
+        if left[k] < 0:
+            i = start[k]
+            for c in range(3):
+                nlo[k, c] = lo[i, c]
+                nhi[k, c] = hi[i, c]
+        else:
+            a = left[k]
+            b = right[k]
+            for c in range(3):
+                nlo[k, c] = min(nlo[a, c], nlo[b, c])
+                nhi[k, c] = max(nhi[a, c], nhi[b, c])
 
 
 @njit(cache=True, nogil=True)
 def _state_hits(
-    seg, radii, moving, allowed, kinds, Rs, cs, hs, olo, ohi, buf, first_only, out_pairs
+    seg, radii, moving, allowed, tree, kinds, Rs, cs, hs, olo, ohi, buf, first_only, out_pairs
 ):
     """Colliding pairs of one state; returns how many were written to out_pairs (m, 3).
 
     Row = (link, other, other_is_link). With ``first_only`` stops at the first. ``buf``:
-    scratch from :func:`_scratch`.
+    scratch from :func:`_scratch`. Broad phase: a bounding-box tree over the chain's
+    consecutive links, traversed against each obstacle and against itself, pruning node
+    pairs whose boxes are apart or that hold no checked pair; cost ~ L log L.
     """
-    lo, hi, order, w = buf
-    L = seg.shape[0]
+    lo, hi, w, nlo, nhi, stack = buf
+    start, end, left, right, prefix = tree
     n_obs = kinds.shape[0]
     _link_boxes(seg, radii, lo, hi)
+    _node_boxes(tree, lo, hi, nlo, nhi)
     m = 0
-    for li in range(L):
-        if not moving[li]:
-            continue
-        for oi in range(n_obs):
-            if not _overlap(lo, hi, li, olo, ohi, oi, 0.0):
+    for oi in range(n_obs):
+        top = 0
+        stack[0, 0] = 0
+        top = 1
+        while top > 0:
+            top -= 1
+            k = stack[top, 0]
+            if not _overlap(nlo, nhi, k, olo, ohi, oi, 0.0):
                 continue
-            if capsule_obstacle_hit(
+            if left[k] >= 0:
+                stack[top, 0] = left[k]
+                stack[top + 1, 0] = right[k]
+                top += 2
+                continue
+            li = start[k]
+            if moving[li] and capsule_obstacle_hit(
                 kinds[oi], Rs[oi], cs[oi], hs[oi], seg[li, 0], seg[li, 1], radii[li], w
             ):
                 out_pairs[m, 0] = li
@@ -200,19 +245,33 @@ def _state_hits(
                 m += 1
                 if first_only:
                     return m
-    ax = _sweep_order(lo, hi, order)
-    for a in range(L):
-        i = order[a]
-        for b in range(a + 1, L):
-            j = order[b]
-            if lo[j, ax] > hi[i, ax]:
-                break
-            p = min(i, j)
-            q = max(i, j)
-            if not allowed[p, q]:
-                continue
-            if not _overlap(lo, hi, i, lo, hi, j, 0.0):
-                continue
+    # self: node pairs (a, b); a == b means "pairs within a"
+    stack[0, 0] = 0
+    stack[0, 1] = 0
+    top = 1
+    while top > 0:
+        top -= 1
+        a = stack[top, 0]
+        b = stack[top, 1]
+        if not _any_allowed(prefix, start[a], end[a], start[b], end[b]):
+            continue
+        if a == b:
+            if left[a] >= 0:
+                stack[top, 0] = left[a]
+                stack[top, 1] = left[a]
+                stack[top + 1, 0] = right[a]
+                stack[top + 1, 1] = right[a]
+                stack[top + 2, 0] = left[a]
+                stack[top + 2, 1] = right[a]
+                top += 3
+            continue
+        if not _overlap(nlo, nhi, a, nlo, nhi, b, 0.0):
+            continue
+        a_leaf = left[a] < 0
+        b_leaf = left[b] < 0
+        if a_leaf and b_leaf:
+            p = min(start[a], start[b])
+            q = max(start[a], start[b])
             d2, _, _ = seg_seg(seg[p, 0], seg[p, 1], seg[q, 0], seg[q, 1])
             rr = radii[p] + radii[q]
             if d2 <= rr * rr:
@@ -222,45 +281,65 @@ def _state_hits(
                 m += 1
                 if first_only:
                     return m
+            continue
+        if b_leaf or (not a_leaf and end[a] - start[a] >= end[b] - start[b]):
+            stack[top, 0] = left[a]
+            stack[top, 1] = b
+            stack[top + 1, 0] = right[a]
+            stack[top + 1, 1] = b
+        else:
+            stack[top, 0] = a
+            stack[top, 1] = left[b]
+            stack[top + 1, 0] = a
+            stack[top + 1, 1] = right[b]
+        top += 2
     return m
 
 
 @njit(cache=True, nogil=True)
 def _scratch(L):
-    """Per-call scratch of the narrow and broad phase: (lo, hi, order, w)."""
-    return np.empty((L, 3)), np.empty((L, 3)), np.arange(L), np.zeros(32)
+    """Per-call scratch of the narrow and broad phase: (lo, hi, w, node lo, node hi, stack)."""
+    n = 2 * L
+    return (
+        np.empty((L, 3)),
+        np.empty((L, 3)),
+        np.zeros(32),
+        np.empty((n, 3)),
+        np.empty((n, 3)),
+        np.empty((4 * n + 64, 2), dtype=np.int64),
+    )
 
 
 @njit(cache=True, nogil=True)
-def valid_batch(segs, radii, moving, allowed, kinds, Rs, cs, hs, olo, ohi, out):
+def valid_batch(segs, radii, moving, allowed, tree, kinds, Rs, cs, hs, olo, ohi, out):
     """Validity of every state: segs (k, L, 2, 3) → out (k,) bool."""
     k, L = segs.shape[0], segs.shape[1]
     buf = _scratch(L)
     pairs = np.empty((1, 3), dtype=np.int64)
     for s in range(k):
         m = _state_hits(
-            segs[s], radii, moving, allowed, kinds, Rs, cs, hs, olo, ohi, buf, True, pairs
+            segs[s], radii, moving, allowed, tree, kinds, Rs, cs, hs, olo, ohi, buf, True, pairs
         )
         out[s] = m == 0
     return out
 
 
 @njit(cache=True, nogil=True)
-def first_invalid(segs, radii, moving, allowed, kinds, Rs, cs, hs, olo, ohi):
+def first_invalid(segs, radii, moving, allowed, tree, kinds, Rs, cs, hs, olo, ohi):
     """Index of the first invalid state of segs (k, L, 2, 3), or -1."""
     k, L = segs.shape[0], segs.shape[1]
     buf = _scratch(L)
     pairs = np.empty((1, 3), dtype=np.int64)
     for s in range(k):
         if _state_hits(
-            segs[s], radii, moving, allowed, kinds, Rs, cs, hs, olo, ohi, buf, True, pairs
+            segs[s], radii, moving, allowed, tree, kinds, Rs, cs, hs, olo, ohi, buf, True, pairs
         ):
             return s
     return -1
 
 
 @njit(cache=True, nogil=True)
-def armz_first_invalid(Q, T0, T1, M, radii, moving, allowed, kinds, Rs, cs, hs, olo, ohi):
+def armz_first_invalid(Q, T0, T1, M, radii, moving, allowed, tree, kinds, Rs, cs, hs, olo, ohi):
     """As :func:`first_invalid` with Arm-Z kinematics fused in: no FK past the first hit."""
     k, dof = Q.shape
     L = dof + 1
@@ -270,7 +349,7 @@ def armz_first_invalid(Q, T0, T1, M, radii, moving, allowed, kinds, Rs, cs, hs, 
     for s in range(k):
         armz_segments(Q[s : s + 1], T0, T1, M, seg)
         if _state_hits(
-            seg[0], radii, moving, allowed, kinds, Rs, cs, hs, olo, ohi, buf, True, pairs
+            seg[0], radii, moving, allowed, tree, kinds, Rs, cs, hs, olo, ohi, buf, True, pairs
         ):
             return s
     return -1
@@ -318,6 +397,7 @@ def armz_edge_first_invalid(
     radii,
     moving,
     allowed,
+    tree,
     kinds,
     Rs,
     cs,
@@ -330,23 +410,25 @@ def armz_edge_first_invalid(
     n, Q = edge_states(q_a, q_b, joint_step, continuous, limit, cap)
     if n > cap:
         return n, -1
-    bad = armz_first_invalid(Q, T0, T1, M, radii, moving, allowed, kinds, Rs, cs, hs, olo, ohi)
+    bad = armz_first_invalid(
+        Q, T0, T1, M, radii, moving, allowed, tree, kinds, Rs, cs, hs, olo, ohi
+    )
     return n, bad
 
 
 @njit(cache=True, nogil=True)
-def all_hits(seg, radii, moving, allowed, kinds, Rs, cs, hs, olo, ohi):
+def all_hits(seg, radii, moving, allowed, tree, kinds, Rs, cs, hs, olo, ohi):
     """Every colliding pair of one state (L, 2, 3): (m, 3) rows (link, other, other_is_link)."""
     L = seg.shape[0]
     out = np.empty((L * kinds.shape[0] + L * L, 3), dtype=np.int64)
     m = _state_hits(
-        seg, radii, moving, allowed, kinds, Rs, cs, hs, olo, ohi, _scratch(L), False, out
+        seg, radii, moving, allowed, tree, kinds, Rs, cs, hs, olo, ohi, _scratch(L), False, out
     )
     return out[:m].copy()
 
 
 @njit(cache=True, nogil=True)
-def pair_distances_kernel(seg, radii, moving, allowed, kinds, Rs, cs, hs, olo, ohi, margin):
+def pair_distances_kernel(seg, radii, moving, allowed, tree, kinds, Rs, cs, hs, olo, ohi, margin):
     """Every checked pair of one state whose signed distance is below ``margin`` [m].
 
     Returns (idx (m, 3) int: link, other, other_is_link; d (m,); t_link (m,);
@@ -500,10 +582,12 @@ class Core:
         lo, hi = scene.aabbs()
         self.olo = np.ascontiguousarray(lo, dtype=float).reshape(n, 3)
         self.ohi = np.ascontiguousarray(hi, dtype=float).reshape(n, 3)
+        self.tree = chain_tree(allowed)
         self._geo = (
             self.radii,
             self.moving,
             self.allowed,
+            self.tree,
             self.kinds,
             self.Rs,
             self.cs,
@@ -611,7 +695,9 @@ class Core:
 
     def hits(self, q: Array) -> np.ndarray:
         """Every colliding pair at q: (m, 3) rows (link, other, other_is_link)."""
-        return all_hits(self.segments(q)[0], *self._geo)
+        h = all_hits(self.segments(q)[0], *self._geo)
+        # the checker's order: scene pairs by (link, obstacle), then link pairs by (i, j)
+        return h[np.lexsort((h[:, 1], h[:, 0], h[:, 2]))]
 
     def pair_distances(self, q: Array, margin_m: float) -> PairDistances:
         """Every checked pair at q (dof,) whose signed distance is below ``margin_m``."""
