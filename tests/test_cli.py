@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import os
 import shutil
 import subprocess
 import sys
@@ -69,6 +70,11 @@ def test_solve_execute_plot_round_trip(capsys, tmp_path):
         == 1
     )
 
+    plan_bytes = plan_path.read_bytes()
+    umask = os.umask(0o022)
+    os.umask(umask)
+    # an ordinary file (0644 under the usual umask), not mkstemp's 0600
+    assert plan_path.stat().st_mode & 0o777 == 0o666 & ~umask
     code, out, _ = run(capsys, "execute", str(plan_path), "--json")
     assert code == 0
     executed = json.loads(out)
@@ -76,11 +82,33 @@ def test_solve_execute_plot_round_trip(capsys, tmp_path):
     assert ex["path_valid"] is True and ex["leg"] == 0
     assert ex["final_pos_err_m"] == pytest.approx(leg["pos_err_m"], abs=0.05)
     assert len(ex["q_actual_rad"]) > 1
+    # the execution goes beside the plan; the plan itself is never rewritten
+    assert plan_path.read_bytes() == plan_bytes
+    assert json.loads((tmp_path / "plan.exec.json").read_text()) == executed
+    code, out, _ = run(capsys, "execute", str(plan_path), "--out", str(tmp_path / "x.json"))
+    assert code == 0 and json.loads((tmp_path / "x.json").read_text())["executions"]
 
     code, out, _ = run(capsys, "plot", str(plan_path), "--out", str(tmp_path / "fig"), "--json")
     files = json.loads(out)
     assert code == 0 and any(f.endswith("stall.png") for f in files)
     assert all((tmp_path / "fig" / f.split("/")[-1]).stat().st_size > 10_000 for f in files)
+
+
+def test_execute_refuses_a_plan_whose_problem_changed(capsys, tmp_path):
+    problem = tmp_path / "pocket.toml"
+    shutil.copy(PROBLEMS / "armz_pocket.toml", problem)
+    plan_path = tmp_path / "plan.json"
+    argv = ("solve", str(problem), "--planner", "gradient.analytic", "--max-iterations", "5")
+    assert run(capsys, *argv, "--out", str(plan_path))[0] == 0
+    plan = json.loads(plan_path.read_text())
+    assert len(plan["problem_sha256"]) == 64
+    problem.write_text(problem.read_text() + "\n# edited after planning\n")
+    code, _, err = run(capsys, "execute", str(plan_path))
+    assert code == 2 and "changed since planning" in " ".join(err.split())
+    assert not (tmp_path / "plan.exec.json").exists()
+    code, out, _ = run(capsys, "execute", str(plan_path), "--allow-changed-problem")
+    assert code == 0 and "changed since planning" in out
+    assert (tmp_path / "plan.exec.json").exists()
 
 
 def test_table_output_names_every_leg(capsys, tmp_path):
@@ -128,7 +156,7 @@ def test_a_plan_file_of_another_format_is_refused(capsys, tmp_path):
     bad = tmp_path / "plan.json"
     bad.write_text(json.dumps({"format": "something/9", "legs": []}))
     code, out, err = run(capsys, "plot", str(bad))
-    assert code == 2 and "[format] expected 'plannerlab.plan/1'" in " ".join(err.split())
+    assert code == 2 and "[format] expected 'plannerlab.plan/2'" in " ".join(err.split())
     bad.write_text(json.dumps({"format": "plannerlab.plan/1", "problem": "x"}))
     code, out, err = run(capsys, "execute", str(bad))
     assert code == 2 and "is missing" in err

@@ -14,7 +14,7 @@ from plannerlab.errors import PlanFileError
 
 def read_plan(path: str | Path) -> Any:
     """:meth:`Plan.load` with the errors a user can cause turned into ``PlanFileError`` s."""
-    from plannerlab.bench.task import Plan
+    from plannerlab.record.plan import Plan
 
     path = Path(path)
     if path.is_dir():

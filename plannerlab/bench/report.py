@@ -62,20 +62,14 @@ from typing import Any
 
 from plannerlab.bench.trials import ERROR_STATUS, SUMMARY_COLUMNS, TOTAL_KEYS
 from plannerlab.record.files import write_json_atomic, write_text_atomic
+from plannerlab.record.leg import Status
 
-#: values of the ``status ENUM`` run property, in order (index = stored value)
-STATUS_ENUM: tuple[str, ...] = (
-    "solved",
-    "approximate",
-    "local_minimum",
-    "budget_exhausted",
-    "invalid_start",
-    "invalid_goal",
-    "invalid_path",
-    "failed",
-    ERROR_STATUS,
-    "unreachable",  # appended: earlier indices keep their meaning
-)
+#: values of the ``status ENUM`` run property (index = stored value): the planner statuses
+#: in :class:`Status` order, with ``error`` (the trial raised) at index 8, where it stood
+#: before statuses were added to :class:`Status`; those follow it, so that a stored index
+#: keeps its meaning
+_STATUSES = [s.value for s in Status]
+STATUS_ENUM: tuple[str, ...] = (*_STATUSES[:8], ERROR_STATUS, *_STATUSES[8:])
 
 TRIAL_COLUMNS = (
     "key",
@@ -230,6 +224,16 @@ def trial_rows(records: Iterable[Mapping[str, Any]]) -> list[dict[str, Any]]:
     return rows
 
 
+def _lengths(extra: Mapping[str, Any]) -> dict[str, Any]:
+    """The path lengths a planner reports in ``extra`` (before/after simplification, …)."""
+    return {
+        str(k): v
+        for k, v in extra.items()
+        if "length" in str(k)
+        and (v is None or (isinstance(v, int | float) and not isinstance(v, bool)))
+    }
+
+
 def leg_rows(records: Iterable[Mapping[str, Any]]) -> list[dict[str, Any]]:
     """One flat row per leg of every trial (keys :data:`LEG_COLUMNS`)."""
     rows = []
@@ -244,6 +248,8 @@ def leg_rows(records: Iterable[Mapping[str, Any]]) -> list[dict[str, Any]]:
                     "planner": r["planner"],
                     "seed": r["seed"],
                     **{k: x.get(k) for k in LEG_COLUMNS if k in x},
+                    "path_points": x.get("path_points"),
+                    "extra_lengths": _lengths(x.get("extra") or {}),
                     "exec_success": e.get("success"),
                     "exec_path_valid": e.get("path_valid"),
                     "exec_max_track_err_rad": e.get("max_track_err_rad"),

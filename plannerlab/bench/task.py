@@ -2,106 +2,30 @@
 
 A *task* is every leg of a problem in order; leg ``i`` starts where leg ``i − 1``'s path
 ended (the planned end, or the executed end for closed-loop planners, which execute as
-they plan). A plan file (JSON) holds the per-leg :class:`PlanResult` s, the seed, the
-settings, the budget and the package versions, so that ``plannerlab execute PLAN.json``
-and ``plannerlab plot PLAN.json`` can use it later.
+they plan). :func:`solve_legs` returns a :class:`~plannerlab.record.plan.Plan`, the record
+that plan files hold.
 """
 
 from __future__ import annotations
 
-import json
 from collections.abc import Callable, Sequence
 from contextlib import ExitStack
-from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
-from plannerlab.errors import PlanFileError
 from plannerlab.planners import get_entry, make_planner
-from plannerlab.planners.base import PlanResult, Status
-from plannerlab.problem.catalog import load_problem, resolve_problem_path
 from plannerlab.problem.goals import unreachable_reason
 from plannerlab.problem.load import Budget, Problem
-from plannerlab.record.files import versions, write_json_atomic
-
-PLAN_FORMAT = "plannerlab.plan/1"
+from plannerlab.record.files import versions
+from plannerlab.record.leg import PlanResult, Status
+from plannerlab.record.plan import Plan, file_sha256
 
 
 def leg_rng(seed: int, leg: int) -> np.random.Generator:
     """The generator of one leg of one trial: independent streams per (seed, leg)."""
     return np.random.default_rng(np.random.SeedSequence([int(seed), int(leg)]))
-
-
-@dataclass(frozen=True, eq=False)
-class Plan:
-    """A planner's results over some legs of a problem."""
-
-    problem: str
-    problem_file: str
-    planner: str
-    seed: int
-    budget: dict[str, Any]
-    legs: tuple[PlanResult, ...]
-    overrides: dict[str, Any] = field(default_factory=dict)
-    versions: dict[str, str] = field(default_factory=dict)
-    executions: tuple[dict[str, Any], ...] = ()
-
-    @property
-    def solved(self) -> bool:
-        return all(r.solved for r in self.legs)
-
-    def full_path(self) -> np.ndarray:
-        """All legs' paths joined (m, dof)."""
-        parts = [self.legs[0].path] + [r.path[1:] for r in self.legs[1:]]
-        return np.concatenate(parts)
-
-    def to_dict(self) -> dict[str, Any]:
-        return {
-            "format": PLAN_FORMAT,
-            "problem": self.problem,
-            "problem_file": self.problem_file,
-            "planner": self.planner,
-            "seed": self.seed,
-            "overrides": self.overrides,
-            "budget": self.budget,
-            "versions": self.versions,
-            "legs": [r.to_dict() for r in self.legs],
-            "executions": list(self.executions),
-        }
-
-    def save(self, path: str | Path) -> Path:
-        return write_json_atomic(path, self.to_dict())
-
-    @classmethod
-    def load(cls, path: str | Path) -> Plan:
-        path = Path(path)
-        try:
-            data = json.loads(path.read_text(encoding="utf-8"))
-        except FileNotFoundError:
-            raise PlanFileError(f"{path}: no such plan file") from None
-        except json.JSONDecodeError as exc:
-            raise PlanFileError(f"{path}: not JSON ({exc})") from None
-        if not isinstance(data, dict) or data.get("format") != PLAN_FORMAT:
-            raise PlanFileError(f"{path}: [format] expected {PLAN_FORMAT!r}")
-        try:
-            return cls(
-                problem=data["problem"],
-                problem_file=data["problem_file"],
-                planner=data["planner"],
-                seed=int(data["seed"]),
-                budget=data["budget"],
-                legs=tuple(PlanResult.from_dict(r) for r in data["legs"]),
-                overrides=data.get("overrides", {}),
-                versions=data.get("versions", {}),
-                executions=tuple(data.get("executions", [])),
-            )
-        except KeyError as exc:
-            raise PlanFileError(f"{path}: [{exc.args[0]}] is missing") from None
-
-    def load_problem(self) -> Problem:
-        return load_problem(self.problem_file)
 
 
 def _unreachable(
@@ -174,9 +98,11 @@ def solve_legs(
             q = r.path[-1]
             if stop_on_failure and r.status is not Status.SOLVED:
                 break
+    problem_file = Path(problem.source) if Path(problem.source).is_file() else None
     return Plan(
         problem=problem.name,
-        problem_file=str(resolve_problem_path(problem.source)) if problem.source else "",
+        problem_file=str(problem_file) if problem_file else "",
+        problem_sha256=file_sha256(problem_file) if problem_file else "",
         planner=planner_name,
         seed=seed,
         budget=budget.to_dict(),

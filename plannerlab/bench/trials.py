@@ -56,6 +56,8 @@ from typing import Any
 import numpy as np
 
 from plannerlab.errors import PlannerlabError
+from plannerlab.record.codec import dumps, to_data
+from plannerlab.record.leg import PlanResult, Status
 
 LOGGER = logging.getLogger(__name__)
 
@@ -192,15 +194,6 @@ def parse_seeds(spec: str) -> list[int]:
 
 
 # ---------------------------------------------------------------------- one trial
-def _num(x: Any) -> Any:
-    """A JSON-safe number: NaN -> None, ±inf -> None (tables show them as "-")."""
-    if isinstance(x, np.generic):
-        x = x.item()
-    if isinstance(x, float) and not math.isfinite(x):
-        return None
-    return x
-
-
 def _seed_ompl(seed: int) -> bool:
     """Seed OMPL's process-global RNG if the OMPL adapter imports; False when it cannot."""
     try:
@@ -227,33 +220,15 @@ def _thinned(rows: np.ndarray, most: int = MAX_PROGRESS_ROWS) -> np.ndarray:
     return rows[np.unique(np.linspace(0, len(rows) - 1, most).round().astype(int))]
 
 
-def _leg_record(r: Any, continuous: np.ndarray) -> dict[str, Any]:
+def _leg_record(r: PlanResult, continuous: np.ndarray) -> dict[str, Any]:
+    """The leg's :class:`PlanResult` record without its path and trace (a store holds
+    hundreds of legs; ``path_sha256`` identifies the path), plus its joint-space length."""
     from plannerlab.robots.paths import path_length
 
-    path = np.ascontiguousarray(r.path, dtype=float)
-    extra_lengths = {
-        str(k): _num(float(v))
-        for k, v in dict(r.extra).items()
-        if "length" in str(k) and isinstance(v, int | float | np.number) and not isinstance(v, bool)
-    }
     return {
-        "leg": int(r.leg),
-        "goal": r.goal,
-        "status": r.status.value,
-        "reason": r.reason,
-        "time_s": _num(float(r.time_s)),
-        "iterations": int(r.iterations),
-        "collision_checks": int(r.collision_checks),
-        "fk_calls": int(r.fk_calls),
-        "pos_err_m": _num(float(r.pos_err_m)),
-        "angle_err_deg": _num(float(r.angle_err_deg)),
-        "local_minima": int(r.local_minima),
-        "escapes": int(r.escapes),
-        "path_length": _num(path_length(path, continuous)),
-        "path_points": int(len(path)),
-        "path_sha256": hashlib.sha256(path.tobytes()).hexdigest()[:16],
-        "extra_lengths": extra_lengths,
-        "progress": [[_num(float(v)) for v in row] for row in _thinned(r.progress)],
+        **r.to_dict(include_path=False),
+        "path_length": to_data(path_length(r.path, continuous)),
+        "progress": to_data(_thinned(r.progress)),
     }
 
 
@@ -263,16 +238,16 @@ def _execution_record(executions: Sequence[Any]) -> dict[str, Any]:
             "leg": e.leg,
             "success": bool(e.success),
             "path_valid": bool(e.path_valid),
-            "max_track_err_rad": _num(e.max_track_err_rad),
-            "track_err_limit_rad": _num(e.track_err_limit_rad),
+            "max_track_err_rad": to_data(e.max_track_err_rad),
+            "track_err_limit_rad": to_data(e.track_err_limit_rad),
             "timing": e.timing,
-            "duration_s": _num(e.duration_s),
-            "max_tip_track_err_m": _num(e.max_tip_track_err_m),
+            "duration_s": to_data(e.duration_s),
+            "max_tip_track_err_m": to_data(e.max_tip_track_err_m),
             "contacts": len(e.contacts),
-            "final_pos_err_m": _num(e.final_pos_err_m),
-            "final_angle_err_deg": _num(e.final_angle_err_deg),
-            "sim_time_s": _num(e.sim_time_s),
-            "wall_time_s": _num(e.wall_time_s),
+            "final_pos_err_m": to_data(e.final_pos_err_m),
+            "final_angle_err_deg": to_data(e.final_angle_err_deg),
+            "sim_time_s": to_data(e.sim_time_s),
+            "wall_time_s": to_data(e.wall_time_s),
             "reason": e.reason,
         }
         for e in executions
@@ -281,19 +256,19 @@ def _execution_record(executions: Sequence[Any]) -> dict[str, Any]:
     return {
         "success": bool(executions) and all(x["success"] for x in legs),
         "path_valid": all(x["path_valid"] for x in legs),
-        "max_track_err_rad": _num(max((e.max_track_err_rad for e in executions), default=0.0)),
+        "max_track_err_rad": to_data(max((e.max_track_err_rad for e in executions), default=0.0)),
         "contacts": sum(x["contacts"] for x in legs),
-        "final_pos_err_m": _num(last.final_pos_err_m) if last else None,
-        "final_angle_err_deg": _num(last.final_angle_err_deg) if last else None,
+        "final_pos_err_m": to_data(last.final_pos_err_m) if last else None,
+        "final_angle_err_deg": to_data(last.final_angle_err_deg) if last else None,
         "legs": legs,
     }
 
 
 def _trial_status(legs: Sequence[Mapping[str, Any]]) -> str:
     for leg in legs:
-        if leg["status"] != "solved":
+        if leg["status"] != Status.SOLVED:
             return str(leg["status"])
-    return "solved" if legs else "failed"
+    return Status.SOLVED.value if legs else Status.FAILED.value
 
 
 #: per-leg numbers summed into a trial's ``totals``
@@ -348,7 +323,7 @@ def run_trial(trial: Trial) -> dict[str, Any]:
         rec["status"] = _trial_status(legs)
         rec["success"] = bool(legs) and all(x["status"] == "solved" for x in legs)
         rec["error"] = None
-        rec["totals"] = {k: _num(sum((x[k] or 0) for x in legs)) for k in TOTAL_KEYS}
+        rec["totals"] = {k: to_data(sum((x[k] or 0) for x in legs)) for k in TOTAL_KEYS}
         rec["final_pos_err_m"] = legs[-1]["pos_err_m"] if legs else None
         rec["final_angle_err_deg"] = legs[-1]["angle_err_deg"] if legs else None
         rec["execution"] = None
@@ -478,7 +453,7 @@ class TrialStore:
             with open(self.path, "a", encoding="utf-8") as fh:
 
                 def append(rec: Mapping[str, Any]) -> None:
-                    fh.write(json.dumps(rec, separators=(",", ":"), allow_nan=False) + "\n")
+                    fh.write(dumps(rec) + "\n")
                     fh.flush()
                     os.fsync(fh.fileno())
 

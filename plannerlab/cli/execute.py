@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 import argparse
-import json
+import logging
 from pathlib import Path
 from typing import Any
 
@@ -14,7 +14,8 @@ from rich.table import Table
 from plannerlab.cli.common import fmt, require_display
 from plannerlab.cli.solve import add_plan_arguments, leg_table, solve_and_save
 from plannerlab.cli.tables import table
-from plannerlab.errors import PlannerlabError
+from plannerlab.errors import PlanFileError, PlannerlabError
+from plannerlab.record.codec import dumps
 
 
 def execution_table(legs: Any, executions: Any) -> Table:
@@ -66,19 +67,30 @@ def execution_table(legs: Any, executions: Any) -> Table:
 
 
 def cmd_execute(args: argparse.Namespace, console: Console) -> int:
-    from dataclasses import replace
-
     from plannerlab.bench.plan_check import check_plan, read_plan
+    from plannerlab.record.files import versions
+    from plannerlab.record.plan import ExecutionFile, execution_path
     from plannerlab.sim.execute import execute_legs
 
     require_display(args.gui)
     if args.problem.endswith(".json"):
-        out = Path(args.problem)
-        plan = read_plan(out)
+        plan_file = Path(args.problem)
+        plan = read_plan(plan_file)
+        changed = plan.problem_changed()
+        if changed and not args.allow_changed_problem:
+            raise PlanFileError(
+                f"{plan_file}: {changed}; plan again, or pass --allow-changed-problem "
+                "to execute the old plan on the new problem"
+            )
+        if changed:
+            logging.getLogger(__name__).warning("%s: %s", plan_file, changed)
+            if not args.json:
+                console.print(f"[yellow]warning:[/yellow] {changed}")
     else:
         if not args.planner:
             raise PlannerlabError("execute PROBLEM needs --planner NAME (or give a PLAN.json)")
-        plan, out = solve_and_save(args, console)
+        plan, plan_file = solve_and_save(args, console)
+    out = Path(args.out) if args.out else execution_path(plan_file)
     problem = plan.load_problem()
     if args.problem.endswith(".json"):
         check_plan(plan, problem, args.problem)
@@ -88,18 +100,23 @@ def cmd_execute(args: argparse.Namespace, console: Console) -> int:
         executions = execute_legs(
             problem, [r.path for r in plan.legs], first_leg=plan.legs[0].leg, gui=args.gui
         )
-    plan = replace(plan, executions=tuple(e.to_dict() for e in executions))
-    plan.save(out)
+    record = ExecutionFile.of(plan, plan_file, executions, versions())
+    record.save(out)
     if args.json:
-        print(json.dumps(plan.to_dict()))
-        return 1 if args.strict and not all(e.success for e in executions) else 0
+        print(dumps(record.to_dict()))
+        return 1 if args.strict and not record.success else 0
     console.print(leg_table(plan, f"{plan.planner} on {plan.problem}, seed {plan.seed}: plan"))
     console.print(execution_table(plan.legs, executions))
-    console.print(f"plan and execution written to {out}")
+    console.print(f"execution written to {out} (plan: {plan_file})")
     return 1 if args.strict and not all(e.success for e in executions) else 0
 
 
 def add_parser(sub: Any) -> None:
     p = sub.add_parser("execute", help="plan (or load a plan) and execute it in PyBullet")
     add_plan_arguments(p, "execute")
+    p.add_argument(
+        "--allow-changed-problem",
+        action="store_true",
+        help="execute a plan even if its problem file changed since planning (warns)",
+    )
     p.set_defaults(func=cmd_execute)

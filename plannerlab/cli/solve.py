@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import argparse
-import json
 from pathlib import Path
 from typing import Any
 
@@ -22,6 +21,7 @@ from plannerlab.cli.common import (
     seed_int,
 )
 from plannerlab.cli.tables import table
+from plannerlab.record.codec import dumps
 
 
 def leg_table(plan: Any, title: str) -> Table:
@@ -61,7 +61,9 @@ def _default_plan_path(problem: str, planner: str, seed: int) -> Path:
     return RESULTS_DIR / "plans" / f"{problem}__{planner}__seed{seed}.json"
 
 
-def solve_and_save(args: argparse.Namespace, console: Console) -> Any:
+def solve_and_save(args: argparse.Namespace, console: Console, out: Path | None = None) -> Any:
+    """Solve as the flags say and write the plan file (``out``, default beside the
+    results); return the plan and where it went."""
     from plannerlab.bench.task import solve_legs
     from plannerlab.problem.catalog import load_problem
 
@@ -71,7 +73,7 @@ def solve_and_save(args: argparse.Namespace, console: Console) -> Any:
     overrides = parse_overrides(args.set)
     legs = legs_from_spec(problem, args.legs)
     n_legs = len(legs) if legs is not None else problem.legs
-    out = Path(args.out) if args.out else _default_plan_path(problem.name, args.planner, args.seed)
+    out = out or _default_plan_path(problem.name, args.planner, args.seed)
     out.parent.mkdir(parents=True, exist_ok=True)  # a path that cannot exist fails now
     status = console.status(f"{args.planner} on {problem.name}: leg 1/{n_legs}")
 
@@ -101,9 +103,9 @@ def solve_and_save(args: argparse.Namespace, console: Console) -> Any:
 
 def cmd_solve(args: argparse.Namespace, console: Console) -> int:
     require_display(args.gui)
-    plan, out = solve_and_save(args, console)
+    plan, out = solve_and_save(args, console, Path(args.out) if args.out else None)
     if args.json:
-        print(json.dumps(plan.to_dict()))
+        print(dumps(plan.to_dict()))
     else:
         console.print(leg_table(plan, f"{plan.planner} on {plan.problem}, seed {plan.seed}"))
         console.print(f"plan written to {out}")
@@ -139,7 +141,15 @@ def add_plan_arguments(p: argparse.ArgumentParser, name: str) -> None:
         metavar="KEY=VALUE",
         help="override a planner setting (repeatable)",
     )
-    p.add_argument("--out", help="plan file to write (default results/plans/...)")
+    p.add_argument(
+        "--out",
+        help=(
+            "plan file to write (default results/plans/PROBLEM__PLANNER__seedN.json)"
+            if name == "solve"
+            else "execution file to write (default: PLAN.exec.json beside the plan; "
+            "a plan made here goes to results/plans/)"
+        ),
+    )
     p.add_argument("--json", action="store_true", help="machine-readable output")
     p.add_argument(
         "--gui", action="store_true", help="PyBullet window instead of DIRECT (needs a display)"

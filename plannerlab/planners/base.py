@@ -8,31 +8,28 @@ PlanResult``. Failure is a status with a reason, never ``None`` or an exception 
 from __future__ import annotations
 
 import dataclasses
-import enum
 import math
 import time
 from collections.abc import Mapping
-from dataclasses import dataclass, field
 from typing import Any, Protocol, runtime_checkable
 
 import numpy as np
 
-from plannerlab.errors import PlanFileError, PlannerlabError
+from plannerlab.errors import PlannerlabError
+from plannerlab.record.leg import PROGRESS_COLUMNS, PlanResult, Status, settings_dict
 from plannerlab.robots.base import Array
 
-
-class Status(enum.StrEnum):
-    """How a planning call ended."""
-
-    SOLVED = "solved"  #: the path ends inside the goal region and was checked collision-free
-    APPROXIMATE = "approximate"  #: ended outside the goal region but as close as it got
-    LOCAL_MINIMUM = "local_minimum"  #: descent stalled (objective flat while above epsilon)
-    BUDGET_EXHAUSTED = "budget_exhausted"  #: ran out of iterations, checks or time
-    INVALID_START = "invalid_start"  #: the start state is in collision
-    INVALID_GOAL = "invalid_goal"  #: no valid goal state could be found
-    UNREACHABLE = "unreachable"  #: the goal is farther than the robot reaches (not planned)
-    INVALID_PATH = "invalid_path"  #: a path was found but failed the fine re-check
-    FAILED = "failed"  #: any other failure, see ``reason``
+__all__ = [
+    "PROGRESS_COLUMNS",
+    "Deadline",
+    "Progress",
+    "PlanResult",
+    "Planner",
+    "Status",
+    "Stepper",
+    "settings_dict",
+    "with_overrides",
+]
 
 
 @runtime_checkable
@@ -48,31 +45,21 @@ class Stepper(Protocol):
         ...
 
 
-def _jsonable(value: Any) -> Any:
-    if isinstance(value, np.ndarray):
-        if value.dtype.kind == "f" and not np.all(np.isfinite(value)):
-            return _jsonable(value.tolist())  # NaN/inf are not JSON
-        return value.tolist()
-    if isinstance(value, np.generic):
-        return value.item()
-    if isinstance(value, float) and not math.isfinite(value):
-        return None if math.isnan(value) else ("inf" if value > 0 else "-inf")
-    if isinstance(value, Mapping):
-        return {str(k): _jsonable(v) for k, v in value.items()}
-    if isinstance(value, list | tuple):
-        return [_jsonable(v) for v in value]
-    if isinstance(value, enum.Enum):
-        return value.value
-    return value
+class Planner(Protocol):
+    """A planner instance: a registry name and frozen settings."""
 
+    name: str
+    settings: Any
 
-def settings_dict(settings: Any) -> dict[str, Any]:
-    """A frozen settings dataclass as plain JSON-able data."""
-    return _jsonable(dataclasses.asdict(settings)) if dataclasses.is_dataclass(settings) else {}
-
-
-#: the columns of :attr:`PlanResult.progress`, in order
-PROGRESS_COLUMNS = ("time_s", "collision_checks", "best_goal_dist", "best_cost")
+    def solve(
+        self,
+        problem: Any,
+        leg: int,
+        budget: Any,
+        rng: np.random.Generator,
+        q_start: Array | None = None,
+        stepper: Stepper | None = None,
+    ) -> PlanResult: ...
 
 
 class Progress:
@@ -162,113 +149,6 @@ class Progress:
         for t, c, d in series:
             p.note(goal_dist=float(d), time_s=float(t), checks=int(c))
         return p.finish(cost=final_cost)
-
-
-@dataclass(frozen=True, eq=False)
-class PlanResult:
-    """What a planner returns for one leg.
-
-    Attributes:
-        planner: registry name.
-        problem: problem name.
-        leg: leg index; ``goal`` is the goal's name.
-        status: see :class:`Status`; ``reason`` says why in words.
-        path: (m, dof) joint path from the start; m >= 1.
-        time_s: wall time of ``solve`` [s].
-        iterations: planner iterations (descent steps, tree expansions, …).
-        collision_checks: states checked for collision during planning.
-        fk_calls: forward-kinematics evaluations (states), where the planner counts them.
-        pos_err_m, angle_err_deg: tip errors of the path's last state.
-        trace: objective (or best goal distance) per iteration, for plots.
-        progress: (k, 4) rows ``(time_s, collision_checks, best_goal_dist, best_cost)``
-            (:data:`PROGRESS_COLUMNS`), one whenever the best goal distance or the best
-            cost improved, plus one at the end: how the planner got there over time
-            (OMPL's benchmark "progress properties"; see :class:`Progress`).
-        local_minima, escapes: local minima met, and how many of them were left.
-        seed: the trial's seed (None if not seeded by a trial).
-        settings: the planner's settings as data.
-        extra: planner-specific numbers (path length before/after simplification, …).
-    """
-
-    planner: str
-    problem: str
-    leg: int
-    goal: str
-    status: Status
-    reason: str
-    path: Array
-    time_s: float = 0.0
-    iterations: int = 0
-    collision_checks: int = 0
-    fk_calls: int = 0
-    pos_err_m: float = math.nan
-    angle_err_deg: float = math.nan
-    trace: Array = field(default_factory=lambda: np.zeros(0))
-    progress: Array = field(default_factory=lambda: np.zeros((0, 4)))
-    local_minima: int = 0
-    escapes: int = 0
-    seed: int | None = None
-    settings: Mapping[str, Any] = field(default_factory=dict)
-    extra: Mapping[str, Any] = field(default_factory=dict)
-
-    def __post_init__(self) -> None:
-        object.__setattr__(self, "status", Status(self.status))
-        path = np.atleast_2d(np.array(self.path, dtype=float))
-        path.setflags(write=False)
-        object.__setattr__(self, "path", path)
-        trace = np.array(self.trace, dtype=float).reshape(-1)
-        trace.setflags(write=False)
-        object.__setattr__(self, "trace", trace)
-        progress = np.array(self.progress, dtype=float).reshape(-1, len(PROGRESS_COLUMNS))
-        progress.setflags(write=False)
-        object.__setattr__(self, "progress", progress)
-
-    @property
-    def solved(self) -> bool:
-        return self.status is Status.SOLVED
-
-    @property
-    def q_final(self) -> Array:
-        return self.path[-1]
-
-    def to_dict(self) -> dict[str, Any]:
-        d = {f.name: getattr(self, f.name) for f in dataclasses.fields(self)}
-        return _jsonable(d)
-
-    @classmethod
-    def from_dict(cls, data: Mapping[str, Any]) -> PlanResult:
-        try:
-            values = dict(data)
-            for k in ("pos_err_m", "angle_err_deg", "time_s"):
-                if values.get(k) is None:
-                    values[k] = math.nan
-            if values.get("progress") is not None:  # JSON has no NaN: None stands for it
-                values["progress"] = [
-                    [math.nan if v is None else v for v in row] for row in values["progress"]
-                ]
-            return cls(**values)
-        except (TypeError, ValueError) as exc:
-            raise PlanFileError(f"not a plan result: {exc}") from None
-
-    def replace(self, **changes: Any) -> PlanResult:
-        return dataclasses.replace(self, **changes)
-
-
-class Planner(Protocol):
-    """A planner instance: a registry name and frozen settings."""
-
-    name: str
-    settings: Any
-
-    def solve(
-        self,
-        problem: Any,
-        leg: int,
-        budget: Any,
-        rng: np.random.Generator,
-        q_start: Array | None = None,
-        stepper: Stepper | None = None,
-    ) -> PlanResult: ...
 
 
 class Deadline:

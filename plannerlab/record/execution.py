@@ -1,0 +1,258 @@
+"""The record of one executed leg: :class:`Execution` and its :class:`ContactRecord` s.
+
+:mod:`plannerlab.sim.execute` produces them; ``plannerlab execute`` writes them to an
+execution file beside the plan, and the trial store keeps them, through the one codec
+(:mod:`plannerlab.record.codec`).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from collections.abc import Mapping
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from plannerlab.errors import PlannerlabError
+from plannerlab.record.codec import read_float, to_data
+from plannerlab.robots.base import Array
+
+
+@dataclass(frozen=True)
+class ContactRecord:
+    """One (robot link, other) pair that was in contact during an execution.
+
+    Attributes:
+        link_name: robot link.
+        other_name: obstacle name, or the other robot link when ``other_is_link``.
+        other_is_link: True for self-contact.
+        max_depth_m: largest penetration depth seen [m].
+        first_time_s: simulated time the pair was first seen, from the leg's start [s].
+        p_world_m: (3,) contact point at the largest depth, world frame [m].
+    """
+
+    link_name: str
+    other_name: str
+    other_is_link: bool
+    max_depth_m: float
+    first_time_s: float
+    p_world_m: tuple[float, float, float]
+
+    def to_dict(self) -> dict[str, Any]:
+        return to_data(
+            {
+                "link_name": self.link_name,
+                "other_name": self.other_name,
+                "other_is_link": self.other_is_link,
+                "max_depth_m": self.max_depth_m,
+                "first_time_s": self.first_time_s,
+                "p_world_m": list(self.p_world_m),
+            }
+        )
+
+    @classmethod
+    def from_dict(cls, data: Mapping[str, Any]) -> ContactRecord:
+        return cls(
+            link_name=str(data["link_name"]),
+            other_name=str(data["other_name"]),
+            other_is_link=bool(data["other_is_link"]),
+            max_depth_m=read_float(data["max_depth_m"]),
+            first_time_s=read_float(data["first_time_s"]),
+            p_world_m=tuple(float(v) for v in data["p_world_m"]),
+        )
+
+
+_ARRAY_FIELDS = (
+    "t_s",
+    "q_cmd_rad",
+    "q_actual_rad",
+    "track_err_rad",
+    "tip_track_err_m",
+    "q_start_rad",
+    "q_final_rad",
+)
+_FLOAT_FIELDS = (
+    "final_pos_err_m",
+    "final_angle_err_deg",
+    "start_offset_rad",
+    "final_track_err_rad",
+    "final_tip_track_err_m",
+    "duration_s",
+    "spline_dev",
+)
+
+
+@dataclass(frozen=True, eq=False)
+class Execution:
+    """What happened when a path was executed in the simulator.
+
+    Attributes:
+        problem: problem name.
+        leg: leg index, or None when the path was run without a goal.
+        goal: the leg's goal name (or None).
+        path_valid: the FCL re-check found no collision.
+        recheck_joint_step: re-check resolution [rad per joint].
+        recheck_states: interpolated states the re-check looked at.
+        recheck_first_invalid_edge: first path edge with a collision (or None).
+        recheck_pairs: colliding (link, other) names at the first invalid state.
+        waypoint_step: densification of the commanded path, or the spline's knot
+            spacing for ``"toppra"`` [rad per joint].
+        steps_per_waypoint: physics steps per commanded waypoint (``"waypoints"``
+            timing) or per logged sample (``"toppra"``).
+        settle_steps: physics steps holding the last waypoint.
+        dt_s: physics step [s].
+        contact_tol_m: penetration depth above which a contact counted [m].
+        gravity_mps2: gravity of the world, world frame [m/s²].
+        t_s: (M,) simulated time at which each waypoint's state was logged, from the
+            leg's start [s].
+        q_cmd_rad: (M, dof) commanded (densified) waypoints.
+        q_actual_rad: (M, dof) state reached at the end of each waypoint's steps
+            (PyBullet's raw, unwrapped joint values).
+        track_err_rad: (M,) max over joints of the wrapped |q_cmd − q_actual| [rad];
+            for ``"toppra"``, also the max over every physics step since the previous
+            logged sample.
+        tip_track_err_m: (M,) distance between commanded and actual tip [m].
+        contacts: every (link, other) pair in contact, see :class:`ContactRecord`.
+        q_start_rad: (dof,) the state the execution started from.
+        carried_over: True when the start state was where the previous leg really
+            ended (:func:`execute_legs`), not a reset to the path's first waypoint.
+        start_offset_rad: max wrapped |q_start − path[0]| over joints [rad].
+        q_final_rad: (dof,) state after settling.
+        final_track_err_rad, final_tip_track_err_m: tracking errors after settling.
+        final_pos_err_m, final_angle_err_deg: final tip errors against the leg's goal
+            [m, deg] (NaN without a leg).
+        goal_reached: final state inside the goal region (None without a leg).
+        sim_time_s: simulated time of this execution (physics steps × dt) [s].
+        wall_time_s: wall-clock time of this execution, re-check included [s].
+        reason: why it succeeded or failed, in words.
+        track_err_limit_rad: the largest ``max_track_err_rad`` a clean execution may
+            show [rad] (the problem's ``[simulation] max_track_err_rad``).
+        timing: ``"toppra"`` (retimed trajectory, position+velocity targets every physics
+            step) or ``"waypoints"`` (densified waypoints, position targets held for
+            ``steps_per_waypoint`` steps each).
+        duration_s: the commanded motion's duration, settling excluded [s].
+        trajectory_valid: the FCL re-check of the retimed trajectory's commanded states
+            (None for ``"waypoints"``, whose commands are the densified path itself).
+        spline_dev: largest distance between the retimed spline and the path's
+            polyline at the knot-interval midpoints [rad or m] (NaN for ``"waypoints"``).
+    """
+
+    problem: str
+    leg: int | None
+    goal: str | None
+    path_valid: bool
+    recheck_joint_step: float
+    recheck_states: int
+    recheck_first_invalid_edge: int | None
+    recheck_pairs: tuple[tuple[str, str], ...]
+    waypoint_step: float
+    steps_per_waypoint: int
+    settle_steps: int
+    dt_s: float
+    contact_tol_m: float
+    gravity_mps2: tuple[float, float, float]
+    t_s: Array
+    q_cmd_rad: Array
+    q_actual_rad: Array
+    track_err_rad: Array
+    tip_track_err_m: Array
+    contacts: tuple[ContactRecord, ...]
+    q_start_rad: Array
+    carried_over: bool
+    start_offset_rad: float
+    q_final_rad: Array
+    final_track_err_rad: float
+    final_tip_track_err_m: float
+    final_pos_err_m: float
+    final_angle_err_deg: float
+    goal_reached: bool | None
+    sim_time_s: float
+    wall_time_s: float
+    reason: str
+    track_err_limit_rad: float = 0.05
+    timing: str = "waypoints"
+    duration_s: float = math.nan
+    trajectory_valid: bool | None = None
+    spline_dev: float = math.nan
+
+    def __post_init__(self) -> None:
+        for name in _ARRAY_FIELDS:
+            a = np.array(getattr(self, name), dtype=float)
+            if name in ("q_cmd_rad", "q_actual_rad"):
+                a = a.reshape(len(a), -1) if a.size else a.reshape(0, len(self.q_final_rad))
+            a.setflags(write=False)
+            object.__setattr__(self, name, a)
+        for name in _FLOAT_FIELDS:
+            object.__setattr__(self, name, read_float(getattr(self, name)))
+        object.__setattr__(self, "gravity_mps2", tuple(float(g) for g in self.gravity_mps2))
+        object.__setattr__(
+            self, "recheck_pairs", tuple((str(a), str(b)) for a, b in self.recheck_pairs)
+        )
+        object.__setattr__(
+            self,
+            "contacts",
+            tuple(
+                c if isinstance(c, ContactRecord) else ContactRecord.from_dict(c)
+                for c in self.contacts
+            ),
+        )
+
+    @property
+    def tracked(self) -> bool:
+        """The maximum joint tracking error stayed within ``track_err_limit_rad``."""
+        return self.max_track_err_rad <= self.track_err_limit_rad
+
+    @property
+    def success(self) -> bool:
+        """Executed cleanly: re-check valid, no contact, tracking error within the limit,
+        and (with a leg) the final state in the goal."""
+        return (
+            self.path_valid
+            and self.trajectory_valid is not False
+            and not self.contacts
+            and self.tracked
+            and self.goal_reached is not False
+        )
+
+    @property
+    def max_track_err_rad(self) -> float:
+        """Largest per-waypoint tracking error [rad] (0 for an empty log)."""
+        return float(np.max(self.track_err_rad, initial=0.0))
+
+    @property
+    def max_tip_track_err_m(self) -> float:
+        """Largest per-waypoint tip tracking error [m] (0 for an empty log)."""
+        return float(np.max(self.tip_track_err_m, initial=0.0))
+
+    @property
+    def max_contact_depth_m(self) -> float:
+        """Deepest contact of the execution [m] (0 without contacts)."""
+        return max((c.max_depth_m for c in self.contacts), default=0.0)
+
+    def to_dict(self) -> dict[str, Any]:
+        """Plain JSON-able data (the codec's convention); :meth:`from_dict` reads it back."""
+        out = {f.name: getattr(self, f.name) for f in dataclasses.fields(self)}
+        out["contacts"] = [c.to_dict() for c in self.contacts]
+        return to_data(out)
+
+    @classmethod
+    def from_dict(cls, data: Mapping[str, Any]) -> Execution:
+        """Rebuild an execution from :meth:`to_dict` output.
+
+        Raises:
+            PlannerlabError: ``data`` is not an execution record.
+        """
+        fields = dataclasses.fields(cls)
+        try:
+            values = {
+                f.name: data[f.name]
+                for f in fields
+                if f.name in data or f.default is dataclasses.MISSING
+            }
+            for k in ("sim_time_s", "wall_time_s", "dt_s", "contact_tol_m"):
+                values[k] = read_float(values[k])
+            return cls(**values)
+        except (KeyError, TypeError, ValueError) as exc:
+            raise PlannerlabError(f"not an execution record: {exc!r}") from None

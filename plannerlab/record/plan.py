@@ -1,0 +1,228 @@
+"""Plan files and execution files: a planner's legs, and what executing them did.
+
+A plan file (``plannerlab.plan/2``) holds the per-leg :class:`~plannerlab.record.leg.PlanResult`
+records, the seed, the overrides, the budget, the package versions and the SHA-256 of the
+problem file it was planned on. ``plannerlab execute PLAN.json`` never rewrites it: the
+executions go to an execution file (``plannerlab.execution/1``, default ``PLAN.exec.json``
+beside the plan), and executing refuses a plan whose problem file changed since planning
+(unless told to go on with a warning).
+"""
+
+from __future__ import annotations
+
+import hashlib
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+
+from plannerlab.errors import PlanFileError
+from plannerlab.record.codec import dumps, loads
+from plannerlab.record.execution import Execution
+from plannerlab.record.files import write_text_atomic
+from plannerlab.record.leg import PlanResult
+
+if TYPE_CHECKING:
+    from plannerlab.problem.load import Problem
+
+PLAN_FORMAT = "plannerlab.plan/2"
+#: plan files written before the problem hash (read, not written)
+_OLD_PLAN_FORMATS = ("plannerlab.plan/1",)
+EXECUTION_FORMAT = "plannerlab.execution/1"
+
+
+def file_sha256(path: str | Path) -> str:
+    """SHA-256 (hex) of a file's bytes."""
+    return hashlib.sha256(Path(path).read_bytes()).hexdigest()
+
+
+def _read_json(path: Path, what: str) -> Any:
+    try:
+        text = path.read_text(encoding="utf-8")
+    except FileNotFoundError:
+        raise PlanFileError(f"{path}: no such {what}") from None
+    except IsADirectoryError:
+        raise PlanFileError(f"{path}: a directory, expected a {what}") from None
+    except UnicodeDecodeError:
+        raise PlanFileError(f"{path}: not UTF-8 text, expected a {what}") from None
+    try:
+        return loads(text)
+    except ValueError as exc:
+        raise PlanFileError(f"{path}: not JSON ({exc})") from None
+
+
+@dataclass(frozen=True, eq=False)
+class Plan:
+    """A planner's results over some legs of a problem.
+
+    Attributes:
+        problem: problem name; ``problem_file`` the file it was loaded from and
+            ``problem_sha256`` that file's hash at planning time ("" if unknown).
+        planner, seed, overrides, budget: what was run.
+        legs: one :class:`PlanResult` per leg, in order.
+        versions: package versions of the planning run.
+    """
+
+    problem: str
+    problem_file: str
+    planner: str
+    seed: int
+    budget: dict[str, Any]
+    legs: tuple[PlanResult, ...]
+    overrides: dict[str, Any] = field(default_factory=dict)
+    versions: dict[str, str] = field(default_factory=dict)
+    problem_sha256: str = ""
+
+    @property
+    def solved(self) -> bool:
+        return all(r.solved for r in self.legs)
+
+    def full_path(self) -> np.ndarray:
+        """All legs' paths joined (m, dof)."""
+        parts = [self.legs[0].path] + [r.path[1:] for r in self.legs[1:]]
+        return np.concatenate(parts)
+
+    def to_dict(self) -> dict[str, Any]:
+        return {
+            "format": PLAN_FORMAT,
+            "problem": self.problem,
+            "problem_file": self.problem_file,
+            "problem_sha256": self.problem_sha256,
+            "planner": self.planner,
+            "seed": self.seed,
+            "overrides": self.overrides,
+            "budget": self.budget,
+            "versions": self.versions,
+            "legs": [r.to_dict() for r in self.legs],
+        }
+
+    def save(self, path: str | Path) -> Path:
+        return write_text_atomic(path, dumps(self.to_dict(), indent=1) + "\n")
+
+    @classmethod
+    def load(cls, path: str | Path) -> Plan:
+        path = Path(path)
+        data = _read_json(path, "plan file")
+        if not isinstance(data, dict) or data.get("format") not in (
+            PLAN_FORMAT,
+            *_OLD_PLAN_FORMATS,
+        ):
+            raise PlanFileError(f"{path}: [format] expected {PLAN_FORMAT!r}")
+        try:
+            legs = data["legs"]
+            if not isinstance(legs, list) or not legs:
+                raise PlanFileError(f"{path}: [legs] expected a non-empty list of legs")
+            return cls(
+                problem=data["problem"],
+                problem_file=data["problem_file"],
+                planner=data["planner"],
+                seed=int(data["seed"]),
+                budget=data["budget"],
+                legs=tuple(PlanResult.from_dict(r) for r in legs),
+                overrides=data.get("overrides", {}),
+                versions=data.get("versions", {}),
+                problem_sha256=data.get("problem_sha256", ""),
+            )
+        except KeyError as exc:
+            raise PlanFileError(f"{path}: [{exc.args[0]}] is missing") from None
+        except PlanFileError as exc:
+            if str(exc).startswith(str(path)):
+                raise
+            raise PlanFileError(f"{path}: [legs] {exc}") from None
+
+    def problem_changed(self) -> str | None:
+        """Why the problem file is not the one planned on, in words (None: unchanged)."""
+        p = Path(self.problem_file)
+        if not p.is_file():
+            return f"the problem file {p} no longer exists"
+        if self.problem_sha256 and file_sha256(p) != self.problem_sha256:
+            return f"the problem file {p} changed since planning (SHA-256 differs)"
+        return None
+
+    def load_problem(self) -> Problem:
+        from plannerlab.problem.catalog import load_problem
+
+        return load_problem(self.problem_file)
+
+
+@dataclass(frozen=True, eq=False)
+class ExecutionFile:
+    """The executions of a plan's legs, as ``plannerlab execute`` writes them.
+
+    Attributes:
+        plan_file: the plan that was executed; ``problem_sha256`` its problem's hash.
+        executions: one :class:`Execution` per executed leg.
+        versions: package versions of the execution run.
+    """
+
+    plan_file: str
+    problem: str
+    planner: str
+    seed: int
+    problem_sha256: str
+    executions: tuple[Execution, ...]
+    versions: dict[str, str] = field(default_factory=dict)
+
+    @property
+    def success(self) -> bool:
+        return bool(self.executions) and all(e.success for e in self.executions)
+
+    def to_dict(self) -> dict[str, Any]:
+        return {
+            "format": EXECUTION_FORMAT,
+            "plan_file": self.plan_file,
+            "problem": self.problem,
+            "planner": self.planner,
+            "seed": self.seed,
+            "problem_sha256": self.problem_sha256,
+            "versions": self.versions,
+            "executions": [e.to_dict() for e in self.executions],
+        }
+
+    def save(self, path: str | Path) -> Path:
+        return write_text_atomic(path, dumps(self.to_dict(), indent=1) + "\n")
+
+    @classmethod
+    def of(
+        cls,
+        plan: Plan,
+        plan_file: str | Path,
+        executions: Sequence[Execution],
+        versions: dict[str, str],
+    ) -> ExecutionFile:
+        return cls(
+            plan_file=str(plan_file),
+            problem=plan.problem,
+            planner=plan.planner,
+            seed=plan.seed,
+            problem_sha256=plan.problem_sha256,
+            executions=tuple(executions),
+            versions=versions,
+        )
+
+    @classmethod
+    def load(cls, path: str | Path) -> ExecutionFile:
+        path = Path(path)
+        data = _read_json(path, "execution file")
+        if not isinstance(data, dict) or data.get("format") != EXECUTION_FORMAT:
+            raise PlanFileError(f"{path}: [format] expected {EXECUTION_FORMAT!r}")
+        try:
+            return cls(
+                plan_file=data["plan_file"],
+                problem=data["problem"],
+                planner=data["planner"],
+                seed=int(data["seed"]),
+                problem_sha256=data.get("problem_sha256", ""),
+                executions=tuple(Execution.from_dict(e) for e in data["executions"]),
+                versions=data.get("versions", {}),
+            )
+        except KeyError as exc:
+            raise PlanFileError(f"{path}: [{exc.args[0]}] is missing") from None
+
+
+def execution_path(plan_file: str | Path) -> Path:
+    """Where ``plannerlab execute PLAN.json`` writes by default: ``PLAN.exec.json``."""
+    p = Path(plan_file)
+    return p.with_name(p.name.removesuffix(".json") + ".exec.json")
