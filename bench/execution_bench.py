@@ -25,8 +25,8 @@ import numpy as np
 
 
 def main(argv: list[str]) -> int:
-    from plannerlab.bench.task import Plan
     from plannerlab.record.files import versions
+    from plannerlab.record.plan import Plan
     from plannerlab.sim.execute import execute_legs
 
     if argv:

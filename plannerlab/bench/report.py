@@ -253,7 +253,7 @@ def leg_rows(records: Iterable[Mapping[str, Any]]) -> list[dict[str, Any]]:
                     "exec_success": e.get("success"),
                     "exec_path_valid": e.get("path_valid"),
                     "exec_max_track_err_rad": e.get("max_track_err_rad"),
-                    "exec_contacts": e.get("contacts"),
+                    "exec_contacts": len(e["contacts"]) if "contacts" in e else None,
                     "exec_final_pos_err_m": e.get("final_pos_err_m"),
                     "exec_final_angle_err_deg": e.get("final_angle_err_deg"),
                     "exec_reason": e.get("reason"),

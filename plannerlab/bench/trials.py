@@ -57,6 +57,7 @@ import numpy as np
 
 from plannerlab.errors import PlannerlabError
 from plannerlab.record.codec import dumps, to_data
+from plannerlab.record.execution import Execution
 from plannerlab.record.leg import PlanResult, Status
 
 LOGGER = logging.getLogger(__name__)
@@ -232,32 +233,16 @@ def _leg_record(r: PlanResult, continuous: np.ndarray) -> dict[str, Any]:
     }
 
 
-def _execution_record(executions: Sequence[Any]) -> dict[str, Any]:
-    legs = [
-        {
-            "leg": e.leg,
-            "success": bool(e.success),
-            "path_valid": bool(e.path_valid),
-            "max_track_err_rad": to_data(e.max_track_err_rad),
-            "track_err_limit_rad": to_data(e.track_err_limit_rad),
-            "timing": e.timing,
-            "duration_s": to_data(e.duration_s),
-            "max_tip_track_err_m": to_data(e.max_tip_track_err_m),
-            "contacts": len(e.contacts),
-            "final_pos_err_m": to_data(e.final_pos_err_m),
-            "final_angle_err_deg": to_data(e.final_angle_err_deg),
-            "sim_time_s": to_data(e.sim_time_s),
-            "wall_time_s": to_data(e.wall_time_s),
-            "reason": e.reason,
-        }
-        for e in executions
-    ]
+def _execution_record(executions: Sequence[Execution]) -> dict[str, Any]:
+    """The trial's executions: each leg's :class:`Execution` record without its
+    per-waypoint log, and the verdict over the legs."""
+    legs = [e.to_dict(include_log=False) for e in executions]
     last = executions[-1] if executions else None
     return {
-        "success": bool(executions) and all(x["success"] for x in legs),
-        "path_valid": all(x["path_valid"] for x in legs),
+        "success": bool(executions) and all(e.success for e in executions),
+        "path_valid": all(e.path_valid for e in executions),
         "max_track_err_rad": to_data(max((e.max_track_err_rad for e in executions), default=0.0)),
-        "contacts": sum(x["contacts"] for x in legs),
+        "contacts": sum(len(e.contacts) for e in executions),
         "final_pos_err_m": to_data(last.final_pos_err_m) if last else None,
         "final_angle_err_deg": to_data(last.final_angle_err_deg) if last else None,
         "legs": legs,

@@ -73,6 +73,8 @@ _ARRAY_FIELDS = (
     "q_start_rad",
     "q_final_rad",
 )
+#: the per-waypoint log, left out of a trial store's copy
+_LOG_FIELDS = ("t_s", "q_cmd_rad", "q_actual_rad", "track_err_rad", "tip_track_err_m")
 _FLOAT_FIELDS = (
     "final_pos_err_m",
     "final_angle_err_deg",
@@ -231,10 +233,24 @@ class Execution:
         """Deepest contact of the execution [m] (0 without contacts)."""
         return max((c.max_depth_m for c in self.contacts), default=0.0)
 
-    def to_dict(self) -> dict[str, Any]:
-        """Plain JSON-able data (the codec's convention); :meth:`from_dict` reads it back."""
+    def to_dict(self, *, include_log: bool = True) -> dict[str, Any]:
+        """Plain JSON-able data (the codec's convention); :meth:`from_dict` reads it back.
+
+        Args:
+            include_log: False leaves out the per-waypoint log (``t_s``, ``q_cmd_rad``,
+                ``q_actual_rad``, ``track_err_rad``, ``tip_track_err_m``: a trial store
+                keeps hundreds of legs) and writes ``log_points``, ``success``,
+                ``max_track_err_rad`` and ``max_tip_track_err_m`` instead.
+        """
         out = {f.name: getattr(self, f.name) for f in dataclasses.fields(self)}
         out["contacts"] = [c.to_dict() for c in self.contacts]
+        if not include_log:
+            for name in _LOG_FIELDS:
+                del out[name]
+            out["log_points"] = len(self.t_s)
+            out["success"] = self.success
+            out["max_track_err_rad"] = self.max_track_err_rad
+            out["max_tip_track_err_m"] = self.max_tip_track_err_m
         return to_data(out)
 
     @classmethod

@@ -1,11 +1,12 @@
 """Plan files and execution files: a planner's legs, and what executing them did.
 
-A plan file (``plannerlab.plan/2``) holds the per-leg :class:`~plannerlab.record.leg.PlanResult`
-records, the seed, the overrides, the budget, the package versions and the SHA-256 of the
-problem file it was planned on. ``plannerlab execute PLAN.json`` never rewrites it: the
-executions go to an execution file (``plannerlab.execution/1``, default ``PLAN.exec.json``
-beside the plan), and executing refuses a plan whose problem file changed since planning
-(unless told to go on with a warning).
+A plan file (``plannerlab.plan/2``) holds the per-leg
+:class:`~plannerlab.record.leg.PlanResult` records (each path as its waypoints), the seed,
+the overrides, the budget, the package versions and the SHA-256 of the problem file it
+was planned on. ``plannerlab execute PLAN.json`` never rewrites it: the executions go to
+an execution file (``plannerlab.execution/1``, default ``PLAN.exec.json`` beside the
+plan), and executing refuses a plan whose problem file changed since planning (unless
+told to go on with a warning).
 """
 
 from __future__ import annotations
@@ -19,10 +20,11 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from plannerlab.errors import PlanFileError
-from plannerlab.record.codec import dumps, loads
+from plannerlab.record.codec import dumps, loads, to_data
 from plannerlab.record.execution import Execution
 from plannerlab.record.files import write_text_atomic
 from plannerlab.record.leg import PlanResult
+from plannerlab.robots.paths import waypoints
 
 if TYPE_CHECKING:
     from plannerlab.problem.load import Problem
@@ -85,6 +87,10 @@ class Plan:
         return np.concatenate(parts)
 
     def to_dict(self) -> dict[str, Any]:
+        """The plan file's content. Each leg's path is stored as its waypoints
+        (:func:`~plannerlab.robots.paths.waypoints`: states inside a straight joint-space
+        segment are left out, as executing densifies every segment again), so a plan file
+        stays small (an interpolated OMPL path of 14 000 states is a few dozen corners)."""
         return {
             "format": PLAN_FORMAT,
             "problem": self.problem,
@@ -95,7 +101,7 @@ class Plan:
             "overrides": self.overrides,
             "budget": self.budget,
             "versions": self.versions,
-            "legs": [r.to_dict() for r in self.legs],
+            "legs": [{**r.to_dict(), "path": to_data(waypoints(r.path))} for r in self.legs],
         }
 
     def save(self, path: str | Path) -> Path:

@@ -96,3 +96,51 @@ def path_length(path: Array, continuous: np.ndarray) -> float:
         return 0.0
     d = joint_difference(path[1:], path[:-1], continuous)
     return float(np.sum(np.linalg.norm(d, axis=1)))
+
+
+def _on_segment(a: Array, b: Array, inner: Array, tol_rad: float) -> Array:
+    """For each row of ``inner`` (k, dof): within ``tol_rad`` of segment a–b, between a and b."""
+    ab = b - a
+    den = float(ab @ ab)
+    if den == 0.0:
+        return np.linalg.norm(inner - a, axis=1) <= tol_rad
+    t = (inner - a) @ ab / den
+    off = np.linalg.norm(inner - a - t[:, None] * ab[None, :], axis=1)
+    return (off <= tol_rad) & (t >= 0.0) & (t <= 1.0)
+
+
+def waypoints(path: Array, tol_rad: float = 1e-9) -> Array:
+    """The path's waypoints: states that lie inside a straight joint-space segment are left
+    out (an interpolated path comes back as the corners it was interpolated between).
+
+    A state is dropped only when it lies within ``tol_rad`` (Euclidean, joint space) of the
+    segment between the kept states around it, and between them. The first and last
+    states are always kept. Differences are taken as stored (a continuous joint's wrap at
+    ±pi is a corner).
+
+    Args:
+        path: (m, dof) joint path.
+        tol_rad: distance from the segment below which a state counts as on it.
+
+    Returns:
+        (k, dof) with k <= m, the kept states in order (copies).
+    """
+    path = np.atleast_2d(np.asarray(path, dtype=float))
+    m = len(path)
+    if m <= 2:
+        return path.copy()
+    # candidates: interior states on the segment between their two neighbours
+    prev, mid, nxt = path[:-2], path[1:-1], path[2:]
+    d = nxt - prev
+    den = np.einsum("ij,ij->i", d, d)
+    t = np.einsum("ij,ij->i", mid - prev, d) / np.where(den > 0, den, 1.0)
+    off = np.linalg.norm(mid - prev - t[:, None] * d, axis=1)
+    droppable = (off <= tol_rad) & (t >= 0.0) & (t <= 1.0)
+    corners = [0, *(np.flatnonzero(~droppable) + 1).tolist(), m - 1]
+    # every dropped state must lie on the segment between the corners around it
+    keep = [0]
+    for a, b in zip(corners[:-1], corners[1:], strict=True):
+        if b - a > 1 and not bool(np.all(_on_segment(path[a], path[b], path[a + 1 : b], tol_rad))):
+            keep.extend(range(a + 1, b))  # a slow curve: keep its states as they are
+        keep.append(b)
+    return path[keep].copy()
