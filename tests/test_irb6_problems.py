@@ -20,6 +20,7 @@ from plannerlab.planners import PlanResult, make_planner
 from plannerlab.problem.catalog import load_problem, resolve_problem_path
 from plannerlab.problem.load import Problem
 from plannerlab.problem.scene import Scene
+from plannerlab.robots.irb6.goals import sample_goal_state
 from plannerlab.robots.irb6.ik import solve_ik
 from plannerlab.robots.irb6.model import IRb6
 
@@ -43,7 +44,7 @@ def _goal_states(problem: Problem, n: int, seed: int) -> list[np.ndarray]:
     rng = np.random.default_rng(seed)
     out = []
     for _ in range(n):
-        q = problem.robot.sample_goal_state(problem.goals[0], rng)
+        q = sample_goal_state(problem.robot, problem.goals[0], rng)
         assert q is not None
         out.append(q)
     return out
@@ -134,11 +135,11 @@ def test_the_pillar_forces_the_track_to_move() -> None:
 def test_sample_goal_state_hook_is_deterministic_and_checks_seeds() -> None:
     problem = load_problem("irb6_case2_two_intervals")
     robot, goal = problem.robot, problem.goals[0]
-    a = robot.sample_goal_state(goal, np.random.default_rng(5), seeds=[problem.q_start])
-    b = robot.sample_goal_state(goal, np.random.default_rng(5), seeds=[problem.q_start])
+    a = sample_goal_state(robot, goal, np.random.default_rng(5), seeds=[problem.q_start])
+    b = sample_goal_state(robot, goal, np.random.default_rng(5), seeds=[problem.q_start])
     assert a is not None and np.array_equal(a, b)
     with pytest.raises(PlannerlabError, match="seed"):
-        robot.sample_goal_state(goal, np.random.default_rng(5), seeds=[np.zeros(3)])
+        sample_goal_state(robot, goal, np.random.default_rng(5), seeds=[np.zeros(3)])
 
 
 # ----------------------------------------------------------------------------- CLI

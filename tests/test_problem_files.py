@@ -93,12 +93,9 @@ BAD = {
     "misspelt_key": (GOOD.replace("size_m", "sizes_m"), "obstacles[0].sizes_m", "not a known key"),
     "no_goals": (GOOD[: GOOD.index("[[goals]]")], "goals", "missing"),
     "syntax": (GOOD.replace("[robot]", "[robot"), "<syntax>", "valid TOML"),
-    "start_in_collision": (
-        GOOD.replace("center_m = [3.0, 0.0, 2.0]", "center_m = [0.5, 0.0, 2.0]"),
-        "start",
-        "module_1 x wall",
-    ),
 }
+
+START_IN_COLLISION = GOOD.replace("center_m = [3.0, 0.0, 2.0]", "center_m = [0.5, 0.0, 2.0]")
 
 
 @pytest.mark.parametrize("case", BAD, ids=list(BAD))
@@ -112,6 +109,17 @@ def test_bad_file_names_file_key_and_expectation(tmp_path, case):
     assert f"[{key}]" in msg
     assert expected in msg
     assert err.value.key == key
+
+
+def test_a_start_in_collision_is_refused_where_planning_starts(tmp_path):
+    """Loading needs no collision checker; planning checks the start once, naming the pairs."""
+    from plannerlab.bench.task import solve_legs
+
+    problem = load_problem(write(tmp_path, START_IN_COLLISION))
+    with pytest.raises(ProblemError) as err:
+        solve_legs(problem, "gradient.analytic", 0)
+    assert err.value.key == "start" and "module_1 x wall" in str(err.value)
+    assert str(problem.source) in str(err.value)
 
 
 def test_missing_file_and_unknown_problem_name(tmp_path):

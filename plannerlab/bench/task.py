@@ -15,6 +15,7 @@ from typing import Any
 
 import numpy as np
 
+from plannerlab.errors import ProblemError
 from plannerlab.planners import get_entry, make_planner
 from plannerlab.problem.goals import unreachable_reason
 from plannerlab.problem.load import Budget, Problem
@@ -48,6 +49,16 @@ def _unreachable(
     )
 
 
+def _check_problem_start(problem: Problem) -> None:
+    """Raise a ProblemError naming the colliding pairs if the problem's start collides."""
+    from plannerlab.collision.fcl_checker import CollisionChecker
+    from plannerlab.planners.base import start_collision
+
+    reason = start_collision(CollisionChecker(problem.robot, problem.scene), problem.q_start)
+    if reason is not None:
+        raise ProblemError(problem.source, "start", f"a collision-free start state; {reason}")
+
+
 def solve_legs(
     problem: Problem,
     planner_name: str,
@@ -69,6 +80,8 @@ def solve_legs(
     budget = budget or problem.budget
     legs = list(range(problem.legs)) if legs is None else list(legs)
     results: list[PlanResult] = []
+    if legs:  # the first leg starts at the problem's start state
+        _check_problem_start(problem)
     with ExitStack() as stack:
         stepper = None
         if entry.needs_stepper:

@@ -1,15 +1,16 @@
 """The planner registry: planners are looked up by name and imported on first use.
 
 An entry maps a name to ``"module:factory"``; the factory is called as
-``factory(name, overrides)`` and returns a planner with frozen settings. OMPL planners
-are all served by :mod:`plannerlab.planners.ompl` (the only module importing ``ompl``).
+``factory(name, overrides, **entry.options)`` and returns a planner with frozen settings.
+OMPL planners are all served by :mod:`plannerlab.planners.ompl` (the only module importing
+``ompl``).
 """
 
 from __future__ import annotations
 
 import importlib
 from collections.abc import Mapping
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from types import MappingProxyType
 from typing import Any
 
@@ -27,6 +28,9 @@ class PlannerEntry:
         summary: one line for ``plannerlab planners``.
         needs_stepper: the planner runs a simulator in its loop (closed-loop modes).
         robots: robot kinds it applies to (None: every joint-vector robot).
+        options: keyword arguments the factory gets besides the name and the overrides
+            (the OMPL class of an ``ompl.*`` planner), so that no planner module has to
+            look itself up in this registry.
     """
 
     name: str
@@ -34,6 +38,7 @@ class PlannerEntry:
     summary: str
     needs_stepper: bool = False
     robots: tuple[str, ...] | None = None
+    options: Mapping[str, Any] = field(default_factory=dict)
 
 
 #: OMPL geometric planners shipped in the ``ompl`` wheel: registry suffix -> OMPL class.
@@ -124,7 +129,10 @@ def _entries() -> dict[str, PlannerEntry]:
     for suffix, cls in OMPL_PLANNERS.items():
         entries.append(
             PlannerEntry(
-                f"ompl.{suffix}", "plannerlab.planners.ompl:make", f"OMPL {cls} (geometric)"
+                f"ompl.{suffix}",
+                "plannerlab.planners.ompl:make",
+                f"OMPL {cls} (geometric)",
+                options=MappingProxyType({"ompl_class": cls}),
             )
         )
     return {e.name: e for e in entries}
@@ -150,7 +158,8 @@ def make_planner(name: str, overrides: Mapping[str, Any] | None = None) -> Plann
     """A planner by registry name, with some settings overridden."""
     entry = get_entry(name)
     module_name, factory = entry.target.split(":")
-    return getattr(importlib.import_module(module_name), factory)(name, dict(overrides or {}))
+    factory_fn = getattr(importlib.import_module(module_name), factory)
+    return factory_fn(name, dict(overrides or {}), **entry.options)
 
 
 __all__ = [

@@ -28,6 +28,7 @@ __all__ = [
     "Status",
     "Stepper",
     "settings_dict",
+    "start_collision",
     "with_overrides",
 ]
 
@@ -149,6 +150,15 @@ class Progress:
         for t, c, d in series:
             p.note(goal_dist=float(d), time_s=float(t), checks=int(c))
         return p.finish(cost=final_cost)
+
+
+def start_collision(checker: Any, q_start: Array) -> str | None:
+    """Why a leg cannot start at ``q_start``: its colliding pairs in words, or None when it
+    is collision-free. The one start-state check (one collision check when valid)."""
+    if checker.is_valid(q_start):
+        return None
+    pairs = ", ".join(f"{a} x {b}" for a, b in checker.colliding_pairs(q_start))
+    return f"the start state collides: {pairs}"
 
 
 class Deadline:

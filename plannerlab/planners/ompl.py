@@ -94,13 +94,14 @@ import ompl.geometric as og
 import ompl.util as ou
 
 from plannerlab.collision.fcl_checker import CollisionChecker
-from plannerlab.errors import PlannerlabError, UnknownNameError
+from plannerlab.errors import PlannerlabError
 from plannerlab.planners.base import (
     Deadline,
     PlanResult,
     Progress,
     Status,
     settings_dict,
+    start_collision,
     with_overrides,
 )
 from plannerlab.problem.goals import GoalRegion
@@ -731,9 +732,9 @@ class OMPLPlanner:
                 extra=dict(extra),
             )
 
-        if not checker.is_valid(q0):
-            pairs = ", ".join(f"{a} x {b}" for a, b in checker.colliding_pairs(q0))
-            return result(Status.INVALID_START, f"the start state collides: {pairs}", q0[None], 0)
+        start_problem = start_collision(checker, q0)
+        if start_problem is not None:
+            return result(Status.INVALID_START, start_problem, q0[None], 0)
         fk[0] += 1
         progress.note(float(goal.distance(robot, q0)))  # where the search starts from
 
@@ -1070,20 +1071,18 @@ class OMPLPlanner:
                 return None, False, "Timeout"
 
 
-def make(name: str, overrides: Mapping[str, Any] | None = None) -> OMPLPlanner:
-    """Registry factory: ``ompl.<suffix>`` with settings overridden by name.
+def make(name: str, overrides: Mapping[str, Any] | None = None, *, ompl_class: str) -> OMPLPlanner:
+    """Registry factory: the OMPL geometric planner ``ompl_class`` (``"RRTConnect"``, as
+    the registry entry ``name`` says), with settings overridden by name.
 
     Raises:
-        UnknownNameError: unknown planner or setting name (lists the known ones).
+        UnknownNameError: unknown setting name (lists the known ones).
+        PlannerlabError: ``ompl_class`` has no settings here.
     """
-    from plannerlab.planners import OMPL_PLANNERS
-
-    suffix = name.split(".", 1)[1] if name.startswith("ompl.") else name
-    if suffix not in OMPL_PLANNERS:
-        raise UnknownNameError("planner", name, [f"ompl.{k}" for k in OMPL_PLANNERS])
-    cls = OMPL_PLANNERS[suffix]
-    settings = with_overrides(SETTINGS_BY_CLASS[cls](), dict(overrides or {}), name)
-    return OMPLPlanner(name=name, ompl_class=cls, settings=settings)
+    if ompl_class not in SETTINGS_BY_CLASS:
+        raise PlannerlabError(f"{name}: OMPL class {ompl_class!r} is not served by this adapter")
+    settings = with_overrides(SETTINGS_BY_CLASS[ompl_class](), dict(overrides or {}), name)
+    return OMPLPlanner(name=name, ompl_class=ompl_class, settings=settings)
 
 
 __all__ = [

@@ -1,8 +1,8 @@
 """Finding and loading problems: what users call.
 
-:func:`load_problem` parses a problem file (see :mod:`plannerlab.problem.load`) and then makes
-the checks that need the collision checker: the start state must be collision-free
-(the error names the colliding pairs).
+:func:`load_problem` parses and validates a problem file (see :mod:`plannerlab.problem.load`);
+it imports no engine. Whether the start state is collision-free is checked where planning
+starts (:func:`plannerlab.bench.task.solve_legs`), once.
 """
 
 from __future__ import annotations
@@ -10,8 +10,7 @@ from __future__ import annotations
 import os
 from pathlib import Path
 
-from plannerlab.collision.fcl_checker import CollisionChecker
-from plannerlab.errors import ProblemError, UnknownNameError
+from plannerlab.errors import UnknownNameError
 from plannerlab.problem.load import Problem, parse_problem
 
 
@@ -46,19 +45,8 @@ def resolve_problem_path(name_or_path: str | Path, cwd: Path | None = None) -> P
     raise UnknownNameError("problem", str(name_or_path), [q.stem for q in list_problems()])
 
 
-def check_start(problem: Problem, checker: CollisionChecker | None = None) -> None:
-    """Raise a ProblemError naming the colliding pairs if the start is in collision."""
-    checker = checker or CollisionChecker(problem.robot, problem.scene)
-    if not checker.is_valid(problem.q_start):
-        pairs = checker.colliding_pairs(problem.q_start)
-        listing = ", ".join(f"{a} x {b}" for a, b in pairs)
-        raise ProblemError(
-            problem.source, "start", f"a collision-free start state; it collides: {listing}"
-        )
-
-
 def load_problem(name_or_path: str | Path) -> Problem:
-    """Parse, validate and collision-check a problem (by bundled name or by path)."""
-    problem = parse_problem(resolve_problem_path(name_or_path))
-    check_start(problem)
-    return problem
+    """Parse and validate a problem (by bundled name or by path). Needs no engine: the
+    start state is collision-checked where planning starts
+    (:func:`plannerlab.bench.task.solve_legs`)."""
+    return parse_problem(resolve_problem_path(name_or_path))

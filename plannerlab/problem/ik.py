@@ -17,9 +17,10 @@ Only numpy is used here; a collision checker is passed in (anything with
 
 from __future__ import annotations
 
+import importlib
 from collections.abc import Sequence
 from dataclasses import dataclass
-from typing import Protocol
+from typing import Any, Protocol
 
 import numpy as np
 
@@ -79,9 +80,10 @@ def solve_ik(
     ``max_step_rad``. The descent aims at ``target_fraction`` of the tolerances (deeper
     than needed, so the result is robustly inside) and stops early once there.
 
-    A robot that has analytic IK provides ``robot.sample_goal_state(goal, rng, seeds)``
-    (a state inside the region, collision ignored, or None); it is used instead of the
-    numeric descent, and each candidate is collision-checked here.
+    A robot kind with an analytic IK has a sampler in :data:`ANALYTIC_GOAL_SAMPLERS`
+    (``sampler(robot, goal, rng, seeds)``: a state inside the region, collision ignored,
+    or None); it is used instead of the numeric descent, and each candidate is
+    collision-checked here.
 
     Args:
         robot: any joint-vector robot.
@@ -142,6 +144,21 @@ def solve_ik(
     return IKResult(q, True, iterations, "inside both tolerances", pos_err, ang_err)
 
 
+#: robot kind -> "module:function" sampling its goal regions through an analytic IK,
+#: called as ``function(robot, goal, rng, seeds=...)`` (imported on first use)
+ANALYTIC_GOAL_SAMPLERS: dict[str, str] = {
+    "irb6": "plannerlab.robots.irb6.goals:sample_goal_state",
+}
+
+
+def _analytic_goal_sampler(robot: Any) -> Any:
+    target = ANALYTIC_GOAL_SAMPLERS.get(getattr(robot, "kind", ""))
+    if target is None:
+        return None
+    module_name, func = target.split(":")
+    return getattr(importlib.import_module(module_name), func)
+
+
 def sample_goal_state(
     robot: Robot,
     goal: GoalRegion,
@@ -177,9 +194,10 @@ def sample_goal_state(
     plain IK is not enough for A-E; a collision-aware (null-space) repair is what is
     missing here.
 
-    A robot that has analytic IK provides ``robot.sample_goal_state(goal, rng, seeds)``
-    (a state inside the region, collision ignored, or None); it is used instead of the
-    numeric descent, and each candidate is collision-checked here.
+    A robot kind with an analytic IK has a sampler in :data:`ANALYTIC_GOAL_SAMPLERS`
+    (``sampler(robot, goal, rng, seeds)``: a state inside the region, collision ignored,
+    or None); it is used instead of the numeric descent, and each candidate is
+    collision-checked here.
 
     Args:
         robot: any joint-vector robot.
@@ -196,12 +214,12 @@ def sample_goal_state(
         (dof,) state inside the region and collision-free, or None after ``attempts``.
     """
     seed_list = [np.asarray(s, dtype=float).reshape(robot.dof) for s in seeds]
-    analytic = getattr(robot, "sample_goal_state", None)
+    analytic = _analytic_goal_sampler(robot)
     if analytic is not None:
         # Robots with analytic IK (the IRb-6) sample the region themselves; each candidate
         # still costs one collision check here.
         for _ in range(attempts):
-            q = analytic(goal, rng, seeds=seed_list or None)
+            q = analytic(robot, goal, rng, seeds=seed_list or None)
             if q is not None and checker.is_valid(q):
                 return np.asarray(q, dtype=float)
         return None

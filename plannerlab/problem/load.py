@@ -26,6 +26,7 @@ File layout (every key is documented in ``docs/problem-format.md``)::
 
 from __future__ import annotations
 
+import importlib
 import math
 import tomllib
 from collections.abc import Mapping
@@ -38,7 +39,6 @@ import numpy as np
 from plannerlab.errors import ProblemError, UnknownNameError, did_you_mean
 from plannerlab.problem.goals import GoalRegion
 from plannerlab.problem.scene import OBSTACLE_TYPES, Box, Cylinder, Obstacle, Scene, Sphere
-from plannerlab.robots import build_robot
 from plannerlab.robots.base import Array, Robot, pose_matrix
 
 KNOWN_TABLES = (
@@ -414,6 +414,29 @@ def _simulation(top: TableReader, robot: Robot) -> SimSettings:
         max_track_err_rad=sim.number("max_track_err_rad", 0.05, positive=True),
         origin=origin,
     )
+
+
+#: robot type in a problem file -> "module:function" building it from the [robot] table
+ROBOT_TYPES: dict[str, str] = {
+    "armz": "plannerlab.robots.armz.model:from_table",
+    "irb6": "plannerlab.robots.irb6.model:from_table",
+    "continuum_chain": "plannerlab.robots.continuum.model:from_table",
+}
+
+
+def build_robot(reader: TableReader) -> Robot:
+    """Build the robot described by a problem file's ``[robot]`` table; the family's module
+    is imported only now."""
+    kind = reader.string("type")
+    if kind not in ROBOT_TYPES:
+        import difflib
+
+        close = difflib.get_close_matches(kind, ROBOT_TYPES, n=1)
+        hint = f" (did you mean {close[0]!r}?)" if close else ""
+        raise reader.fail("type", f"one of {', '.join(ROBOT_TYPES)}, got {kind!r}{hint}")
+    module_name, func = ROBOT_TYPES[kind].split(":")
+    builder = getattr(importlib.import_module(module_name), func)
+    return builder(reader)
 
 
 def problem_from_dict(data: Mapping[str, Any], source: str) -> Problem:

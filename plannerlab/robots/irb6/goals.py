@@ -17,6 +17,8 @@ The result is checked with the forward kinematics before it is returned. Only nu
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -24,6 +26,9 @@ from plannerlab.errors import PlannerlabError
 from plannerlab.robots.base import Array
 from plannerlab.robots.irb6.ik import IKAnswer, solve_ik, solve_with_lambda0
 from plannerlab.robots.irb6.model import IRb6
+
+if TYPE_CHECKING:
+    from plannerlab.problem.goals import GoalRegion
 
 
 def _perpendicular_basis(c: Array) -> tuple[Array, Array]:
@@ -151,3 +156,51 @@ def sample_irb6_goal(
         if pos_err <= pos_tol_m + 1e-9 and math.acos(cos_err) <= tol_rad + 1e-9:
             return q
     return None
+
+
+def sample_goal_state(
+    robot: IRb6,
+    goal: GoalRegion,
+    rng: np.random.Generator,
+    seeds: Sequence[Array] | None = None,
+) -> Array | None:
+    """One joint vector inside a goal region, drawn through the analytic IK, or None.
+
+    The common goal sampler (:func:`plannerlab.problem.ik.sample_goal_state`) calls this
+    for the IRb-6 (its analytic inverse kinematics instead of restarting a numeric
+    descent): it wraps :func:`sample_irb6_goal`, which draws a flange pose
+    inside the region (position ball, approach cone, free roll) and solves it; in the
+    ambiguous cases λ0 is drawn uniformly from the pose's feasible λ0 set, so repeated
+    calls spread over every interval of the track that reaches the goal.
+
+    The collision check is the caller's job: the state returned is only guaranteed to
+    be within the joint ranges with its flange inside the region.
+
+    Args:
+        robot: the IRb-6 model.
+        goal: target flange position ``goal.p_world_m`` and approach vector
+            ``goal.n_world`` in the WORLD frame, tolerances ``goal.pos_tol_m`` [m] and
+            ``goal.angle_tol_deg`` [deg].
+        rng: the trial's generator (the only source of randomness).
+        seeds: states near which the goal is wanted (e.g. the leg's start); the first
+            one's θ5 picks the θ5 branch at the ends of its 360° range. The analytic IK
+            needs no other seed.
+
+    Returns:
+        q (6,) or None when no attempt of the sampler reached the region.
+    """
+    previous_theta5 = None
+    if seeds is not None and len(seeds) > 0:
+        first = np.asarray(seeds[0], dtype=float)
+        if first.shape != (robot.dof,):
+            raise PlannerlabError(f"IRb6: a seed must have shape (6,), got {first.shape}")
+        previous_theta5 = float(first[5])
+    return sample_irb6_goal(
+        robot,
+        goal.p_world_m,
+        goal.n_world,
+        float(goal.pos_tol_m),
+        float(goal.angle_tol_deg),
+        rng,
+        previous_theta5_rad=previous_theta5,
+    )

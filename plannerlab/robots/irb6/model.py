@@ -63,13 +63,14 @@ neighbours, nor between the column and the upper arm (the parallelogram links si
 side on the real arm; the capsule model would make them overlap when θ2 < 0 and θ3 < 0).
 
 Problem files build the model with :func:`from_table` (``[robot] type = "irb6"``); goal
-regions are sampled through the analytic IK by :meth:`IRb6.sample_goal_state`.
+regions are sampled through the analytic IK by
+:func:`plannerlab.robots.irb6.goals.sample_goal_state`.
 """
 
 from __future__ import annotations
 
 import math
-from collections.abc import Callable, Sequence
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
 
@@ -80,7 +81,7 @@ from plannerlab.errors import PlannerlabError
 from plannerlab.robots.base import Array, pose_matrix, rot_x, rot_y, rot_z, trans, urdf_origin
 
 if TYPE_CHECKING:
-    from plannerlab.problem.goals import GoalRegion
+    pass
 
 #: rotation flange-at-θ5=0 in the wrist frame: columns a = y_w, b = z_w, c = x_w
 _R_WRIST_FLANGE0 = np.array([[0.0, 0.0, 1.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]])
@@ -342,55 +343,6 @@ class IRb6:
         ends = o[..., 2:6, :]
         moving = np.stack([starts, ends], axis=-2)  # (..., 4, 2, 3)
         return np.concatenate([rail_w[..., None, :, :], moving], axis=-3)
-
-    # ------------------------------------------------------------------ goal sampling
-    def sample_goal_state(
-        self,
-        goal: GoalRegion,
-        rng: np.random.Generator,
-        seeds: Sequence[Array] | None = None,
-    ) -> Array | None:
-        """One joint vector inside a goal region, drawn through the analytic IK, or None.
-
-        This is the hook the common goal sampler calls for robots that have an analytic
-        inverse kinematics (instead of restarting a numeric descent): it wraps
-        :func:`plannerlab.robots.irb6.goals.sample_irb6_goal`, which draws a flange pose
-        inside the region (position ball, approach cone, free roll) and solves it; in the
-        ambiguous cases λ0 is drawn uniformly from the pose's feasible λ0 set, so repeated
-        calls spread over every interval of the track that reaches the goal.
-
-        The collision check is the caller's job: the state returned is only guaranteed to
-        be within the joint ranges with its flange inside the region.
-
-        Args:
-            goal: target flange position ``goal.p_world_m`` and approach vector
-                ``goal.n_world`` in the WORLD frame, tolerances ``goal.pos_tol_m`` [m] and
-                ``goal.angle_tol_deg`` [deg].
-            rng: the trial's generator (the only source of randomness).
-            seeds: states near which the goal is wanted (e.g. the leg's start); the first
-                one's θ5 picks the θ5 branch at the ends of its 360° range. The analytic IK
-                needs no other seed.
-
-        Returns:
-            q (6,) or None when no attempt of the sampler reached the region.
-        """
-        from plannerlab.robots.irb6.goals import sample_irb6_goal  # imports this module
-
-        previous_theta5 = None
-        if seeds is not None and len(seeds) > 0:
-            first = np.asarray(seeds[0], dtype=float)
-            if first.shape != (self.dof,):
-                raise PlannerlabError(f"IRb6: a seed must have shape (6,), got {first.shape}")
-            previous_theta5 = float(first[5])
-        return sample_irb6_goal(
-            self,
-            goal.p_world_m,
-            goal.n_world,
-            float(goal.pos_tol_m),
-            float(goal.angle_tol_deg),
-            rng,
-            previous_theta5_rad=previous_theta5,
-        )
 
     # ------------------------------------------------------------------ URDF
     def urdf_joint_positions(self, q: Array) -> Array:

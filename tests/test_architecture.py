@@ -1,0 +1,157 @@
+"""The house rules, checked on the source: no import cycles between plannerlab modules,
+each engine imported only in its room, ``print`` only in the CLI, and loading a problem
+light (none of the engines)."""
+
+from __future__ import annotations
+
+import ast
+import json
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+PACKAGE = Path(__file__).resolve().parents[1] / "plannerlab"
+
+#: engine -> the only place (a module path prefix, relative to the package) that may import it
+ENGINE_ROOMS = {
+    "fcl": ("collision/",),
+    "ompl": ("planners/ompl.py",),
+    "pybullet": ("sim/",),
+    "matplotlib": ("plot/",),
+}
+
+
+def _modules() -> dict[str, Path]:
+    out = {}
+    for path in sorted(PACKAGE.rglob("*.py")):
+        parts = path.relative_to(PACKAGE.parent).with_suffix("").parts
+        if parts[-1] == "__init__":
+            parts = parts[:-1]
+        out[".".join(parts)] = path
+    return out
+
+
+MODULES = _modules()
+
+
+def _imports(module: str, path: Path) -> list[tuple[str, int]]:
+    """(imported module, line) for every import in ``path``, relative ones resolved."""
+    tree = ast.parse(path.read_text(encoding="utf-8"), filename=str(path))
+    package = module if path.name == "__init__.py" else module.rpartition(".")[0]
+    out = []
+    for node in ast.walk(tree):
+        if isinstance(node, ast.Import):
+            out += [(alias.name, node.lineno) for alias in node.names]
+        elif isinstance(node, ast.ImportFrom):
+            base = node.module or ""
+            if node.level:
+                parent = package.split(".")
+                parent = parent[: len(parent) - (node.level - 1)]
+                base = ".".join([*parent, base] if base else parent)
+            # ``from plannerlab.x import y`` imports the module plannerlab.x.y when there is
+            # one, else the name y from plannerlab.x
+            for alias in node.names:
+                sub = f"{base}.{alias.name}"
+                out.append((sub if sub in MODULES else base, node.lineno))
+    return out
+
+
+def _internal_graph() -> dict[str, set[str]]:
+    graph: dict[str, set[str]] = {m: set() for m in MODULES}
+    for module, path in MODULES.items():
+        for name, _ in _imports(module, path):
+            if name in MODULES and name != module:
+                graph[module].add(name)
+    return graph
+
+
+def _cycles(graph: dict[str, set[str]]) -> list[list[str]]:
+    """Strongly connected components with more than one module (Tarjan)."""
+    index: dict[str, int] = {}
+    low: dict[str, int] = {}
+    stack: list[str] = []
+    on_stack: set[str] = set()
+    out: list[list[str]] = []
+
+    def visit(v: str) -> None:
+        index[v] = low[v] = len(index)
+        stack.append(v)
+        on_stack.add(v)
+        for w in sorted(graph[v]):
+            if w not in index:
+                visit(w)
+                low[v] = min(low[v], low[w])
+            elif w in on_stack:
+                low[v] = min(low[v], index[w])
+        if low[v] == index[v]:
+            comp = []
+            while True:
+                w = stack.pop()
+                on_stack.discard(w)
+                comp.append(w)
+                if w == v:
+                    break
+            if len(comp) > 1:
+                out.append(sorted(comp))
+
+    for v in sorted(graph):
+        if v not in index:
+            visit(v)
+    return out
+
+
+def test_no_import_cycles_between_plannerlab_modules():
+    """Every import counts: at module level, inside functions and under TYPE_CHECKING."""
+    assert _cycles(_internal_graph()) == []
+
+
+def test_the_cycle_finder_finds_a_cycle():
+    assert _cycles({"a": {"b"}, "b": {"c"}, "c": {"a"}, "d": {"a"}}) == [["a", "b", "c"]]
+
+
+@pytest.mark.parametrize("engine", sorted(ENGINE_ROOMS))
+def test_each_engine_is_imported_only_in_its_room(engine):
+    rooms = ENGINE_ROOMS[engine]
+    offenders = []
+    for module, path in MODULES.items():
+        rel = path.relative_to(PACKAGE).as_posix()
+        if rel.startswith(rooms):
+            continue
+        for name, line in _imports(module, path):
+            if name == engine or name.startswith(engine + "."):
+                offenders.append(f"{rel}:{line} imports {name}")
+    assert offenders == []
+
+
+def test_print_only_in_the_cli():
+    offenders = []
+    for path in sorted(PACKAGE.rglob("*.py")):
+        rel = path.relative_to(PACKAGE).as_posix()
+        if rel.startswith("cli/") or rel == "__main__.py":
+            continue
+        tree = ast.parse(path.read_text(encoding="utf-8"))
+        for node in ast.walk(tree):
+            if (
+                isinstance(node, ast.Call)
+                and isinstance(node.func, ast.Name)
+                and node.func.id == "print"
+            ):
+                offenders.append(f"{rel}:{node.lineno}")
+    assert offenders == []
+
+
+def test_loading_a_problem_imports_no_engine():
+    code = (
+        "import json, sys\n"
+        "from plannerlab.problem import load_problem\n"
+        "for name in ('armz_pocket', 'irb6_case1', 'continuum_case1'):\n"
+        "    load_problem(name)\n"
+        "engines = ('fcl', 'ompl', 'pybullet', 'matplotlib')\n"
+        "print(json.dumps(sorted(m for m in sys.modules if m.split('.')[0] in engines)))\n"
+    )
+    out = subprocess.run(
+        [sys.executable, "-c", code], capture_output=True, text=True, check=True, timeout=120
+    )
+    assert json.loads(out.stdout.strip().splitlines()[-1]) == []
