@@ -15,10 +15,11 @@ from typing import Any
 
 import numpy as np
 
-from plannerlab.errors import ProblemError
+from plannerlab.errors import PlanFileError, ProblemError
 from plannerlab.planners import get_entry, make_planner
 from plannerlab.problem.goals import unreachable_reason
 from plannerlab.problem.load import Budget, Problem
+from plannerlab.record.execution import Execution
 from plannerlab.record.files import versions
 from plannerlab.record.leg import PlanResult, Status
 from plannerlab.record.plan import Plan, file_sha256
@@ -123,3 +124,32 @@ def solve_legs(
         overrides=dict(overrides or {}),
         versions=versions(),
     )
+
+
+def execute_plan(
+    plan: Plan,
+    problem: Problem | None = None,
+    *,
+    allow_changed_problem: bool = False,
+    gui: bool = False,
+) -> list[Execution]:
+    """Execute every leg of ``plan`` in PyBullet, in one world, each leg from where the
+    previous one really ended (:func:`plannerlab.sim.execute.execute_legs`).
+
+    Args:
+        plan: what :func:`solve_legs` returned, or :meth:`Plan.load` read.
+        problem: the problem it was planned on (default: load ``plan.problem_file``,
+            refusing a file that changed since planning unless ``allow_changed_problem``).
+        gui: a PyBullet window instead of DIRECT.
+
+    Raises:
+        PlanFileError: the problem file changed since planning.
+    """
+    from plannerlab.sim.execute import execute_legs
+
+    if problem is None:
+        changed = plan.problem_changed()
+        if changed and not allow_changed_problem:
+            raise PlanFileError(f"{plan.problem}: {changed}")
+        problem = plan.load_problem()
+    return execute_legs(problem, [r.path for r in plan.legs], first_leg=plan.legs[0].leg, gui=gui)

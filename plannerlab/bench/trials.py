@@ -643,6 +643,56 @@ def run_comparison(
     return ComparisonRun(records=records, ran=ran, skipped=skipped, missing=missing)
 
 
+def compare(
+    problems: Sequence[str | Path],
+    planners: Sequence[str],
+    seeds: Iterable[int],
+    store: TrialStore | str | Path,
+    *,
+    budget: Mapping[str, Scalar] | None = None,
+    settings: Mapping[str, Mapping[str, Scalar]] | None = None,
+    execute: bool = False,
+    jobs: int = 1,
+    on_done: Callable[[dict[str, Any], bool], None] | None = None,
+) -> ComparisonRun:
+    """Every planner on every problem with every seed, each trial in its own process,
+    resumable from ``store`` (what ``plannerlab compare`` runs).
+
+    Args:
+        problems: bundled problem names or problem file paths.
+        planners: registry names.
+        seeds: one trial per seed (seeds outermost within a problem, so that an
+            interrupted run stays balanced over the planners).
+        store: the trial store (JSON lines) to append to and resume from.
+        budget: budget overrides for every trial (``max_collision_checks``, …).
+        settings: per planner, settings overrides.
+        execute: execute each trial's solved legs in PyBullet.
+        jobs: trial processes alive at once.
+        on_done: see :func:`run_comparison`.
+    """
+    from plannerlab.problem.catalog import load_problem, resolve_problem_path
+
+    seeds = list(seeds)
+    trials = []
+    for p in problems:
+        path = resolve_problem_path(p)
+        name = load_problem(path).name
+        trials += [
+            Trial.make(
+                name,
+                path,
+                planner,
+                seed,
+                budget=budget,
+                settings=(settings or {}).get(planner),
+                execute=execute,
+            )
+            for seed in seeds
+            for planner in planners
+        ]
+    return run_comparison(trials, store, jobs, on_done)
+
+
 # ---------------------------------------------------------------------- statistics
 def wilson_interval(successes: int, n: int, confidence: float = 0.95) -> tuple[float, float]:
     """Wilson score interval of a binomial proportion (95 % by default), from
@@ -753,6 +803,7 @@ __all__ = [
     "SUMMARY_COLUMNS",
     "ComparisonRun",
     "Trial",
+    "compare",
     "TrialStore",
     "default_name",
     "default_trial_timeout_s",

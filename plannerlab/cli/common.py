@@ -1,4 +1,5 @@
-"""What the subcommands share: number formatting, budget and leg flags, setting overrides."""
+"""What the subcommands share: budget and leg flags, setting overrides; numbers are
+formatted by :func:`plannerlab.bench.report.fmt`, as in the tables."""
 
 from __future__ import annotations
 
@@ -10,28 +11,40 @@ from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
-from plannerlab.errors import PlannerlabError
+from plannerlab.errors import PlannerlabError, UnknownNameError
 
 RESULTS_DIR = Path("results")
 
 
-def fmt(x: Any, digits: int = 3) -> str:
-    if x is None:
-        return "-"
-    if isinstance(x, float):
-        if math.isnan(x):
-            return "-"
-        return f"{x:.{digits}g}" if abs(x) < 1e4 else f"{x:.0f}"
-    return str(x)
-
-
 def parse_overrides(items: Sequence[str] | None) -> dict[str, str]:
-    out: dict[str, str] = {}
+    """``--set KEY=VALUE`` items -> ``{key: value}`` (values stay strings; the planner's
+    settings coerce them, see :func:`plannerlab.planners.base.with_overrides`)."""
+    return {key: value for _, key, value in _split_sets(items, scoped=False)}
+
+
+def parse_scoped_overrides(
+    items: Sequence[str] | None, planners: Sequence[str]
+) -> dict[str, dict[str, str]]:
+    """``--set PLANNER:KEY=VALUE`` items -> ``{planner: {key: value}}``; the planner must be
+    one of ``planners``."""
+    out: dict[str, dict[str, str]] = {}
+    for planner, key, value in _split_sets(items, scoped=True):
+        if planner not in planners:
+            raise UnknownNameError("planner in --set (not in --planners)", planner, planners)
+        out.setdefault(planner, {})[key] = value
+    return out
+
+
+def _split_sets(items: Sequence[str] | None, *, scoped: bool) -> list[tuple[str, str, str]]:
+    """The one parser of ``--set``: (planner or "", key, value) per item."""
+    form = "PLANNER:KEY=VALUE" if scoped else "KEY=VALUE"
+    out = []
     for item in items or []:
-        if "=" not in item:
-            raise PlannerlabError(f"--set expects KEY=VALUE, got {item!r}")
-        k, v = item.split("=", 1)
-        out[k.strip()] = v.strip()
+        lhs, eq, value = item.partition("=")
+        planner, colon, key = lhs.rpartition(":") if scoped else ("", "", lhs)
+        if not eq or not key.strip() or (scoped and (not colon or not planner.strip())):
+            raise PlannerlabError(f"--set expects {form}, got {item!r}")
+        out.append((planner.strip(), key.strip(), value.strip()))
     return out
 
 

@@ -52,6 +52,7 @@ from plannerlab.cli.common import (
     add_budget_args,
     leg_spec,
     legs_from_spec,
+    parse_scoped_overrides,
     positive_int,
     positive_seconds,
 )
@@ -149,23 +150,6 @@ def _split(spec: str) -> list[str]:
     return [x.strip() for x in spec.split(",") if x.strip()]
 
 
-def parse_settings(items: list[str] | None, planners: list[str]) -> dict[str, dict[str, str]]:
-    """``["ompl.rrt:range=0.5", ...]`` -> ``{"ompl.rrt": {"range": "0.5"}}``."""
-    out: dict[str, dict[str, str]] = {}
-    for item in items or []:
-        lhs, eq, value = item.partition("=")
-        planner, colon, key = lhs.rpartition(":")
-        if not eq or not colon or not planner.strip() or not key.strip():
-            raise PlannerlabError(f"--set expects PLANNER:KEY=VALUE, got {item!r}")
-        planner = planner.strip()
-        if planner not in planners:
-            from plannerlab.errors import UnknownNameError
-
-            raise UnknownNameError("planner in --set (not in --planners)", planner, planners)
-        out.setdefault(planner, {})[key.strip()] = value.strip()
-    return out
-
-
 def _command(args: argparse.Namespace) -> str:
     """The command that reproduces (and resumes) this comparison, canonically spelled."""
     parts = [
@@ -255,7 +239,7 @@ def cmd_compare(args: argparse.Namespace, console: Console) -> int:
     if not planners:
         raise PlannerlabError("--planners: give at least one planner name")
     entries = {name: get_entry(name) for name in planners}  # unknown: "did you mean"
-    settings = parse_settings(args.set, planners)
+    settings = parse_scoped_overrides(args.set, planners)
     for name in planners:
         make_planner(name, settings.get(name))  # unknown setting or bad value: raises now
     problems = []

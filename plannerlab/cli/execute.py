@@ -11,7 +11,8 @@ from rich.console import Console
 from rich.markup import escape
 from rich.table import Table
 
-from plannerlab.cli.common import fmt, require_display
+from plannerlab.bench.report import fmt
+from plannerlab.cli.common import require_display
 from plannerlab.cli.solve import add_plan_arguments, leg_table, solve_and_save
 from plannerlab.cli.tables import table
 from plannerlab.errors import PlanFileError, PlannerlabError

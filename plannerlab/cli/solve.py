@@ -9,11 +9,11 @@ from typing import Any
 from rich.console import Console
 from rich.table import Table
 
+from plannerlab.bench.report import fmt
 from plannerlab.cli.common import (
     RESULTS_DIR,
     add_budget_args,
     budget_from_args,
-    fmt,
     leg_spec,
     legs_from_spec,
     parse_overrides,

@@ -6,7 +6,8 @@ is the :class:`~plannerlab.planners.base.Stepper` closed-loop planners drive.
 :func:`execute_legs` runs consecutive legs in one world.
 """
 
-from plannerlab.sim.execute import ContactRecord, Execution, execute, execute_legs
+from plannerlab.record.execution import ContactRecord, Execution
+from plannerlab.sim.execute import execute, execute_legs
 from plannerlab.sim.world import DT_S, GRAVITY_MPS2, Contact, SimWorld
 
 __all__ = [

@@ -1,0 +1,74 @@
+"""The public API: light to import, and the README's example runs as written."""
+
+from __future__ import annotations
+
+import json
+import os
+import re
+import subprocess
+import sys
+from pathlib import Path
+
+import nbformat
+
+import plannerlab
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+def test_every_export_resolves_and_nothing_else_does():
+    for name in plannerlab.__all__:
+        assert getattr(plannerlab, name) is not None
+    assert set(plannerlab.__all__) <= set(dir(plannerlab))
+    try:
+        plannerlab.not_a_name  # noqa: B018
+    except AttributeError as exc:
+        assert "not_a_name" in str(exc)
+    else:
+        raise AssertionError("an unknown attribute resolved")
+
+
+def test_import_plannerlab_loads_no_engine_and_no_submodule():
+    code = (
+        "import json, sys\n"
+        "import plannerlab\n"
+        "heavy = ('numpy', 'fcl', 'ompl', 'pybullet', 'matplotlib')\n"
+        "print(json.dumps(sorted(m for m in sys.modules\n"
+        "                        if m.split('.')[0] in heavy or m.startswith('plannerlab.'))))\n"
+    )
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    assert json.loads(out.stdout) == []
+
+
+def test_the_readme_example_runs(tmp_path):
+    readme = (ROOT / "README.md").read_text(encoding="utf-8")
+    (example,) = re.findall(r"```python\n(.*?)```", readme, flags=re.S)
+    assert len(example.strip().splitlines()) <= 14
+    out = subprocess.run(
+        [sys.executable, "-c", example],
+        capture_output=True,
+        text=True,
+        cwd=tmp_path,
+        timeout=600,
+        env={**os.environ, "MPLBACKEND": "Agg", "PYTHONPATH": str(ROOT)},
+    )
+    assert out.returncode == 0, out.stderr[-2000:]
+    assert "ompl.rrtconnect" in out.stdout  # the comparison's table
+    records = [json.loads(line) for line in (tmp_path / "trials.jsonl").read_text().splitlines()]
+    assert sorted((r["planner"], r["seed"]) for r in records) == [
+        ("gradient", 0),
+        ("gradient", 1),
+        ("ompl.rrtconnect", 0),
+        ("ompl.rrtconnect", 1),
+    ]
+
+
+def test_the_notebook_uses_only_the_public_api():
+    nb = nbformat.read(ROOT / "notebooks" / "compare.ipynb", as_version=4)
+    code = "\n".join(c.source for c in nb.cells if c.cell_type == "code")
+    assert "import plannerlab as pl" in code
+    assert re.findall(r"(?:from|import) plannerlab\.\w+", code) == []
+
+
+def test_the_export_table_and_all_agree():
+    assert sorted(plannerlab.__all__) == sorted(plannerlab._EXPORTS)
