@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import hashlib
 from pathlib import Path
 
 import numpy as np
@@ -9,12 +10,19 @@ import pytest
 
 from plannerlab.problem.goals import GoalRegion
 from plannerlab.problem.load import Budget, Problem
-from plannerlab.problem.scene import Box, Scene
+from plannerlab.problem.scene import Box, Scene, Sphere
 from plannerlab.robots.armz.model import ArmZ
-from plannerlab.robots.base import pose_matrix
+from plannerlab.robots.base import pose_matrix, trans
 
 ROOT = Path(__file__).resolve().parents[1]
 PROBLEMS = ROOT / "problems"
+
+
+def path_digest(path: np.ndarray) -> str:
+    """First 16 hex digits of the SHA-256 of a path rounded to 1e-6 rad (float noise below
+    that does not change it): the golden value of a fixed-seed regression."""
+    rounded = np.round(np.asarray(path, dtype=np.float64), 6) + 0.0  # + 0.0: no -0.0
+    return hashlib.sha256(np.ascontiguousarray(rounded).tobytes()).hexdigest()[:16]
 
 
 @pytest.fixture
@@ -43,6 +51,24 @@ def small_armz_problem(n_modules: int = 6, with_wall: bool = True) -> Problem:
         goals=(GoalRegion("goal", p, n, 0.1, 10.0),),
         budget=Budget(max_iterations=500),
         joint_step=0.02,
+    )
+
+
+def toy_problem(radius_m: float = 0.3, max_collision_checks: int = 20_000) -> Problem:
+    """The toy problem of the planner tests: a 6-module Arm-Z (5 joints) at the straight
+    column beside one sphere, goal a short way from the start."""
+    robot = ArmZ(n_modules=6, collision_radius_m=radius_m)
+    q0 = np.full(robot.dof, np.pi)
+    p, n = robot.tip(np.array([np.pi, 2.2, np.pi, 2.5, np.pi]))
+    scene = Scene((Sphere("ball", trans(1.2, 0.0, 2.0), 0.4),))
+    return Problem(
+        "toy",
+        robot,
+        scene,
+        q0,
+        (GoalRegion("near", p, n, 0.15, 15.0),),
+        Budget(max_collision_checks=max_collision_checks),
+        joint_step=0.05,
     )
 
 

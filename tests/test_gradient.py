@@ -6,7 +6,7 @@ import dataclasses
 
 import numpy as np
 import pytest
-from conftest import colliding_state, small_armz_problem
+from conftest import colliding_state, path_digest, small_armz_problem
 
 from plannerlab.collision.fcl_checker import CollisionChecker
 from plannerlab.errors import PlannerlabError, UnknownNameError
@@ -81,16 +81,14 @@ def test_start_in_collision_is_reported_not_raised():
 
 
 # ---------------------------------------------------------------- fixed-seed regressions
-def test_pocket_stalls_at_the_same_iteration_and_state_every_run():
+def test_pocket_stalls_at_the_pinned_iteration_and_path():
+    """Golden values (seed 0; the method ignores its generator): the stall iteration and a
+    digest of the path. A change here is a change of the paper's method."""
     problem = load_problem("armz_pocket")
-    runs = [
-        make_planner("gradient").solve(problem, 0, problem.budget, np.random.default_rng(s))
-        for s in (0, 1)
-    ]
-    a, b = runs
-    assert a.status is Status.LOCAL_MINIMUM and b.status is Status.LOCAL_MINIMUM
-    assert a.iterations == b.iterations == a.extra["stall_iteration"]
-    np.testing.assert_array_equal(a.path, b.path)
+    a = make_planner("gradient").solve(problem, 0, problem.budget, np.random.default_rng(0))
+    assert a.status is Status.LOCAL_MINIMUM
+    assert (a.iterations, a.extra["stall_iteration"], len(a.path)) == (61, 61, 62)
+    assert path_digest(a.path) == "aea7e8cd10bd02ea"
     assert a.local_minima == 1
     # the stall is real: far from the goal, and f flat over the stall window
     assert a.pos_err_m > 1.0
@@ -114,15 +112,13 @@ def test_analytic_variant_follows_the_faithful_one_on_the_pocket():
     assert an.collision_checks < fd.collision_checks  # no dof+1 checks per gradient
 
 
-def test_inspection_leg_reaches_the_same_final_state_every_run():
+def test_inspection_leg_stalls_at_the_pinned_iteration_and_path():
+    """Golden values on the paper's entry leg (150-iteration budget, seed 0)."""
     problem = load_problem("armz_inspection")
     budget = problem.budget.replace(max_iterations=150)
-    a, b = (
-        make_planner("gradient").solve(problem, 0, budget, np.random.default_rng(s)) for s in (0, 7)
-    )
-    assert a.status == b.status
-    np.testing.assert_array_equal(a.path[-1], b.path[-1])
-    assert a.iterations == b.iterations <= 150
+    r = make_planner("gradient").solve(problem, 0, budget, np.random.default_rng(0))
+    assert (r.status, r.iterations, len(r.path)) == (Status.LOCAL_MINIMUM, 73, 74)
+    assert path_digest(r.path) == "4b672d5cc99932b1"
 
 
 def test_descent_keeps_bounded_joints_inside_their_limits():

@@ -15,35 +15,17 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from conftest import toy_problem
 
 from plannerlab.collision.fcl_checker import CollisionChecker
 from plannerlab.errors import UnknownNameError
 from plannerlab.planners import OMPL_PLANNERS, REGISTRY, Status, get_entry, make_planner
 from plannerlab.problem.goals import GoalRegion
 from plannerlab.problem.ik import sample_goal_state, solve_ik
-from plannerlab.problem.load import Budget, Problem
-from plannerlab.problem.scene import Scene, Sphere
+from plannerlab.problem.load import Budget
 from plannerlab.robots.armz.model import ArmZ
-from plannerlab.robots.base import trans
 
 ROOT = Path(__file__).resolve().parents[1]
-
-
-def toy_problem(radius_m: float = 0.3) -> Problem:
-    """6-module Arm-Z (5 joints) beside a sphere; goal a short way from the start."""
-    robot = ArmZ(n_modules=6, collision_radius_m=radius_m)
-    q0 = np.full(robot.dof, np.pi)
-    p, n = robot.tip(np.array([np.pi, 2.2, np.pi, 2.5, np.pi]))
-    scene = Scene((Sphere("ball", trans(1.2, 0.0, 2.0), 0.4),))
-    return Problem(
-        "toy",
-        robot,
-        scene,
-        q0,
-        (GoalRegion("near", p, n, 0.15, 15.0),),
-        Budget(max_collision_checks=20_000),
-        joint_step=0.05,
-    )
 
 
 # ---------------------------------------------------------------------------- names

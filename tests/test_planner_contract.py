@@ -1,13 +1,14 @@
 """The shared check every registered planner must pass (cf. Gymnasium's ``check_env``).
 
 Parametrized over :data:`plannerlab.planners.REGISTRY` with planner names as test ids, on
-a trivial problem built here: a 6-module Arm-Z (5 joints) beside one sphere, goal a short
+the toy problem of conftest.py: a 6-module Arm-Z (5 joints) beside one sphere, goal a short
 way from the start (planners of another robot family get a bundled problem of theirs;
 closed-loop planners get a PyBullet world as their stepper). ``chord_arc`` touches
 obstacles by design: its path may collide only in the contacts it declares.
 
 For each planner: it solves; the path starts at the start and ends in the goal region;
-every edge is collision-free at a fine resolution; the same seed gives the identical path;
+every edge is collision-free at a fine resolution; the same seed gives the identical path
+(planners that ignore their generator: any seed does);
 a tiny collision-check budget is respected; settings are unchanged by ``solve``; the
 result survives a JSON round trip.
 
@@ -22,22 +23,19 @@ Regression budgets are collision checks, never wall-clock time.
 from __future__ import annotations
 
 import copy
-import importlib.util
 import json
 import multiprocessing as mp
 from typing import Any
 
 import numpy as np
 import pytest
+from conftest import toy_problem
 
 from plannerlab.collision.fcl_checker import CollisionChecker
 from plannerlab.planners import REGISTRY, PlanResult, Status, make_planner
 from plannerlab.planners.base import settings_dict
-from plannerlab.problem.goals import GoalRegion
 from plannerlab.problem.load import Budget, Problem
-from plannerlab.problem.scene import Scene, Sphere
-from plannerlab.robots.armz.model import ArmZ
-from plannerlab.robots.base import joint_difference, trans
+from plannerlab.robots.base import joint_difference
 from plannerlab.robots.paths import path_length
 
 SEED = 7
@@ -71,49 +69,26 @@ OVERRIDES: dict[str, dict[str, Any]] = {
 }
 
 
-def trivial_problem() -> Problem:
-    """6-module Arm-Z (5 joints), straight column start, one sphere, goal nearby."""
-    robot = ArmZ(n_modules=6, collision_radius_m=0.3)
-    q0 = np.full(robot.dof, np.pi)
-    q_goal = np.array([np.pi, 2.2, np.pi, 2.5, np.pi])
-    p, n = robot.tip(q_goal)
-    scene = Scene((Sphere("ball", trans(1.2, 0.0, 2.0), 0.4),))
-    goal = GoalRegion("near", p, n, 0.15, 15.0)
-    return Problem(
-        "trivial", robot, scene, q0, (goal,), Budget(max_collision_checks=CHECKS), joint_step=0.05
-    )
-
-
 def problem_for(name: str) -> Problem:
-    """The trivial Arm-Z problem, or for planners of other robot families a bundled one
+    """The toy Arm-Z problem (conftest), or for planners of other robot families a bundled one
     they solve quickly (the continuum case 3 for ``chord_arc``)."""
     robots = REGISTRY[name].robots
     if robots is not None and "armz" not in robots:
         from plannerlab.problem.catalog import load_problem
 
         return load_problem("continuum_case3")
-    return trivial_problem()
+    return toy_problem(max_collision_checks=CHECKS)
 
 
 def _budget(name: str) -> Budget:
     return Budget(max_collision_checks=BUDGETS.get(name, CHECKS))
 
 
-def _gradient_missing() -> bool:
-    return importlib.util.find_spec("plannerlab.planners.gradient") is None
-
-
 def _params() -> list[Any]:
     params = []
-    for name, entry in REGISTRY.items():
+    for name in REGISTRY:
         marks = []
-        if entry.target.startswith("plannerlab.planners.gradient") and _gradient_missing():
-            marks.append(
-                pytest.mark.xfail(
-                    reason="plannerlab/planners/gradient.py not written yet (lead)", strict=False
-                )
-            )
-        elif name in KNOWN_FAILURES:
+        if name in KNOWN_FAILURES:
             marks.append(pytest.mark.xfail(reason=KNOWN_FAILURES[name], strict=True))
         params.append(pytest.param(name, id=name, marks=marks))
     return params
@@ -186,7 +161,13 @@ def test_path_collision_free_at_fine_resolution(name: str) -> None:
 
 @pytest.mark.parametrize("name", PARAMS)
 def test_same_seed_same_path(name: str) -> None:
-    if name.startswith("ompl."):
+    """Planners that draw from their generator: the same seed gives the same path.
+    Deterministic planners (``uses_rng=False``): another seed gives the same path too (the
+    gradient's golden values live in test_gradient and test_traps)."""
+    if not REGISTRY[name].uses_rng:
+        a, b = _solve(name, SEED), _solve(name, SEED + 1)
+        assert np.array_equal(a.path, b.path)
+    elif name.startswith("ompl."):
         ctx = mp.get_context("spawn")
         with ctx.Pool(2, maxtasksperchild=1) as pool:
             a, b = pool.starmap(_solve_in_fresh_process, [(name, SEED), (name, SEED)])

@@ -12,6 +12,7 @@ import dataclasses
 
 import numpy as np
 import pytest
+from conftest import path_digest
 
 from plannerlab.collision.fcl_checker import CollisionChecker
 from plannerlab.planners import make_planner
@@ -67,12 +68,20 @@ def test_faithful_gradient_stalls_far_from_the_goal(trap):
     np.testing.assert_allclose(an.path[-1], r.path[-1], atol=1e-4)
 
 
-def test_stall_is_deterministic(trap):
-    a, b = (solve(trap, "gradient.analytic", seed) for seed in (0, 1))
-    assert a.status is Status.LOCAL_MINIMUM and b.status is Status.LOCAL_MINIMUM
-    assert a.extra["stall_iteration"] == b.extra["stall_iteration"]
-    np.testing.assert_array_equal(a.path[-1], b.path[-1])
-    np.testing.assert_array_equal(a.path, b.path)
+#: golden values of the analytic variant (seed 0; it ignores its generator):
+#: (stall iteration, digest of the path)
+STALLS = {
+    "armz_pocket": (61, "aea7e8cd10bd02ea"),
+    "armz_window": (62, "c8787a785bde3682"),
+    "armz_cavity": (62, "1722a37cf1067b1a"),
+    "armz_thin_wall": (62, "70a2f0ba2aa47b8a"),
+}
+
+
+def test_stall_is_pinned(trap):
+    r = solve(trap, "gradient.analytic")
+    assert r.status is Status.LOCAL_MINIMUM
+    assert (r.extra["stall_iteration"], path_digest(r.path)) == STALLS[trap.name]
 
 
 def test_without_the_trap_the_gradient_reaches_the_goal(trap):

@@ -28,6 +28,8 @@ class PlannerEntry:
         summary: one line for ``plannerlab planners``.
         needs_stepper: the planner runs a simulator in its loop (closed-loop modes).
         robots: robot kinds it applies to (None: every joint-vector robot).
+        uses_rng: the planner draws from its generator (False: deterministic methods that
+            ignore it; the contract checks that seeds do not change their path).
         options: keyword arguments the factory gets besides the name and the overrides
             (the OMPL class of an ``ompl.*`` planner), so that no planner module has to
             look itself up in this registry.
@@ -38,6 +40,7 @@ class PlannerEntry:
     summary: str
     needs_stepper: bool = False
     robots: tuple[str, ...] | None = None
+    uses_rng: bool = True
     options: Mapping[str, Any] = field(default_factory=dict)
 
 
@@ -70,6 +73,7 @@ def _entries() -> dict[str, PlannerEntry]:
             "gradient",
             "plannerlab.planners.gradient:make",
             "the Arm-Z paper's gradient method, faithful (finite differences, kinematic steps)",
+            uses_rng=False,
         ),
         PlannerEntry(
             "gradient.closed_loop",
@@ -77,12 +81,14 @@ def _entries() -> dict[str, PlannerEntry]:
             "the paper's gradient method with PyBullet in the loop (100 steps of "
             "1/240 s per iteration)",
             needs_stepper=True,
+            uses_rng=False,
         ),
         PlannerEntry(
             "gradient.analytic",
             "plannerlab.planners.gradient:make",
             "faster variant: the same descent with the analytic Jacobian gradient "
             "instead of dof + 1 objective evaluations",
+            uses_rng=False,
         ),
     ]
     entries.append(
@@ -124,6 +130,7 @@ def _entries() -> dict[str, PlannerEntry]:
             "continuum robot's chord-arc tree search with obstacle wrapping (contact at the "
             "problem's collision points)",
             robots=("continuum_chain",),
+            uses_rng=False,
         )
     )
     for suffix, cls in OMPL_PLANNERS.items():
