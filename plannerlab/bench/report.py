@@ -573,7 +573,9 @@ def ompl_log(problem: str, records: Sequence[Mapping[str, Any]], meta: Mapping[s
     ]
     for p in planners:
         runs = by_planner[p]
-        settings = next((r.get("settings_used") for r in runs if r.get("settings_used")), {})
+        settings: dict[str, Any] = next(
+            (r["settings_used"] for r in runs if r.get("settings_used")), {}
+        )
         common = [f"{k} = {_one_line(json.dumps(v))}" for k, v in sorted(settings.items())]
         lines += [p, f"{len(common)} common properties", *common]
         lines.append(f"{len(_RUN_PROPERTIES)} properties for each run")

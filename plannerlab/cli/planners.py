@@ -14,7 +14,7 @@ from plannerlab.cli.tables import table
 def cmd_planners(args: argparse.Namespace, console: Console) -> int:
     from plannerlab.planners import REGISTRY
 
-    rows = [
+    rows: list[dict[str, Any]] = [
         {
             "name": e.name,
             "summary": e.summary,

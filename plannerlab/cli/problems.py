@@ -19,7 +19,7 @@ def cmd_problems(args: argparse.Namespace, console: Console) -> int:
     from plannerlab.problem.catalog import list_problems
     from plannerlab.problem.load import parse_problem
 
-    rows = []
+    rows: list[dict[str, Any]] = []
     for path in list_problems():
         p = parse_problem(path)
         rows.append(

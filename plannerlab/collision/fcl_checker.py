@@ -139,8 +139,8 @@ class CollisionChecker:
             self._links[i] = fcl.CollisionObject(
                 fcl.Capsule(float(self._radii[i]), float(max(lengths[i], 1e-9))), fcl.Transform()
             )
-        for i, obj in enumerate(self._links):
-            obj.setTransform(fcl.Transform(R[i], centres[i]))
+        for k, obj in enumerate(self._links):
+            obj.setTransform(fcl.Transform(R[k], centres[k]))
 
     # ------------------------------------------------------------------ pre-test
     def _candidates(self, segs: Array) -> tuple[Array, Array]:

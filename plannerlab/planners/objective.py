@@ -13,6 +13,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from plannerlab.problem.goals import GoalRegion
+from plannerlab.problem.ik import ValidityChecker
 from plannerlab.robots.base import Array, Robot
 
 
@@ -31,7 +32,7 @@ class Objective:
 
     robot: Robot
     goal: GoalRegion
-    checker: object | None = None
+    checker: ValidityChecker | None = None
     r1: float = 1.0
     r2: float = 1.0
     penalty: float = 1e5

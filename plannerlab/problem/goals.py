@@ -11,6 +11,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+from numpy.typing import NDArray
 
 from plannerlab.robots.base import Array, Robot
 
@@ -62,7 +63,7 @@ class GoalRegion:
         cosang = np.clip(np.asarray(n_world) @ self.n_world, -1.0, 1.0)
         return pos_err, np.degrees(np.arccos(cosang))
 
-    def contains(self, robot: Robot, q: Array) -> Array:
+    def contains(self, robot: Robot, q: Array) -> NDArray[np.bool_]:
         """True where q is inside both tolerances (scalar bool for one q)."""
         pos_err, ang_err = self.errors(robot, q)
         return (pos_err <= self.pos_tol_m) & (ang_err <= self.angle_tol_deg)

@@ -110,10 +110,10 @@ def solve_ik(
     iterations = 0
     for iterations in range(1, max_iterations + 1):  # noqa: B007 - count survives the loop
         p, n = robot.tip(q)
-        pos_err, ang_err = goal.errors_from_tip(p, n)
+        pos_e, ang_e = goal.errors_from_tip(p, n)
         if (
-            pos_err <= target_fraction * goal.pos_tol_m
-            and ang_err <= target_fraction * goal.angle_tol_deg
+            pos_e <= target_fraction * goal.pos_tol_m
+            and ang_e <= target_fraction * goal.angle_tol_deg
         ):
             iterations -= 1
             break

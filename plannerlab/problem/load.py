@@ -79,7 +79,7 @@ class Budget:
             "time_limit_s": self.time_limit_s,
         }
         values.update({k: v for k, v in changes.items() if v is not None})
-        return Budget(**values)
+        return Budget(**values)  # type: ignore[arg-type]
 
     def to_dict(self) -> dict[str, Any]:
         return {

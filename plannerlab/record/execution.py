@@ -17,7 +17,7 @@ import numpy as np
 
 from plannerlab.errors import PlannerlabError
 from plannerlab.record.codec import read_float, to_data
-from plannerlab.robots.base import Array
+from plannerlab.robots.base import Array, as_xyz
 
 
 @dataclass(frozen=True)
@@ -60,7 +60,7 @@ class ContactRecord:
             other_is_link=bool(data["other_is_link"]),
             max_depth_m=read_float(data["max_depth_m"]),
             first_time_s=read_float(data["first_time_s"]),
-            p_world_m=tuple(float(v) for v in data["p_world_m"]),
+            p_world_m=as_xyz(data["p_world_m"]),
         )
 
 

@@ -38,7 +38,9 @@ class Status(enum.StrEnum):
 
 def settings_dict(settings: Any) -> dict[str, Any]:
     """A frozen settings dataclass as plain JSON-able data."""
-    return to_data(dataclasses.asdict(settings)) if dataclasses.is_dataclass(settings) else {}
+    if dataclasses.is_dataclass(settings) and not isinstance(settings, type):
+        return to_data(dataclasses.asdict(settings))
+    return {}
 
 
 #: the columns of :attr:`PlanResult.progress`, in order

@@ -14,7 +14,7 @@ from __future__ import annotations
 from typing import Protocol, runtime_checkable
 
 import numpy as np
-from numpy.typing import NDArray
+from numpy.typing import ArrayLike, NDArray
 
 Array = NDArray[np.float64]
 
@@ -88,7 +88,7 @@ def joint_difference(q_to: Array, q_from: Array, continuous: NDArray[np.bool_]) 
     return np.where(continuous, (d + np.pi) % (2.0 * np.pi) - np.pi, d)
 
 
-def rot_x(a: Array) -> Array:
+def rot_x(a: ArrayLike) -> Array:
     """Rotations about x for angles a (...,) -> (..., 4, 4)."""
     a = np.asarray(a, dtype=float)
     c, s = np.cos(a), np.sin(a)
@@ -102,7 +102,7 @@ def rot_x(a: Array) -> Array:
     return T
 
 
-def rot_y(a: Array) -> Array:
+def rot_y(a: ArrayLike) -> Array:
     """Rotations about y for angles a (...,) -> (..., 4, 4)."""
     a = np.asarray(a, dtype=float)
     c, s = np.cos(a), np.sin(a)
@@ -116,7 +116,7 @@ def rot_y(a: Array) -> Array:
     return T
 
 
-def rot_z(a: Array) -> Array:
+def rot_z(a: ArrayLike) -> Array:
     """Rotations about z for angles a (...,) -> (..., 4, 4)."""
     a = np.asarray(a, dtype=float)
     c, s = np.cos(a), np.sin(a)
@@ -130,6 +130,12 @@ def rot_z(a: Array) -> Array:
     return T
 
 
+def as_xyz(v: ArrayLike) -> tuple[float, float, float]:
+    """A 3-vector as a tuple of three floats (for records)."""
+    x, y, z = (float(c) for c in np.asarray(v, dtype=float).reshape(3))
+    return (x, y, z)
+
+
 def trans(x: float, y: float, z: float) -> Array:
     """Pure translation (4, 4)."""
     T = np.eye(4)
@@ -137,9 +143,9 @@ def trans(x: float, y: float, z: float) -> Array:
     return T
 
 
-def rpy_to_matrix(rpy_rad: Array) -> Array:
+def rpy_to_matrix(rpy_rad: ArrayLike) -> Array:
     """Fixed-axis roll, pitch, yaw (URDF convention: R = Rz(yaw) Ry(pitch) Rx(roll)) -> (3, 3)."""
-    r, p, y = (float(v) for v in rpy_rad)
+    r, p, y = (float(v) for v in np.asarray(rpy_rad, dtype=float).reshape(3))
     return (rot_z(y) @ rot_y(p) @ rot_x(r))[:3, :3]
 
 
@@ -156,7 +162,7 @@ def matrix_to_rpy(R: Array) -> Array:
     return np.array([roll, pitch, yaw])
 
 
-def pose_matrix(xyz_m: Array, rpy_rad: Array) -> Array:
+def pose_matrix(xyz_m: ArrayLike, rpy_rad: ArrayLike) -> Array:
     """T (4, 4) from a position [m] and URDF roll-pitch-yaw [rad]."""
     T = np.eye(4)
     T[:3, :3] = rpy_to_matrix(rpy_rad)

@@ -58,7 +58,7 @@ from plannerlab.collision.fcl_checker import CollisionChecker
 from plannerlab.errors import PlannerlabError
 from plannerlab.problem.load import Problem
 from plannerlab.record.execution import ContactRecord, Execution
-from plannerlab.robots.base import Array, joint_difference
+from plannerlab.robots.base import Array, as_xyz, joint_difference
 from plannerlab.robots.paths import densify
 from plannerlab.sim.retime import retime, unwrap_path
 from plannerlab.sim.world import SimWorld
@@ -243,9 +243,7 @@ def _run(
         reached = bool(pos_err <= goal.pos_tol_m and ang_err <= goal.angle_tol_deg)
 
     contacts = tuple(
-        ContactRecord(
-            link, other, is_link, float(rec[0]), float(rec[1]), tuple(float(v) for v in rec[2])
-        )
+        ContactRecord(link, other, is_link, float(rec[0]), float(rec[1]), as_xyz(rec[2]))
         for (link, other, is_link), rec in sorted(seen.items(), key=lambda kv: kv[1][1])
     )
 

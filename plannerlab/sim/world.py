@@ -53,7 +53,7 @@ from scipy.spatial.transform import Rotation
 
 from plannerlab.errors import PlannerlabError
 from plannerlab.problem.scene import Box, Cylinder, Obstacle, Scene, Sphere
-from plannerlab.robots.base import Array, Robot, joint_difference
+from plannerlab.robots.base import Array, Robot, as_xyz, joint_difference
 
 #: the paper's control step [s]
 DT_S: float = 1.0 / 240.0
@@ -514,10 +514,10 @@ class SimWorld:
                     if k < i:  # name the lower link first; the point lies on it
                         name, other = other, name
                         p_on_robot = pt[6] if p_on_robot is pt[5] else pt[5]
-                out.append(Contact(name, other, True, depth, tuple(float(v) for v in p_on_robot)))
+                out.append(Contact(name, other, True, depth, as_xyz(p_on_robot)))
             else:
                 if i is not None and i in fixed:
                     continue
                 other = self.obstacle_names.get(b, f"body_{b}")
-                out.append(Contact(name, other, False, depth, tuple(float(v) for v in p_on_robot)))
+                out.append(Contact(name, other, False, depth, as_xyz(p_on_robot)))
         return out

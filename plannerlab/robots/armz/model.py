@@ -62,6 +62,9 @@ class ArmZ:
     module_inertia_kgm2: tuple[float, float, float] = (0.25, 0.25, 0.5)
     joint_torque_limit_nm: float = 100.0
     joint_velocity_limit_rad_s: float = 10.0
+    #: fixed parts of the chain, computed in __post_init__
+    _M: Array = field(init=False, repr=False, compare=False)
+    _T_base_j1: Array = field(init=False, repr=False, compare=False)
 
     kind: str = field(default="armz", init=False)
 

@@ -42,7 +42,7 @@ def _sample_ball(center: Array, radius_m: float, rng: np.random.Generator) -> Ar
     if radius_m <= 0.0:
         return center.copy()
     v = rng.normal(size=3)
-    v /= max(np.linalg.norm(v), 1e-300)
+    v /= max(float(np.linalg.norm(v)), 1e-300)
     return center + v * radius_m * rng.random() ** (1.0 / 3.0)
 
 

@@ -176,7 +176,7 @@ def _parse_pose(pose: Pose) -> Array:
     if isinstance(pose, (tuple, list)) and len(pose) == 3:
         p, c, roll = pose
         return pose_from_approach(p, c, float(roll))  # type: ignore[arg-type]
-    if np.shape(pose) == (4, 4):
+    if np.shape(pose) == (4, 4):  # type: ignore[arg-type]
         return _check_transform(pose, "T_station_flange")
     raise PlannerlabError(
         "IRb-6 IK: the pose must be a (4, 4) T_station_flange or a (p_station_m, "

@@ -533,7 +533,7 @@ def from_table(reader: Any) -> IRb6:
 
     def angle_span(name: str) -> tuple[float, float]:
         default = getattr(d, name.replace("_deg", "_rad"))
-        lo, hi = span(name, tuple(math.degrees(v) for v in default), "deg")
+        lo, hi = span(name, (math.degrees(default[0]), math.degrees(default[1])), "deg")
         return (math.radians(lo), math.radians(hi))
 
     side = reader.string("dead_wedge_side", d.dead_wedge_side)
