@@ -224,6 +224,12 @@ def trial_rows(records: Iterable[Mapping[str, Any]]) -> list[dict[str, Any]]:
     return rows
 
 
+def _n_contacts(contacts: Any) -> int | None:
+    """Contacts of an executed leg: its list of contact records (a count in stores written
+    before the trial legs were Execution records)."""
+    return len(contacts) if isinstance(contacts, list) else contacts
+
+
 def _lengths(extra: Mapping[str, Any]) -> dict[str, Any]:
     """The path lengths a planner reports in ``extra`` (before/after simplification, …)."""
     return {
@@ -253,7 +259,7 @@ def leg_rows(records: Iterable[Mapping[str, Any]]) -> list[dict[str, Any]]:
                     "exec_success": e.get("success"),
                     "exec_path_valid": e.get("path_valid"),
                     "exec_max_track_err_rad": e.get("max_track_err_rad"),
-                    "exec_contacts": len(e["contacts"]) if "contacts" in e else None,
+                    "exec_contacts": _n_contacts(e.get("contacts")),
                     "exec_final_pos_err_m": e.get("final_pos_err_m"),
                     "exec_final_angle_err_deg": e.get("final_angle_err_deg"),
                     "exec_reason": e.get("reason"),
