@@ -480,7 +480,10 @@ class ChordArcPlanner:
             total_length_m=robot.length_m,
             obstacles=_planar_obstacles(problem.scene, float(T[2, 3])),
             collision_points_m=collision_points(problem),
-            target_xy_m=tuple(float(v) for v in problem.goal(leg).p_world_m[:2]),
+            target_xy_m=(
+                float(problem.goal(leg).p_world_m[0]),
+                float(problem.goal(leg).p_world_m[1]),
+            ),
         )
 
     def planning_query(self, problem: Any, query: ChordArcQuery) -> ChordArcQuery:

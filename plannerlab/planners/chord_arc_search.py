@@ -71,6 +71,7 @@ from dataclasses import dataclass, field
 from typing import Any, Literal
 
 import numpy as np
+from numpy.typing import NDArray
 
 from plannerlab.errors import PlannerlabError
 from plannerlab.robots.base import Array
@@ -166,16 +167,18 @@ class _Geometry:
         poly = [i for i, o in enumerate(self.obstacles) if isinstance(o, ConvexPolygon)]
         self.circle_ids = np.array(circ, dtype=int)
         self.poly_ids = np.array(poly, dtype=int)
-        self.cc = np.array([self.obstacles[i].center_m for i in circ]).reshape(-1, 2)
-        self.cr = np.array([self.obstacles[i].radius_m for i in circ], dtype=float)
-        e_max = max((len(self.obstacles[i].vertices_m) for i in poly), default=0)
+        circles = [o for o in self.obstacles if isinstance(o, Circle)]
+        polygons = [o for o in self.obstacles if isinstance(o, ConvexPolygon)]
+        self.cc = np.array([c.center_m for c in circles]).reshape(-1, 2)
+        self.cr: Array = np.array([c.radius_m for c in circles], dtype=np.float64)
+        e_max = max((len(g.vertices_m) for g in polygons), default=0)
         self.e_max = e_max
         self.verts: list[Array] = []
         self.edges: list[Array] = []  # (E, 2) edge vectors v_{j+1} - v_j
         normals = np.zeros((len(poly), e_max, 2))
         offsets = np.zeros((len(poly), e_max))
-        for k, i in enumerate(poly):
-            v = np.array(self.obstacles[i].vertices_m)
+        for k, g in enumerate(polygons):
+            v = np.array(g.vertices_m)
             d = np.roll(v, -1, axis=0) - v
             n = np.stack([d[:, 1], -d[:, 0]], axis=1) / np.hypot(d[:, 0], d[:, 1])[:, None]
             b = np.einsum("ij,ij->i", n, v)
@@ -624,7 +627,7 @@ def _sample_fractions(max_length_m: float, step_m: float) -> Array:
 
 def _arcs_free(
     geo: _Geometry, p0: Array, t0: Array, theta: Array, length: Array, settings: ChordArcSettings
-) -> Array:
+) -> NDArray[np.bool_]:
     """(K,) True where arcs (starting at p0 (K, 2) with tangents t0 (K, 2)) are free.
 
     Arc k gets ``ceil(L_k / step) + 1`` samples, both ends included; all samples of a
@@ -694,7 +697,7 @@ class _Level:
     theta: Array  # (N,) arc that ended here
     length: Array  # (N,)
     used_length: Array  # (N,)
-    used: Array  # (N, m) bool
+    used: NDArray[np.bool_]  # (N, m)
 
 
 def _search(query: ChordArcQuery, prep: _Prepared, settings: ChordArcSettings) -> SearchResult:
@@ -997,7 +1000,10 @@ def solve_chord_arc(
     dropped: list[DroppedSolution] = []
     for sol in search.solutions:
         out = _check(sol, prep, settings)
-        (plans if isinstance(out, ChordArcPlan) else dropped).append(out)
+        if isinstance(out, ChordArcPlan):
+            plans.append(out)
+        else:
+            dropped.append(out)
     return ChordArcResult(search, tuple(plans), tuple(dropped))
 
 

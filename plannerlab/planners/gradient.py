@@ -291,6 +291,7 @@ class GradientPlanner:
                 robot.continuous, q - step, np.clip(q - step, robot.lower, robot.upper)
             )
             if closed:
+                assert stepper is not None  # closed-loop mode checked for a stepper above
                 q_next = wrap_to_pi(stepper.move_towards(q_target, s.sim_steps), robot.continuous)
             else:
                 left = deadline.checks_left()

@@ -244,8 +244,9 @@ class HybridPlanner:
                 notes.append(f"rrtconnect from stall {minima}: {rrt.status.value}")
                 if rrt.solved:
                     path.extend(rrt.path[1:])
-                    record["left_stall"] = len(rrt.path) > 1
-                    escapes += int(record["left_stall"])
+                    left_stall = len(rrt.path) > 1
+                    record["left_stall"] = left_stall
+                    escapes += int(left_stall)
                     return done(
                         Status.SOLVED,
                         f"descent stalled; RRT-Connect reached the goal region from "

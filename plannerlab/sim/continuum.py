@@ -71,6 +71,7 @@ import pybullet
 
 from plannerlab.errors import PlannerlabError
 from plannerlab.problem.load import Problem
+from plannerlab.robots.base import as_xyz
 from plannerlab.sim.world import Contact, SimWorld
 
 #: physics time step [s] (PyBullet's and the Arm-Z paper's; see the module docstring)
@@ -427,7 +428,7 @@ def execute_chord_arc(
             other,
             is_link,
             ok,
-            tuple(float(v) for v in rec[2]),
+            as_xyz(rec[2]),
             float(rec[0]),
             float(rec[1]),
             int(rec[3]),
