@@ -188,7 +188,7 @@ class LocalBackend:
                 f"start_method: expected one of {', '.join(START_METHODS)}, got {start_method!r}"
             )
         self.start_method = start_method
-        self._ctx = multiprocessing.get_context(start_method)
+        self._ctx: Any = multiprocessing.get_context(start_method)
         if start_method == "forkserver":
             self._ctx.set_forkserver_preload(list(PRELOAD_MODULES))
             _start_fork_server()

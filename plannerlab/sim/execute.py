@@ -170,7 +170,7 @@ def _run(
 
     if traj is not None:
         n = max(1, int(math.ceil(traj.duration_s / world.dt_s - 1e-9)))
-        t_all = np.arange(1, n + 1) * world.dt_s
+        t_all: Array = np.arange(1, n + 1, dtype=np.float64) * world.dt_s
         q_urdf = traj.sample(np.concatenate([[0.0], t_all]))[0]
         # Step k goes from t_k to t_k+1: the position target is the reference at t_k and
         # the velocity target the reference's mean velocity over the step (PyBullet's
@@ -188,7 +188,7 @@ def _run(
         traj_check = checker.check_path(q_all[thin], recheck_step)
         err_all = np.empty(n)
         logged = sorted(set(range(LOG_EVERY_STEPS - 1, n, LOG_EVERY_STEPS)) | {n - 1})
-        q_act_list = []
+        q_act_list: list[Array] = []
         for k in range(n):
             world.command_urdf(q_urdf[k], qd_urdf[k], position_gain=TRACK_POSITION_GAIN)
             run_steps(1)

@@ -121,9 +121,9 @@ class Trajectory:
             q = np.repeat(self.knots[-1:], len(t), axis=0)
             return q, np.zeros_like(q)
         traj = self._traj
-        q = np.asarray(traj(t), dtype=float).reshape(len(t), -1)  # type: ignore[operator]
-        qd = np.asarray(traj(t, 1), dtype=float).reshape(len(t), -1)  # type: ignore[operator]
-        return q, qd
+        q_t: Array = np.asarray(traj(t), dtype=np.float64).reshape(len(t), -1)  # type: ignore[operator]
+        qd_t: Array = np.asarray(traj(t, 1), dtype=np.float64).reshape(len(t), -1)  # type: ignore[operator]
+        return q_t, qd_t
 
 
 def retime(
