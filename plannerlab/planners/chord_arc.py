@@ -421,7 +421,7 @@ def capsule_distances(
         & (lo[:, None, 1] <= o_hi[None, :, 1])
         & (hi[:, None, 1] >= o_lo[None, :, 1])
     )  # (N, O)
-    for o in np.flatnonzero(near_all.any(axis=0)):
+    for o in np.flatnonzero(near_all.any(axis=0)).tolist():
         obs = obstacles[o]
         near = np.flatnonzero(near_all[:, o])
         if isinstance(obs, Circle):

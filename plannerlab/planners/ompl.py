@@ -362,7 +362,7 @@ def _ompl_logging(logger: logging.Logger) -> Iterator[None]:
 
 
 # ---------------------------------------------------------------------------- helpers
-def _recheck_cost(path: Array, joint_step: float, continuous: Array) -> int:
+def _recheck_cost(path: Array, joint_step: float, continuous: np.ndarray) -> int:
     """Collision checks ``checker.check_path(path, joint_step)`` will make (all states of
     the densified path), computed without checking anything."""
     path = np.atleast_2d(np.asarray(path, dtype=float))
