@@ -14,7 +14,7 @@ none of the engines)::
 The data flow is one way: problem file → :func:`load_problem` → planner
 (:func:`make_planner`, :func:`solve`) → record (:class:`Plan`, :class:`PlanResult`) →
 :func:`execute` (:class:`Execution`) → table (:func:`compare`, :func:`summarise`,
-:func:`markdown_report`); figures with :func:`snapshot_figure` and :func:`trace_figure`.
+:func:`markdown_report`); figures with :func:`snapshot_figure` and :func:`trace_figure`, animations with :func:`animate_plan`.
 """
 
 from __future__ import annotations
@@ -29,6 +29,7 @@ if TYPE_CHECKING:
     from plannerlab.bench.trials import ComparisonRun, Trial, compare, summarise
     from plannerlab.errors import PlannerlabError
     from plannerlab.planners import make_planner, planner_names
+    from plannerlab.plot.animate import animate_plan
     from plannerlab.plot.plans import snapshot_figure, trace_figure
     from plannerlab.problem.catalog import list_problems, load_problem
     from plannerlab.problem.load import Budget, Problem
@@ -59,6 +60,7 @@ _EXPORTS: dict[str, str] = {
     "markdown_report": "plannerlab.bench.report:markdown",
     "snapshot_figure": "plannerlab.plot.plans:snapshot_figure",
     "trace_figure": "plannerlab.plot.plans:trace_figure",
+    "animate_plan": "plannerlab.plot.animate:animate_plan",
 }
 
 __all__ = [
@@ -72,6 +74,7 @@ __all__ = [
     "Problem",
     "Status",
     "Trial",
+    "animate_plan",
     "compare",
     "execute",
     "list_problems",
