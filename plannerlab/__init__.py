@@ -14,7 +14,8 @@ none of the engines)::
 The data flow is one way: problem file → :func:`load_problem` → planner
 (:func:`make_planner`, :func:`solve`) → record (:class:`Plan`, :class:`PlanResult`) →
 :func:`execute` (:class:`Execution`) → table (:func:`compare`, :func:`summarise`,
-:func:`markdown_report`); figures with :func:`snapshot_figure` and :func:`trace_figure`, animations with :func:`animate_plan`.
+:func:`markdown_report`); figures with :func:`snapshot_figure` and :func:`trace_figure`,
+animations with :func:`animate_plan`.
 """
 
 from __future__ import annotations

@@ -25,8 +25,8 @@ def cmd_animate(args: argparse.Namespace, console: Console) -> int:
     problem = plan.load_problem()
     check_plan(plan, problem, args.plan)
     out = Path(args.out) if args.out else Path(args.plan).with_suffix(f".{args.format}")
-    executions = plan_executions(plan)
-    note = "with its execution record"
+    executions = plan_executions(args.plan)
+    note = "with its execution record (PLAN.exec.json)"
     if not executions and not args.no_execute:
         from plannerlab.sim.execute import execute_legs
 
@@ -34,7 +34,7 @@ def cmd_animate(args: argparse.Namespace, console: Console) -> int:
             executions = execute_legs(
                 problem, [r.path for r in plan.legs], first_leg=plan.legs[0].leg
             )
-        note = "executed now (the plan file had no execution; `plannerlab execute` keeps one)"
+        note = "executed now (no PLAN.exec.json beside the plan; `plannerlab execute` writes one)"
     elif not executions:
         note = "planned motion only (--no-execute)"
     with console.status(f"drawing {args.frames} frames"):

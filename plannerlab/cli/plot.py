@@ -9,17 +9,14 @@ from typing import Any
 
 from rich.console import Console
 
-from plannerlab.errors import PlanFileError
 
+def plan_executions(plan_file: str | Path) -> list[Any]:
+    """The executions ``plannerlab execute PLAN.json`` wrote beside the plan
+    (``PLAN.exec.json``), or none when it has not been executed."""
+    from plannerlab.record.plan import ExecutionFile, execution_path
 
-def plan_executions(plan: Any) -> list[Any]:
-    """The executions stored in a plan file (``plannerlab execute`` writes them)."""
-    from plannerlab.sim.execute import Execution
-
-    try:
-        return [Execution.from_dict(d) for d in plan.executions]
-    except Exception as exc:  # a hand-edited or older record
-        raise PlanFileError(f"executions: not an execution record ({exc})") from None
+    path = execution_path(plan_file)
+    return list(ExecutionFile.load(path).executions) if path.exists() else []
 
 
 def cmd_plot(args: argparse.Namespace, console: Console) -> int:
@@ -30,7 +27,7 @@ def cmd_plot(args: argparse.Namespace, console: Console) -> int:
     problem = plan.load_problem()
     check_plan(plan, problem, args.plan)
     out_dir = Path(args.out) if args.out else Path(args.plan).with_suffix("")
-    files = plot_plan(plan, problem, out_dir, plan_executions(plan))
+    files = plot_plan(plan, problem, out_dir, plan_executions(args.plan))
     if args.json:
         print(json.dumps([str(f) for f in files]))
     else:

@@ -24,6 +24,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 from numba import njit
@@ -598,10 +599,11 @@ class Core:
         self._continuous = np.ascontiguousarray(robot.continuous, dtype=np.bool_)
         self._armz = getattr(robot, "kind", "") == "armz"
         if self._armz:
-            T0 = np.ascontiguousarray(robot.T_world_base, dtype=float)
+            armz: Any = robot  # an ArmZ: its fixed transforms feed the compiled kinematics
+            T0 = np.ascontiguousarray(armz.T_world_base, dtype=np.float64)
             self._T0 = T0
-            self._T1 = T0 @ robot._T_base_j1
-            self._M = np.ascontiguousarray(robot._M, dtype=float)
+            self._T1 = T0 @ armz._T_base_j1
+            self._M = np.ascontiguousarray(armz._M, dtype=np.float64)
 
     # ------------------------------------------------------------------ kinematics
     def _Q(self, Q: Array) -> np.ndarray:

@@ -64,7 +64,7 @@ def motion_frames(
     settled (``q_final_rad``). Without one, the planned path is densified at the
     problem's joint step."""
     by_leg = {e.leg: e for e in executions}
-    tracks = []
+    tracks: list[tuple[Any, Array, Array | None, Any]] = []
     for r in legs:
         e = by_leg.get(r.leg)
         if e is not None and len(e.q_cmd_rad):
@@ -99,7 +99,7 @@ def animation_figure(
     tips_e = tip_points(problem, executed_all) if executed_all is not None else None
     pts = [tips_p, chain_points(problem, planned_all[0])]
     pts += [chain_points(problem, q) for q in planned_all[:: max(len(frames) // 8, 1)]]
-    if executed_all is not None:
+    if executed_all is not None and tips_e is not None:
         pts += [tips_e, chain_points(problem, executed_all[-1])]
     bounds = scene_bounds(problem, np.concatenate(pts))
     fig = _figure(bounds)

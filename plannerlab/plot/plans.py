@@ -262,10 +262,11 @@ def snapshot_figure(
     ax3, views = motion_axes(fig, bounds)
     draw_scene_3d(ax3, problem)
     draw_goals(ax3, problem, None)
-    for ax, dims in views:
-        draw_scene_2d(ax, problem, dims)
-        draw_goals(ax, problem, dims)
-    for ax, dims in [(ax3, None), *views]:
+    for ax_2d, dims_2d in views:
+        draw_scene_2d(ax_2d, problem, dims_2d)
+        draw_goals(ax_2d, problem, dims_2d)
+    panels: list[tuple[Any, tuple[int, int] | None]] = [(ax3, None), *views]
+    for ax, dims in panels:
         for k, q in enumerate(ghost_qs):
             draw_arm(
                 ax,
