@@ -231,6 +231,10 @@ CLI_CASES = {
     "unknown_planner": (["--planner", "ompl.rrtconect"], "ompl.rrtconnect"),
     "unknown_setting": (["--set", "no_such_setting=3"], "no_such_setting"),
     "set_without_equals": (["--set", "alpha"], "--set"),
+    "goal_selection_unknown": (
+        ["--planner", "ompl.rrtconnect", "--set", "goal_selection=far"],
+        "goal_selection",
+    ),
 }
 
 
