@@ -42,6 +42,8 @@ except ImportError:  # pragma: no cover - the adapter is optional while being wr
     HAVE_OMPL = False
 
 PROBLEM = "armz_pocket"
+#: a trial on it lasts many seconds (seven legs of the clearance descent)
+SLOW_PROBLEM = "armz_inspection"
 PLANNERS = ["gradient", "gradient.analytic"] + (["ompl.rrtconnect"] if HAVE_OMPL else [])
 SEEDS = [0, 1, 2]
 MAX_CHECKS = 300
@@ -368,9 +370,9 @@ def test_cli_trial_timeout_records_timeouts(tmp_path: Path) -> None:
         code = main(
             [
                 "compare",
-                PROBLEM,
+                SLOW_PROBLEM,  # the clearance descent plans for many seconds here
                 "--planners",
-                "gradient",
+                "gradient.clearance",
                 "--seeds",
                 "0",
                 "--trial-timeout",
@@ -474,7 +476,9 @@ def test_a_trial_whose_process_dies_is_recorded(tmp_path: Path) -> None:
     import threading
 
     path = resolve_problem_path(PROBLEM).resolve()
-    victim = Trial.make(PROBLEM, path, "gradient", 0)  # default budget: a few seconds
+    slow_path = resolve_problem_path(SLOW_PROBLEM).resolve()
+    # the clearance descent over the paper's seven legs: many seconds, whatever the machine
+    victim = Trial.make(SLOW_PROBLEM, slow_path, "gradient.clearance", 0)
     other = Trial.make(PROBLEM, path, "gradient.analytic", 0, budget={"max_collision_checks": 100})
     killed: list[int] = []
 
