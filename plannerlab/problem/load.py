@@ -40,6 +40,7 @@ from plannerlab.errors import ProblemError, UnknownNameError, did_you_mean
 from plannerlab.problem.goals import GoalRegion
 from plannerlab.problem.scene import OBSTACLE_TYPES, Box, Cylinder, Obstacle, Scene, Sphere
 from plannerlab.robots.base import Array, Robot, pose_matrix
+from plannerlab.robots.schema import COMMON_KEYS, Key, RobotTable, TableValueError
 
 KNOWN_TABLES = (
     "problem",
@@ -186,7 +187,15 @@ class TableReader:
         return v
 
     def number(
-        self, name: str, default: Any = ..., *, positive: bool = False, nonnegative: bool = False
+        self,
+        name: str,
+        default: Any = ...,
+        *,
+        positive: bool = False,
+        nonnegative: bool = False,
+        minimum: float | None = None,
+        maximum: float | None = None,
+        why_maximum: str = "",
     ) -> float:
         v = self.raw(name, default)
         if isinstance(v, bool) or not isinstance(v, int | float):
@@ -198,6 +207,14 @@ class TableReader:
             raise self.fail(name, f"a positive number, got {v}")
         if nonnegative and v < 0:
             raise self.fail(name, f"a number >= 0, got {v}")
+        if minimum is not None and v < minimum:
+            raise self.fail(name, f"a number >= {minimum:g}, got {v:g}")
+        if maximum is not None and v > maximum:
+            raise self.fail(
+                name,
+                f"a number <= {maximum:g}, got {v:g}"
+                + (f" ({why_maximum})" if why_maximum else ""),
+            )
         return v
 
     def integer(
@@ -416,17 +433,79 @@ def _simulation(top: TableReader, robot: Robot) -> SimSettings:
     )
 
 
-#: robot type in a problem file -> "module:function" building it from the [robot] table
+#: robot type in a problem file -> "module:attribute" of its table declaration
+#: (:class:`~plannerlab.robots.schema.RobotTable`, beside the robot's model); a family is
+#: imported only when a problem asks for it
 ROBOT_TYPES: dict[str, str] = {
-    "armz": "plannerlab.robots.armz.model:from_table",
-    "irb6": "plannerlab.robots.irb6.model:from_table",
-    "continuum_chain": "plannerlab.robots.continuum.model:from_table",
+    "armz": "plannerlab.robots.armz.schema:TABLE",
+    "irb6": "plannerlab.robots.irb6.schema:TABLE",
+    "continuum_chain": "plannerlab.robots.continuum.schema:TABLE",
 }
 
 
+def robot_table(kind: str) -> RobotTable:
+    """The ``[robot]`` table declaration of robot type ``kind`` (imports its family).
+
+    Raises:
+        UnknownNameError: for a type that is not in :data:`ROBOT_TYPES`.
+    """
+    if kind not in ROBOT_TYPES:
+        raise UnknownNameError("robot type", kind, ROBOT_TYPES)
+    module_name, attribute = ROBOT_TYPES[kind].split(":")
+    table: RobotTable = getattr(importlib.import_module(module_name), attribute)
+    return table
+
+
+def _table_value(reader: TableReader, key: Key) -> Any:
+    """The value of one declared key (its default when absent), checked as declared."""
+    name = key.name
+    if key.kind == "integer":
+        minimum = None if key.minimum is None else int(key.minimum)
+        maximum = None if key.maximum is None else int(key.maximum)
+        return reader.integer(
+            name, key.default, minimum=minimum, maximum=maximum, why_maximum=key.why_maximum
+        )
+    if key.kind == "number":
+        return reader.number(
+            name,
+            key.default,
+            positive=key.positive,
+            minimum=key.minimum,
+            maximum=key.maximum,
+            why_maximum=key.why_maximum,
+        )
+    if key.kind == "vector":
+        v = reader.vector(name, key.length, default=list(key.default))  # type: ignore[arg-type]
+        if key.ordered and v[0] > v[1]:
+            unit = f" [{key.unit}]" if key.unit else ""
+            raise reader.fail(
+                name, f"[lower, upper] with lower <= upper{unit}, got {[float(x) for x in v]}"
+            )
+        return v
+    s = reader.string(name, key.default)
+    if key.choices and s not in key.choices:
+        choices = " or ".join(
+            f'"{c}"' + (" (the default)" if c == key.default else "") for c in key.choices
+        )
+        raise reader.fail(name, f"{choices}, got {s!r}")
+    return s
+
+
+def parse_robot_table(reader: TableReader, table: RobotTable) -> dict[str, Any]:
+    """Every declared key's checked value (defaults filled in) from a ``[robot]`` table.
+
+    Raises:
+        ProblemError: naming the file and ``robot.<key>``: a key the table does not declare
+            (with "did you mean"), a value of the wrong kind, out of its limits, or not
+            among its choices.
+    """
+    reader.unknown_keys((COMMON_KEYS[0], *table.names, *COMMON_KEYS[1:]))
+    return {key.name: _table_value(reader, key) for key in table.keys}
+
+
 def build_robot(reader: TableReader) -> Robot:
-    """Build the robot described by a problem file's ``[robot]`` table; the family's module
-    is imported only now."""
+    """Build the robot described by a problem file's ``[robot]`` table: its type's declared
+    keys are parsed here, then its family's constructor builds it."""
     kind = reader.string("type")
     if kind not in ROBOT_TYPES:
         import difflib
@@ -434,9 +513,13 @@ def build_robot(reader: TableReader) -> Robot:
         close = difflib.get_close_matches(kind, ROBOT_TYPES, n=1)
         hint = f" (did you mean {close[0]!r}?)" if close else ""
         raise reader.fail("type", f"one of {', '.join(ROBOT_TYPES)}, got {kind!r}{hint}")
-    module_name, func = ROBOT_TYPES[kind].split(":")
-    builder = getattr(importlib.import_module(module_name), func)
-    return builder(reader)
+    table = robot_table(kind)
+    values = parse_robot_table(reader, table)
+    try:
+        robot: Robot = table.build(values)
+    except TableValueError as exc:
+        raise reader.fail(exc.key, exc.expected) from None
+    return robot
 
 
 def problem_from_dict(data: Mapping[str, Any], source: str) -> Problem:

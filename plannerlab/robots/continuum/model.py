@@ -48,11 +48,10 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from dataclasses import dataclass, field
-from typing import Any
 
 import numpy as np
 
-from plannerlab.robots.base import Array, matrix_to_rpy, pose_matrix, rot_z, urdf_origin
+from plannerlab.robots.base import Array, pose_matrix, rot_z, urdf_origin
 
 # --------------------------------------------------------------------------- section math
 
@@ -522,45 +521,6 @@ class ContinuumChain:
         return "".join(parts)
 
 
-#: largest ``n_links`` a problem file may ask for (the bundled problems use 40)
-MAX_LINKS = 400
-
-
-def from_table(reader: Any) -> ContinuumChain:
-    """Build a chain from a problem file's ``[robot]`` table (a ``problem.TableReader``)."""
-    reader.unknown_keys(
-        (
-            "type",
-            "n_links",
-            "length_m",
-            "link_radius_m",
-            "max_joint_deg",
-            "base_xyz_m",
-            "base_rpy_deg",
-            "link_mass_kg",
-            "note",
-        )
-    )
-    T = reader.pose("base_xyz_m", "base_rpy_deg")  # identity when both are absent
-    rpy = matrix_to_rpy(T[:3, :3])
-    if abs(rpy[0]) > 1e-9 or abs(rpy[1]) > 1e-9:
-        raise reader.fail("base_rpy_deg", "roll = pitch = 0 (the continuum chain is planar)")
-    return ContinuumChain(
-        n_links=reader.integer(
-            "n_links",
-            40,
-            minimum=1,
-            maximum=MAX_LINKS,
-            why_maximum="collision checking and simulation grow with the link count",
-        ),
-        length_m=reader.number("length_m", 0.5, positive=True),
-        link_radius_m=reader.number("link_radius_m", 0.002, positive=True),
-        max_joint_rad=float(np.deg2rad(reader.number("max_joint_deg", 90.0, positive=True))),
-        T_world_base=T,
-        link_mass_kg=reader.number("link_mass_kg", 0.01, positive=True),
-    )
-
-
 __all__ = [
     "ContinuumChain",
     "T_bend",
@@ -568,7 +528,6 @@ __all__ = [
     "arc_points",
     "arc_points_local",
     "chord_length",
-    "from_table",
     "planar_frame",
     "section_ik",
     "section_tip",

@@ -62,7 +62,8 @@ upper arm and the wrist (wrist point → flange). Self-collision is not counted 
 neighbours, nor between the column and the upper arm (the parallelogram links sit side by
 side on the real arm; the capsule model would make them overlap when θ2 < 0 and θ3 < 0).
 
-Problem files build the model with :func:`from_table` (``[robot] type = "irb6"``); goal
+Problem files build the model from the ``[robot]`` table declared in
+:mod:`plannerlab.robots.irb6.schema` (``type = "irb6"``); goal
 regions are sampled through the analytic IK by
 :func:`plannerlab.robots.irb6.goals.sample_goal_state`.
 """
@@ -72,16 +73,12 @@ from __future__ import annotations
 import math
 from collections.abc import Callable
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING, Any
 
 import numpy as np
 from numpy.typing import NDArray
 
 from plannerlab.errors import PlannerlabError
-from plannerlab.robots.base import Array, pose_matrix, rot_x, rot_y, rot_z, trans, urdf_origin
-
-if TYPE_CHECKING:
-    pass
+from plannerlab.robots.base import Array, rot_x, rot_y, rot_z, trans, urdf_origin
 
 #: rotation flange-at-θ5=0 in the wrist frame: columns a = y_w, b = z_w, c = x_w
 _R_WRIST_FLANGE0 = np.array([[0.0, 0.0, 1.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]])
@@ -480,95 +477,3 @@ class IRb6:
             parts.append("  </joint>")
         parts.append("</robot>")
         return "\n".join(parts) + "\n"
-
-
-#: keys of the ``[robot]`` table (type = "irb6"); every parameter is optional
-ROBOT_TABLE_KEYS = (
-    "type",
-    "note",
-    "shoulder_height_m",
-    "lower_arm_m",
-    "upper_arm_m",
-    "wrist_to_flange_m",
-    "track_range_m",
-    "theta1_range_deg",
-    "theta2_range_deg",
-    "theta3_range_deg",
-    "theta4_range_deg",
-    "theta5_range_deg",
-    "dead_wedge_side",
-    "rail_height_m",
-    "rail_radius_m",
-    "column_radius_m",
-    "lower_arm_radius_m",
-    "upper_arm_radius_m",
-    "wrist_radius_m",
-    "base_xyz_m",
-    "base_rpy_deg",
-)
-
-
-def from_table(reader: Any) -> IRb6:
-    """Build an IRb-6 on LP-1 from a problem file's ``[robot]`` table (type = "irb6").
-
-    Every parameter is optional; the defaults are the model's (``docs/papers.md`` §2).
-    Lengths in metres, joint ranges as ``[lower, upper]`` in degrees (the track range in
-    metres), the station frame's pose in the world as ``base_xyz_m`` [m] and
-    ``base_rpy_deg`` (URDF roll, pitch, yaw) [deg]. Errors name the file and the key.
-
-    Args:
-        reader: a :class:`plannerlab.problem.load.TableReader` on the ``[robot]`` table.
-    """
-    reader.unknown_keys(ROBOT_TABLE_KEYS)
-    d = IRb6()
-
-    def length(name: str) -> float:
-        return reader.number(name, getattr(d, name), positive=True)
-
-    def span(name: str, default: tuple[float, float], unit: str) -> tuple[float, float]:
-        lo, hi = (float(v) for v in reader.vector(name, 2, default=list(default)))
-        if lo > hi:
-            raise reader.fail(name, f"[lower, upper] with lower <= upper [{unit}], got {[lo, hi]}")
-        return (lo, hi)
-
-    def angle_span(name: str) -> tuple[float, float]:
-        default = getattr(d, name.replace("_deg", "_rad"))
-        lo, hi = span(name, (math.degrees(default[0]), math.degrees(default[1])), "deg")
-        return (math.radians(lo), math.radians(hi))
-
-    side = reader.string("dead_wedge_side", d.dead_wedge_side)
-    if side not in ("-z", "+z"):
-        raise reader.fail("dead_wedge_side", f'"-z" (the paper\'s) or "+z", got {side!r}')
-    if reader.has("base_xyz_m") or reader.has("base_rpy_deg"):
-        xyz = reader.vector("base_xyz_m", 3, default=[0.0, 0.0, 0.0])
-        rpy_deg = reader.vector("base_rpy_deg", 3, default=[0.0, 0.0, 0.0])
-        T = pose_matrix(xyz, np.deg2rad(rpy_deg))
-    else:
-        T = np.eye(4)
-    values: dict[str, Any] = {
-        name: length(name)
-        for name in (
-            "shoulder_height_m",
-            "lower_arm_m",
-            "upper_arm_m",
-            "wrist_to_flange_m",
-            "rail_radius_m",
-            "column_radius_m",
-            "lower_arm_radius_m",
-            "upper_arm_radius_m",
-            "wrist_radius_m",
-        )
-    }
-    values["rail_height_m"] = reader.number("rail_height_m", d.rail_height_m)
-    values["track_range_m"] = span("track_range_m", d.track_range_m, "m")
-    for j in range(1, 6):
-        values[f"theta{j}_range_rad"] = angle_span(f"theta{j}_range_deg")
-    try:
-        return IRb6(dead_wedge_side=side, T_world_base=T, **values)
-    except PlannerlabError as exc:  # a combination the model rejects: name the table key
-        message = str(exc)
-        key = next(
-            (k for k in ROBOT_TABLE_KEYS[2:] if k.replace("_deg", "_rad") in message),
-            "theta3_range_deg" if "column axis" in message else "base_rpy_deg",
-        )
-        raise reader.fail(key, f"a valid IRb-6 parameter set ({message})") from None
