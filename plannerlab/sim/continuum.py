@@ -402,7 +402,7 @@ def execute_chord_arc(
                     closest[name] = {
                         "obstacle": name,
                         "distance_m": d,
-                        "link": world._link_name(pt[3])[0],
+                        "link": world.link_name(pt[3])[0],
                         "p_world_m": list(p),
                         "collision_point": best[1],
                         "point_distance_m": None if best[1] is None else best[0],

@@ -475,7 +475,11 @@ class SimWorld:
             by_index[-1] = _pose(pos, orn) @ self._T_com_rootlink
         return np.stack([by_index[j] for j in self._frame_links])
 
-    def _link_name(self, pb_link: int) -> tuple[str, int | None]:
+    def link_name(self, pb_link: int) -> tuple[str, int | None]:
+        """The name of a PyBullet link index of the robot's body, and its index among
+        ``robot.link_names`` (None for a URDF link that is no robot link: the base, a
+        fixed mount). Contact and closest-point queries report links by PyBullet index.
+        """
         i = self._robot_link.get(pb_link)
         if i is None:
             return self.urdf_link_names[pb_link], None
@@ -505,9 +509,9 @@ class SimWorld:
             if a != self.body:  # make the robot side A
                 a, b, la, lb = b, a, lb, la
                 p_on_robot = pt[6]
-            name, i = self._link_name(la)
+            name, i = self.link_name(la)
             if b == self.body:
-                other, k = self._link_name(lb)
+                other, k = self.link_name(lb)
                 if i is not None and k is not None:
                     if (min(i, k), max(i, k)) in excluded:
                         continue
