@@ -57,14 +57,13 @@ def _solve(case: int, overrides: dict | None = None, seed: int = 0) -> PlanResul
 
 
 def _execute(case: int) -> dict:
-    """Worker: plan (default settings) and execute in PyBullet; plain data back."""
+    """Worker: plan (default settings) and execute in PyBullet; the records as plain data
+    back (through the codec, as a plan file and an execution file hold them)."""
     from plannerlab.sim.continuum import execute_chord_arc
 
     problem = load_problem(f"continuum_case{case}")
     r = _solve(case)
-    out = execute_chord_arc(problem, r.path, r.extra, leg=r.leg).to_dict()
-    out["plan"] = {"extra": r.extra}
-    return out
+    return {"plan": r.to_dict(), "execution": execute_chord_arc(problem, r).to_dict()}
 
 
 _RRT = """
@@ -243,21 +242,33 @@ def test_execution_reaches_the_target_touching_only_the_planned_points(
     region (5 mm), every contact is at the planned collision point (on the obstacle that
     owns it) or with the sleeve, and the motion is the paper's follow / push / re-bend /
     follow for one contact."""
+    from plannerlab.record.execution import Execution
+
     problem = load_problem(f"continuum_case{case}")
-    e = executions[case].result(timeout=900)
-    sol = e["plan"]["extra"]["solutions"][e["chosen"]]
+    data = executions[case].result(timeout=900)
+    plan = PlanResult.from_dict(data["plan"])
+    e = Execution.from_dict(data["execution"])
+    sol = plan.extra["solutions"][e.extra["chosen"]]
     assert tuple(sol["contact_indices"]) == CHOSEN_POINTS[case]
+    assert tuple(e.extra["collision_points_used"]) == CHOSEN_POINTS[case]
     assert [m["kind"] for m in sol["motion"]] == ["follow", "push", "rebend", "follow"]
-    assert e["tip_error_m"] < problem.goal(0).pos_tol_m, e["reason"]
-    assert e["unexpected"] == 0, e["reason"]
-    guides = set(e["plan"]["extra"]["guide_obstacles"])
+    assert e.final_pos_err_m < problem.goal(0).pos_tol_m, e.reason
+    assert e.goal_reached and e.leg == 0 and e.goal == problem.goal(0).name
+    assert not e.unexpected_contacts, e.reason
+    assert e.success, e.reason
+    assert e.path_valid is None  # no FCL re-check: the path touches by design
+    guides = set(plan.extra["guide_obstacles"])
     owners = set(sol["contact_obstacles"])
-    touched = {c["other_name"] for c in e["contacts"]}
+    touched = {c.other_name for c in e.contacts}
     assert touched <= owners | guides, touched
+    # the log: one row per commanded waypoint, the chain on the path to 1 cm
+    assert e.q_cmd_rad.shape == e.q_actual_rad.shape == (len(e.t_s), problem.robot.dof)
+    np.testing.assert_array_equal(e.q_cmd_rad, plan.path)
+    assert e.max_tip_track_err_m < 1e-3 and e.max_track_err_rad < 1e-2
     # the chain grazes the planned corner (within 1 mm: planned for its radius, the
     # axis passes r from the corner) and comes that close to nothing else
-    near = {a["obstacle"]: a for a in e["approaches"]}
-    assert set(near) == owners, e["approaches"]
+    near = {a["obstacle"]: a for a in e.extra["approaches"]}
+    assert set(near) == owners, e.extra["approaches"]
     for a in near.values():
         assert a["at_collision_point"] and a["collision_point"] in CHOSEN_POINTS[case], a
         assert a["distance_m"] < 1e-3

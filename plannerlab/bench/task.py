@@ -15,7 +15,7 @@ from typing import Any
 
 import numpy as np
 
-from plannerlab.errors import PlanFileError, ProblemError
+from plannerlab.errors import PlanFileError, PlannerlabError, ProblemError
 from plannerlab.planners import get_entry, make_planner
 from plannerlab.problem.goals import unreachable_reason
 from plannerlab.problem.load import Budget, Problem
@@ -126,6 +126,31 @@ def solve_legs(
     )
 
 
+def execute_results(
+    problem: Problem, results: Sequence[PlanResult], *, gui: bool = False
+) -> list[Execution]:
+    """Execute planned legs in PyBullet: one :class:`Execution` per leg, in order.
+
+    Ordinary legs run in one world, each from where the previous one really ended
+    (:func:`plannerlab.sim.execute.execute_legs`). Legs of a contact-permitting planner
+    (``extra["allows_contact"]``: ``chord_arc``, whose paths touch the collision points
+    on purpose) run in :func:`plannerlab.sim.continuum.execute_chord_arc`, which sorts
+    expected from unexpected contacts; each of them starts from its path's first state.
+
+    Raises:
+        PlannerlabError: no legs, or a contact plan's leg without a chosen solution.
+    """
+    if not results:
+        raise PlannerlabError("nothing to execute: the plan has no legs")
+    if any(r.extra.get("allows_contact") for r in results):
+        from plannerlab.sim.continuum import execute_chord_arc
+
+        return [execute_chord_arc(problem, r, gui=gui) for r in results]
+    from plannerlab.sim.execute import execute_legs
+
+    return execute_legs(problem, [r.path for r in results], first_leg=results[0].leg, gui=gui)
+
+
 def execute_plan(
     plan: Plan,
     problem: Problem | None = None,
@@ -133,8 +158,9 @@ def execute_plan(
     allow_changed_problem: bool = False,
     gui: bool = False,
 ) -> list[Execution]:
-    """Execute every leg of ``plan`` in PyBullet, in one world, each leg from where the
-    previous one really ended (:func:`plannerlab.sim.execute.execute_legs`).
+    """Execute every leg of ``plan`` in PyBullet (:func:`execute_results`: in one world,
+    each leg from where the previous one really ended; a contact plan's legs in the
+    continuum's executor).
 
     Args:
         plan: what :func:`solve_legs` returned, or :meth:`Plan.load` read.
@@ -145,11 +171,9 @@ def execute_plan(
     Raises:
         PlanFileError: the problem file changed since planning.
     """
-    from plannerlab.sim.execute import execute_legs
-
     if problem is None:
         changed = plan.problem_changed()
         if changed and not allow_changed_problem:
             raise PlanFileError(f"{plan.problem}: {changed}")
         problem = plan.load_problem()
-    return execute_legs(problem, [r.path for r in plan.legs], first_leg=plan.legs[0].leg, gui=gui)
+    return execute_results(problem, plan.legs, gui=gui)

@@ -240,9 +240,9 @@ def _execution_record(executions: Sequence[Execution]) -> dict[str, Any]:
     last = executions[-1] if executions else None
     return {
         "success": bool(executions) and all(e.success for e in executions),
-        "path_valid": all(e.path_valid for e in executions),
+        "path_valid": all(e.path_valid is not False for e in executions),
         "max_track_err_rad": to_data(max((e.max_track_err_rad for e in executions), default=0.0)),
-        "contacts": sum(len(e.contacts) for e in executions),
+        "contacts": sum(len(e.unexpected_contacts) for e in executions),
         "final_pos_err_m": to_data(last.final_pos_err_m) if last else None,
         "final_angle_err_deg": to_data(last.final_angle_err_deg) if last else None,
         "legs": legs,
@@ -320,13 +320,9 @@ def run_trial(trial: Trial) -> dict[str, Any]:
             solved_prefix += 1
         rec["executed_legs"] = solved_prefix if trial.execute else 0
         if trial.execute and solved_prefix:
-            from plannerlab.sim.execute import execute_legs
+            from plannerlab.bench.task import execute_results
 
-            executions = execute_legs(
-                problem,
-                [r.path for r in plan.legs[:solved_prefix]],
-                first_leg=plan.legs[0].leg,
-            )
+            executions = execute_results(problem, plan.legs[:solved_prefix])
             rec["execution"] = _execution_record(executions)
     except Exception as exc:  # a crashing trial is a record, never the end of the run
         last = traceback.format_exception_only(type(exc), exc)[-1].strip()

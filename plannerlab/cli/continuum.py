@@ -1,7 +1,7 @@
 """``plannerlab continuum``: the continuum paper's table, figures and execution.
 
-    plannerlab continuum CASE... [--runs 20] [--figures DIR] [--execute] [--json]
-                                 [--set KEY=VALUE]
+    plannerlab continuum CASE... [--runs 20] [--figures DIR] [--execute] [--out DIR]
+                                 [--json] [--set KEY=VALUE]
 
 ``CASE`` is a problem name or path, or a bare number N for ``continuum_caseN``. For each
 case the ``chord_arc`` planner is run ``--runs`` times (after one warm-up run) and the
@@ -14,6 +14,15 @@ target) is written per case to ``--figures`` (default ``results/``). ``--execute
 runs the chosen solution in PyBullet (:func:`plannerlab.sim.continuum.execute_chord_arc`)
 and shows the tip error and the expected / unexpected contacts.
 
+The data behind each row are the house's records: the first run is planned by
+:func:`plannerlab.bench.task.solve_legs` (seed 0) into a :class:`~plannerlab.record.plan.Plan`
+whose one :class:`~plannerlab.record.leg.PlanResult` gives the row, and the execution is
+an :class:`~plannerlab.record.execution.Execution`. ``--out DIR`` writes them as any
+``solve`` / ``execute`` would: ``DIR/<case>.plan.json`` and ``DIR/<case>.plan.exec.json``
+(so ``plannerlab plot`` and ``plannerlab execute`` read them). ``--json`` prints one
+document (``planner``, ``runs``, ``overrides``, ``cases``: per case the timing summary,
+the files written, and the ``plan`` and ``execution`` records through the one codec).
+
 Argument parsing and printing only; the work is done by the library.
 """
 
@@ -22,7 +31,6 @@ from __future__ import annotations
 import argparse
 import contextlib
 import dataclasses
-import json
 import os
 import statistics
 import sys
@@ -64,6 +72,12 @@ def add_continuum_parser(subparsers: Any) -> argparse.ArgumentParser:
         action="append",
         metavar="KEY=VALUE",
         help="override a chord_arc setting (repeatable)",
+    )
+    p.add_argument(
+        "--out",
+        metavar="DIR",
+        help="write each case's plan to DIR/<case>.plan.json (and, with --execute, its "
+        "execution to DIR/<case>.plan.exec.json), readable by plot and execute",
     )
     p.add_argument("--json", action="store_true", help="machine-readable output")
     p.set_defaults(func=cmd_continuum)
@@ -146,19 +160,61 @@ def _figure(planner: Any, problem: Any, result: Any, out: Path) -> Path:
     return draw_case(query, shown, out / f"{problem.name}.png", title=title)
 
 
+@dataclasses.dataclass(frozen=True)
+class CaseRun:
+    """One case of the table: the records behind its row and the timing summary.
+
+    Attributes:
+        plan: the first (warm-up) run as a plan (:func:`plannerlab.bench.task.solve_legs`,
+            seed 0): its one leg's :class:`~plannerlab.record.leg.PlanResult` is the row.
+        execution: the chosen solution executed in PyBullet (``--execute``), or None.
+        timing: ``runs``, ``search_median_s``, ``solve_median_s``, ``same_every_run``,
+            ``solutions_zero_thickness`` and the paper's row (``paper``, or None).
+        files: what was written: ``figure``, ``thickness_figure``, ``plan_file``,
+            ``execution_file``.
+    """
+
+    plan: Any
+    execution: Any
+    timing: dict[str, Any]
+    files: dict[str, str]
+
+    @property
+    def result(self) -> Any:
+        return self.plan.legs[0]
+
+    def to_dict(self) -> dict[str, Any]:
+        """The case as data: the records through their own ``to_dict`` (the codec's)."""
+        return {
+            "problem": self.plan.problem,
+            **self.timing,
+            "files": self.files,
+            "plan": self.plan.to_dict(),
+            "execution": None if self.execution is None else self.execution.to_dict(),
+        }
+
+
 def run_case(
-    case: str, runs: int, overrides: dict[str, Any], figures: Path | None, do_execute: bool
-) -> dict[str, Any]:
-    """One row of the table as data (JSON-able)."""
-    from plannerlab.bench.task import leg_rng
+    case: str,
+    runs: int,
+    overrides: dict[str, Any],
+    figures: Path | None,
+    do_execute: bool,
+    out: Path | None = None,
+) -> CaseRun:
+    """One row of the table: the plan record, the timed runs, the execution record."""
+    from plannerlab.bench.task import execute_results, leg_rng, solve_legs
     from plannerlab.planners import make_planner
     from plannerlab.planners.chord_arc import PAPER_TABLE, guide_obstacles
     from plannerlab.problem.catalog import load_problem
+    from plannerlab.record.files import versions
+    from plannerlab.record.plan import ExecutionFile, execution_path
 
     problem = load_problem(_case_name(case))
     planner = make_planner("chord_arc", overrides)
     budget = problem.budget
-    first = planner.solve(problem, 0, budget, leg_rng(0, 0))  # warm-up, and the result
+    plan = solve_legs(problem, "chord_arc", 0, legs=[0], overrides=overrides)  # warm-up
+    first = plan.legs[0]
     solve_s, search_s, counts = [], [], set()
     for i in range(runs):
         r = planner.solve(problem, 0, budget, leg_rng(i, 0))
@@ -168,61 +224,58 @@ def run_case(
     paper = PAPER_TABLE.get(problem.name)
     thin = make_planner("chord_arc", {**overrides, "inflate_by_radius": False})
     thin_r = thin.solve(problem, 0, budget, leg_rng(0, 0))
-    sol = first.extra["solutions"]
-    chosen = first.extra["chosen"]
-    row: dict[str, Any] = {
-        "problem": problem.name,
-        "status": first.status.value,
-        "reason": first.reason,
+    timing: dict[str, Any] = {
         "runs": runs,
-        "search_median_s": statistics.median(search_s) if runs else None,
-        "solve_median_s": statistics.median(solve_s) if runs else None,
-        "collision_points": len(first.extra["collision_points_m"]),
-        "solutions": len(sol),
-        "inflated": bool(first.settings.get("inflate_by_radius")),
-        "solutions_zero_thickness": len(thin_r.extra["solutions"]),
-        "dropped": len(first.extra["dropped"]),
-        "dropped_reasons": [d["reason"] for d in first.extra["dropped"]],
-        "chosen": chosen,
-        "chosen_contacts": sol[chosen]["contact_indices"] if chosen is not None else None,
-        "expansions": first.iterations,
+        "search_median_s": statistics.median(search_s),
+        "solve_median_s": statistics.median(solve_s),
         "same_every_run": len(counts) <= 1,
+        "solutions_zero_thickness": len(thin_r.extra["solutions"]),
         "paper": None if paper is None else dataclasses.asdict(paper),
-        "solutions_data": sol,
-        "settings": dict(first.settings),
     }
-    if figures is not None and sol:
-        row["figure"] = str(_figure(planner, problem, first, figures))
-        row["thickness_figure"] = str(_thickness_figure(planner, problem, figures))
+    files: dict[str, str] = {}
+    if figures is not None and first.extra["solutions"]:
+        files["figure"] = str(_figure(planner, problem, first, figures))
+        files["thickness_figure"] = str(_thickness_figure(planner, problem, figures))
+    execution = None
     if do_execute and first.extra.get("chosen") is not None:
-        from plannerlab.sim.continuum import execute_chord_arc
-
         guide_obstacles(problem)  # validated (the plan's extra carries the names)
-        row["execution"] = execute_chord_arc(
-            problem, first.path, first.extra, leg=first.leg
-        ).to_dict()
-    return row
+        (execution,) = execute_results(problem, plan.legs)
+    if out is not None:
+        plan_file = plan.save(out / f"{problem.name}.plan.json")
+        files["plan_file"] = str(plan_file)
+        if execution is not None:
+            record = ExecutionFile.of(plan, plan_file, [execution], versions())
+            files["execution_file"] = str(record.save(execution_path(plan_file)))
+    return CaseRun(plan, execution, timing, files)
 
 
 def cmd_continuum(args: argparse.Namespace, console: Console) -> int:
-    """``plannerlab continuum``: print the table (or JSON); write the figures."""
+    """``plannerlab continuum``: print the table (or JSON); write the figures and plans."""
     from plannerlab.cli.common import parse_overrides
     from plannerlab.errors import PlannerlabError
+    from plannerlab.record.codec import dumps
 
     if args.runs < 1:
         raise PlannerlabError(f"--runs must be >= 1, got {args.runs}")
     overrides = parse_overrides(args.set)
     figures = None if args.no_figures else Path(args.figures)
-    rows = []
+    out = None if args.out is None else Path(args.out)
+    rows: list[CaseRun] = []
     with console.status("chord_arc") as status, _stdout_to_stderr(args.json):
         for case in args.cases:
             status.update(
                 f"chord_arc on {_case_name(case)}: {args.runs} runs"
                 + (" and PyBullet" if args.execute else "")
             )
-            rows.append(run_case(case, args.runs, overrides, figures, args.execute))
+            rows.append(run_case(case, args.runs, overrides, figures, args.execute, out))
     if args.json:
-        print(json.dumps(rows))
+        doc = {
+            "planner": "chord_arc",
+            "runs": args.runs,
+            "overrides": overrides,
+            "cases": [row.to_dict() for row in rows],
+        }
+        print(dumps(doc))
         return 0
     t = Table(
         title=f"chord_arc on the continuum paper's cases (median of {args.runs} runs; "
@@ -247,42 +300,52 @@ def cmd_continuum(args: argparse.Namespace, console: Console) -> int:
     for col in cols:
         t.add_column(escape(col), justify="right", no_wrap=(col == "case"))
     notes = []
-    for r in rows:
-        paper = r["paper"]
+    for row in rows:
+        r, timing = row.result, row.timing
+        paper = timing["paper"]
+        sol = r.extra["solutions"]
+        chosen = r.extra.get("chosen")
         p_ms = f"{paper['time_s'] * 1e3:.0f}" if paper else "-"
         p_pts = f" ({paper['collision_points']})" if paper else ""
         p_sol = f" ({paper['solutions']})" if paper else ""
-        style = "green" if r["status"] == "solved" else "red"
+        style = "green" if r.status == "solved" else "red"
         cells = [
-            r["problem"].removeprefix("continuum_"),
-            f"[{style}]{r['status']}[/{style}]",
-            f"{r['search_median_s'] * 1e3:.2f}",
-            f"{r['solve_median_s'] * 1e3:.0f}",
+            r.problem.removeprefix("continuum_"),
+            f"[{style}]{r.status.value}[/{style}]",
+            f"{timing['search_median_s'] * 1e3:.2f}",
+            f"{timing['solve_median_s'] * 1e3:.0f}",
             p_ms,
-            f"{r['collision_points']}{p_pts}",
-            f"{r['solutions']}{p_sol}",
-            str(r["solutions_zero_thickness"]),
-            str(r["dropped"]),
-            "-" if r["chosen"] is None else f"#{r['chosen']}: {r['chosen_contacts']}",
-            "yes" if r["same_every_run"] else "[red]no[/red]",
+            f"{len(r.extra['collision_points_m'])}{p_pts}",
+            f"{len(sol)}{p_sol}",
+            str(timing["solutions_zero_thickness"]),
+            str(len(r.extra["dropped"])),
+            "-" if chosen is None else f"#{chosen}: {sol[chosen]['contact_indices']}",
+            "yes" if timing["same_every_run"] else "[red]no[/red]",
         ]
         if args.execute:
-            e = r.get("execution")
+            e = row.execution
             if e is None:
                 cells += ["-", "-", "-"]
             else:
-                u = e["unexpected"]
+                u = len(e.unexpected_contacts)
                 cells += [
-                    f"{e['tip_error_m'] * 1e3:.2f}",
-                    str(e["expected"]),
+                    f"{e.final_pos_err_m * 1e3:.2f}",
+                    str(len(e.expected_contacts)),
                     f"[red]{u}[/red]" if u else "0",
                 ]
-                notes.append(f"{r['problem']} execution: {e['reason']}")
+                notes.append(f"{r.problem} execution: {e.reason}")
         t.add_row(*cells)
-        for d in r["dropped_reasons"]:
-            notes.append(f"{r['problem']} dropped: {d}")
-        if "figure" in r:
-            notes.append(f"{r['problem']} figures: {r['figure']}, {r['thickness_figure']}")
+        for d in r.extra["dropped"]:
+            notes.append(f"{r.problem} dropped: {d['reason']}")
+        if "figure" in row.files:
+            notes.append(
+                f"{r.problem} figures: {row.files['figure']}, {row.files['thickness_figure']}"
+            )
+        if "plan_file" in row.files:
+            written = row.files["plan_file"]
+            if "execution_file" in row.files:
+                written += f", {row.files['execution_file']}"
+            notes.append(f"{r.problem} written: {written}")
     t.caption = escape(
         "\n".join(
             [
@@ -299,4 +362,4 @@ def cmd_continuum(args: argparse.Namespace, console: Console) -> int:
     return 0
 
 
-__all__ = ["add_continuum_parser", "cmd_continuum", "run_case"]
+__all__ = ["CaseRun", "add_continuum_parser", "cmd_continuum", "run_case"]

@@ -41,10 +41,13 @@ def execution_table(legs: Any, executions: Any) -> Table:
     )
     notes = []
     for r, e in zip(legs, executions, strict=True):
-        names = [f"{c.link_name} x {c.other_name}" for c in e.contacts]
+        names = [f"{c.link_name} x {c.other_name}" for c in e.unexpected_contacts]
         if names:
             notes.append(f"leg {r.leg} {r.goal}: contacts " + ", ".join(names))
-        if not e.path_valid:
+        if e.expected_contacts:
+            planned = ", ".join(f"{c.link_name} x {c.other_name}" for c in e.expected_contacts)
+            notes.append(f"leg {r.leg} {r.goal}: planned contacts {planned}")
+        if e.path_valid is False:
             pairs = ", ".join(f"{a} x {b}" for a, b in e.recheck_pairs)
             notes.append(
                 f"leg {r.leg} {r.goal}: FCL re-check collides on edge "
@@ -53,7 +56,7 @@ def execution_table(legs: Any, executions: Any) -> Table:
         t.add_row(
             str(r.leg),
             escape(str(r.goal)),
-            "valid" if e.path_valid else "[red]collides[/red]",
+            {True: "valid", False: "[red]collides[/red]", None: "contact plan"}[e.path_valid],
             fmt(e.final_pos_err_m),
             fmt(e.final_angle_err_deg),
             fmt(e.max_track_err_rad),
@@ -69,9 +72,9 @@ def execution_table(legs: Any, executions: Any) -> Table:
 
 def cmd_execute(args: argparse.Namespace, console: Console) -> int:
     from plannerlab.bench.plan_check import check_plan, read_plan
+    from plannerlab.bench.task import execute_plan
     from plannerlab.record.files import versions
     from plannerlab.record.plan import ExecutionFile, execution_path
-    from plannerlab.sim.execute import execute_legs
 
     require_display(args.gui)
     if args.problem.endswith(".json"):
@@ -98,9 +101,7 @@ def cmd_execute(args: argparse.Namespace, console: Console) -> int:
     if not args.json:
         console.print(f"simulation: {problem.simulation.origin}", highlight=False)
     with console.status(f"executing {len(plan.legs)} legs in PyBullet"):
-        executions = execute_legs(
-            problem, [r.path for r in plan.legs], first_leg=plan.legs[0].leg, gui=args.gui
-        )
+        executions = execute_plan(plan, problem, gui=args.gui)
     record = ExecutionFile.of(plan, plan_file, executions, versions())
     record.save(out)
     if args.json:

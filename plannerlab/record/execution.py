@@ -1,8 +1,10 @@
 """The record of one executed leg: :class:`Execution` and its :class:`ContactRecord` s.
 
-:mod:`plannerlab.sim.execute` produces them; ``plannerlab execute`` writes them to an
-execution file beside the plan, and the trial store keeps them, through the one codec
-(:mod:`plannerlab.record.codec`).
+:mod:`plannerlab.sim.execute` produces them, and
+:func:`plannerlab.sim.continuum.execute_chord_arc` for a contact-permitting plan (the
+continuum's); ``plannerlab execute`` and ``plannerlab continuum --execute --out`` write
+them to an execution file beside the plan, and the trial store keeps them, through the
+one codec (:mod:`plannerlab.record.codec`).
 """
 
 from __future__ import annotations
@@ -10,7 +12,7 @@ from __future__ import annotations
 import dataclasses
 import math
 from collections.abc import Mapping
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
@@ -31,6 +33,15 @@ class ContactRecord:
         max_depth_m: largest penetration depth seen [m].
         first_time_s: simulated time the pair was first seen, from the leg's start [s].
         p_world_m: (3,) contact point at the largest depth, world frame [m].
+        expected: the plan asked for this contact (a contact-permitting planner's
+            collision point, or a guide it slides in; see
+            :func:`plannerlab.sim.continuum.execute_chord_arc`, which keys its records
+            by (link, other, expected), so one pair may appear once each way). False for
+            every contact of an ordinary plan: any contact is a failure there.
+        collision_point: index of the plan's nearest collision point on that obstacle at
+            the deepest point (contact-permitting plans only; else None).
+        distance_m: planar distance from ``p_world_m`` to that collision point [m]
+            (None without one).
     """
 
     link_name: str
@@ -39,6 +50,9 @@ class ContactRecord:
     max_depth_m: float
     first_time_s: float
     p_world_m: tuple[float, float, float]
+    expected: bool = False
+    collision_point: int | None = None
+    distance_m: float | None = None
 
     def to_dict(self) -> dict[str, Any]:
         return to_data(
@@ -49,11 +63,16 @@ class ContactRecord:
                 "max_depth_m": self.max_depth_m,
                 "first_time_s": self.first_time_s,
                 "p_world_m": list(self.p_world_m),
+                "expected": self.expected,
+                "collision_point": self.collision_point,
+                "distance_m": self.distance_m,
             }
         )
 
     @classmethod
     def from_dict(cls, data: Mapping[str, Any]) -> ContactRecord:
+        point = data.get("collision_point")
+        dist = data.get("distance_m")
         return cls(
             link_name=str(data["link_name"]),
             other_name=str(data["other_name"]),
@@ -61,6 +80,9 @@ class ContactRecord:
             max_depth_m=read_float(data["max_depth_m"]),
             first_time_s=read_float(data["first_time_s"]),
             p_world_m=as_xyz(data["p_world_m"]),
+            expected=bool(data.get("expected", False)),
+            collision_point=None if point is None else int(point),
+            distance_m=None if dist is None else float(dist),
         )
 
 
@@ -83,6 +105,7 @@ _FLOAT_FIELDS = (
     "final_tip_track_err_m",
     "duration_s",
     "spline_dev",
+    "recheck_joint_step",
 )
 
 
@@ -94,8 +117,10 @@ class Execution:
         problem: problem name.
         leg: leg index, or None when the path was run without a goal.
         goal: the leg's goal name (or None).
-        path_valid: the FCL re-check found no collision.
-        recheck_joint_step: re-check resolution [rad per joint].
+        path_valid: the FCL re-check found no collision; None when no re-check was made
+            (a contact-permitting plan, whose path touches obstacles by design: the
+            planner classified its contacts, the simulator's are in ``contacts``).
+        recheck_joint_step: re-check resolution [rad per joint] (NaN without a re-check).
         recheck_states: interpolated states the re-check looked at.
         recheck_first_invalid_edge: first path edge with a collision (or None).
         recheck_pairs: colliding (link, other) names at the first invalid state.
@@ -144,7 +169,7 @@ class Execution:
     problem: str
     leg: int | None
     goal: str | None
-    path_valid: bool
+    path_valid: bool | None
     recheck_joint_step: float
     recheck_states: int
     recheck_first_invalid_edge: int | None
@@ -178,6 +203,7 @@ class Execution:
     duration_s: float = math.nan
     trajectory_valid: bool | None = None
     spline_dev: float = math.nan
+    extra: Mapping[str, Any] = field(default_factory=dict)
 
     def __post_init__(self) -> None:
         for name in _ARRAY_FIELDS:
@@ -189,6 +215,7 @@ class Execution:
         for name in _FLOAT_FIELDS:
             object.__setattr__(self, name, read_float(getattr(self, name)))
         object.__setattr__(self, "gravity_mps2", tuple(float(g) for g in self.gravity_mps2))
+        object.__setattr__(self, "extra", dict(self.extra))
         object.__setattr__(
             self, "recheck_pairs", tuple((str(a), str(b)) for a, b in self.recheck_pairs)
         )
@@ -207,13 +234,23 @@ class Execution:
         return self.max_track_err_rad <= self.track_err_limit_rad
 
     @property
+    def expected_contacts(self) -> tuple[ContactRecord, ...]:
+        """The contacts the plan asked for (none for an ordinary plan)."""
+        return tuple(c for c in self.contacts if c.expected)
+
+    @property
+    def unexpected_contacts(self) -> tuple[ContactRecord, ...]:
+        """Every other contact: each one makes the execution a failure."""
+        return tuple(c for c in self.contacts if not c.expected)
+
+    @property
     def success(self) -> bool:
-        """Executed cleanly: re-check valid, no contact, tracking error within the limit,
-        and (with a leg) the final state in the goal."""
+        """Executed cleanly: re-check not failed, no unexpected contact, tracking error
+        within the limit, and (with a leg) the final state in the goal."""
         return (
-            self.path_valid
+            self.path_valid is not False
             and self.trajectory_valid is not False
-            and not self.contacts
+            and not self.unexpected_contacts
             and self.tracked
             and self.goal_reached is not False
         )

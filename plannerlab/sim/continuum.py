@@ -48,14 +48,23 @@ planner's default), the capsules graze the corner: their axes pass 1.87-1.90 mm 
 on the paper's cases (the links are chords of the arcs), and PyBullet reports no
 penetrating contact there.
 
-The tip error is the final tip's distance to the leg's target (the goals of the paper's
-cases constrain position only). :attr:`ContinuumExecution.success` = the tip ends inside
-the goal region and no contact is unexpected. An FCL re-check of the path is not made
-here: it reports the collision-point contacts by design; the planner's
+**The record.** The result is the one execution record,
+:class:`plannerlab.record.execution.Execution` (what :mod:`plannerlab.sim.execute`
+returns for every other plan), so ``plannerlab execute`` and ``plannerlab continuum
+--execute`` write it to the same execution file. The continuum's facts sit in its
+fields: the tip error is ``final_pos_err_m`` (the final tip's distance to the leg's
+target; the goals of the paper's cases constrain position only), every contact a
+:class:`~plannerlab.record.execution.ContactRecord` with ``expected`` (and the nearest
+``collision_point``), and the rest (chosen solution, tolerance, closest approaches) in
+``extra``. ``path_valid`` is None: an FCL re-check of the path is not made here, it
+reports the collision-point contacts by design; the planner's
 ``extra["expected_contacts"]`` holds its classification.
+:attr:`~plannerlab.record.execution.Execution.success` = the tip ends inside the goal
+region, no contact is unexpected and the joints tracked the path within the problem's
+``[simulation] max_track_err_rad`` (mixing the bend joints [rad] and the insertion [m]).
 
-Takes plain data (the path and the plan's ``extra``), imports no planner; nothing is
-printed.
+Takes plain data (the leg's :class:`~plannerlab.record.leg.PlanResult`, from the planner
+or from a plan file), imports no planner; nothing is printed.
 """
 
 from __future__ import annotations
@@ -63,7 +72,6 @@ from __future__ import annotations
 import math
 import time
 from collections.abc import Mapping
-from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
@@ -71,7 +79,10 @@ import pybullet
 
 from plannerlab.errors import PlannerlabError
 from plannerlab.problem.load import Problem
-from plannerlab.robots.base import as_xyz
+from plannerlab.record.execution import ContactRecord, Execution
+from plannerlab.record.leg import PlanResult
+from plannerlab.robots.base import Array, as_xyz
+from plannerlab.robots.paths import densify
 from plannerlab.sim.world import Contact, SimWorld
 
 #: physics time step [s] (PyBullet's and the Arm-Z paper's; see the module docstring)
@@ -94,142 +105,6 @@ SOLVERS: dict[str, int] = {
 }
 #: PyBullet constraint-solver iterations per step (None: PyBullet's default, 50)
 SOLVER_ITERATIONS: int | None = None
-
-
-@dataclass(frozen=True)
-class ClassifiedContact:
-    """The deepest contact point of one (robot link, other, verdict) during the execution.
-
-    Attributes:
-        link_name, other_name, other_is_link: the pair (see :class:`plannerlab.sim.Contact`).
-        expected: at one of the chosen solution's collision points.
-        p_world_m: (3,) deepest such contact point on the link [m].
-        max_depth_m: its penetration depth [m].
-        first_time_s: simulated time the pair was first seen with this verdict [s].
-        points: contact points (steps × points) with this verdict.
-        collision_point: index (into the problem's collision points) of the nearest
-            collision point on that obstacle at the deepest point, or None.
-        distance_m: planar distance from ``p_world_m`` to that point [m] (None if none).
-    """
-
-    link_name: str
-    other_name: str
-    other_is_link: bool
-    expected: bool
-    p_world_m: tuple[float, float, float]
-    max_depth_m: float
-    first_time_s: float
-    points: int
-    collision_point: int | None
-    distance_m: float | None
-
-    def to_dict(self) -> dict[str, Any]:
-        return {
-            "link_name": self.link_name,
-            "other_name": self.other_name,
-            "other_is_link": self.other_is_link,
-            "expected": self.expected,
-            "p_world_m": list(self.p_world_m),
-            "max_depth_m": self.max_depth_m,
-            "first_time_s": self.first_time_s,
-            "points": self.points,
-            "collision_point": self.collision_point,
-            "distance_m": self.distance_m,
-        }
-
-
-def _num(v: float | None) -> float | None:
-    return None if v is None or not math.isfinite(v) else float(v)
-
-
-@dataclass(frozen=True)
-class ContinuumExecution:
-    """What the chosen chord_arc solution did in PyBullet.
-
-    Attributes:
-        problem, leg, goal: what was executed.
-        chosen: index of the executed solution in the plan's ``extra["solutions"]``.
-        collision_points_used: indices of its collision points.
-        tolerance_m: contacts within this of one of them are expected [m].
-        tip_error_m: final tip distance to the target [m].
-        goal_reached: final tip inside the goal region.
-        max_tip_track_err_m: largest commanded-vs-actual tip distance at the waypoints [m].
-        final_track_err: largest |q_cmd − q| after settling [rad; m for the insertion].
-        q_final: the state reached at the end.
-        contacts: every (link, other, verdict) seen, deepest point each.
-        approaches: per obstacle (guides excepted) that the chain came within
-            ``approach_m`` of, the closest approach over the waypoints: ``obstacle``,
-            ``distance_m`` (negative: penetration), ``link``, ``p_world_m`` (on the
-            link), ``collision_point`` (nearest chosen one on that obstacle, or None) and
-            ``point_distance_m``, and ``at_collision_point`` (within ``tolerance_m``).
-            With position-controlled joints contact carries no load, so a plan for the
-            robot's radius grazes its corners: this shows where.
-        waypoints, dt_s, steps_per_waypoint, settle_steps: how it was run.
-        sim_time_s, wall_time_s: duration.
-        reason: the verdict in words.
-    """
-
-    problem: str
-    leg: int
-    goal: str
-    chosen: int
-    collision_points_used: tuple[int, ...]
-    tolerance_m: float
-    tip_error_m: float
-    goal_reached: bool
-    max_tip_track_err_m: float
-    final_track_err: float
-    q_final: tuple[float, ...]
-    contacts: tuple[ClassifiedContact, ...]
-    approaches: tuple[dict[str, Any], ...]
-    waypoints: int
-    dt_s: float
-    steps_per_waypoint: int
-    settle_steps: int
-    sim_time_s: float
-    wall_time_s: float
-    reason: str
-
-    @property
-    def expected_contacts(self) -> tuple[ClassifiedContact, ...]:
-        return tuple(c for c in self.contacts if c.expected)
-
-    @property
-    def unexpected_contacts(self) -> tuple[ClassifiedContact, ...]:
-        return tuple(c for c in self.contacts if not c.expected)
-
-    @property
-    def success(self) -> bool:
-        """The tip reached the goal region and every contact was expected."""
-        return self.goal_reached and not self.unexpected_contacts
-
-    def to_dict(self) -> dict[str, Any]:
-        """Plain JSON-able data (non-finite numbers become None)."""
-        return {
-            "problem": self.problem,
-            "leg": self.leg,
-            "goal": self.goal,
-            "chosen": self.chosen,
-            "collision_points_used": list(self.collision_points_used),
-            "tolerance_m": self.tolerance_m,
-            "tip_error_m": _num(self.tip_error_m),
-            "goal_reached": self.goal_reached,
-            "max_tip_track_err_m": _num(self.max_tip_track_err_m),
-            "final_track_err": _num(self.final_track_err),
-            "q_final": list(self.q_final),
-            "contacts": [c.to_dict() for c in self.contacts],
-            "approaches": [dict(a) for a in self.approaches],
-            "expected": len(self.expected_contacts),
-            "unexpected": len(self.unexpected_contacts),
-            "success": self.success,
-            "waypoints": self.waypoints,
-            "dt_s": self.dt_s,
-            "steps_per_waypoint": self.steps_per_waypoint,
-            "settle_steps": self.settle_steps,
-            "sim_time_s": self.sim_time_s,
-            "wall_time_s": self.wall_time_s,
-            "reason": self.reason,
-        }
 
 
 def classify_point(
@@ -259,12 +134,43 @@ def classify_point(
     return best[0] <= tolerance_m, best[1], best[0]
 
 
+def densify_chord_arc_path(path: Array, settings: Mapping[str, Any]) -> Array:
+    """The joint path as the planner sampled it, from its waypoints.
+
+    A plan file stores a path as its waypoints (states inside a straight joint-space
+    segment left out: the straight chain sliding through the sleeve is one such segment).
+    The planner's path moves the insertion by at most ``path_step_m`` and every bend
+    joint by at most ``path_joint_step_rad`` per waypoint; every segment is cut to those
+    steps again (joint 0 is the insertion [m], the rest bend joints [rad]). A path that
+    already keeps to them comes back unchanged (its steps may exceed them by the
+    planner's 1e-9 refinement slack; 1e-6 is allowed).
+
+    Args:
+        path: (m, dof) joint path.
+        settings: the plan's settings (:attr:`PlanResult.settings` of ``chord_arc``); a
+            path without ``path_step_m`` and ``path_joint_step_rad`` is returned as is.
+    """
+    path = np.atleast_2d(np.asarray(path, dtype=float))
+    if "path_step_m" not in settings or "path_joint_step_rad" not in settings:
+        return path
+    steps = np.full(path.shape[1], float(settings["path_joint_step_rad"]))
+    steps[0] = float(settings["path_step_m"])
+    if not np.all(steps > 0):
+        raise PlannerlabError(
+            f"settings path_step_m and path_joint_step_rad must be positive, got "
+            f"{steps[0]}, {steps[-1]}"
+        )
+    slack = 1.0 + 1e-6
+    if len(path) < 2 or np.max(np.abs(np.diff(path, axis=0)) / steps) <= slack:
+        return path
+    scaled, _ = densify(path / steps, slack, np.zeros(path.shape[1], dtype=bool))
+    return scaled * steps
+
+
 def execute_chord_arc(
     problem: Problem,
-    path: Any,
-    extra: Mapping[str, Any],
+    result: PlanResult,
     *,
-    leg: int = 0,
     tolerance_m: float | None = None,
     dt_s: float = DT_S,
     steps_per_waypoint: int = STEPS_PER_WAYPOINT,
@@ -277,24 +183,37 @@ def execute_chord_arc(
     approach_m: float = APPROACH_M,
     gravity_mps2: tuple[float, float, float] | None = None,
     gui: bool = False,
-) -> ContinuumExecution:
-    """Execute a ``chord_arc`` plan's joint path in PyBullet and classify its contacts.
+) -> Execution:
+    """Execute a ``chord_arc`` leg's joint path in PyBullet and classify its contacts.
 
-    Plain data in (no planner import): the path and the plan's ``extra`` (a
-    :attr:`plannerlab.planners.base.PlanResult.extra` of the ``chord_arc`` planner, or
-    the same mapping read back from a plan file). The world is reset to the path's first
-    state (the retracted robot); each waypoint is commanded for ``steps_per_waypoint``
-    steps of ``dt_s``, the last one held for ``settle_steps``. The path is not densified
-    further (it moves at most the planner's ``path_step_m`` / ``path_joint_step_rad`` per
-    waypoint).
+    Plain data in (no planner import): the leg's :class:`PlanResult`, as the planner
+    returned it or as :meth:`plannerlab.record.plan.Plan.load` read it back (its path is
+    cut to the planner's steps again, :func:`densify_chord_arc_path`). The world is reset
+    to the path's first state (the retracted robot); each waypoint is commanded for
+    ``steps_per_waypoint`` steps of ``dt_s``, the last one held for ``settle_steps``.
+
+    Returns:
+        the one execution record, :class:`Execution`, with ``timing = "waypoints"``:
+        ``path_valid`` None (no FCL re-check: the path touches the collision points by
+        design, the planner classified its contacts), every contact a
+        :class:`ContactRecord` with ``expected`` / ``collision_point`` / ``distance_m``,
+        the tip error in ``final_pos_err_m``, the per-waypoint log (``track_err_rad``
+        mixes the bend joints [rad] and the insertion [m]) and in ``extra``:
+        ``executor`` ("chord_arc"), ``chosen``, ``collision_points_used``,
+        ``contact_tolerance_m``, ``guide_obstacles``, ``solver``, ``solver_iterations``
+        and ``approaches``: per obstacle (guides excepted) that the chain came within
+        ``approach_m`` of, the closest approach over the waypoints: ``obstacle``,
+        ``distance_m`` (negative: penetration), ``link``, ``p_world_m`` (on the link),
+        ``collision_point`` (nearest chosen one on that obstacle, or None),
+        ``point_distance_m`` and ``at_collision_point`` (within the tolerance). With
+        position-controlled joints contact carries no load, so a plan for the robot's
+        radius grazes its corners: this shows where.
 
     Args:
         problem: the problem the plan was made for.
-        path: (m, dof) joint path of the chosen solution.
-        extra: the plan's extra data: ``chosen``, ``solutions`` (its
-            ``contact_indices``, ``contact_points_m``, ``contact_obstacles``),
-            ``contact_tolerance_m`` and ``guide_obstacles`` (names; optional).
-        leg: the leg the path was planned for (its goal gives the tip error).
+        result: the leg: its ``path``, ``leg``, ``settings`` and ``extra`` (``chosen``,
+            ``solutions`` (their ``contact_indices``, ``contact_points_m``,
+            ``contact_obstacles``), ``contact_tolerance_m``, ``guide_obstacles``).
         tolerance_m: expected-contact radius [m]; default ``extra["contact_tolerance_m"]``.
         dt_s: physics time step [s].
         steps_per_waypoint: physics steps per waypoint.
@@ -306,8 +225,7 @@ def execute_chord_arc(
             default).
         min_depth_m: penetration depth above which a contact point counts [m].
         approach_m: after every waypoint, the chain's closest points to every obstacle
-            but the guides are read up to this distance [m] (see
-            :attr:`ContinuumExecution.approaches`).
+            but the guides are read up to this distance [m].
         gravity_mps2: default: the problem's ``[simulation] gravity_mps2``.
         gui: PyBullet's GUI instead of DIRECT.
 
@@ -316,11 +234,13 @@ def execute_chord_arc(
             nothing was solved), a path of the wrong shape, or a bad parameter.
     """
     t0 = time.perf_counter()
+    extra = result.extra
     chosen = extra.get("chosen") if isinstance(extra, Mapping) else None
     if chosen is None or "solutions" not in extra:
         raise PlannerlabError(
-            "execute_chord_arc needs a chord_arc plan with a chosen solution "
-            "(extra['chosen'] and extra['solutions'])"
+            f"{problem.name} leg {result.leg}: execute_chord_arc needs a chord_arc plan "
+            "with a chosen solution (extra['chosen'] and extra['solutions']); "
+            f"this leg is {result.status.value}"
         )
     if solver not in SOLVERS:
         raise PlannerlabError(f"solver must be one of {', '.join(SOLVERS)}, got {solver!r}")
@@ -330,11 +250,13 @@ def execute_chord_arc(
             f"got {dt_s}, {steps_per_waypoint}, {settle_steps}"
         )
     robot = problem.robot
-    path = np.asarray(path, dtype=float)
+    leg = result.leg
+    path = np.asarray(result.path, dtype=float)
     if path.ndim != 2 or path.shape[1] != robot.dof or len(path) < 1:
         raise PlannerlabError(
             f"path must be (m >= 1, {robot.dof}) for {problem.name}, got {path.shape}"
         )
+    path = densify_chord_arc_path(path, result.settings)
     sol = extra["solutions"][int(chosen)]
     tol = float(extra["contact_tolerance_m"] if tolerance_m is None else tolerance_m)
     idx = [int(i) for i in sol["contact_indices"]]
@@ -349,7 +271,8 @@ def execute_chord_arc(
     seen: dict[tuple[str, str, bool, bool], list[Any]] = {}
     closest: dict[str, dict[str, Any]] = {}
     tips_cmd = robot.tip(path)[0]
-    tip_track = np.empty(len(path))
+    q_act = np.empty_like(path)
+    t_s = np.empty(len(path))
     with SimWorld(
         robot,
         problem.scene,
@@ -372,11 +295,9 @@ def execute_chord_arc(
                     key = (c.link_name, c.other_name, c.other_is_link, ok)
                     rec = seen.get(key)
                     if rec is None:
-                        seen[key] = [c.depth_m, t, c.p_world_m, 1, near, dist]
-                    else:
-                        rec[3] += 1
-                        if c.depth_m > rec[0]:
-                            rec[0], rec[2], rec[4], rec[5] = c.depth_m, c.p_world_m, near, dist
+                        seen[key] = [c.depth_m, t, c.p_world_m, near, dist]
+                    elif c.depth_m > rec[0]:
+                        rec[0], rec[2], rec[3], rec[4] = c.depth_m, c.p_world_m, near, dist
 
         world.client.setPhysicsEngineParameter(constraintSolverType=SOLVERS[solver])
         if solver_iterations is not None:
@@ -410,30 +331,35 @@ def execute_chord_arc(
                     }
 
         world.reset(path[0])
+        steps0 = world.steps_taken
+        q_start = world.state()
         for k, q in enumerate(path):
             world.command(q)
             run(steps_per_waypoint)
             approach()
-            tip_track[k] = np.linalg.norm(robot.tip(world.state())[0] - tips_cmd[k])
+            q_act[k] = world.state()
+            t_s[k] = (world.steps_taken - steps0) * world.dt_s
         run(settle_steps)
         q_final = world.state()
-        sim_time = world.steps_taken * world.dt_s
+        sim_time = (world.steps_taken - steps0) * world.dt_s
+        gravity_used = world.gravity_mps2
 
-    pe, _ = goal.errors(robot, q_final)
+    tip_track = np.linalg.norm(robot.tip(q_act)[0] - tips_cmd, axis=1)
+    track = np.max(np.abs(q_act - path), axis=1)
+    pe, ae = goal.errors(robot, q_final)
     tip_err = float(pe)
     reached = bool(goal.contains(robot, q_final))
     contacts = tuple(
-        ClassifiedContact(
-            link,
-            other,
-            is_link,
-            ok,
-            as_xyz(rec[2]),
-            float(rec[0]),
-            float(rec[1]),
-            int(rec[3]),
-            rec[4],
-            None if rec[5] is None else float(rec[5]),
+        ContactRecord(
+            link_name=link,
+            other_name=other,
+            other_is_link=is_link,
+            max_depth_m=float(rec[0]),
+            first_time_s=float(rec[1]),
+            p_world_m=as_xyz(rec[2]),
+            expected=ok,
+            collision_point=rec[3],
+            distance_m=None if rec[4] is None else float(rec[4]),
         )
         for (link, other, is_link, ok), rec in sorted(seen.items(), key=lambda kv: kv[1][1])
     )
@@ -467,36 +393,67 @@ def execute_chord_arc(
             else "AWAY from the collision points"
         )
         words.append(f"closest to {name}: {a['distance_m'] * 1e3:.2f} mm, {where}")
-    return ContinuumExecution(
+    track_limit = problem.simulation.max_track_err_rad
+    max_track = float(np.max(track, initial=0.0))
+    if max_track > track_limit:
+        words.append(
+            f"tracking error {max_track:.3g} (rad; m for the insertion) exceeds the limit "
+            f"{track_limit:g} ([simulation] max_track_err_rad)"
+        )
+    return Execution(
         problem=problem.name,
         leg=leg,
         goal=goal.name,
-        chosen=int(chosen),
-        collision_points_used=tuple(idx),
-        tolerance_m=tol,
-        tip_error_m=tip_err,
-        goal_reached=reached,
-        max_tip_track_err_m=float(np.max(tip_track, initial=0.0)),
-        final_track_err=float(np.max(np.abs(q_final - path[-1]), initial=0.0)),
-        q_final=tuple(float(v) for v in q_final),
-        contacts=contacts,
-        approaches=tuple(closest[n] for n in sorted(closest)),
-        waypoints=len(path),
-        dt_s=float(dt_s),
+        path_valid=None,
+        recheck_joint_step=math.nan,
+        recheck_states=0,
+        recheck_first_invalid_edge=None,
+        recheck_pairs=(),
+        waypoint_step=float(np.max(np.abs(np.diff(path, axis=0)), initial=0.0)),
         steps_per_waypoint=int(steps_per_waypoint),
         settle_steps=int(settle_steps),
+        dt_s=float(dt_s),
+        contact_tol_m=float(min_depth_m),
+        gravity_mps2=gravity_used,
+        t_s=t_s,
+        q_cmd_rad=path,
+        q_actual_rad=q_act,
+        track_err_rad=track,
+        tip_track_err_m=tip_track,
+        contacts=contacts,
+        q_start_rad=q_start,
+        carried_over=False,
+        start_offset_rad=float(np.max(np.abs(q_start - path[0]), initial=0.0)),
+        q_final_rad=q_final,
+        final_track_err_rad=float(np.max(np.abs(q_final - path[-1]), initial=0.0)),
+        final_tip_track_err_m=float(np.linalg.norm(robot.tip(q_final)[0] - tips_cmd[-1])),
+        final_pos_err_m=tip_err,
+        final_angle_err_deg=float(ae),
+        goal_reached=reached,
         sim_time_s=float(sim_time),
         wall_time_s=time.perf_counter() - t0,
         reason="; ".join(words),
+        track_err_limit_rad=track_limit,
+        timing="waypoints",
+        duration_s=len(path) * steps_per_waypoint * float(dt_s),
+        extra={
+            "executor": "chord_arc",
+            "chosen": int(chosen),
+            "collision_points_used": idx,
+            "contact_tolerance_m": tol,
+            "guide_obstacles": sorted(guides),
+            "solver": solver,
+            "solver_iterations": solver_iterations,
+            "approaches": [closest[n] for n in sorted(closest)],
+        },
     )
 
 
 __all__ = [
-    "ClassifiedContact",
-    "ContinuumExecution",
     "DT_S",
     "SETTLE_STEPS",
     "STEPS_PER_WAYPOINT",
     "classify_point",
+    "densify_chord_arc_path",
     "execute_chord_arc",
 ]

@@ -1,0 +1,209 @@
+"""``plannerlab continuum`` speaks the house's records (issue 12, item 1).
+
+* ``--json`` is one JSON document whose per-case entries embed the plan record (as the
+  plan file holds it) and the execution record, written through the one codec.
+* ``--out DIR`` writes ``<case>.plan.json`` and ``<case>.plan.exec.json``, which
+  ``plannerlab execute`` and ``plannerlab plot`` read like any other plan: ``execute``
+  runs a contact plan in the continuum's executor (expected contacts are no failure).
+* The records: a contact the plan asked for is no failure, any other contact is; an
+  execution without an FCL re-check (``path_valid`` None) is not an invalid one; files
+  written before these fields read back.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+from conftest import ROOT
+
+from plannerlab.record.execution import ContactRecord, Execution
+from plannerlab.record.plan import ExecutionFile, Plan
+
+CASE = "continuum_case3"
+
+
+def plannerlab(*argv: str, cwd: Path = ROOT) -> subprocess.CompletedProcess[str]:
+    env = dict(os.environ, MPLBACKEND="Agg", PYTHONPATH=str(ROOT))
+    return subprocess.run(
+        [sys.executable, "-m", "plannerlab", *argv],
+        capture_output=True,
+        text=True,
+        cwd=cwd,
+        env=env,
+        timeout=600,
+    )
+
+
+@pytest.fixture(scope="module")
+def continuum_run(tmp_path_factory) -> tuple[dict, Path]:
+    """``plannerlab continuum 3 --runs 2 --execute --out DIR --json`` (no figures)."""
+    out = tmp_path_factory.mktemp("continuum")
+    proc = plannerlab(
+        "continuum", "3", "--runs", "2", "--execute", "--no-figures", "--out", str(out), "--json"
+    )
+    assert proc.returncode == 0, proc.stderr
+    return json.loads(proc.stdout), out  # one document: raises on anything around it
+
+
+def test_json_embeds_the_plan_and_execution_records(continuum_run) -> None:
+    doc, out = continuum_run
+    assert doc["planner"] == "chord_arc" and doc["runs"] == 2
+    (case,) = doc["cases"]
+    assert case["problem"] == CASE
+    assert case["runs"] == 2 and case["same_every_run"] is True
+    assert case["paper"] == {"time_s": 0.04, "collision_points": 5, "solutions": 1}
+    assert case["search_median_s"] > 0 and case["solve_median_s"] > 0
+    # the plan entry is the plan file's content
+    plan_file = out / f"{CASE}.plan.json"
+    assert case["files"]["plan_file"] == str(plan_file)
+    assert case["plan"] == json.loads(plan_file.read_text())
+    plan = Plan.load(plan_file)
+    (leg,) = plan.legs
+    assert plan.planner == "chord_arc" and plan.seed == 0 and plan.problem == CASE
+    assert leg.solved and leg.extra["chosen"] == 0
+    assert leg.extra["solutions"][0]["contact_indices"] == [1]
+    # the execution entry is the execution file's record
+    ex = ExecutionFile.load(out / f"{CASE}.plan.exec.json")
+    assert ex.plan_file == str(plan_file) and ex.planner == "chord_arc"
+    (e,) = ex.executions
+    assert case["execution"] == e.to_dict()
+    assert e.extra["executor"] == "chord_arc" and e.extra["collision_points_used"] == [1]
+    assert e.success and not e.unexpected_contacts and e.path_valid is None
+    assert e.final_pos_err_m < 1e-3
+
+
+def test_plannerlab_execute_runs_a_continuum_plan(continuum_run, tmp_path) -> None:
+    """The plan file holds the path's waypoints; execute cuts them to the planner's steps
+    again and runs them in the continuum's executor: the same tip error as the
+    in-memory path (1e-16 m apart measured; 1e-6 m allowed)."""
+    doc, out = continuum_run
+    exec_file = tmp_path / "again.exec.json"
+    proc = plannerlab("execute", str(out / f"{CASE}.plan.json"), "--out", str(exec_file), "--json")
+    assert proc.returncode == 0, proc.stderr
+    (e,) = ExecutionFile.load(exec_file).executions
+    assert json.loads(proc.stdout)["executions"] == [e.to_dict()]
+    assert e.extra["executor"] == "chord_arc" and e.success, e.reason
+    first = Execution.from_dict(doc["cases"][0]["execution"])
+    assert math.isclose(e.final_pos_err_m, first.final_pos_err_m, abs_tol=1e-6)
+    assert abs(len(e.t_s) - len(first.t_s)) <= 1  # evenly re-cut straight segments
+    steps = np.abs(np.diff(e.q_cmd_rad, axis=0))
+    assert np.max(steps[:, 0]) <= 0.002 * (1 + 1e-6)  # insertion [m]
+    assert np.max(steps[:, 1:]) <= 0.02 * (1 + 1e-6)  # bend joints [rad]
+
+
+def test_plannerlab_plot_reads_a_continuum_plan(continuum_run, tmp_path) -> None:
+    _, out = continuum_run
+    proc = plannerlab("plot", str(out / f"{CASE}.plan.json"), "--out", str(tmp_path), "--json")
+    assert proc.returncode == 0, proc.stderr
+    files = json.loads(proc.stdout)
+    assert any(Path(f).name == "leg0_target_end.png" for f in files)
+    assert all(Path(f).stat().st_size > 0 for f in files)
+
+
+def test_densify_restores_the_planner_steps_and_keeps_a_sampled_path() -> None:
+    from plannerlab.bench.task import solve_legs
+    from plannerlab.problem.catalog import load_problem
+    from plannerlab.robots.paths import waypoints
+    from plannerlab.sim.continuum import densify_chord_arc_path
+
+    problem = load_problem("continuum_case2")
+    (r,) = solve_legs(problem, "chord_arc", 0).legs
+    assert densify_chord_arc_path(r.path, r.settings) is r.path  # already at its steps
+    corners = waypoints(r.path)
+    assert len(corners) < len(r.path) / 2
+    again = densify_chord_arc_path(corners, r.settings)
+    # case 2's straight stretches were sampled evenly: the same states come back
+    assert again.shape == r.path.shape
+    np.testing.assert_allclose(again, r.path, atol=1e-12)
+    np.testing.assert_array_equal(densify_chord_arc_path(corners, {}), corners)
+
+
+def _contact(expected: bool) -> ContactRecord:
+    return ContactRecord("link_3", "slab", False, 1e-4, 0.5, (0.1, 0.2, 0.0), expected, 1, 2e-3)
+
+
+def _execution(contacts: tuple[ContactRecord, ...], path_valid: bool | None) -> Execution:
+    q = np.zeros((2, 3))
+    return Execution(
+        problem="p",
+        leg=0,
+        goal="g",
+        path_valid=path_valid,
+        recheck_joint_step=math.nan,
+        recheck_states=0,
+        recheck_first_invalid_edge=None,
+        recheck_pairs=(),
+        waypoint_step=0.01,
+        steps_per_waypoint=12,
+        settle_steps=240,
+        dt_s=1 / 240,
+        contact_tol_m=0.0,
+        gravity_mps2=(0.0, 0.0, -9.81),
+        t_s=[0.05, 0.1],
+        q_cmd_rad=q,
+        q_actual_rad=q,
+        track_err_rad=[0.0, 0.0],
+        tip_track_err_m=[0.0, 0.0],
+        contacts=contacts,
+        q_start_rad=q[0],
+        carried_over=False,
+        start_offset_rad=0.0,
+        q_final_rad=q[-1],
+        final_track_err_rad=0.0,
+        final_tip_track_err_m=0.0,
+        final_pos_err_m=1e-4,
+        final_angle_err_deg=math.nan,
+        goal_reached=True,
+        sim_time_s=1.1,
+        wall_time_s=0.3,
+        reason="r",
+        extra={"approaches": [{"obstacle": "slab", "distance_m": -math.inf}]},
+    )
+
+
+def test_expected_contacts_are_no_failure_and_others_are() -> None:
+    assert _execution((_contact(True),), None).success
+    assert not _execution((_contact(True), _contact(False)), None).success
+    assert not _execution((_contact(True),), False).success
+    e = _execution((_contact(True), _contact(False)), None)
+    assert e.expected_contacts == (_contact(True),)
+    assert e.unexpected_contacts == (_contact(False),)
+
+
+def test_execution_extra_and_contact_fields_round_trip_through_the_codec() -> None:
+    from plannerlab.record.codec import dumps, loads
+
+    e = _execution((_contact(True), _contact(False)), None)
+    data = loads(dumps(e.to_dict()))
+    assert data["extra"]["approaches"][0]["distance_m"] is None  # non-finite: the codec's
+    assert data["recheck_joint_step"] is None and data["path_valid"] is None
+    back = Execution.from_dict(data)
+    assert back.contacts == e.contacts and back.path_valid is None
+    assert math.isnan(back.recheck_joint_step)
+    # a contact written before ``expected`` existed reads back as unexpected
+    old = dict(_contact(True).to_dict())
+    for k in ("expected", "collision_point", "distance_m"):
+        del old[k]
+    assert ContactRecord.from_dict(old) == ContactRecord(
+        "link_3", "slab", False, 1e-4, 0.5, (0.1, 0.2, 0.0)
+    )
+
+
+def test_sim_world_names_its_links_publicly() -> None:
+    from plannerlab.problem.catalog import load_problem
+    from plannerlab.sim import SimWorld
+
+    problem = load_problem(CASE)
+    robot = problem.robot
+    with SimWorld(robot, problem.scene) as world:
+        named = {j: world.link_name(j) for j in world.urdf_link_names}
+    robot_links = {name: i for name, i in named.values() if i is not None}
+    assert robot_links == {n: i for i, n in enumerate(robot.link_names)}
+    assert all(name == world.urdf_link_names[j] for j, (name, i) in named.items() if i is None)
