@@ -1,4 +1,5 @@
-"""Shared fixtures: small problems built in code, and paths to the bundled ones."""
+"""Shared fixtures: small problems built in code, the tiny problem file (TOML text) the
+problem-file tests break one key at a time, and paths to the bundled problems."""
 
 from __future__ import annotations
 
@@ -16,6 +17,59 @@ from plannerlab.robots.base import pose_matrix, trans
 
 ROOT = Path(__file__).resolve().parents[1]
 PROBLEMS = ROOT / "problems"
+
+
+#: the one small valid problem file of the tests: a 6-module Arm-Z (5 joints) at the
+#: straight column, a wall beside it, one goal ("up") above it; every table a test may edit
+#: is present (use :func:`tiny_problem_text` to change one thing, ``+`` to add a table)
+TINY_PROBLEM_TOML = """\
+[problem]
+name = "tiny"
+description = "a short Arm-Z and one box"
+
+[robot]
+type = "armz"
+n_modules = 6
+
+[start]
+fill_deg = 180.0
+
+[[obstacles]]
+name = "wall"
+type = "box"
+center_m = [3.0, 0.0, 2.0]
+size_m = [0.4, 4.0, 4.0]
+
+[[goals]]
+name = "up"
+p_m = [0.5, 0.0, 3.0]
+n = [0.0, 0.0, 1.0]
+pos_tol_m = 0.1
+angle_tol_deg = 10.0
+
+[budget]
+max_iterations = 50
+
+[checking]
+joint_step = 0.05
+"""
+
+
+def tiny_problem_text(old: str, new: str) -> str:
+    """:data:`TINY_PROBLEM_TOML` with the one occurrence of ``old`` replaced by ``new``."""
+    count = TINY_PROBLEM_TOML.count(old)
+    assert count == 1, f"{old!r} occurs {count} times in the tiny problem file, not once"
+    return TINY_PROBLEM_TOML.replace(old, new)
+
+
+def write_problem(directory: Path, text: str | bytes, name: str = "p.toml") -> Path:
+    """Write a problem file (text as UTF-8, or bytes as they are) and return its path."""
+    path = directory / name
+    if isinstance(text, bytes):
+        path.write_bytes(text)
+    else:
+        path.write_text(text, encoding="utf-8")
+    return path
 
 
 def path_digest(path: np.ndarray) -> str:

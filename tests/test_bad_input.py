@@ -16,43 +16,11 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from conftest import PROBLEMS, ROOT
+from conftest import PROBLEMS, ROOT, TINY_PROBLEM_TOML, tiny_problem_text, write_problem
 
 from plannerlab.cli.main import main
 from plannerlab.planners.base import PlanResult, Status
 from plannerlab.problem.load import parse_problem
-
-VALID = """\
-[problem]
-name = "tiny"
-description = "a short Arm-Z and one box"
-
-[robot]
-type = "armz"
-n_modules = 6
-
-[start]
-fill_deg = 180.0
-
-[[obstacles]]
-name = "wall"
-type = "box"
-center_m = [3.0, 0.0, 2.0]
-size_m = [0.4, 4.0, 4.0]
-
-[[goals]]
-name = "up"
-p_m = [0.5, 0.0, 3.0]
-n = [0.0, 0.0, 1.0]
-pos_tol_m = 0.1
-angle_tol_deg = 10.0
-
-[budget]
-max_iterations = 50
-
-[checking]
-joint_step = 0.05
-"""
 
 
 def run(capsys, *argv: str) -> tuple[int, str, str]:
@@ -72,97 +40,116 @@ def assert_clean_error(code: int, err: str, *names: str) -> None:
         assert name in err, f"{name!r} not in {err!r}"
 
 
-def write(tmp_path: Path, text: str | bytes, name: str = "p.toml") -> Path:
-    p = tmp_path / name
-    if isinstance(text, bytes):
-        p.write_bytes(text)
-    else:
-        p.write_text(text, encoding="utf-8")
-    return p
-
-
 def test_the_valid_problem_is_valid(tmp_path):
-    problem = parse_problem(write(tmp_path, VALID))
+    problem = parse_problem(write_problem(tmp_path, TINY_PROBLEM_TOML))
     assert problem.name == "tiny" and problem.robot.dof == 5
 
 
 # --------------------------------------------------------------- problem files
-def replace(old: str, new: str) -> str:
-    assert old in VALID, old
-    return VALID.replace(old, new)
-
-
 PROBLEM_CASES = {
     # name: (file text, key that must be named)
-    "misspelled_table": (VALID + "\n[simulaton]\ngravity_mps2 = [0, 0, 0]\n", "simulaton"),
-    "unknown_table": (VALID + "\n[extra_stuff]\na = 1\n", "extra_stuff"),
-    "unknown_problem_key": (replace('name = "tiny"', 'name = "tiny"\ntitel = "x"'), "titel"),
-    "missing_problem_name": (replace('name = "tiny"\n', ""), "problem.name"),
-    "unknown_robot_type": (replace('type = "armz"', 'type = "armzz"'), "robot.type"),
-    "huge_n_modules": (replace("n_modules = 6", "n_modules = 10000"), "robot.n_modules"),
-    "n_modules_float": (replace("n_modules = 6", "n_modules = 6.5"), "robot.n_modules"),
-    "unknown_robot_key": (replace("n_modules = 6", "n_modules = 6\nmodules = 3"), "robot.modules"),
-    "two_starts": (replace("fill_deg = 180.0", "fill_deg = 180.0\nfill = 3.0"), "start"),
-    "start_wrong_length": (replace("fill_deg = 180.0", "q = [1.0, 2.0]"), "start.q"),
-    "obstacle_bad_type": (replace('type = "box"', 'type = "cube"'), "obstacles[0].type"),
+    "misspelled_table": (
+        TINY_PROBLEM_TOML + "\n[simulaton]\ngravity_mps2 = [0, 0, 0]\n",
+        "simulaton",
+    ),
+    "unknown_table": (TINY_PROBLEM_TOML + "\n[extra_stuff]\na = 1\n", "extra_stuff"),
+    "unknown_problem_key": (
+        tiny_problem_text('name = "tiny"', 'name = "tiny"\ntitel = "x"'),
+        "titel",
+    ),
+    "missing_problem_name": (tiny_problem_text('name = "tiny"\n', ""), "problem.name"),
+    "unknown_robot_type": (tiny_problem_text('type = "armz"', 'type = "armzz"'), "robot.type"),
+    "huge_n_modules": (tiny_problem_text("n_modules = 6", "n_modules = 10000"), "robot.n_modules"),
+    "n_modules_float": (tiny_problem_text("n_modules = 6", "n_modules = 6.5"), "robot.n_modules"),
+    "unknown_robot_key": (
+        tiny_problem_text("n_modules = 6", "n_modules = 6\nmodules = 3"),
+        "robot.modules",
+    ),
+    "two_starts": (tiny_problem_text("fill_deg = 180.0", "fill_deg = 180.0\nfill = 3.0"), "start"),
+    "start_wrong_length": (tiny_problem_text("fill_deg = 180.0", "q = [1.0, 2.0]"), "start.q"),
+    "obstacle_bad_type": (tiny_problem_text('type = "box"', 'type = "cube"'), "obstacles[0].type"),
     "obstacle_negative_size": (
-        replace("size_m = [0.4, 4.0, 4.0]", "size_m = [0.4, -4.0, 4.0]"),
+        tiny_problem_text("size_m = [0.4, 4.0, 4.0]", "size_m = [0.4, -4.0, 4.0]"),
         "obstacles[0].size_m",
     ),
     "obstacle_nan_center": (
-        replace("center_m = [3.0, 0.0, 2.0]", "center_m = [nan, 0.0, 2.0]"),
+        tiny_problem_text("center_m = [3.0, 0.0, 2.0]", "center_m = [nan, 0.0, 2.0]"),
         "obstacles[0].center_m",
     ),
     "duplicate_obstacle": (
-        VALID + '\n[[obstacles]]\nname = "wall"\ntype = "sphere"\ncenter_m = [9, 9, 9]\n'
+        TINY_PROBLEM_TOML
+        + '\n[[obstacles]]\nname = "wall"\ntype = "sphere"\ncenter_m = [9, 9, 9]\n'
         "radius_m = 0.5\n",
         "obstacles[1].name",
     ),
-    "no_goals": (VALID.split("[[goals]]")[0] + "[budget]\nmax_iterations = 5\n", "goals"),
+    "no_goals": (
+        TINY_PROBLEM_TOML.split("[[goals]]")[0] + "[budget]\nmax_iterations = 5\n",
+        "goals",
+    ),
     "duplicate_goal_names": (
-        VALID + '\n[[goals]]\nname = "up"\np_m = [1, 0, 3]\nn = [0, 0, 1]\npos_tol_m = 0.1\n'
+        TINY_PROBLEM_TOML
+        + '\n[[goals]]\nname = "up"\np_m = [1, 0, 3]\nn = [0, 0, 1]\npos_tol_m = 0.1\n'
         "angle_tol_deg = 10\n",
         "goals[1].name",
     ),
-    "numeric_goal_name": (replace('name = "up"', 'name = "3"'), "goals[0].name"),
-    "empty_goal_name": (replace('name = "up"', 'name = " "'), "goals[0].name"),
-    "angle_tol_270": (replace("angle_tol_deg = 10.0", "angle_tol_deg = 270"), "angle_tol_deg"),
-    "negative_pos_tol": (replace("pos_tol_m = 0.1", "pos_tol_m = -0.1"), "goals[0].pos_tol_m"),
-    "zero_normal": (replace("n = [0.0, 0.0, 1.0]", "n = [0.0, 0.0, 0.0]"), "goals[0].n"),
-    "unknown_goal_key": (replace("pos_tol_m = 0.1", "pos_tol_m = 0.1\ntol = 1"), "goals[0].tol"),
+    "numeric_goal_name": (tiny_problem_text('name = "up"', 'name = "3"'), "goals[0].name"),
+    "empty_goal_name": (tiny_problem_text('name = "up"', 'name = " "'), "goals[0].name"),
+    "angle_tol_270": (
+        tiny_problem_text("angle_tol_deg = 10.0", "angle_tol_deg = 270"),
+        "angle_tol_deg",
+    ),
+    "negative_pos_tol": (
+        tiny_problem_text("pos_tol_m = 0.1", "pos_tol_m = -0.1"),
+        "goals[0].pos_tol_m",
+    ),
+    "zero_normal": (tiny_problem_text("n = [0.0, 0.0, 1.0]", "n = [0.0, 0.0, 0.0]"), "goals[0].n"),
+    "unknown_goal_key": (
+        tiny_problem_text("pos_tol_m = 0.1", "pos_tol_m = 0.1\ntol = 1"),
+        "goals[0].tol",
+    ),
     "zero_check_budget": (
-        replace("max_iterations = 50", "max_collision_checks = 0"),
+        tiny_problem_text("max_iterations = 50", "max_collision_checks = 0"),
         "budget.max_collision_checks",
     ),
-    "unknown_budget_key": (replace("max_iterations = 50", "max_checks = 50"), "budget.max_checks"),
-    "tiny_joint_step": (replace("joint_step = 0.05", "joint_step = 1e-9"), "checking.joint_step"),
-    "huge_joint_step": (replace("joint_step = 0.05", "joint_step = 10.0"), "checking.joint_step"),
+    "unknown_budget_key": (
+        tiny_problem_text("max_iterations = 50", "max_checks = 50"),
+        "budget.max_checks",
+    ),
+    "tiny_joint_step": (
+        tiny_problem_text("joint_step = 0.05", "joint_step = 1e-9"),
+        "checking.joint_step",
+    ),
+    "huge_joint_step": (
+        tiny_problem_text("joint_step = 0.05", "joint_step = 10.0"),
+        "checking.joint_step",
+    ),
     "gravity_two_numbers": (
-        VALID + "\n[simulation]\ngravity_mps2 = [0, -9.81]\n",
+        TINY_PROBLEM_TOML + "\n[simulation]\ngravity_mps2 = [0, -9.81]\n",
         "simulation.gravity_mps2",
     ),
     "witness_wrong_joint_count": (
-        VALID + "\n[witness]\npath_rad = [[3.14, 3.14, 3.14, 3.14, 3.14], [1.0, 2.0]]\n",
+        TINY_PROBLEM_TOML
+        + "\n[witness]\npath_rad = [[3.14, 3.14, 3.14, 3.14, 3.14], [1.0, 2.0]]\n",
         "witness.path_rad[1]",
     ),
     "witness_one_waypoint": (
-        VALID + "\n[witness]\npath_rad = [[3.14, 3.14, 3.14, 3.14, 3.14]]\n",
+        TINY_PROBLEM_TOML + "\n[witness]\npath_rad = [[3.14, 3.14, 3.14, 3.14, 3.14]]\n",
         "witness.path_rad",
     ),
     "continuum_nan_point": (
-        VALID + "\n[continuum]\ncollision_points_m = [[0.1, 0.2], [nan, 0.2]]\n",
+        TINY_PROBLEM_TOML + "\n[continuum]\ncollision_points_m = [[0.1, 0.2], [nan, 0.2]]\n",
         "continuum.collision_points_m[1]",
     ),
     "continuum_unknown_guide": (
-        VALID + '\n[continuum]\nguide_obstacles = ["sleeve"]\n',
+        TINY_PROBLEM_TOML + '\n[continuum]\nguide_obstacles = ["sleeve"]\n',
         "continuum.guide_obstacles",
     ),
     "continuum_unknown_key": (
-        VALID + "\n[continuum]\ncollision_point_m = [[0.1, 0.2]]\n",
+        TINY_PROBLEM_TOML + "\n[continuum]\ncollision_point_m = [[0.1, 0.2]]\n",
         "continuum.collision_point_m",
     ),
-    "toml_syntax": (VALID + "\n[goals\n", "<syntax>"),
-    "latin1_text": (VALID.replace("a short", "café, a short").encode("latin-1"), "<encoding>"),
+    "toml_syntax": (TINY_PROBLEM_TOML + "\n[goals\n", "<syntax>"),
+    "latin1_text": (tiny_problem_text("a short", "café, a short").encode("latin-1"), "<encoding>"),
     "binary_file": (bytes(range(256)) * 4, "<encoding>"),
 }
 
@@ -170,25 +157,25 @@ PROBLEM_CASES = {
 @pytest.mark.parametrize("case", sorted(PROBLEM_CASES))
 def test_bad_problem_file(capsys, tmp_path, case):
     text, key = PROBLEM_CASES[case]
-    path = write(tmp_path, text)
+    path = write_problem(tmp_path, text)
     code, _, err = run(capsys, "solve", str(path), "--planner", "gradient")
     assert_clean_error(code, err, str(path), key)
 
 
 def test_misspelled_table_suggests_the_right_one(capsys, tmp_path):
-    path = write(tmp_path, PROBLEM_CASES["misspelled_table"][0])
+    path = write_problem(tmp_path, PROBLEM_CASES["misspelled_table"][0])
     code, _, err = run(capsys, "solve", str(path), "--planner", "gradient")
     assert_clean_error(code, err, "did you mean 'simulation'")
 
 
 def test_huge_robot_is_refused_with_the_cost(capsys, tmp_path):
-    path = write(tmp_path, PROBLEM_CASES["huge_n_modules"][0])
+    path = write_problem(tmp_path, PROBLEM_CASES["huge_n_modules"][0])
     code, _, err = run(capsys, "solve", str(path), "--planner", "gradient")
     assert_clean_error(code, err, "<= 100", "10000")
 
 
 def test_tiny_joint_step_is_refused_with_the_cost(capsys, tmp_path):
-    path = write(tmp_path, PROBLEM_CASES["tiny_joint_step"][0])
+    path = write_problem(tmp_path, PROBLEM_CASES["tiny_joint_step"][0])
     code, _, err = run(capsys, "solve", str(path), "--planner", "gradient")
     assert_clean_error(code, err, "collision checks")
 
@@ -353,7 +340,7 @@ def test_directory_as_plan_file(capsys, tmp_path):
 
 # --------------------------------------------------------------- as a user sees it
 def test_subprocess_shows_one_error_line_and_no_traceback(tmp_path):
-    path = write(tmp_path, PROBLEM_CASES["latin1_text"][0])
+    path = write_problem(tmp_path, PROBLEM_CASES["latin1_text"][0])
     proc = subprocess.run(
         [sys.executable, "-m", "plannerlab", "solve", str(path), "--planner", "gradient"],
         capture_output=True,
@@ -369,8 +356,8 @@ def test_subprocess_shows_one_error_line_and_no_traceback(tmp_path):
 
 # --------------------------------------------------------------- right diagnoses
 def test_goal_beyond_the_arm_is_unreachable_before_planning(capsys, tmp_path):
-    far = replace("p_m = [0.5, 0.0, 3.0]", "p_m = [100.0, 0.0, 3.0]")
-    path = write(tmp_path, far)
+    far = tiny_problem_text("p_m = [0.5, 0.0, 3.0]", "p_m = [100.0, 0.0, 3.0]")
+    path = write_problem(tmp_path, far)
     code, out, _ = run(
         capsys,
         "solve",
@@ -423,14 +410,14 @@ def test_reach_bound_holds_for_random_armz_states():
 
 
 def test_armz_without_simulation_table_runs_gravity_free_and_says_so(tmp_path):
-    problem = parse_problem(write(tmp_path, VALID))
+    problem = parse_problem(write_problem(tmp_path, TINY_PROBLEM_TOML))
     assert problem.simulation.gravity_mps2 == (0.0, 0.0, 0.0)
     assert "gravity off" in problem.simulation.origin
 
 
 def test_base_rpy_without_base_xyz_is_honoured(tmp_path):
-    text = replace("n_modules = 6", "n_modules = 6\nbase_rpy_deg = [0.0, 0.0, 90.0]")
-    problem = parse_problem(write(tmp_path, text))
+    text = tiny_problem_text("n_modules = 6", "n_modules = 6\nbase_rpy_deg = [0.0, 0.0, 90.0]")
+    problem = parse_problem(write_problem(tmp_path, text))
     assert np.allclose(problem.robot.T_world_base[:3, 3], 0.0)
     assert np.allclose(problem.robot.T_world_base[:3, 0], [0.0, 1.0, 0.0], atol=1e-12)
 
@@ -439,7 +426,7 @@ def test_problem_names_resolve_from_the_working_directory_first(tmp_path, monkey
     from plannerlab.problem.catalog import resolve_problem_path
 
     (tmp_path / "problems").mkdir()
-    mine = write(tmp_path / "problems", VALID, "armz_pocket.toml")
+    mine = write_problem(tmp_path / "problems", TINY_PROBLEM_TOML, "armz_pocket.toml")
     monkeypatch.chdir(tmp_path)
     assert resolve_problem_path("armz_pocket").resolve() == mine.resolve()
 

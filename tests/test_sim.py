@@ -255,19 +255,14 @@ def test_a_path_the_arm_cannot_follow_is_not_executed_cleanly() -> None:
 
 
 def test_problem_file_sets_the_tracking_limit(tmp_path) -> None:
+    from conftest import TINY_PROBLEM_TOML, write_problem
+
     from plannerlab.errors import ProblemError
     from plannerlab.problem.load import parse_problem
 
-    text = (
-        "[problem]\nname = 't'\n[robot]\ntype = 'armz'\nn_modules = 6\n"
-        "[start]\nfill = 3.141592653589793\n"
-        "[[goals]]\nname = 'g'\np_m = [0, 0, 3]\nn = [0, 0, 1]\npos_tol_m = 0.1\n"
-        "angle_tol_deg = 10\n[simulation]\nmax_track_err_rad = 0.02\n"
-    )
-    path = tmp_path / "t.toml"
-    path.write_text(text)
+    path = write_problem(tmp_path, TINY_PROBLEM_TOML + "[simulation]\nmax_track_err_rad = 0.02\n")
     assert parse_problem(path).simulation.max_track_err_rad == 0.02
-    path.write_text(text.replace("0.02", "-1"))
+    path = write_problem(tmp_path, TINY_PROBLEM_TOML + "[simulation]\nmax_track_err_rad = -1\n")
     with pytest.raises(ProblemError, match=r"simulation\.max_track_err_rad"):
         parse_problem(path)
 
