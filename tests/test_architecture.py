@@ -125,6 +125,18 @@ def test_each_engine_is_imported_only_in_its_room(engine):
     assert offenders == []
 
 
+def test_robots_import_nothing_from_the_problem_loader():
+    """A family declares its [robot] table; problem/ parses it: the import goes one way."""
+    offenders = [
+        f"{path.relative_to(PACKAGE).as_posix()}:{line} imports {name}"
+        for module, path in MODULES.items()
+        if module.startswith("plannerlab.robots")
+        for name, line in _imports(module, path)
+        if name == "plannerlab.problem" or name.startswith("plannerlab.problem.")
+    ]
+    assert offenders == []
+
+
 def test_print_only_in_the_cli():
     offenders = []
     for path in sorted(PACKAGE.rglob("*.py")):

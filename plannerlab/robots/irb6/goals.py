@@ -18,7 +18,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
-from typing import TYPE_CHECKING
+from typing import Protocol
 
 import numpy as np
 
@@ -27,8 +27,22 @@ from plannerlab.robots.base import Array
 from plannerlab.robots.irb6.ik import IKAnswer, solve_ik, solve_with_lambda0
 from plannerlab.robots.irb6.model import IRb6
 
-if TYPE_CHECKING:
-    from plannerlab.problem.goals import GoalRegion
+
+class GoalRegion(Protocol):
+    """What the sampler reads of a goal region (a
+    :class:`plannerlab.problem.goals.GoalRegion`; robots/ does not import problem/)."""
+
+    @property
+    def p_world_m(self) -> Array: ...
+
+    @property
+    def n_world(self) -> Array: ...
+
+    @property
+    def pos_tol_m(self) -> float: ...
+
+    @property
+    def angle_tol_deg(self) -> float: ...
 
 
 def _perpendicular_basis(c: Array) -> tuple[Array, Array]:
