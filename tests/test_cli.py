@@ -35,6 +35,26 @@ def test_problems_and_planners_list_as_json(capsys):
     } <= planners
 
 
+def test_problems_lists_the_local_folder_first(capsys, tmp_path, monkeypatch):
+    """A name resolves from ./problems first: the listing shows those files (a broken one
+    with its error), then the bundled problems they do not shadow."""
+    (tmp_path / "problems").mkdir()
+    shutil.copy(PROBLEMS / "armz_pocket.toml", tmp_path / "problems" / "my_pocket.toml")
+    shutil.copy(PROBLEMS / "armz_window.toml", tmp_path / "problems" / "armz_window.toml")
+    (tmp_path / "problems" / "broken.toml").write_text("[robot\n")
+    monkeypatch.chdir(tmp_path)
+    code, out, _ = run(capsys, "problems", "--json")
+    rows = json.loads(out)
+    by_name = {r["name"]: r for r in rows}
+    assert code == 0
+    assert [r["name"] for r in rows[:3]] == ["armz_window", "broken", "my_pocket"]
+    assert by_name["my_pocket"]["from"] == "./problems" and by_name["my_pocket"]["dof"] == 23
+    assert "broken.toml" in by_name["broken"]["error"]
+    assert by_name["armz_window"]["file"] == str(tmp_path / "problems" / "armz_window.toml")
+    assert by_name["armz_pocket"]["from"] == "bundled"
+    assert sum(r["name"] == "armz_window" for r in rows) == 1  # shadowed, listed once
+
+
 def test_solve_execute_plot_round_trip(capsys, tmp_path):
     plan_path = tmp_path / "plan.json"
     code, out, _ = run(

@@ -192,6 +192,7 @@ def test_csv_and_markdown_name_every_planner(comparison: dict) -> None:
         assert f"| {pl} |" in md
     assert "plannerlab compare armz_pocket" in md and "--max-checks 300" in md
     assert "ompl" in md and "## Machine" in md
+    assert "may add at most 1 % to the checks and to the time" in md  # the budget footnote
     meta = json.loads((folder / "meta.json").read_text())
     assert meta["seeds"] == SEEDS and meta["budget"] == {"max_collision_checks": MAX_CHECKS}
 

@@ -258,3 +258,42 @@ def test_iteration_budget_respected(name: str) -> None:
     r = _solve(name, SEED, Budget(max_iterations=TINY_ITERATIONS))
     limit = TINY_ITERATIONS + ITERATION_SLACK.get(name, 0)
     assert r.iterations <= limit, (r.iterations, r.reason)
+
+
+#: the time-limit check: a room where no planner finishes in the limit, so each runs until
+#: its limit stops it (the one test here that reads a clock: it asserts a limit, not a speed)
+TIME_LIMIT_S = 0.3
+#: a planner may end this late: 1 % (the re-check of a found path) plus one poll interval
+#: of its loop, generous for a loaded 2-core machine
+TIME_SLACK_S = 0.2
+
+
+@pytest.mark.parametrize("name", PARAMS)
+def test_time_limit_respected(name: str) -> None:
+    import time
+
+    from plannerlab.problem.catalog import load_problem
+
+    robots = REGISTRY[name].robots
+    problem = load_problem(
+        "continuum_case3" if robots is not None and "armz" not in robots else "armz_inspection"
+    )
+    planner = make_planner(name, OVERRIDES.get(name, {}))
+    budget = Budget(time_limit_s=TIME_LIMIT_S)
+    # engines loaded before the clock (once per process, not the planner's time)
+    CollisionChecker(problem.robot, problem.scene)
+    if name.startswith("ompl.") or "rrtconnect" in name:
+        import plannerlab.planners.ompl  # noqa: F401
+    t0 = time.perf_counter()
+    if REGISTRY[name].needs_stepper:
+        from plannerlab.sim import SimWorld
+
+        with SimWorld(problem.robot, problem.scene, gravity_mps2=(0.0, 0.0, 0.0)) as world:
+            t0 = time.perf_counter()
+            r = planner.solve(problem, 0, budget, np.random.default_rng(SEED), stepper=world)
+    else:
+        r = planner.solve(problem, 0, budget, np.random.default_rng(SEED))
+    wall_s = time.perf_counter() - t0
+    assert wall_s <= TIME_LIMIT_S * 1.01 + TIME_SLACK_S, (wall_s, r.status, r.reason)
+    if r.status is Status.BUDGET_EXHAUSTED:
+        assert "time limit" in r.reason, r.reason

@@ -343,6 +343,15 @@ TABLE_NOTES = (
     "executed trials of the largest joint tracking error."
 )
 
+#: how far a planner may go past its budget, said under every comparison table
+BUDGET_NOTE = (
+    "Budgets: a planner stops within its iteration, collision-check and time limits; the "
+    "final fine re-check of a found path may add at most 1 % to the checks and to the time "
+    "(a path whose re-check does not fit is budget_exhausted, not trusted); a time limit is "
+    "looked at once per planner loop, so a trial may end one loop late; a trial running "
+    "past --trial-timeout is killed and recorded as timeout."
+)
+
 
 def _md_table(headers: Sequence[str], rows: Iterable[Sequence[str]]) -> str:
     def esc(s: str) -> str:
@@ -376,7 +385,7 @@ def markdown(
             _md_table(headers, [summary_cells(r, executed) for r in rows if r["problem"] == p])
         )
         out.append("")
-    out += [TABLE_NOTES, ""]
+    out += [TABLE_NOTES, "", BUDGET_NOTE, ""]
     errors = [r for r in records if r.get("status") == ERROR_STATUS]
     if errors:
         out += ["## Errors", ""]

@@ -443,3 +443,6 @@ def _print_tables(console: Console, rows: list[dict[str, Any]], columns: list[st
         "checks summed over legs. All columns: --wide, report.md, summary.csv.[/dim]",
         highlight=False,
     )
+    from plannerlab.bench.report import BUDGET_NOTE
+
+    console.print(f"[dim]{escape(BUDGET_NOTE)}[/dim]", highlight=False)

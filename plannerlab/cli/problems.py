@@ -1,4 +1,5 @@
-"""`plannerlab problems`: the bundled problems."""
+"""`plannerlab problems`: the problems a name resolves to (``./problems`` first, then the
+bundled ones)."""
 
 from __future__ import annotations
 
@@ -16,23 +17,29 @@ WIDE = 120
 
 
 def cmd_problems(args: argparse.Namespace, console: Console) -> int:
-    from plannerlab.problem.catalog import list_problems
+    from plannerlab.errors import PlannerlabError
+    from plannerlab.problem.catalog import list_problems, problem_origin
     from plannerlab.problem.load import parse_problem
 
     rows: list[dict[str, Any]] = []
     for path in list_problems():
-        p = parse_problem(path)
-        rows.append(
-            {
-                "name": p.name,
-                "file": str(path),
-                "robot": p.robot.kind,
-                "dof": p.robot.dof,
-                "legs": [g.name for g in p.goals],
-                "obstacles": len(p.scene.obstacles),
-                "description": p.description,
-            }
+        row: dict[str, Any] = {"name": path.stem, "file": str(path), "from": problem_origin(path)}
+        try:
+            p = parse_problem(path)
+        except PlannerlabError as exc:  # a broken local file is listed with its error
+            row.update(error=str(exc), robot="-", dof=None, legs=[], obstacles=None)
+            row["description"] = f"error: {exc}"
+            rows.append(row)
+            continue
+        row.update(
+            problem_name=p.name,  # its [problem] name; the command line uses the file's stem
+            robot=p.robot.kind,
+            dof=p.robot.dof,
+            legs=[g.name for g in p.goals],
+            obstacles=len(p.scene.obstacles),
+            description=p.description,
         )
+        rows.append(row)
     if args.json:
         print(json.dumps(rows, indent=1))
         return 0
@@ -40,6 +47,7 @@ def cmd_problems(args: argparse.Namespace, console: Console) -> int:
     beside = console.width >= WIDE
     cols: list[tuple[str, Kind]] = [
         ("name", "name"),
+        ("from", "name"),
         ("robot", "name"),
         ("dof", "num"),
         ("obstacles", "num"),
@@ -47,7 +55,14 @@ def cmd_problems(args: argparse.Namespace, console: Console) -> int:
     ]
     t = table("problems", cols + ([("description", "text")] if beside else []), compact=True)
     for r in rows:
-        cells = [r["name"], r["robot"], str(r["dof"]), str(r["obstacles"]), ", ".join(r["legs"])]
+        cells = [
+            r["name"],
+            r["from"],
+            r["robot"],
+            "-" if r["dof"] is None else str(r["dof"]),
+            "-" if r["obstacles"] is None else str(r["obstacles"]),
+            ", ".join(r["legs"]),
+        ]
         t.add_row(*[escape(c) for c in cells], *([escape(r["description"])] if beside else []))
     console.print(t)
     if not beside:
@@ -57,6 +72,8 @@ def cmd_problems(args: argparse.Namespace, console: Console) -> int:
 
 
 def add_parser(sub: Any) -> None:
-    p = sub.add_parser("problems", help="list the bundled problems")
+    p = sub.add_parser(
+        "problems", help="list the problems: ./problems first, then the bundled ones"
+    )
     p.add_argument("--json", action="store_true", help="print one JSON document")
     p.set_defaults(func=cmd_problems)

@@ -556,11 +556,11 @@ class Core:
         self.n_links = L
         self.moving = np.array([i not in robot.fixed_links for i in range(L)])
         allowed = np.zeros((L, L), dtype=bool)
+        excluded = set(robot.excluded_pairs)  # a property: computed once here
+        fixed = set(robot.fixed_links)
         for i in range(L):
             for j in range(i + 1, L):
-                allowed[i, j] = (i, j) not in robot.excluded_pairs and not (
-                    i in robot.fixed_links and j in robot.fixed_links
-                )
+                allowed[i, j] = (i, j) not in excluded and not (i in fixed and j in fixed)
         self.allowed = allowed
         n = len(scene.obstacles)
         self.kinds = np.zeros(n, dtype=np.int64)
@@ -604,6 +604,28 @@ class Core:
             self._T0 = T0
             self._T1 = T0 @ armz._T_base_j1
             self._M = np.ascontiguousarray(armz._M, dtype=np.float64)
+        self._warm_up()
+
+    def _warm_up(self) -> None:
+        """Call every compiled kernel once, so that numba's compilation (first run on an
+        empty cache, about 11 s) or loading from its cache (about 0.5 s per process) happens
+        here, when the checker is built, and not inside a planner's time limit."""
+        kernels = (
+            (armz_frames, armz_segments, armz_first_invalid, armz_edge_first_invalid)
+            if self._armz
+            else (first_invalid, edge_states)
+        ) + (valid_batch, all_hits, pair_distances_kernel)
+        if all(k.signatures for k in kernels):
+            return  # compiled or loaded already in this process
+        q = np.clip(np.zeros(self.robot.dof), self.robot.lower, self.robot.upper)
+        q2 = np.vstack([q, q])
+        self.fk(q)
+        self.valid(q2)
+        self.is_valid(q)
+        self.first_invalid(q2)
+        self.edge_first_invalid(q, q, 1.0)
+        self.hits(q)
+        self.pair_distances(q, 0.0)
 
     # ------------------------------------------------------------------ kinematics
     def _Q(self, Q: Array) -> np.ndarray:

@@ -19,6 +19,7 @@ pedestal by design) and the robot's ``excluded_pairs`` (neighbours that always t
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import fcl
@@ -41,6 +42,8 @@ class PathCheck:
         first_invalid_edge: index of the first waypoint edge with a collision (or None).
         first_invalid_state: the first colliding interpolated state (or None).
         pairs: the colliding pairs at that state (names).
+        complete: False when ``stop`` ended the check early (``valid`` is then False,
+            with no colliding state).
     """
 
     valid: bool
@@ -49,6 +52,7 @@ class PathCheck:
     first_invalid_state: Array | None = None
     pairs: tuple[tuple[str, str], ...] = ()
     backend: str = "fcl"
+    complete: bool = True
 
 
 def _rotations_z_to(d: Array) -> Array:
@@ -322,10 +326,31 @@ class CollisionChecker:
             return -max((c.penetration_depth for c in res.contacts), default=0.0)
         return float(fcl.distance(o1, o2, self._distance_request, fcl.DistanceResult()))
 
-    def check_path(self, path: Array, joint_step: float) -> PathCheck:
-        """Check every state of a path densified to at most ``joint_step`` per joint."""
+    def check_path(
+        self,
+        path: Array,
+        joint_step: float,
+        stop: Callable[[], bool] | None = None,
+        chunk: int = 4096,
+    ) -> PathCheck:
+        """Check every state of a path densified to at most ``joint_step`` per joint.
+
+        ``stop`` (a time limit, say) is asked before each ``chunk`` of states; once it says
+        True the check ends, incomplete (``complete`` False). The same states are checked,
+        and counted, as without it.
+        """
         states, owners = densify(path, joint_step, self.robot.continuous)
-        bad = self.first_invalid(states)
+        step = len(states) if stop is None else max(int(chunk), 1)
+        bad = None
+        for i in range(0, len(states), max(step, 1)):
+            if stop is not None and stop():
+                return PathCheck(
+                    valid=False, states_checked=i, backend=self.backend, complete=False
+                )
+            b = self.first_invalid(states[i : i + step])
+            if b is not None:
+                bad = i + b
+                break
         if bad is None:
             return PathCheck(valid=True, states_checked=len(states), backend=self.backend)
         q_bad = states[bad]

@@ -51,6 +51,10 @@ Design (measured on ``armz_inspection``, 23 continuous joints):
   improves it); if they are not, the leg is BUDGET_EXHAUSTED with the numbers, and the
   path is not trusted. Slack: the re-check may end at most 1 % over
   ``max_collision_checks`` (its cost is known exactly only once the path is final).
+  The time limit is held the same way: once a path exists, planning stops early enough
+  to re-check it at the rate measured so far (seconds per check), and the steps after
+  planning (interpolation, conversion, the re-check) stop at ``time_limit_s`` + 1 %;
+  a path whose re-check did not finish is BUDGET_EXHAUSTED, not trusted.
 * **PRM / PRM\\***: OMPL's ``PRM::solve`` checks for a solution in a second thread; with
   Python callbacks the wheel deadlocks there (the caller keeps the GIL while joining).
   These two are therefore driven single-threaded: ``growRoadmap``/``expandRoadmap`` in
@@ -284,6 +288,10 @@ _RESERVE_EVERY_POLLS = 8
 #: the reserve is this many times the re-check's cost: planners and the simplifier poll
 #: their termination condition between steps that use checks, so they stop a little late
 _RESERVE_FACTOR = 1.25
+#: the steps after planning (the fine re-check) may run this fraction past the time limit
+_TIME_SLACK = 0.01
+#: states converted / re-checked between two looks at the clock
+_CHUNK_STATES = 2048
 _LIFTED = frozenset({"InformedRRTstar", "SORRTstar", "BITstar", "AORRTC"})
 _MOTION_CHECKS = ("batched", "ompl")
 #: OMPL's GoalRegion is satisfied when distanceGoal < threshold (strict)
@@ -463,6 +471,14 @@ class _Space:
             for j, i in enumerate(self.bound_idx):
                 state[j] = float(q[i])
 
+    def pair_metric(self, A: Array, B: Array) -> Array:
+        """OMPL's distance between the rows of A and B (k, dof) pairwise."""
+        d = np.abs(joint_difference(A, B, self.robot.continuous)).reshape(len(A), -1)
+        out = d[:, self.cont_idx].sum(axis=1) if self.cont_idx else np.zeros(len(A))
+        if self.bound_idx:
+            out = out + np.linalg.norm(d[:, self.bound_idx], axis=1)
+        return out
+
     def metric(self, Q: Array, q: Array) -> Array:
         """OMPL's distance from each row of Q (k, dof) to q: L1 continuous + L2 bounded."""
         d = np.abs(joint_difference(Q, q[None, :], self.robot.continuous))
@@ -506,10 +522,25 @@ class _GuardedChecker:
         self.checker = checker
         self.budget = budget
 
+    def out_of_time(self) -> bool:
+        """The time limit is reached."""
+        tl = self.budget.deadline.budget.time_limit_s
+        return tl is not None and self.budget.deadline.elapsed_s >= tl
+
+    def _out_of_time(self) -> bool:
+        """Past the time limit: refuse, so that loops which do not poll the termination
+        condition (the goal pool's IK, FMT*'s and BFMT*'s expansion) end quickly too."""
+        if self.out_of_time():
+            self.budget.refused += 1
+            return True
+        return False
+
     def is_valid(self, q: Array) -> bool:
         left = self.budget.checks_left()
         if left is not None and left <= 0:
             self.budget.refused += 1
+            return False
+        if self._out_of_time():
             return False
         return self.checker.is_valid(q)
 
@@ -519,6 +550,8 @@ class _GuardedChecker:
         One call to the checker for the whole edge (interpolation included); with too
         little budget left for the whole edge, checks what it may, then refuses.
         """
+        if self._out_of_time():
+            return False
         left = self.budget.checks_left()
         n, bad = self.checker.check_edge(q_a, q_b, joint_step, left)
         if left is not None and left < n:
@@ -750,7 +783,9 @@ class OMPLPlanner:
             if s.goal_selection == "near":
                 q_goal = _near_goal(problem, leg, q0, checker, bud)
             else:
-                q_goal = sample_goal_state(robot, goal, guard, rng, seeds=[q0], attempts=per_slot)
+                q_goal = sample_goal_state(
+                    robot, goal, guard, rng, seeds=[q0], attempts=per_slot, stop=guard.out_of_time
+                )
             if q_goal is not None:
                 pool.append(wrap_to_pi(q_goal, robot.continuous))
         extra["goal_pool"] = len(pool)
@@ -834,6 +869,13 @@ class OMPLPlanner:
             return _recheck_cost(Q, recheck_step, robot.continuous)
 
         reserve = [0]
+        time_limit = bud.deadline.budget.time_limit_s
+
+        def past_time() -> bool:
+            """The steps after planning are over the time limit (+ its slack)."""
+            return time_limit is not None and bud.deadline.elapsed_s > time_limit * (
+                1.0 + _TIME_SLACK
+            )
 
         def planning_done() -> bool:
             """Any limit reached, or a path was found and the checks left are just enough
@@ -841,7 +883,7 @@ class OMPLPlanner:
             whole budget improving it and leave nothing for its re-check)."""
             if bud.poll():
                 return True
-            if bud.max_checks is None:
+            if bud.max_checks is None and time_limit is None:
                 return False
             if hasattr(planner, "bestCost"):
                 # RRT*, Informed RRT*, BIT* add their path to the problem definition only
@@ -855,6 +897,14 @@ class OMPLPlanner:
             elif pdef.hasSolution() and (reserve[0] == 0 or bud.polls % _RESERVE_EVERY_POLLS == 0):
                 reserve[0] = recheck_cost(og.PathGeometric(pdef.getSolutionPath()))
             if reserve[0] == 0:
+                return False
+            if time_limit is not None:
+                # the re-check's time at this solve's own rate (planning overhead included)
+                used = bud.deadline.checks_used
+                rate_s = bud.deadline.elapsed_s / max(used, 1)
+                if bud.deadline.elapsed_s + _RESERVE_FACTOR * reserve[0] * rate_s >= time_limit:
+                    return True
+            if bud.max_checks is None:
                 return False
             return bud.deadline.checks_used + _RESERVE_FACTOR * reserve[0] >= bud.max_checks
 
@@ -930,12 +980,20 @@ class OMPLPlanner:
             extra["simplify_checks"] = checker.checks - c0
         extra["length_simplified"] = float(ompl_path.length())
         extra["waypoints_simplified"] = int(ompl_path.getStateCount())
+        waypoints = wrap_to_pi(
+            np.array([space.to_q(ompl_path.getState(i)) for i in range(ompl_path.getStateCount())]),
+            robot.continuous,
+        )
+        if guard.out_of_time():  # a path found at the limit: no time left to densify it
+            return self._out_of_time(result, status_text, waypoints, iterations, time_limit)
         if s.interpolate:
             ompl_path.interpolate()
-        path = np.array(
-            [space.to_q(ompl_path.getState(i)) for i in range(ompl_path.getStateCount())]
-        )
-        path = wrap_to_pi(path, robot.continuous)
+        rows: list[Array] = []
+        for i in range(ompl_path.getStateCount()):
+            if i % _CHUNK_STATES == 0 and past_time():
+                return self._out_of_time(result, status_text, waypoints, iterations, time_limit)
+            rows.append(space.to_q(ompl_path.getState(i)))
+        path = wrap_to_pi(np.array(rows), robot.continuous)
         if float(np.max(np.abs(joint_difference(path[0], q0, robot.continuous)))) > 1e-6:
             return result(
                 Status.FAILED,
@@ -962,8 +1020,10 @@ class OMPLPlanner:
                     iterations,
                 )
         c0 = checker.checks
-        check = checker.check_path(path, recheck_step)
+        check = checker.check_path(path, recheck_step, stop=past_time, chunk=_CHUNK_STATES)
         extra["validation_checks"] = checker.checks - c0
+        if not check.complete:
+            return self._out_of_time(result, status_text, path, iterations, time_limit)
         if not check.valid:
             return result(
                 Status.INVALID_PATH,
@@ -979,6 +1039,25 @@ class OMPLPlanner:
             Status.APPROXIMATE,
             f"{self.ompl_class}: {status_text}; ends outside the goal region"
             + (f" ({why_stopped})" if why_stopped else ""),
+            path,
+            iterations,
+        )
+
+    def _out_of_time(
+        self,
+        result: Callable[..., PlanResult],
+        status_text: str,
+        path: Array,
+        iterations: int,
+        time_limit: float | None,
+    ) -> PlanResult:
+        """The time limit (+ its slack) ran out after planning, before the path's re-check
+        finished: the path is not trusted."""
+        return result(
+            Status.BUDGET_EXHAUSTED,
+            f"{self.ompl_class} found a path ({status_text}) but the time limit of "
+            f"{time_limit:g} s (+{_TIME_SLACK:.0%}) ran out before its re-check at "
+            "joint_step/4 finished: the path is not trusted; give a larger --time-limit",
             path,
             iterations,
         )
@@ -1016,6 +1095,9 @@ class OMPLPlanner:
             planner.expandRoadmapPtc(
                 ob.PlannerTerminationCondition(lambda s=expand_until: bud.poll() or bud.polls >= s)
             )
+            tl = bud.deadline.budget.time_limit_s
+            if tl is not None and bud.deadline.elapsed_s >= tl:
+                return None, False, "Timeout"  # no search of a roadmap grown past the time
             data = ob.PlannerData(si)
             planner.getPlannerData(data)
             n = data.numVertices()
@@ -1040,12 +1122,8 @@ class OMPLPlanner:
                 c = np.array(cols + extra_cols, dtype=int)
                 if len(r):
                     w = (
-                        np.array(
-                            [
-                                float(space.metric(allV[a][None], allV[b])[0])
-                                for a, b in zip(r[: len(rows)], c[: len(rows)], strict=True)
-                            ]
-                            + extra_w
+                        np.concatenate(
+                            [space.pair_metric(allV[r[: len(rows)]], allV[c[: len(rows)]]), extra_w]
                         )
                         + 1e-12
                     )

@@ -21,10 +21,25 @@ def problems_dir() -> Path:
     return Path(env) if env else Path(__file__).resolve().parents[2] / "problems"
 
 
-def list_problems() -> list[Path]:
-    """Every problem file in :func:`problems_dir`, sorted by name."""
+def list_problems(cwd: Path | None = None) -> list[Path]:
+    """Every problem a name resolves to (see :func:`resolve_problem_path`): the files of
+    ``./problems`` (relative to ``cwd``, default the current directory), then the bundled
+    ones (:func:`problems_dir`) that no local file of the same name shadows; each group
+    sorted by name."""
+    local_dir = (cwd or Path.cwd()) / "problems"
+    bundled_dir = problems_dir()
+    local = sorted(local_dir.glob("*.toml")) if local_dir.is_dir() else []
+    bundled = sorted(bundled_dir.glob("*.toml")) if bundled_dir.is_dir() else []
+    if local_dir.is_dir() and bundled_dir.is_dir() and local_dir.samefile(bundled_dir):
+        return bundled  # run from the repository: ./problems is the bundled folder
+    names = {p.stem for p in local}
+    return local + [p for p in bundled if p.stem not in names]
+
+
+def problem_origin(path: Path) -> str:
+    """Where a listed problem file comes from: ``"bundled"`` or ``"./problems"``."""
     d = problems_dir()
-    return sorted(d.glob("*.toml")) if d.is_dir() else []
+    return "bundled" if d.is_dir() and path.parent.resolve() == d.resolve() else "./problems"
 
 
 def resolve_problem_path(name_or_path: str | Path, cwd: Path | None = None) -> Path:
@@ -42,7 +57,7 @@ def resolve_problem_path(name_or_path: str | Path, cwd: Path | None = None) -> P
     candidate = problems_dir() / f"{name_or_path}.toml"
     if candidate.exists():
         return candidate
-    raise UnknownNameError("problem", str(name_or_path), [q.stem for q in list_problems()])
+    raise UnknownNameError("problem", str(name_or_path), [q.stem for q in list_problems(cwd)])
 
 
 def load_problem(name_or_path: str | Path) -> Problem:

@@ -18,7 +18,7 @@ Only numpy is used here; a collision checker is passed in (anything with
 from __future__ import annotations
 
 import importlib
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from typing import Any, Protocol
 
@@ -170,6 +170,7 @@ def sample_goal_state(
     noise_growth: float = 1.35,
     uniform_fraction: float = 0.5,
     max_iterations: int = 150,
+    stop: Callable[[], bool] | None = None,
 ) -> Array | None:
     """A collision-free state inside both tolerances of ``goal``, or None.
 
@@ -209,9 +210,11 @@ def sample_goal_state(
         noise_start_rad, noise_growth: noise schedule around the seeds [rad].
         uniform_fraction: share of restarts from uniformly random states.
         max_iterations: descent steps per attempt.
+        stop: asked before each attempt (a time limit, say); True ends the search (None).
 
     Returns:
-        (dof,) state inside the region and collision-free, or None after ``attempts``.
+        (dof,) state inside the region and collision-free, or None after ``attempts``
+        (or once ``stop`` says so).
     """
     seed_list = [np.asarray(s, dtype=float).reshape(robot.dof) for s in seeds]
     analytic = _analytic_goal_sampler(robot)
@@ -219,11 +222,15 @@ def sample_goal_state(
         # Robots with analytic IK (the IRb-6) sample the region themselves; each candidate
         # still costs one collision check here.
         for _ in range(attempts):
+            if stop is not None and stop():
+                return None
             q = analytic(robot, goal, rng, seeds=seed_list or None)
             if q is not None and checker.is_valid(q):
                 return np.asarray(q, dtype=float)
         return None
     for k in range(attempts):
+        if stop is not None and stop():
+            return None
         use_uniform = not seed_list or (k >= len(seed_list) and rng.random() < uniform_fraction)
         if use_uniform:
             q0 = rng.uniform(robot.lower, robot.upper)
