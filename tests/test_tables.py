@@ -166,9 +166,12 @@ def test_listing_commands_fit(width: int, command: str, monkeypatch, capsys) -> 
     lines = capsys.readouterr().out.splitlines()
     _fits(lines, width)
     _whole([r["name"] for r in rows], lines)
-    if command == "problems":  # each row whole on its line: name, robot, dof, obstacles
+    if command == "problems":  # each row whole on its line: name, from, robot, dof, obstacles
         for r in rows:
-            pattern = rf"^{r['name']}\s+{r['robot']}\s+{r['dof']}\s+{r['obstacles']}\s"
+            pattern = (
+                rf"^{r['name']}\s+{re.escape(r['from'])}\s+{r['robot']}\s+{r['dof']}\s+"
+                rf"{r['obstacles']}\s"
+            )
             assert any(re.search(pattern, line) for line in lines), r["name"]
 
 
