@@ -610,7 +610,7 @@ class Core:
         """Call every compiled kernel once, so that numba's compilation (first run on an
         empty cache, about 11 s) or loading from its cache (about 0.5 s per process) happens
         here, when the checker is built, and not inside a planner's time limit."""
-        kernels = (
+        kernels: tuple[Any, ...] = (
             (armz_frames, armz_segments, armz_first_invalid, armz_edge_first_invalid)
             if self._armz
             else (first_invalid, edge_states)

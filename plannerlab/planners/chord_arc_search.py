@@ -59,8 +59,9 @@ curvature, follow the next arc (``a·θ`` with the curvature of the final shape)
 contact or the target.
 
 **Obstacles** are planar: :class:`Circle` and :class:`ConvexPolygon` (a rectangle with a
-yaw is :meth:`ConvexPolygon.rectangle`). :func:`query_from_toml_data` projects a problem
-file's boxes (yaw only), vertical cylinders and spheres onto the plane z = 0.
+yaw is :meth:`ConvexPolygon.rectangle`). :meth:`plannerlab.planners.chord_arc.ChordArcPlanner.query`
+projects a loaded problem's boxes (yaw only), vertical cylinders and spheres onto the plane
+z = 0.
 """
 
 from __future__ import annotations
