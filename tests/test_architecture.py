@@ -167,3 +167,15 @@ def test_loading_a_problem_imports_no_engine():
         [sys.executable, "-c", code], capture_output=True, text=True, check=True, timeout=120
     )
     assert json.loads(out.stdout.strip().splitlines()[-1]) == []
+
+
+def test_no_planner_module_calls_back_into_the_registry():
+    """Planners that run another planner get its factory from their registry entry."""
+    offenders = []
+    for module, path in MODULES.items():
+        if not module.startswith("plannerlab.planners."):
+            continue
+        for name, line in _imports(module, path):
+            if name == "plannerlab.planners":
+                offenders.append(f"{module}:{line}")
+    assert offenders == []

@@ -3,7 +3,8 @@
 An entry maps a name to ``"module:factory"``; the factory is called as
 ``factory(name, overrides, **entry.options)`` and returns a planner with frozen settings.
 OMPL planners are all served by :mod:`plannerlab.planners.ompl` (the only module importing
-``ompl``).
+``ompl``). Planners that run another planner (the hybrids' RRT-Connect escape) get its
+factory through their entry's options: no planner module looks anything up here.
 """
 
 from __future__ import annotations
@@ -31,8 +32,8 @@ class PlannerEntry:
         uses_rng: the planner draws from its generator (False: deterministic methods that
             ignore it; the contract checks that seeds do not change their path).
         options: keyword arguments the factory gets besides the name and the overrides
-            (the OMPL class of an ``ompl.*`` planner), so that no planner module has to
-            look itself up in this registry.
+            (the OMPL class of an ``ompl.*`` planner, the escape planner's factory of a
+            hybrid), so that no planner module has to look anything up in this registry.
     """
 
     name: str
@@ -67,6 +68,18 @@ OMPL_PLANNERS: Mapping[str, str] = MappingProxyType(
 )
 
 
+def _rrtconnect(overrides: Mapping[str, Any]) -> Planner:
+    """OMPL's RRT-Connect (``ompl.rrtconnect``): the hybrids' escape planner, handed to
+    their factories as ``escape_planner``; ``ompl`` is imported on first use."""
+    from plannerlab.planners.ompl import make
+
+    return make("ompl.rrtconnect", overrides, ompl_class=OMPL_PLANNERS["rrtconnect"])
+
+
+#: options of the planners that escape with RRT-Connect
+_ESCAPE_RRTCONNECT: Mapping[str, Any] = MappingProxyType({"escape_planner": _rrtconnect})
+
+
 def _entries() -> dict[str, PlannerEntry]:
     entries = [
         PlannerEntry(
@@ -96,6 +109,7 @@ def _entries() -> dict[str, PlannerEntry]:
             "gradient+rrtconnect",
             "plannerlab.planners.hybrid:make",
             "gradient descent; at a local minimum RRT-Connect plans from the stall to the goal",
+            options=_ESCAPE_RRTCONNECT,
         )
     )
     entries.append(
@@ -103,6 +117,7 @@ def _entries() -> dict[str, PlannerEntry]:
             "gradient.multistart",
             "plannerlab.planners.hybrid:make",
             "gradient descent restarted from random collision-free states near each stall",
+            options=_ESCAPE_RRTCONNECT,
         )
     )
     for name, summary in (
@@ -122,7 +137,14 @@ def _entries() -> dict[str, PlannerEntry]:
             "found by the clearance descent from the stall",
         ),
     ):
-        entries.append(PlannerEntry(name, "plannerlab.planners.gradient_clearance:make", summary))
+        entries.append(
+            PlannerEntry(
+                name,
+                "plannerlab.planners.gradient_clearance:make",
+                summary,
+                options=_ESCAPE_RRTCONNECT,
+            )
+        )
     entries.append(
         PlannerEntry(
             "chord_arc",

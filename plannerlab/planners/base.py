@@ -16,12 +16,13 @@ from typing import Any, Protocol, runtime_checkable
 import numpy as np
 
 from plannerlab.errors import PlannerlabError
+from plannerlab.problem.load import Budget
 from plannerlab.record.leg import PROGRESS_COLUMNS, PlanResult, Status, settings_dict
 from plannerlab.robots.base import Array
 
 __all__ = [
     "PROGRESS_COLUMNS",
-    "Deadline",
+    "BudgetTracker",
     "Progress",
     "PlanResult",
     "Planner",
@@ -49,8 +50,11 @@ class Stepper(Protocol):
 class Planner(Protocol):
     """A planner instance: a registry name and frozen settings."""
 
-    name: str
-    settings: Any
+    @property
+    def name(self) -> str: ...
+
+    @property
+    def settings(self) -> Any: ...
 
     def solve(
         self,
@@ -72,7 +76,7 @@ class Progress:
     the last one replaces it. The shared helper behind :attr:`PlanResult.progress`.
 
     Args:
-        clock: seconds since the solve started (e.g. ``Deadline.elapsed_s``).
+        clock: seconds since the solve started (e.g. ``BudgetTracker.elapsed_s``).
         checks: collision checks used so far in this solve.
     """
 
@@ -161,22 +165,42 @@ def start_collision(checker: Any, q_start: Array) -> str | None:
     return f"the start state collides: {pairs}"
 
 
-class Deadline:
-    """Budget bookkeeping shared by planners: iterations, collision checks, time."""
+class BudgetTracker:
+    """The budget bookkeeping of one solve: time, collision checks and iterations used,
+    against a :class:`~plannerlab.problem.load.Budget`. The one tracker every planner uses.
+
+    Checks used are those of ``checker`` since the tracker was made plus those charged
+    (:meth:`charge` takes a sub-solve's result, :meth:`charge_checks` a count checked
+    elsewhere). Iterations are the planner's own count, passed to :meth:`exhausted`, or
+    else :attr:`iterations`, the count charged from sub-solves.
+
+    Args:
+        budget: the limits (a field None: no limit of that kind).
+        checker: the collision checker whose ``checks`` count (None: charged checks only).
+    """
 
     def __init__(self, budget: Any, checker: Any | None = None) -> None:
         self.budget = budget
         self.checker = checker
         self._checks0 = checker.checks if checker is not None else 0
         self._t0 = time.perf_counter()
+        #: iterations charged from sub-solves
+        self.iterations = 0
+        #: collision checks charged (sub-solves, checks made elsewhere)
+        self.charged_checks = 0
+        #: forward-kinematics evaluations charged from sub-solves (not a limit; a count)
+        self.fk_calls = 0
 
     @property
     def elapsed_s(self) -> float:
+        """Seconds since the tracker was made."""
         return time.perf_counter() - self._t0
 
     @property
     def checks_used(self) -> int:
-        return (self.checker.checks - self._checks0) if self.checker is not None else 0
+        """Collision checks used: the checker's since the start, plus those charged."""
+        own = (self.checker.checks - self._checks0) if self.checker is not None else 0
+        return own + self.charged_checks
 
     def checks_left(self) -> int | None:
         """Collision checks still allowed (None: no such limit)."""
@@ -185,16 +209,58 @@ class Deadline:
             return None
         return max(b.max_collision_checks - self.checks_used, 0)
 
-    def exhausted(self, iterations: int) -> str | None:
-        """None while within budget, else which limit was hit, in words."""
+    def exhausted(self, iterations: int | None = None) -> str | None:
+        """None while within budget, else which limit was hit, in words.
+
+        Args:
+            iterations: the planner's iterations so far (default: :attr:`iterations`).
+        """
         b = self.budget
-        if b.max_iterations is not None and iterations >= b.max_iterations:
+        used = self.iterations if iterations is None else iterations
+        if b.max_iterations is not None and used >= b.max_iterations:
             return f"iteration budget of {b.max_iterations} used up"
         if b.max_collision_checks is not None and self.checks_used >= b.max_collision_checks:
             return f"collision-check budget of {b.max_collision_checks} used up"
         if b.time_limit_s is not None and self.elapsed_s >= b.time_limit_s:
             return f"time limit of {b.time_limit_s:g} s reached"
         return None
+
+    def remaining(
+        self, checks_cap: int | None = None, *, limit_iterations: bool = True
+    ) -> Budget | None:
+        """The budget left for a sub-solve, or None when a limit is used up.
+
+        Args:
+            checks_cap: at most this many collision checks (an escape's slice).
+            limit_iterations: False gives the sub-solve no iteration limit (a planner
+                that counts its own iterations against the leg's, and the sub-solve's
+                after it returns).
+        """
+        b = self.budget
+        it = None
+        if limit_iterations and b.max_iterations is not None:
+            it = b.max_iterations - self.iterations
+        ch = None if b.max_collision_checks is None else b.max_collision_checks - self.checks_used
+        tl = None if b.time_limit_s is None else b.time_limit_s - self.elapsed_s
+        if (
+            (it is not None and it <= 0)
+            or (ch is not None and ch <= 0)
+            or (tl is not None and tl <= 0)
+        ):
+            return None
+        if checks_cap is not None:
+            ch = checks_cap if ch is None else min(ch, checks_cap)
+        return Budget(max_iterations=it, max_collision_checks=ch, time_limit_s=tl)
+
+    def charge(self, sub: PlanResult) -> None:
+        """Count a sub-solve's iterations, collision checks and FK calls as this solve's."""
+        self.iterations += sub.iterations
+        self.charged_checks += sub.collision_checks
+        self.fk_calls += sub.fk_calls
+
+    def charge_checks(self, checks: int) -> None:
+        """Count collision checks made outside ``checker`` (another checker, a count)."""
+        self.charged_checks += int(checks)
 
 
 def with_overrides(settings: Any, overrides: Mapping[str, Any], planner: str) -> Any:

@@ -87,7 +87,7 @@ import numpy as np
 
 from plannerlab.errors import PlannerlabError, ProblemError
 from plannerlab.planners.base import (
-    Deadline,
+    BudgetTracker,
     PlanResult,
     Progress,
     Status,
@@ -433,13 +433,6 @@ def capsule_distances(
     return out.reshape(np.shape(seg_m)[:-2] + (len(obstacles),))
 
 
-class _CheckCounter:
-    """Counts the states checked (``checks``), as :class:`Deadline` expects."""
-
-    def __init__(self) -> None:
-        self.checks = 0
-
-
 # --------------------------------------------------------------------------- planner
 
 
@@ -543,8 +536,7 @@ class ChordArcPlanner:
     def _classify(
         self,
         robot: ContinuumChain,
-        counter: _CheckCounter,
-        budget: Any,
+        tracker: BudgetTracker,
         plan: ChordArcPlan,
         query: ChordArcQuery,
         path: Array,
@@ -560,10 +552,10 @@ class ChordArcPlanner:
 
         Returns (expected, unexpected, cut short by the check budget).
         """
-        limit = budget.max_collision_checks
-        if limit is not None and limit - counter.checks < len(path):
+        left = tracker.checks_left()
+        if left is not None and left < len(path):
             return [], [], True
-        counter.checks += len(path)
+        tracker.charge_checks(len(path))
         seg = robot.link_segments(path)[..., :2]  # (S, L, 2, 2)
         dist = capsule_distances(seg, query.obstacles, robot.link_radius_m)  # (S, L, O)
         touching = dist < robot.link_radius_m
@@ -639,8 +631,7 @@ class ChordArcPlanner:
         goal = problem.goal(leg)
         real = self.query(problem, leg)
         query = self.planning_query(problem, real)
-        counter = _CheckCounter()
-        deadline = Deadline(budget, counter)
+        tracker = BudgetTracker(budget)  # checks: the contact classification's states
         q0 = np.asarray(problem.q_start if q_start is None else q_start, dtype=float)
         q0 = q0.reshape(robot.dof)
         tol = 2.0 * robot.link_radius_m + s.contact_margin_m
@@ -665,7 +656,7 @@ class ChordArcPlanner:
             extra: dict[str, Any] | None = None,
         ) -> PlanResult:
             pe, ae = goal.errors(robot, path[-1])
-            progress = Progress(lambda: time.perf_counter() - t0, lambda: deadline.checks_used)
+            progress = Progress(lambda: time.perf_counter() - t0, lambda: tracker.checks_used)
             progress.note(float(goal.distance(robot, q0)), time_s=0.0, checks=0)
             solved = status is Status.SOLVED
             rows = progress.finish(
@@ -682,7 +673,7 @@ class ChordArcPlanner:
                 path=path,
                 time_s=time.perf_counter() - t0,
                 iterations=iterations,
-                collision_checks=deadline.checks_used,
+                collision_checks=tracker.checks_used,
                 fk_calls=0,
                 pos_err_m=float(pe),
                 angle_err_deg=float(ae),
@@ -764,9 +755,7 @@ class ChordArcPlanner:
             exp: list[dict[str, Any]] = []
             unexp: list[dict[str, Any]] = []
             if not reason and s.check_contacts and not cut_short:
-                exp, unexp, cut_short = self._classify(
-                    robot, counter, budget, plan, real, path, tol
-                )
+                exp, unexp, cut_short = self._classify(robot, tracker, plan, real, path, tol)
                 if unexp:
                     u = unexp[0]
                     reason = (

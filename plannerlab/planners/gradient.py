@@ -44,7 +44,7 @@ from scipy.optimize import approx_fprime
 from plannerlab.collision.fcl_checker import CollisionChecker
 from plannerlab.errors import PlannerlabError
 from plannerlab.planners.base import (
-    Deadline,
+    BudgetTracker,
     PlanResult,
     Progress,
     Status,
@@ -171,7 +171,7 @@ class GradientPlanner:
         checker = CollisionChecker(robot, problem.scene)
         q = np.array(problem.q_start if q_start is None else q_start, dtype=float)
         f = self.objective(problem, leg, checker)
-        deadline = Deadline(budget, checker)
+        tracker = BudgetTracker(budget, checker)
         closed = s.mode == "closed_loop"
         if closed:
             if stepper is None:
@@ -269,12 +269,12 @@ class GradientPlanner:
                         "blocked_steps": blocked_steps,
                     },
                 )
-            exhausted = deadline.exhausted(iteration)
+            exhausted = tracker.exhausted(iteration)
             # An iteration costs the gradient's checks (dof + 1 with finite differences),
             # at least one state of the step and, in closed loop, one check of the state
             # reached: never start one the check budget cannot pay for.
             grad_cost = robot.dof + 1 if s.gradient == "finite_difference" else 0
-            left = deadline.checks_left()
+            left = tracker.checks_left()
             if exhausted is None and left is not None and left < grad_cost + 1 + int(closed):
                 exhausted = (
                     f"collision-check budget of {budget.max_collision_checks} used up "
@@ -294,7 +294,7 @@ class GradientPlanner:
                 assert stepper is not None  # closed-loop mode checked for a stepper above
                 q_next = wrap_to_pi(stepper.move_towards(q_target, s.sim_steps), robot.continuous)
             else:
-                left = deadline.checks_left()
+                left = tracker.checks_left()
                 q_next, blocked = self._advance_kinematic(problem, checker, q, q_target, left)
                 blocked_steps += int(blocked)
                 q_next = wrap_to_pi(q_next, robot.continuous)

@@ -32,14 +32,17 @@ from __future__ import annotations
 
 import math
 import time
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
 from plannerlab.collision.fcl_checker import CollisionChecker
 from plannerlab.errors import PlannerlabError
 from plannerlab.planners.base import (
-    Deadline,
+    BudgetTracker,
+    Planner,
     PlanResult,
     Progress,
     Status,
@@ -113,9 +116,15 @@ class ClearanceSettings:
 class ClearanceDescent:
     """One descent of F from a start state (see the module docstring)."""
 
-    def __init__(self, name: str, settings: ClearanceSettings) -> None:
+    def __init__(
+        self,
+        name: str,
+        settings: ClearanceSettings,
+        escape_planner: Callable[[Mapping[str, Any]], Planner] | None = None,
+    ) -> None:
         self.name = name
         self.settings = settings
+        self.escape_planner = escape_planner
 
     # ------------------------------------------------------------------ pieces
     def _f(self, robot, goal, q: Array) -> float:
@@ -226,7 +235,7 @@ class ClearanceDescent:
         leg: int,
         q_start: Array,
         checker: CollisionChecker | None,
-        deadline: Deadline,
+        tracker: BudgetTracker,
         goal=None,
         iterations_before: int = 0,
     ) -> tuple[Status, str, list[Array], list[float], int]:
@@ -287,11 +296,11 @@ class ClearanceDescent:
                     trace,
                     iteration,
                 )
-            exhausted = deadline.exhausted(iterations_before + iteration)
-            left = deadline.checks_left()
+            exhausted = tracker.exhausted(iterations_before + iteration)
+            left = tracker.checks_left()
             if exhausted is None and left is not None and left < 1:
                 exhausted = (
-                    f"collision-check budget of {deadline.budget.max_collision_checks} used up"
+                    f"collision-check budget of {tracker.budget.max_collision_checks} used up"
                 )
             if exhausted:
                 return Status.BUDGET_EXHAUSTED, exhausted, path, trace, iteration
@@ -322,12 +331,12 @@ class ClearanceDescent:
 
     # ------------------------------------------------------------------ goals near q
     def near_goal_state(
-        self, problem, leg: int, q: Array, checker: CollisionChecker, deadline: Deadline
+        self, problem, leg: int, q: Array, checker: CollisionChecker, tracker: BudgetTracker
     ) -> Array | None:
         """A collision-free state in leg's goal region found by descending F from q with
         the path left unchecked (the clearance term still steers): a goal *near* q, the
         part of the arm that F does not need to move stays where it is. One check."""
-        status, _, path, _, _ = self.leg_descent(problem, leg, q, None, deadline)
+        status, _, path, _, _ = self.leg_descent(problem, leg, q, None, tracker)
         q_goal = path[-1]
         if status is Status.SOLVED and checker.is_valid(q_goal):
             return q_goal
@@ -340,7 +349,7 @@ class ClearanceDescent:
         leg: int,
         q_start: Array,
         checker: CollisionChecker | None,
-        deadline: Deadline,
+        tracker: BudgetTracker,
         used: int = 0,
     ) -> tuple[Status, str, list[Array], list[float], int]:
         """The descent of one leg: with ``approach_m`` > 0, first to the goal's approach
@@ -363,7 +372,7 @@ class ClearanceDescent:
                 s.subgoal_angle_tol_deg,
             )
             st, reason, seg, tr, it = self.descend(
-                problem, leg, path[-1], checker, deadline, sub, used
+                problem, leg, path[-1], checker, tracker, sub, used
             )
             iterations += it
             path.extend(seg[1:])
@@ -371,7 +380,7 @@ class ClearanceDescent:
             if st not in (Status.SOLVED, Status.LOCAL_MINIMUM):
                 return st, reason, path, trace, iterations
         st, reason, seg, tr, it = self.descend(
-            problem, leg, path[-1], checker, deadline, None, used + iterations
+            problem, leg, path[-1], checker, tracker, None, used + iterations
         )
         path.extend(seg[1:])
         trace.extend(tr)
@@ -384,7 +393,7 @@ class ClearanceDescent:
         leg: int,
         q_stall: Array,
         checker: CollisionChecker,
-        deadline: Deadline,
+        tracker: BudgetTracker,
         used: int,
     ) -> tuple[list[Array], int, str]:
         """Sub-goals near the stall: the tip drawn back along its own body, to the face
@@ -405,7 +414,7 @@ class ClearanceDescent:
         q = np.array(q_stall)
         last_face = F.shape[0] - 1
         for back in range(s.retract_step, robot.dof, s.retract_step):
-            if deadline.exhausted(used + iterations) is not None:
+            if tracker.exhausted(used + iterations) is not None:
                 break
             face = last_face - back
             sub = GoalRegion(
@@ -416,13 +425,13 @@ class ClearanceDescent:
                 s.subgoal_angle_tol_deg,
             )
             st, _, seg, _, it = self.descend(
-                problem, leg, q, checker, deadline, sub, used + iterations
+                problem, leg, q, checker, tracker, sub, used + iterations
             )
             iterations += it
             kept.extend(seg[1:])
             q = kept[-1]
             st2, _, seg2, _, it2 = self.leg_descent(
-                problem, leg, q, checker, deadline, used + iterations
+                problem, leg, q, checker, tracker, used + iterations
             )
             iterations += it2
             if st2 is Status.SOLVED:
@@ -434,30 +443,22 @@ class ClearanceDescent:
         problem,
         leg: int,
         q_stall: Array,
-        checker: CollisionChecker,
-        deadline: Deadline,
+        tracker: BudgetTracker,
         rng: np.random.Generator,
     ) -> tuple[list[Array], int, str]:
-        """RRT-Connect from the stall to a goal state found near it (see near_goal_state)."""
-        from plannerlab.planners import make_planner
-        from plannerlab.problem.load import Budget
-
-        s = self.settings
-        left = deadline.checks_left()
-        cap = s.escape_checks if left is None else min(left, s.escape_checks)
-        if cap <= 0:
-            return [np.array(q_stall)], 0, "no checks left"
-        b = deadline.budget
-        tl = None if b.time_limit_s is None else max(b.time_limit_s - deadline.elapsed_s, 1e-3)
-        rrt = make_planner("ompl.rrtconnect", {"goal_selection": "near", "goal_samples": 1})
-        r = rrt.solve(
-            problem,
-            leg,
-            Budget(max_iterations=None, max_collision_checks=cap, time_limit_s=tl),
-            rng,
-            q_start=q_stall,
-        )
-        checker.checks += r.collision_checks  # the sub-planner's checks count here
+        """RRT-Connect from the stall to a goal state found near it (see near_goal_state),
+        with the checks and time left, at most ``escape_checks`` checks; its iterations
+        count in the leg's afterwards (the caller adds them)."""
+        if self.escape_planner is None:
+            raise PlannerlabError(
+                f"{self.name}: no escape planner given (make it by name, make_planner)"
+            )
+        sub = tracker.remaining(self.settings.escape_checks, limit_iterations=False)
+        if sub is None:
+            return [np.array(q_stall)], 0, f"not started: {tracker.exhausted() or 'no budget'}"
+        rrt = self.escape_planner({"goal_selection": "near", "goal_samples": 1})
+        r = rrt.solve(problem, leg, sub, rng, q_start=q_stall)
+        tracker.charge_checks(r.collision_checks)  # the sub-planner's checks count here
         if r.solved:
             return list(r.path), r.iterations, "rrtconnect"
         return [np.array(q_stall)], r.iterations, f"rrtconnect: {r.status.value}"
@@ -481,14 +482,14 @@ class ClearanceDescent:
         goal = problem.goal(leg)
         checker = CollisionChecker(robot, problem.scene)
         q0 = np.array(problem.q_start if q_start is None else q_start, dtype=float)
-        deadline = Deadline(budget, checker)
+        tracker = BudgetTracker(budget, checker)
         path: list[Array] = [q0]
         trace: list[float] = []
         escapes_log: list[dict] = []
         iterations = 0
         minima = escapes = 0
         descent_rad: list[float] = []
-        progress = Progress(lambda: time.perf_counter() - t0, lambda: checker.checks)
+        progress = Progress(lambda: time.perf_counter() - t0, lambda: tracker.checks_used)
 
         def note(states: list[Array]) -> None:
             """Progress after a descent or an escape: the best goal distance it reached."""
@@ -529,7 +530,7 @@ class ClearanceDescent:
                 path=P,
                 time_s=time.perf_counter() - t0,
                 iterations=iterations,
-                collision_checks=checker.checks,
+                collision_checks=tracker.checks_used,
                 pos_err_m=float(pos_err),
                 angle_err_deg=float(ang_err),
                 trace=np.array(trace),
@@ -547,7 +548,7 @@ class ClearanceDescent:
         q = q0
         while True:
             st, reason, seg, tr, it = self.leg_descent(
-                problem, leg, q, checker, deadline, iterations
+                problem, leg, q, checker, tracker, iterations
             )
             iterations += it
             trace.extend(tr)
@@ -564,11 +565,11 @@ class ClearanceDescent:
                 return done(st, reason)
             if minima > s.max_escapes:
                 return done(st, f"{reason}; {minima} local minima met, {escapes} escaped; gave up")
-            c0 = checker.checks
+            c0 = tracker.checks_used
             if s.escape == "detour":
-                esc, it, how = self._detour(problem, leg, q_stall, checker, deadline, iterations)
+                esc, it, how = self._detour(problem, leg, q_stall, checker, tracker, iterations)
             else:
-                esc, it, how = self._rrtconnect(problem, leg, q_stall, checker, deadline, rng)
+                esc, it, how = self._rrtconnect(problem, leg, q_stall, tracker, rng)
             iterations += it
             left_stall = len(esc) > 1
             escapes += int(left_stall)
@@ -581,7 +582,7 @@ class ClearanceDescent:
                     "start_from_stall_rad": dist(esc[0], q_stall),
                     "descent_before_stall_rad": descent_rad[-1],
                     "left_stall": left_stall,
-                    "checks": checker.checks - c0,
+                    "checks": tracker.checks_used - c0,
                 }
             )
             if not left_stall:
@@ -606,8 +607,16 @@ VARIANTS: dict[str, dict[str, object]] = {
 }
 
 
-def make(name: str, overrides: dict) -> ClearanceDescent:
+def make(
+    name: str,
+    overrides: dict,
+    *,
+    escape_planner: Callable[[Mapping[str, Any]], Planner] | None = None,
+) -> ClearanceDescent:
+    """Registry factory for the ``gradient.clearance`` family. ``escape_planner(overrides)``
+    makes the RRT-Connect planner of the ``rrtconnect`` escape (the registry passes OMPL's,
+    so this module needs neither the registry nor ``ompl``)."""
     if name not in VARIANTS:
         raise PlannerlabError(f"{name} is not a clearance descent ({', '.join(VARIANTS)})")
     base = ClearanceSettings(**VARIANTS[name])  # type: ignore[arg-type]
-    return ClearanceDescent(name, with_overrides(base, overrides, name))
+    return ClearanceDescent(name, with_overrides(base, overrides, name), escape_planner)

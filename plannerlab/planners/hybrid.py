@@ -26,6 +26,7 @@ from __future__ import annotations
 
 import math
 import time
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from typing import Any
 
@@ -34,6 +35,8 @@ import numpy as np
 from plannerlab.collision.fcl_checker import CollisionChecker
 from plannerlab.errors import PlannerlabError
 from plannerlab.planners.base import (
+    BudgetTracker,
+    Planner,
     PlanResult,
     Progress,
     Status,
@@ -95,52 +98,18 @@ class HybridSettings:
         )
 
 
-class _Ledger:
-    """What the sub-solves have used so far, against the overall budget."""
-
-    def __init__(self, budget: Budget) -> None:
-        self.budget = budget
-        self.iterations = 0
-        self.checks = 0
-        self.fk_calls = 0
-        self.t0 = time.perf_counter()
-
-    def add(self, r: PlanResult) -> None:
-        self.iterations += r.iterations
-        self.checks += r.collision_checks
-        self.fk_calls += r.fk_calls
-
-    def remaining(self, checks_cap: int | None = None) -> Budget | None:
-        """The budget left (None when a limit is used up), checks capped at ``checks_cap``."""
-        b = self.budget
-        it = None if b.max_iterations is None else b.max_iterations - self.iterations
-        ch = None if b.max_collision_checks is None else b.max_collision_checks - self.checks
-        tl = None if b.time_limit_s is None else b.time_limit_s - (time.perf_counter() - self.t0)
-        if (
-            (it is not None and it <= 0)
-            or (ch is not None and ch <= 0)
-            or (tl is not None and tl <= 0)
-        ):
-            return None
-        if checks_cap is not None:
-            ch = checks_cap if ch is None else min(ch, checks_cap)
-        return Budget(max_iterations=it, max_collision_checks=ch, time_limit_s=tl)
-
-    def exhausted_reason(self) -> str:
-        b = self.budget
-        if b.max_iterations is not None and self.iterations >= b.max_iterations:
-            return f"iteration budget of {b.max_iterations} used up"
-        if b.max_collision_checks is not None and self.checks >= b.max_collision_checks:
-            return f"collision-check budget of {b.max_collision_checks} used up"
-        return f"time limit of {b.time_limit_s:g} s reached"
-
-
 class HybridPlanner:
     """``gradient+rrtconnect`` and ``gradient.multistart`` (see the module docstring)."""
 
-    def __init__(self, name: str, settings: HybridSettings) -> None:
+    def __init__(
+        self,
+        name: str,
+        settings: HybridSettings,
+        escape_planner: Callable[[Mapping[str, Any]], Planner] | None = None,
+    ) -> None:
         self.name = name
         self.settings = settings
+        self.escape_planner = escape_planner
         self._descent = GradientPlanner(f"{name}/descent", settings.descent())
 
     def solve(
@@ -157,14 +126,15 @@ class HybridPlanner:
         t0 = time.perf_counter()
         robot = problem.robot
         goal = problem.goal(leg)
-        ledger = _Ledger(budget)
+        checker = CollisionChecker(robot, problem.scene)  # the restarts' edges
+        tracker = BudgetTracker(budget, checker)  # and the sub-solves' results, charged
         q = np.array(problem.q_start if q_start is None else q_start, dtype=float)
         path: list[Array] = [q]
         trace: list[float] = []
         minima = escapes = 0
         notes: list[str] = []
         noise = s.restart_noise_rad
-        progress = Progress(lambda: time.perf_counter() - t0, lambda: ledger.checks)
+        progress = Progress(lambda: time.perf_counter() - t0, lambda: tracker.checks_used)
 
         def done(status: Status, reason: str) -> PlanResult:
             p = np.array(path)
@@ -180,9 +150,9 @@ class HybridPlanner:
                 reason=reason,
                 path=p,
                 time_s=time.perf_counter() - t0,
-                iterations=ledger.iterations,
-                collision_checks=ledger.checks,
-                fk_calls=ledger.fk_calls,
+                iterations=tracker.iterations,
+                collision_checks=tracker.checks_used,
+                fk_calls=tracker.fk_calls,
                 pos_err_m=float(pos_err),
                 angle_err_deg=float(ang_err),
                 trace=np.array(trace),
@@ -200,12 +170,12 @@ class HybridPlanner:
             return float(np.linalg.norm(joint_difference(a, b, robot.continuous)))
 
         while True:
-            sub = ledger.remaining()
+            sub = tracker.remaining()
             if sub is None:
-                return done(Status.BUDGET_EXHAUSTED, ledger.exhausted_reason())
-            t_sub, c_sub = time.perf_counter() - t0, ledger.checks
+                return done(Status.BUDGET_EXHAUSTED, _used_up(tracker))
+            t_sub, c_sub = time.perf_counter() - t0, tracker.checks_used
             r = self._descent.solve(problem, leg, sub, rng, q_start=q)
-            ledger.add(r)
+            tracker.charge(r)
             progress.extend(r.progress, t_sub, c_sub)
             path.extend(r.path[1:])
             trace.extend(r.trace.tolist())
@@ -236,10 +206,10 @@ class HybridPlanner:
             }
             escapes_log.append(record)
             if s.escape == "rrtconnect":
-                t_sub, c_sub = time.perf_counter() - t0, ledger.checks
-                rrt = self._rrt_escape(problem, leg, ledger, rng, q)
+                t_sub, c_sub = time.perf_counter() - t0, tracker.checks_used
+                rrt = self._rrt_escape(problem, leg, tracker, rng, q)
                 if rrt is None:
-                    return done(Status.BUDGET_EXHAUSTED, ledger.exhausted_reason())
+                    return done(Status.BUDGET_EXHAUSTED, _used_up(tracker))
                 progress.extend(rrt.progress, t_sub, c_sub)  # an escape: a drop to 0
                 notes.append(f"rrtconnect from stall {minima}: {rrt.status.value}")
                 if rrt.solved:
@@ -253,7 +223,7 @@ class HybridPlanner:
                         f"stall {minima}; {minima} local minima met, {escapes} escaped",
                     )
             # restart near the stall (restart always; rrtconnect after a failed slice)
-            q_new = self._restart(problem, ledger, rng, q, noise)
+            q_new = self._restart(problem, checker, tracker, rng, q, noise)
             noise *= s.restart_noise_growth
             if q_new is None:
                 notes.append(f"no collision-free restart near stall {minima}")
@@ -281,35 +251,45 @@ class HybridPlanner:
         return path[-1]
 
     def _rrt_escape(
-        self, problem: Any, leg: int, ledger: _Ledger, rng: np.random.Generator, q: Array
+        self,
+        problem: Any,
+        leg: int,
+        tracker: BudgetTracker,
+        rng: np.random.Generator,
+        q: Array,
     ) -> PlanResult | None:
-        from plannerlab.planners import make_planner
-
-        sub = ledger.remaining(checks_cap=self.settings.escape_checks)
+        """RRT-Connect from q within an escape's slice of the budget (None: none left)."""
+        if self.escape_planner is None:
+            raise PlannerlabError(
+                f"{self.name}: no escape planner given (make it by name, make_planner)"
+            )
+        sub = tracker.remaining(checks_cap=self.settings.escape_checks)
         if sub is None:
             return None
         overrides = {"range": self.settings.rrt_range} if self.settings.rrt_range > 0 else {}
-        rrt = make_planner("ompl.rrtconnect", overrides)
-        r = rrt.solve(problem, leg, sub, rng, q_start=q)
-        ledger.add(r)
+        r = self.escape_planner(overrides).solve(problem, leg, sub, rng, q_start=q)
+        tracker.charge(r)
         return r
 
     def _restart(
-        self, problem: Any, ledger: _Ledger, rng: np.random.Generator, q: Array, noise_rad: float
+        self,
+        problem: Any,
+        checker: CollisionChecker,
+        tracker: BudgetTracker,
+        rng: np.random.Generator,
+        q: Array,
+        noise_rad: float,
     ) -> Array | None:
-        """A straight, collision-free edge from q to a random state near it: (m, dof)."""
+        """A straight, collision-free edge from q to a random state near it: (m, dof);
+        ``checker`` is the one ``tracker`` counts."""
         robot = problem.robot
-        checker = CollisionChecker(robot, problem.scene)
         for _ in range(self.settings.restart_tries):
-            if ledger.remaining() is None:
+            if tracker.remaining() is None:
                 break
             q_try = wrap_to_pi(q + rng.normal(0.0, noise_rad, robot.dof), robot.continuous)
             q_try = np.clip(q_try, robot.lower, robot.upper)
             edge = interpolate_edge(q, q_try, problem.joint_step, robot.continuous)
-            before = checker.checks
-            ok = checker.first_invalid(edge) is None
-            ledger.checks += checker.checks - before
-            if ok:
+            if checker.first_invalid(edge) is None:
                 return wrap_to_pi(edge, robot.continuous)
         return None
 
@@ -320,8 +300,21 @@ VARIANTS: dict[str, dict[str, object]] = {
 }
 
 
-def make(name: str, overrides: dict) -> HybridPlanner:
-    """Registry factory for ``gradient+rrtconnect`` and ``gradient.multistart``."""
+def _used_up(tracker: BudgetTracker) -> str:
+    return tracker.exhausted() or "budget used up"
+
+
+def make(
+    name: str,
+    overrides: dict,
+    *,
+    escape_planner: Callable[[Mapping[str, Any]], Planner] | None = None,
+) -> HybridPlanner:
+    """Registry factory for ``gradient+rrtconnect`` and ``gradient.multistart``.
+
+    ``escape_planner(overrides)`` makes the RRT-Connect planner of the escapes (the
+    registry passes OMPL's, so this module needs neither the registry nor ``ompl``).
+    """
     if name not in VARIANTS:
         raise PlannerlabError(f"{name} is not a hybrid planner ({', '.join(VARIANTS)})")
     settings = with_overrides(HybridSettings(**VARIANTS[name]), overrides, name)  # type: ignore[arg-type]
@@ -331,4 +324,4 @@ def make(name: str, overrides: dict) -> HybridPlanner:
         raise PlannerlabError(
             f"gradient setting: 'analytic' or 'finite_difference', got {settings.gradient!r}"
         )
-    return HybridPlanner(name, settings)
+    return HybridPlanner(name, settings, escape_planner)

@@ -100,7 +100,7 @@ import ompl.util as ou
 from plannerlab.collision.fcl_checker import CollisionChecker
 from plannerlab.errors import PlannerlabError
 from plannerlab.planners.base import (
-    Deadline,
+    BudgetTracker,
     PlanResult,
     Progress,
     Status,
@@ -488,57 +488,48 @@ class _Space:
         return out
 
 
-class _Budget:
-    """Collision-check, iteration and time limits of one solve, shared by callbacks."""
+class _Guard:
+    """One solve's collision checker and termination condition, behind its
+    :class:`~plannerlab.planners.base.BudgetTracker`: the checker refuses (reports
+    invalid, without checking) once the checks are spent or the time limit is reached;
+    the termination condition counts its polls, which are the iterations of planners that
+    expose no count of their own (``iteration_source``)."""
 
-    def __init__(self, budget: Any, checker: CollisionChecker) -> None:
-        self.deadline = Deadline(budget, checker)
-        self.max_checks = budget.max_collision_checks
+    def __init__(self, checker: CollisionChecker, tracker: BudgetTracker) -> None:
+        self.checker = checker
+        self.tracker = tracker
         self.polls = 0
         self.refused = 0
         self.iteration_source: Callable[[], int] | None = None
-
-    def checks_left(self) -> int | None:
-        if self.max_checks is None:
-            return None
-        return max(self.max_checks - self.deadline.checks_used, 0)
 
     def iterations(self) -> int:
         return self.iteration_source() if self.iteration_source is not None else self.polls
 
     def exhausted(self) -> str | None:
-        return self.deadline.exhausted(self.iterations())
+        return self.tracker.exhausted(self.iterations())
 
     def poll(self) -> bool:
         """The termination condition: True once any limit is reached."""
         self.polls += 1
         return self.exhausted() is not None
 
-
-class _GuardedChecker:
-    """The collision checker behind the budget: refuses (invalid, unchecked) once spent."""
-
-    def __init__(self, checker: CollisionChecker, budget: _Budget) -> None:
-        self.checker = checker
-        self.budget = budget
-
     def out_of_time(self) -> bool:
         """The time limit is reached."""
-        tl = self.budget.deadline.budget.time_limit_s
-        return tl is not None and self.budget.deadline.elapsed_s >= tl
+        tl = self.tracker.budget.time_limit_s
+        return tl is not None and self.tracker.elapsed_s >= tl
 
     def _out_of_time(self) -> bool:
         """Past the time limit: refuse, so that loops which do not poll the termination
         condition (the goal pool's IK, FMT*'s and BFMT*'s expansion) end quickly too."""
         if self.out_of_time():
-            self.budget.refused += 1
+            self.refused += 1
             return True
         return False
 
     def is_valid(self, q: Array) -> bool:
-        left = self.budget.checks_left()
+        left = self.tracker.checks_left()
         if left is not None and left <= 0:
-            self.budget.refused += 1
+            self.refused += 1
             return False
         if self._out_of_time():
             return False
@@ -552,10 +543,10 @@ class _GuardedChecker:
         """
         if self._out_of_time():
             return False
-        left = self.budget.checks_left()
+        left = self.tracker.checks_left()
         n, bad = self.checker.check_edge(q_a, q_b, joint_step, left)
         if left is not None and left < n:
-            self.budget.refused += 1
+            self.refused += 1
             return False
         return bad is None
 
@@ -625,13 +616,13 @@ def _projection(
 
 
 def _near_goal(
-    problem: Any, leg: int, q0: Array, checker: CollisionChecker, bud: _Budget
+    problem: Any, leg: int, q0: Array, checker: CollisionChecker, tracker: BudgetTracker
 ) -> Array | None:
     """The goal state ``gradient.clearance`` selects near q0 (see ``goal_selection``)."""
     from plannerlab.planners.gradient_clearance import make as make_clearance
 
     return make_clearance("gradient.clearance", {}).near_goal_state(
-        problem, leg, q0, checker, bud.deadline
+        problem, leg, q0, checker, tracker
     )
 
 
@@ -703,13 +694,13 @@ class OMPLPlanner:
         ompl_seed: int,
     ) -> PlanResult:
         checker = CollisionChecker(problem.robot, problem.scene)
-        bud = _Budget(budget, checker)
+        guard = _Guard(checker, BudgetTracker(budget, checker))
         try:
-            return self._plan(problem, leg, rng, q_start, ompl_seed, checker, bud)
+            return self._plan(problem, leg, rng, q_start, ompl_seed, guard)
         finally:
             # Python callbacks held by OMPL objects reference the planner through this
             # bound method: break the cycle so every OMPL object is freed with the solve.
-            bud.iteration_source = None
+            guard.iteration_source = None
 
     # ------------------------------------------------------------------ internals
     def _plan(
@@ -719,13 +710,13 @@ class OMPLPlanner:
         rng: np.random.Generator,
         q_start: Array | None,
         ompl_seed: int,
-        checker: CollisionChecker,
-        bud: _Budget,
+        guard: _Guard,
     ) -> PlanResult:
         s = self.settings
         robot: Robot = problem.robot
         goal: GoalRegion = problem.goal(leg)
-        guard = _GuardedChecker(checker, bud)
+        checker, tracker = guard.checker, guard.tracker
+        max_checks = tracker.budget.max_collision_checks
         q0 = wrap_to_pi(
             np.asarray(problem.q_start if q_start is None else q_start, dtype=float).reshape(
                 robot.dof
@@ -734,12 +725,12 @@ class OMPLPlanner:
         )
         fk = [0]
         trace: list[float] = []
-        progress = Progress(lambda: bud.deadline.elapsed_s, lambda: checker.checks)
+        progress = Progress(lambda: tracker.elapsed_s, lambda: checker.checks)
         extra: dict[str, Any] = {"ompl_class": self.ompl_class, "ompl_seed": ompl_seed}
 
         def result(status: Status, reason: str, path: Array, iterations: int) -> PlanResult:
             pos_err, ang_err = (float(v) for v in goal.errors(robot, path[-1]))
-            extra["refused_checks"] = bud.refused
+            extra["refused_checks"] = guard.refused
             solved = status is Status.SOLVED
             rows = progress.finish(
                 float(goal.distance(robot, path[-1])),
@@ -753,7 +744,7 @@ class OMPLPlanner:
                 status=status,
                 reason=reason,
                 path=path,
-                time_s=bud.deadline.elapsed_s,
+                time_s=tracker.elapsed_s,
                 iterations=iterations,
                 collision_checks=checker.checks,
                 fk_calls=fk[0],
@@ -777,11 +768,11 @@ class OMPLPlanner:
         per_slot = max(1, s.max_goal_attempts // max(s.goal_samples, 1))
         pool_cut_short = ""
         for _ in range(s.goal_samples):
-            if bud.exhausted() is not None:
-                pool_cut_short = bud.exhausted() or ""
+            if guard.exhausted() is not None:
+                pool_cut_short = guard.exhausted() or ""
                 break
             if s.goal_selection == "near":
-                q_goal = _near_goal(problem, leg, q0, checker, bud)
+                q_goal = _near_goal(problem, leg, q0, checker, tracker)
             else:
                 q_goal = sample_goal_state(
                     robot, goal, guard, rng, seeds=[q0], attempts=per_slot, stop=guard.out_of_time
@@ -852,9 +843,9 @@ class OMPLPlanner:
                 _projection(space, cell, robot.T_world_base[:3, 3], reach, fk)
             )
         if hasattr(planner, "numIterations"):
-            bud.iteration_source = planner.numIterations
+            guard.iteration_source = planner.numIterations
         elif self.ompl_class in _ROADMAP:
-            bud.iteration_source = planner.milestoneCount
+            guard.iteration_source = planner.milestoneCount
         planner.setProblemDefinition(pdef)
         planner.setup()
 
@@ -869,21 +860,19 @@ class OMPLPlanner:
             return _recheck_cost(Q, recheck_step, robot.continuous)
 
         reserve = [0]
-        time_limit = bud.deadline.budget.time_limit_s
+        time_limit = tracker.budget.time_limit_s
 
         def past_time() -> bool:
             """The steps after planning are over the time limit (+ its slack)."""
-            return time_limit is not None and bud.deadline.elapsed_s > time_limit * (
-                1.0 + _TIME_SLACK
-            )
+            return time_limit is not None and tracker.elapsed_s > time_limit * (1.0 + _TIME_SLACK)
 
         def planning_done() -> bool:
             """Any limit reached, or a path was found and the checks left are just enough
             to re-check it (asymptotically optimal planners would otherwise spend the
             whole budget improving it and leave nothing for its re-check)."""
-            if bud.poll():
+            if guard.poll():
                 return True
-            if bud.max_checks is None and time_limit is None:
+            if max_checks is None and time_limit is None:
                 return False
             if hasattr(planner, "bestCost"):
                 # RRT*, Informed RRT*, BIT* add their path to the problem definition only
@@ -894,24 +883,26 @@ class OMPLPlanner:
                 best = float(planner.bestCost().value())
                 if math.isfinite(best):
                     reserve[0] = int(5.0 * best / problem.joint_step) + 16
-            elif pdef.hasSolution() and (reserve[0] == 0 or bud.polls % _RESERVE_EVERY_POLLS == 0):
+            elif pdef.hasSolution() and (
+                reserve[0] == 0 or guard.polls % _RESERVE_EVERY_POLLS == 0
+            ):
                 reserve[0] = recheck_cost(og.PathGeometric(pdef.getSolutionPath()))
             if reserve[0] == 0:
                 return False
             if time_limit is not None:
                 # the re-check's time at this solve's own rate (planning overhead included)
-                used = bud.deadline.checks_used
-                rate_s = bud.deadline.elapsed_s / max(used, 1)
-                if bud.deadline.elapsed_s + _RESERVE_FACTOR * reserve[0] * rate_s >= time_limit:
+                used = tracker.checks_used
+                rate_s = tracker.elapsed_s / max(used, 1)
+                if tracker.elapsed_s + _RESERVE_FACTOR * reserve[0] * rate_s >= time_limit:
                     return True
-            if bud.max_checks is None:
+            if max_checks is None:
                 return False
-            return bud.deadline.checks_used + _RESERVE_FACTOR * reserve[0] >= bud.max_checks
+            return tracker.checks_used + _RESERVE_FACTOR * reserve[0] >= max_checks
 
         ptc = ob.PlannerTerminationCondition(planning_done)
         if self.ompl_class in _ROADMAP:
             ompl_path, exact, status_text = self._roadmap_solve(
-                planner, si, space, guard, pool, q0, goal, robot, bud, problem.joint_step
+                planner, si, space, guard, pool, q0, goal, robot, problem.joint_step
             )
         else:
             status = planner.solve(ptc)
@@ -922,10 +913,10 @@ class OMPLPlanner:
             ompl_path = (
                 og.PathGeometric(pdef.getSolutionPath()) if usable and pdef.hasSolution() else None
             )
-        iterations = bud.iterations()
+        iterations = guard.iterations()
         extra["ompl_status"] = status_text
         extra["planning_checks"] = checker.checks - c_pool - extra["goal_pool_checks"] + 0
-        why_stopped = bud.exhausted()
+        why_stopped = guard.exhausted()
 
         if ompl_path is None:
             if not pool and pool_cut_short:
@@ -960,20 +951,16 @@ class OMPLPlanner:
             """Stop simplifying at any limit, or once the checks left are just enough to
             re-check the path (a path too long to re-check is simplified until it fits or
             the budget is spent)."""
-            if bud.poll():
+            if guard.poll():
                 return True
-            if bud.max_checks is None:
+            if max_checks is None:
                 return False
-            margin = (
-                bud.max_checks
-                - bud.deadline.checks_used
-                - _RESERVE_FACTOR * recheck_cost(ompl_path)
-            )
+            margin = max_checks - tracker.checks_used - _RESERVE_FACTOR * recheck_cost(ompl_path)
             if margin > 0:
                 fits[0] = True
             return fits[0] and margin <= 0
 
-        if s.simplify and bud.exhausted() is None:
+        if s.simplify and guard.exhausted() is None:
             simplifier = og.PathSimplifier(si, goal_obj)
             c0 = checker.checks
             simplifier.simplify(ompl_path, ob.PlannerTerminationCondition(simplify_done))
@@ -1006,15 +993,15 @@ class OMPLPlanner:
         extra["path_length_rad"] = path_length(path, robot.continuous)
 
         cost = _recheck_cost(path, recheck_step, robot.continuous)
-        if bud.max_checks is not None:
-            left = bud.max_checks + bud.max_checks // 100 - bud.deadline.checks_used
+        if max_checks is not None:
+            left = max_checks + max_checks // 100 - tracker.checks_used
             if cost > left:
                 extra["validation_checks"] = 0
                 return result(
                     Status.BUDGET_EXHAUSTED,
                     f"{self.ompl_class} found a path ({status_text}) but re-checking it at "
                     f"joint_step/4 needs {cost} collision checks and the budget of "
-                    f"{bud.max_checks} (+1 %) leaves {max(left, 0)}: the path is not "
+                    f"{max_checks} (+1 %) leaves {max(left, 0)}: the path is not "
                     "trusted; give a larger --max-checks",
                     path,
                     iterations,
@@ -1067,12 +1054,11 @@ class OMPLPlanner:
         planner: Any,
         si: Any,
         space: _Space,
-        guard: _GuardedChecker,
+        guard: _Guard,
         pool: list[Array],
         q0: Array,
         goal: GoalRegion,
         robot: Robot,
-        bud: _Budget,
         joint_step: float,
     ) -> tuple[Any, bool, str]:
         """PRM / PRM* without OMPL's solution thread (see the module docstring)."""
@@ -1087,16 +1073,19 @@ class OMPLPlanner:
             # OMPL's constructRoadmap alternates growing and expanding in *timed* sub-slices
             # (so the roadmap would depend on the machine's load): do the alternation here,
             # sliced by termination polls, which are deterministic.
-            grow_until = bud.polls + max(1, (2 * slice_polls) // 3)
+            grow_until = guard.polls + max(1, (2 * slice_polls) // 3)
             planner.growRoadmapPtc(
-                ob.PlannerTerminationCondition(lambda s=grow_until: bud.poll() or bud.polls >= s)
+                ob.PlannerTerminationCondition(
+                    lambda s=grow_until: guard.poll() or guard.polls >= s
+                )
             )
-            expand_until = bud.polls + max(1, slice_polls // 3)
+            expand_until = guard.polls + max(1, slice_polls // 3)
             planner.expandRoadmapPtc(
-                ob.PlannerTerminationCondition(lambda s=expand_until: bud.poll() or bud.polls >= s)
+                ob.PlannerTerminationCondition(
+                    lambda s=expand_until: guard.poll() or guard.polls >= s
+                )
             )
-            tl = bud.deadline.budget.time_limit_s
-            if tl is not None and bud.deadline.elapsed_s >= tl:
+            if guard.out_of_time():
                 return None, False, "Timeout"  # no search of a roadmap grown past the time
             data = ob.PlannerData(si)
             planner.getPlannerData(data)
@@ -1145,7 +1134,7 @@ class OMPLPlanner:
                             space.set_state(st, allV[idx])
                             path.append(st)
                         return path, True, "Exact solution"
-            if bud.exhausted() is not None:
+            if guard.exhausted() is not None:
                 return None, False, "Timeout"
 
 
