@@ -1,13 +1,17 @@
-"""The planners' shared pieces (planners/base.py): the one budget tracker."""
+"""The planners' shared pieces (planners/base.py): the one budget tracker and the one way
+to build a result."""
 
 from __future__ import annotations
 
 import numpy as np
+import pytest
 from conftest import toy_problem
 
 from plannerlab.collision.fcl_checker import CollisionChecker
-from plannerlab.planners.base import BudgetTracker, PlanResult, Status
+from plannerlab.planners.base import BudgetTracker, LegRun, PlanResult, Status
+from plannerlab.planners.gradient import GradientSettings
 from plannerlab.problem.load import Budget
+from plannerlab.robots.paths import path_length
 
 
 def _sub_result(iterations: int, checks: int, fk_calls: int = 0) -> PlanResult:
@@ -67,3 +71,51 @@ def test_a_time_limit_counts_from_the_trackers_start():
     assert tracker.exhausted() == "time limit of 1e-09 s reached"
     assert tracker.remaining() is None
     assert BudgetTracker(Budget(time_limit_s=3600.0)).remaining() is not None
+
+
+def test_a_leg_runs_result_has_the_paths_errors_cost_and_the_trackers_counts():
+    problem = toy_problem()
+    robot, goal = problem.robot, problem.goal(0)
+    checker = CollisionChecker(robot, problem.scene)
+    tracker = BudgetTracker(problem.budget, checker)
+    settings = GradientSettings(gamma=0.04)
+    run = LegRun("gradient", settings, problem, 0, tracker)
+    path = np.array([problem.q_start, problem.q_start + 0.1, problem.q_start + 0.3])
+    checker.valid_batch(path)  # three checks
+    tracker.charge_checks(4)
+    run.progress.note(1.5)
+    r = run.result(Status.SOLVED, "done", path, iterations=9, fk_calls=2, trace=[3.0, 2.0])
+    pos_err, ang_err = goal.errors(robot, path[-1])
+    assert (r.planner, r.problem, r.leg, r.goal) == ("gradient", "toy", 0, "near")
+    assert (r.iterations, r.fk_calls, r.collision_checks) == (9, 2, 3 + 4)
+    assert (r.pos_err_m, r.angle_err_deg) == (float(pos_err), float(ang_err))
+    assert r.settings["gamma"] == 0.04 and r.trace.tolist() == [3.0, 2.0]
+    assert 0.0 < r.time_s <= tracker.elapsed_s
+    # the progress: the noted row, then one at the end with the path's length as its cost
+    assert r.progress[0, 2] == 1.5 and r.progress[-1, 1] == 7
+    assert (
+        r.progress[-1, 3]
+        == path_length(path, robot.continuous)
+        == pytest.approx(0.3 * np.sqrt(robot.dof))
+    )
+    unsolved = LegRun("gradient", settings, problem, 0, tracker).result(Status.FAILED, "no", path)
+    assert np.isnan(unsolved.progress[-1, 3])
+    assert unsolved.progress[-1, 2] == float(goal.distance(robot, path[-1]))
+
+
+def test_a_leg_that_is_not_planned_has_no_time_checks_progress_or_settings():
+    problem = toy_problem()
+    r = LegRun("ompl.rrt", None, problem, 0).result(
+        Status.UNREACHABLE, "too far", [problem.q_start]
+    )
+    assert (r.time_s, r.collision_checks, r.iterations) == (0.0, 0, 0)
+    assert r.progress.shape == (0, 4) and dict(r.settings) == {}
+    assert r.path.tolist() == [problem.q_start.tolist()]
+
+
+def test_progress_rows_a_planner_made_itself_are_kept():
+    problem = toy_problem()
+    run = LegRun("gradient", None, problem, 0, BudgetTracker(problem.budget))
+    rows = np.array([[0.5, 10.0, 0.2, np.nan]])
+    r = run.result(Status.BUDGET_EXHAUSTED, "used up", [problem.q_start], progress_rows=rows)
+    assert np.array_equal(r.progress, rows, equal_nan=True)

@@ -17,6 +17,7 @@ import numpy as np
 
 from plannerlab.errors import PlanFileError, PlannerlabError, ProblemError
 from plannerlab.planners import get_entry, make_planner
+from plannerlab.planners.base import LegRun
 from plannerlab.problem.goals import unreachable_reason
 from plannerlab.problem.load import Budget, Problem
 from plannerlab.record.execution import Execution
@@ -35,19 +36,8 @@ def _unreachable(
 ) -> PlanResult:
     """The result of a leg whose goal is out of reach: not planned, the path stays put."""
     q = problem.q_start if q_start is None else np.asarray(q_start, dtype=float)
-    goal = problem.goal(leg)
-    pos_err, ang_err = (float(v) for v in goal.errors(problem.robot, q))
-    return PlanResult(
-        planner=planner_name,
-        problem=problem.name,
-        leg=leg,
-        goal=goal.name,
-        status=Status.UNREACHABLE,
-        reason=why,
-        path=np.asarray(q, dtype=float)[None],
-        pos_err_m=pos_err,
-        angle_err_deg=ang_err,
-    )
+    # no settings, no budget tracker: no time, checks or progress
+    return LegRun(planner_name, None, problem, leg).result(Status.UNREACHABLE, why, [q])
 
 
 def _check_problem_start(problem: Problem) -> None:

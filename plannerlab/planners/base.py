@@ -3,6 +3,10 @@
 Every planner is ``solve(problem, leg, budget, rng, q_start=None, stepper=None) ->
 PlanResult``. Failure is a status with a reason, never ``None`` or an exception (bad
 *input* still raises a :class:`~plannerlab.errors.PlannerlabError`).
+
+The pieces every planner shares: :class:`BudgetTracker` (the budget of one solve, its
+sub-solves charged to it), :class:`LegRun` (the one way to build a :class:`PlanResult`),
+:class:`Progress` (its progress rows) and :func:`start_collision` (the start-state check).
 """
 
 from __future__ import annotations
@@ -19,10 +23,12 @@ from plannerlab.errors import PlannerlabError
 from plannerlab.problem.load import Budget
 from plannerlab.record.leg import PROGRESS_COLUMNS, PlanResult, Status, settings_dict
 from plannerlab.robots.base import Array
+from plannerlab.robots.paths import path_length
 
 __all__ = [
     "PROGRESS_COLUMNS",
     "BudgetTracker",
+    "LegRun",
     "Progress",
     "PlanResult",
     "Planner",
@@ -261,6 +267,108 @@ class BudgetTracker:
     def charge_checks(self, checks: int) -> None:
         """Count collision checks made outside ``checker`` (another checker, a count)."""
         self.charged_checks += int(checks)
+
+
+class LegRun:
+    """One planner's run on one leg, and the one way to build its :class:`PlanResult`.
+
+    It knows the planner (registry name, settings), the problem, the leg (its goal, the
+    robot), the solve's :class:`BudgetTracker` and a :class:`Progress` on the tracker's
+    clock and checks (:attr:`progress`, for the planner to note improvements on).
+    :meth:`result` adds what every result has: the tip errors of the path's last state,
+    the path's cost (joint-space length [rad]) when solved, the progress closed by a last
+    row, the time and the checks used.
+
+    Args:
+        planner: registry name.
+        settings: the planner's frozen settings (None: none, a leg that is not planned).
+        problem: the problem; ``leg`` the leg index.
+        tracker: the solve's budget tracker (None: a leg that is not planned: no time,
+            no checks, no progress rows).
+    """
+
+    def __init__(
+        self,
+        planner: str,
+        settings: Any,
+        problem: Any,
+        leg: int,
+        tracker: BudgetTracker | None = None,
+    ) -> None:
+        self.planner = planner
+        self.settings = settings
+        self.problem = problem
+        self.leg = leg
+        self.robot = problem.robot
+        self.goal = problem.goal(leg)
+        self.tracker = tracker
+        self.progress = (
+            Progress(lambda: tracker.elapsed_s, lambda: tracker.checks_used)
+            if tracker is not None
+            else Progress(lambda: 0.0, lambda: 0)
+        )
+
+    def cost(self, status: Status, path: Array) -> float:
+        """The cost of a result's path: its joint-space length [rad] when solved, else NaN."""
+        if status is not Status.SOLVED:
+            return math.nan
+        return path_length(np.asarray(path, dtype=float), self.robot.continuous)
+
+    def result(
+        self,
+        status: Status,
+        reason: str,
+        path: Any,
+        *,
+        iterations: int = 0,
+        fk_calls: int = 0,
+        trace: Any = None,
+        progress_rows: Array | None = None,
+        local_minima: int = 0,
+        escapes: int = 0,
+        extra: Mapping[str, Any] | None = None,
+    ) -> PlanResult:
+        """The leg's result.
+
+        Args:
+            status, reason: how it ended, in words.
+            path: (m, dof) states from the start (m >= 1).
+            iterations, fk_calls, local_minima, escapes: the planner's counts.
+            trace: objective or best goal distance per iteration (default: none).
+            progress_rows: the progress rows when the planner made them itself (default:
+                :attr:`progress` closed by the last state's goal distance and the cost).
+            extra: planner-specific numbers (copied).
+        """
+        P = np.atleast_2d(np.asarray(path, dtype=float))
+        pos_err, ang_err = self.goal.errors(self.robot, P[-1])
+        if progress_rows is None and self.tracker is not None:
+            progress_rows = self.progress.finish(
+                float(self.goal.distance(self.robot, P[-1])), self.cost(status, P)
+            )
+        t = self.tracker
+        return PlanResult(
+            planner=self.planner,
+            problem=self.problem.name,
+            leg=self.leg,
+            goal=self.goal.name,
+            status=status,
+            reason=reason,
+            path=P,
+            time_s=t.elapsed_s if t is not None else 0.0,
+            iterations=iterations,
+            collision_checks=t.checks_used if t is not None else 0,
+            fk_calls=fk_calls,
+            pos_err_m=float(pos_err),
+            angle_err_deg=float(ang_err),
+            trace=np.zeros(0) if trace is None else np.asarray(trace, dtype=float),
+            progress=(
+                np.zeros((0, len(PROGRESS_COLUMNS))) if progress_rows is None else progress_rows
+            ),
+            local_minima=local_minima,
+            escapes=escapes,
+            settings=settings_dict(self.settings),
+            extra=dict(extra or {}),
+        )
 
 
 def with_overrides(settings: Any, overrides: Mapping[str, Any], planner: str) -> Any:

@@ -88,11 +88,10 @@ import numpy as np
 from plannerlab.errors import PlannerlabError, ProblemError
 from plannerlab.planners.base import (
     BudgetTracker,
+    LegRun,
     PlanResult,
-    Progress,
     Status,
     Stepper,
-    settings_dict,
     with_overrides,
 )
 from plannerlab.planners.chord_arc_search import (
@@ -113,7 +112,6 @@ from plannerlab.planners.chord_arc_search import prepare as prepare_check
 from plannerlab.problem.scene import Box, Cylinder, Scene, Sphere
 from plannerlab.robots.base import Array
 from plannerlab.robots.continuum.model import ContinuumChain
-from plannerlab.robots.paths import path_length
 
 
 @dataclass(frozen=True)
@@ -625,13 +623,13 @@ class ChordArcPlanner:
                 obstacle boundary).
         """
         del rng, stepper
-        t0 = time.perf_counter()
         s = self.settings
+        tracker = BudgetTracker(budget)  # checks: the contact classification's states
+        run = LegRun(self.name, s, problem, leg, tracker)
         robot = problem.robot
         goal = problem.goal(leg)
         real = self.query(problem, leg)
         query = self.planning_query(problem, real)
-        tracker = BudgetTracker(budget)  # checks: the contact classification's states
         q0 = np.asarray(problem.q_start if q_start is None else q_start, dtype=float)
         q0 = q0.reshape(robot.dof)
         tol = 2.0 * robot.link_radius_m + s.contact_margin_m
@@ -647,6 +645,9 @@ class ChordArcPlanner:
             "guide_obstacles": sorted(guide_obstacles(problem)),
         }
 
+        # progress: the search starts at the straight robot, at time 0 with no checks
+        run.progress.note(float(goal.distance(robot, q0)), time_s=0.0, checks=0)
+
         def result(
             status: Status,
             reason: str,
@@ -655,31 +656,13 @@ class ChordArcPlanner:
             trace: Array | None = None,
             extra: dict[str, Any] | None = None,
         ) -> PlanResult:
-            pe, ae = goal.errors(robot, path[-1])
-            progress = Progress(lambda: time.perf_counter() - t0, lambda: tracker.checks_used)
-            progress.note(float(goal.distance(robot, q0)), time_s=0.0, checks=0)
-            solved = status is Status.SOLVED
-            rows = progress.finish(
-                float(goal.distance(robot, path[-1])),
-                path_length(path, robot.continuous) if solved else math.nan,
-            )
-            return PlanResult(
-                planner=self.name,
-                problem=problem.name,
-                leg=leg,
-                goal=goal.name,
-                status=status,
-                reason=reason,
-                path=path,
-                time_s=time.perf_counter() - t0,
+            """The leg's result, with what the search found so far."""
+            return run.result(
+                status,
+                reason,
+                path,
                 iterations=iterations,
-                collision_checks=tracker.checks_used,
-                fk_calls=0,
-                pos_err_m=float(pe),
-                angle_err_deg=float(ae),
-                trace=np.zeros(0) if trace is None else trace,
-                progress=rows,
-                settings=settings_dict(s),
+                trace=trace,
                 extra={**base_extra, **(extra or {})},
             )
 

@@ -34,8 +34,6 @@ region). A **stall** is declared when the best f has not improved by more than
 
 from __future__ import annotations
 
-import math
-import time
 from dataclasses import dataclass
 
 import numpy as np
@@ -45,16 +43,17 @@ from plannerlab.collision.fcl_checker import CollisionChecker
 from plannerlab.errors import PlannerlabError
 from plannerlab.planners.base import (
     BudgetTracker,
+    LegRun,
     PlanResult,
     Progress,
     Status,
     Stepper,
-    settings_dict,
+    start_collision,
     with_overrides,
 )
 from plannerlab.planners.objective import Objective
 from plannerlab.robots.base import Array, wrap_to_pi
-from plannerlab.robots.paths import interpolate_edge, path_length
+from plannerlab.robots.paths import interpolate_edge
 
 
 @dataclass(frozen=True)
@@ -165,13 +164,13 @@ class GradientPlanner:
         """
         del rng
         s = self.settings
-        t0 = time.perf_counter()
         robot = problem.robot
         goal = problem.goal(leg)
         checker = CollisionChecker(robot, problem.scene)
+        tracker = BudgetTracker(budget, checker)
+        run = LegRun(self.name, s, problem, leg, tracker)
         q = np.array(problem.q_start if q_start is None else q_start, dtype=float)
         f = self.objective(problem, leg, checker)
-        tracker = BudgetTracker(budget, checker)
         closed = s.mode == "closed_loop"
         if closed:
             if stepper is None:
@@ -183,106 +182,71 @@ class GradientPlanner:
         clock: list[float] = []  # per state of the path: when it was reached [s]
         checks: list[int] = []  # … and the collision checks used by then
 
-        def result(
-            status: Status,
-            reason: str,
-            path: list[Array],
-            trace: list[float],
-            iterations: int,
-            minima: int = 0,
-            extra: dict | None = None,
-        ) -> PlanResult:
-            pos_err, ang_err = goal.errors(robot, path[-1])
-            # progress from the descent's states (bookkeeping: these FK calls are not counted)
-            cost = (
-                path_length(np.array(path), robot.continuous)
-                if status is Status.SOLVED
-                else math.nan
-            )
-            n = min(len(path), len(clock))  # 0 when the start is refused
-            dists = goal.distance(robot, np.array(path[:n])) if n else []
-            progress = Progress.of_series(clock[:n], checks[:n], dists, cost)
-            return PlanResult(
-                planner=self.name,
-                problem=problem.name,
-                leg=leg,
-                goal=goal.name,
-                status=status,
-                reason=reason,
-                path=np.array(path),
-                time_s=time.perf_counter() - t0,
-                iterations=iterations,
-                collision_checks=checker.checks,
-                fk_calls=f.evaluations,
-                pos_err_m=float(pos_err),
-                angle_err_deg=float(ang_err),
-                trace=np.array(trace),
-                progress=progress,
-                local_minima=minima,
-                escapes=0,
-                settings=settings_dict(s),
-                extra=extra or {},
-            )
+        def progress_rows(status: Status, path: list[Array]) -> Array:
+            """The progress from the descent's states (bookkeeping: these FK calls are not
+            counted), made once at the end."""
+            dists = goal.distance(robot, np.array(path))
+            return Progress.of_series(clock, checks, dists, run.cost(status, np.array(path)))
 
-        if not checker.is_valid(q):
-            pairs = ", ".join(f"{a} x {b}" for a, b in checker.colliding_pairs(q))
-            return result(Status.INVALID_START, f"start in collision: {pairs}", [q], [], 0)
+        why_not = start_collision(checker, q)
+        if why_not is not None:
+            return run.result(Status.INVALID_START, why_not, [q], fk_calls=f.evaluations)
 
         path = [q.copy()]
         value = f(q)
         trace = [value]
-        clock.append(time.perf_counter() - t0)
-        checks.append(checker.checks)
+        clock.append(tracker.elapsed_s)
+        checks.append(tracker.checks_used)
         best, best_iter = value, 0
         blocked_steps = 0
         iteration = 0
         while True:
+            status, reason, extra = None, "", {}
             if goal.contains(robot, q):
-                return result(
-                    Status.SOLVED,
-                    f"in the goal region after {iteration} iterations",
+                status = Status.SOLVED
+                reason = f"in the goal region after {iteration} iterations"
+            elif s.stop_at_epsilon and value < s.epsilon:
+                status = Status.APPROXIMATE
+                reason = f"f = {value:.3g} < epsilon = {s.epsilon} but outside the goal region"
+            elif value >= s.epsilon and iteration - best_iter >= s.stall_window:
+                status = Status.LOCAL_MINIMUM
+                reason = (
+                    f"stalled at iteration {iteration}: best f = {best:.4g} has not improved "
+                    f"by {s.stall_min_decrease} in {s.stall_window} iterations "
+                    f"({blocked_steps} steps blocked by contact)"
+                )
+                extra = {
+                    "stall_iteration": iteration,
+                    "q_stall": q.tolist(),
+                    "blocked_steps": blocked_steps,
+                }
+            else:
+                exhausted = tracker.exhausted(iteration)
+                # An iteration costs the gradient's checks (dof + 1 with finite
+                # differences), at least one state of the step and, in closed loop, one
+                # check of the state reached: never start one the check budget cannot pay
+                # for.
+                grad_cost = robot.dof + 1 if s.gradient == "finite_difference" else 0
+                left = tracker.checks_left()
+                if exhausted is None and left is not None and left < grad_cost + 1 + int(closed):
+                    exhausted = (
+                        f"collision-check budget of {budget.max_collision_checks} used up "
+                        f"(an iteration needs {grad_cost + 1 + int(closed)})"
+                    )
+                if exhausted:
+                    status, reason = Status.BUDGET_EXHAUSTED, exhausted
+            if status is not None:
+                return run.result(
+                    status,
+                    reason,
                     path,
-                    trace,
-                    iteration,
+                    iterations=iteration,
+                    fk_calls=f.evaluations,
+                    trace=trace,
+                    progress_rows=progress_rows(status, path),
+                    local_minima=int(status is Status.LOCAL_MINIMUM),
+                    extra=extra,
                 )
-            if s.stop_at_epsilon and value < s.epsilon:
-                return result(
-                    Status.APPROXIMATE,
-                    f"f = {value:.3g} < epsilon = {s.epsilon} but outside the goal region",
-                    path,
-                    trace,
-                    iteration,
-                )
-            if value >= s.epsilon and iteration - best_iter >= s.stall_window:
-                return result(
-                    Status.LOCAL_MINIMUM,
-                    f"stalled at iteration {iteration}: best f = {best:.4g} has not improved by "
-                    f"{s.stall_min_decrease} in {s.stall_window} iterations "
-                    f"({blocked_steps} steps blocked by contact)",
-                    path,
-                    trace,
-                    iteration,
-                    minima=1,
-                    extra={
-                        "stall_iteration": iteration,
-                        "q_stall": q.tolist(),
-                        "blocked_steps": blocked_steps,
-                    },
-                )
-            exhausted = tracker.exhausted(iteration)
-            # An iteration costs the gradient's checks (dof + 1 with finite differences),
-            # at least one state of the step and, in closed loop, one check of the state
-            # reached: never start one the check budget cannot pay for.
-            grad_cost = robot.dof + 1 if s.gradient == "finite_difference" else 0
-            left = tracker.checks_left()
-            if exhausted is None and left is not None and left < grad_cost + 1 + int(closed):
-                exhausted = (
-                    f"collision-check budget of {budget.max_collision_checks} used up "
-                    f"(an iteration needs {grad_cost + 1 + int(closed)})"
-                )
-            if exhausted:
-                return result(Status.BUDGET_EXHAUSTED, exhausted, path, trace, iteration)
-
             step = s.gamma * self.gradient(f, q)
             if s.max_step_rad > 0:
                 step = np.clip(step, -s.max_step_rad, s.max_step_rad)
@@ -304,8 +268,8 @@ class GradientPlanner:
             value = f(q) if closed else float(f.smooth(q))
             path.append(q.copy())
             trace.append(value)
-            clock.append(time.perf_counter() - t0)
-            checks.append(checker.checks)
+            clock.append(tracker.elapsed_s)
+            checks.append(tracker.checks_used)
             if value < best - s.stall_min_decrease:
                 best, best_iter = value, iteration
 

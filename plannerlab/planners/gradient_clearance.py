@@ -30,8 +30,6 @@ with ``extra["q_stall"]`` and ``extra["descent_rad"]`` (joint-space distance tra
 
 from __future__ import annotations
 
-import math
-import time
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from typing import Any
@@ -42,15 +40,16 @@ from plannerlab.collision.fcl_checker import CollisionChecker
 from plannerlab.errors import PlannerlabError
 from plannerlab.planners.base import (
     BudgetTracker,
+    LegRun,
     Planner,
     PlanResult,
-    Progress,
     Status,
-    settings_dict,
+    start_collision,
     with_overrides,
 )
 from plannerlab.planners.clearance import ClearanceField
 from plannerlab.robots.base import Array, joint_difference, wrap_to_pi
+from plannerlab.robots.paths import path_length
 
 
 @dataclass(frozen=True)
@@ -477,73 +476,50 @@ class ClearanceDescent:
         at a stall, escape from the stall state (``escape`` setting) and descend again."""
         del stepper  # kinematic
         s = self.settings
-        t0 = time.perf_counter()
         robot = problem.robot
         goal = problem.goal(leg)
         checker = CollisionChecker(robot, problem.scene)
         q0 = np.array(problem.q_start if q_start is None else q_start, dtype=float)
         tracker = BudgetTracker(budget, checker)
+        run = LegRun(self.name, s, problem, leg, tracker)
         path: list[Array] = [q0]
         trace: list[float] = []
         escapes_log: list[dict] = []
         iterations = 0
         minima = escapes = 0
         descent_rad: list[float] = []
-        progress = Progress(lambda: time.perf_counter() - t0, lambda: tracker.checks_used)
 
         def note(states: list[Array]) -> None:
             """Progress after a descent or an escape: the best goal distance it reached."""
             if states:
-                progress.note(float(np.min(goal.distance(robot, np.asarray(states)))))
-
-        def length(seg: list[Array]) -> float:
-            if len(seg) < 2:
-                return 0.0
-            P = np.asarray(seg)
-            d = joint_difference(P[1:], P[:-1], robot.continuous)
-            return float(np.sum(np.linalg.norm(d, axis=1)))
+                run.progress.note(float(np.min(goal.distance(robot, np.asarray(states)))))
 
         def dist(a: Array, b: Array) -> float:
             return float(np.linalg.norm(joint_difference(a, b, robot.continuous)))
 
         def done(status: Status, reason: str) -> PlanResult:
-            P = np.array(path)
-            pos_err, ang_err = goal.errors(robot, P[-1])
+            """The leg's result from the state of the loop."""
             extra: dict = {
                 "descent_rad": descent_rad,
                 "escapes": escapes_log,
-                "path_rad": length(path),
+                "path_rad": path_length(np.array(path), robot.continuous),
             }
             if status is Status.LOCAL_MINIMUM:
-                extra["q_stall"] = P[-1].tolist()
-            rows = progress.finish(
-                float(goal.distance(robot, P[-1])),
-                length(path) if status is Status.SOLVED else math.nan,
-            )
-            return PlanResult(
-                planner=self.name,
-                problem=problem.name,
-                leg=leg,
-                goal=goal.name,
-                status=status,
-                reason=reason,
-                path=P,
-                time_s=time.perf_counter() - t0,
+                extra["q_stall"] = np.asarray(path[-1], dtype=float).tolist()
+            return run.result(
+                status,
+                reason,
+                path,
                 iterations=iterations,
-                collision_checks=tracker.checks_used,
-                pos_err_m=float(pos_err),
-                angle_err_deg=float(ang_err),
-                trace=np.array(trace),
-                progress=rows,
+                trace=trace,
                 local_minima=minima,
                 escapes=escapes,
-                settings=settings_dict(s),
                 extra=extra,
             )
 
-        if not checker.is_valid(q0):
-            pairs = ", ".join(f"{a} x {b}" for a, b in checker.colliding_pairs(q0))
-            return done(Status.INVALID_START, f"start in collision: {pairs}")
+        why_not = start_collision(checker, q0)
+        if why_not is not None:
+            return done(Status.INVALID_START, why_not)
         note([q0])
         q = q0
         while True:
@@ -554,7 +530,7 @@ class ClearanceDescent:
             trace.extend(tr)
             note(list(seg))
             path.extend(seg[1:])
-            descent_rad.append(length(seg))
+            descent_rad.append(path_length(np.array(seg), robot.continuous))
             if st is Status.SOLVED:
                 return done(st, f"{reason}; {minima} local minima met, {escapes} escaped")
             if st is not Status.LOCAL_MINIMUM:

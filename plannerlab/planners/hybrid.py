@@ -24,8 +24,6 @@ and whether it left the stall. Both planners report ``local_minima`` and ``escap
 
 from __future__ import annotations
 
-import math
-import time
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from typing import Any
@@ -36,11 +34,10 @@ from plannerlab.collision.fcl_checker import CollisionChecker
 from plannerlab.errors import PlannerlabError
 from plannerlab.planners.base import (
     BudgetTracker,
+    LegRun,
     Planner,
     PlanResult,
-    Progress,
     Status,
-    settings_dict,
     with_overrides,
 )
 from plannerlab.planners.gradient import GradientPlanner, GradientSettings
@@ -123,43 +120,29 @@ class HybridPlanner:
     ) -> PlanResult:
         del stepper
         s = self.settings
-        t0 = time.perf_counter()
         robot = problem.robot
-        goal = problem.goal(leg)
         checker = CollisionChecker(robot, problem.scene)  # the restarts' edges
         tracker = BudgetTracker(budget, checker)  # and the sub-solves' results, charged
+        run = LegRun(self.name, s, problem, leg, tracker)
+        progress = run.progress
         q = np.array(problem.q_start if q_start is None else q_start, dtype=float)
         path: list[Array] = [q]
         trace: list[float] = []
         minima = escapes = 0
         notes: list[str] = []
         noise = s.restart_noise_rad
-        progress = Progress(lambda: time.perf_counter() - t0, lambda: tracker.checks_used)
 
         def done(status: Status, reason: str) -> PlanResult:
-            p = np.array(path)
-            pos_err, ang_err = goal.errors(robot, p[-1])
-            cost = path_length(p, robot.continuous) if status is Status.SOLVED else math.nan
-            rows = progress.finish(float(goal.distance(robot, p[-1])), cost)
-            return PlanResult(
-                planner=self.name,
-                problem=problem.name,
-                leg=leg,
-                goal=goal.name,
-                status=status,
-                reason=reason,
-                path=p,
-                time_s=time.perf_counter() - t0,
+            """The leg's result from the state of the loop."""
+            return run.result(
+                status,
+                reason,
+                path,
                 iterations=tracker.iterations,
-                collision_checks=tracker.checks_used,
                 fk_calls=tracker.fk_calls,
-                pos_err_m=float(pos_err),
-                angle_err_deg=float(ang_err),
-                trace=np.array(trace),
-                progress=rows,
+                trace=trace,
                 local_minima=minima,
                 escapes=escapes,
-                settings=settings_dict(s),
                 extra={"steps": notes, "escapes": escapes_log, "descent_rad": descent_rad},
             )
 
@@ -173,7 +156,7 @@ class HybridPlanner:
             sub = tracker.remaining()
             if sub is None:
                 return done(Status.BUDGET_EXHAUSTED, _used_up(tracker))
-            t_sub, c_sub = time.perf_counter() - t0, tracker.checks_used
+            t_sub, c_sub = tracker.elapsed_s, tracker.checks_used
             r = self._descent.solve(problem, leg, sub, rng, q_start=q)
             tracker.charge(r)
             progress.extend(r.progress, t_sub, c_sub)
@@ -206,7 +189,7 @@ class HybridPlanner:
             }
             escapes_log.append(record)
             if s.escape == "rrtconnect":
-                t_sub, c_sub = time.perf_counter() - t0, tracker.checks_used
+                t_sub, c_sub = tracker.elapsed_s, tracker.checks_used
                 rrt = self._rrt_escape(problem, leg, tracker, rng, q)
                 if rrt is None:
                     return done(Status.BUDGET_EXHAUSTED, _used_up(tracker))

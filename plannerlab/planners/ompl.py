@@ -101,10 +101,9 @@ from plannerlab.collision.fcl_checker import CollisionChecker
 from plannerlab.errors import PlannerlabError
 from plannerlab.planners.base import (
     BudgetTracker,
+    LegRun,
     PlanResult,
-    Progress,
     Status,
-    settings_dict,
     start_collision,
     with_overrides,
 )
@@ -725,35 +724,21 @@ class OMPLPlanner:
         )
         fk = [0]
         trace: list[float] = []
-        progress = Progress(lambda: tracker.elapsed_s, lambda: checker.checks)
+        run = LegRun(self.name, s, problem, leg, tracker)
+        progress = run.progress
         extra: dict[str, Any] = {"ompl_class": self.ompl_class, "ompl_seed": ompl_seed}
 
         def result(status: Status, reason: str, path: Array, iterations: int) -> PlanResult:
-            pos_err, ang_err = (float(v) for v in goal.errors(robot, path[-1]))
+            """The leg's result, with the counts of the solve so far."""
             extra["refused_checks"] = guard.refused
-            solved = status is Status.SOLVED
-            rows = progress.finish(
-                float(goal.distance(robot, path[-1])),
-                path_length(path, robot.continuous) if solved else math.nan,
-            )
-            return PlanResult(
-                planner=self.name,
-                problem=problem.name,
-                leg=leg,
-                goal=goal.name,
-                status=status,
-                reason=reason,
-                path=path,
-                time_s=tracker.elapsed_s,
+            return run.result(
+                status,
+                reason,
+                path,
                 iterations=iterations,
-                collision_checks=checker.checks,
                 fk_calls=fk[0],
-                pos_err_m=pos_err,
-                angle_err_deg=ang_err,
-                trace=np.array(trace),
-                progress=rows,
-                settings=settings_dict(s),
-                extra=dict(extra),
+                trace=trace,
+                extra=extra,
             )
 
         start_problem = start_collision(checker, q0)
