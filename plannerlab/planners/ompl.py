@@ -54,7 +54,10 @@ Design (measured on ``armz_inspection``, 23 continuous joints):
   The time limit is held the same way: once a path exists, planning stops early enough
   to re-check it at the rate measured so far (seconds per check), and the steps after
   planning (interpolation, conversion, the re-check) stop at ``time_limit_s`` + 1 %;
-  a path whose re-check did not finish is BUDGET_EXHAUSTED, not trusted.
+  a path whose re-check did not finish is BUDGET_EXHAUSTED, not trusted. FMT* and BFMT*
+  (``_HARD_STOP``) run long stretches of C++ that poll nothing (their first expansion
+  computes every sample's neighbourhood): past the limit their callbacks raise
+  ``_TimeUp``, which unwinds OMPL's loop back to ``solve``.
 * **PRM / PRM\\***: OMPL's ``PRM::solve`` checks for a solution in a second thread; with
   Python callbacks the wheel deadlocks there (the caller keeps the GIL while joining).
   These two are therefore driven single-threaded: ``growRoadmap``/``expandRoadmap`` in
@@ -289,6 +292,10 @@ _RESERVE_EVERY_POLLS = 8
 _RESERVE_FACTOR = 1.25
 #: the steps after planning (the fine re-check) may run this fraction past the time limit
 _TIME_SLACK = 0.01
+#: planners whose expansion runs long stretches of C++ without polling the termination
+#: condition (FMT*'s and BFMT*'s first expansion computes every sample's neighbourhood):
+#: past the time limit a validity callback raises, and the exception unwinds their solve
+_HARD_STOP = frozenset({"FMT", "BFMT"})
 #: states converted / re-checked between two looks at the clock
 _CHUNK_STATES = 2048
 _LIFTED = frozenset({"InformedRRTstar", "SORRTstar", "BITstar", "AORRTC"})
@@ -487,6 +494,10 @@ class _Space:
         return out
 
 
+class _TimeUp(Exception):
+    """Raised by a validity callback past the time limit: it unwinds OMPL's C++ loop."""
+
+
 class _Guard:
     """One solve's collision checker and termination condition, behind its
     :class:`~plannerlab.planners.base.BudgetTracker`: the checker refuses (reports
@@ -500,6 +511,9 @@ class _Guard:
         self.polls = 0
         self.refused = 0
         self.iteration_source: Callable[[], int] | None = None
+        #: raise _TimeUp past the time limit (set while an OMPL solve runs, for planners
+        #: with loops that poll nothing, see _HARD_STOP)
+        self.hard_stop = False
 
     def iterations(self) -> int:
         return self.iteration_source() if self.iteration_source is not None else self.polls
@@ -510,6 +524,8 @@ class _Guard:
     def poll(self) -> bool:
         """The termination condition: True once any limit is reached."""
         self.polls += 1
+        if self.hard_stop and self.out_of_time():
+            raise _TimeUp()
         return self.exhausted() is not None
 
     def out_of_time(self) -> bool:
@@ -519,9 +535,12 @@ class _Guard:
 
     def _out_of_time(self) -> bool:
         """Past the time limit: refuse, so that loops which do not poll the termination
-        condition (the goal pool's IK, FMT*'s and BFMT*'s expansion) end quickly too."""
+        condition (the goal pool's IK) end quickly too; with ``hard_stop``, raise
+        :class:`_TimeUp` instead, out through OMPL's C++ to the solve."""
         if self.out_of_time():
             self.refused += 1
+            if self.hard_stop:
+                raise _TimeUp()
             return True
         return False
 
@@ -890,7 +909,19 @@ class OMPLPlanner:
                 planner, si, space, guard, pool, q0, goal, robot, problem.joint_step
             )
         else:
-            status = planner.solve(ptc)
+            guard.hard_stop = self.ompl_class in _HARD_STOP
+            try:
+                status = planner.solve(ptc)
+            except _TimeUp:
+                return result(
+                    Status.BUDGET_EXHAUSTED,
+                    f"{self.ompl_class}: time limit of {time_limit:g} s reached (stopped "
+                    "inside its expansion, which polls no termination condition)",
+                    q0[None],
+                    guard.iterations(),
+                )
+            finally:
+                guard.hard_stop = False
             status_text = status.asString()
             kind = status.getStatus()
             exact = kind == ob.PlannerStatus.PlannerStatusType.EXACT_SOLUTION
