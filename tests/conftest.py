@@ -4,6 +4,9 @@ problem-file tests break one key at a time, and paths to the bundled problems.""
 from __future__ import annotations
 
 import hashlib
+import os
+import subprocess
+import sys
 from pathlib import Path
 
 import numpy as np
@@ -53,6 +56,20 @@ max_iterations = 50
 [checking]
 joint_step = 0.05
 """
+
+
+def plannerlab(*argv: str, cwd: Path = ROOT) -> subprocess.CompletedProcess[str]:
+    """The ``plannerlab`` command in a fresh interpreter (for what a user's shell sees:
+    stdout, stderr and exit code, C-level output included)."""
+    env = dict(os.environ, MPLBACKEND="Agg", PYTHONPATH=str(ROOT))
+    return subprocess.run(
+        [sys.executable, "-m", "plannerlab", *argv],
+        capture_output=True,
+        text=True,
+        cwd=cwd,
+        env=env,
+        timeout=600,
+    )
 
 
 def tiny_problem_text(old: str, new: str) -> str:

@@ -14,31 +14,16 @@ from __future__ import annotations
 
 import json
 import math
-import os
-import subprocess
-import sys
 from pathlib import Path
 
 import numpy as np
 import pytest
-from conftest import ROOT
+from conftest import plannerlab
 
 from plannerlab.record.execution import ContactRecord, Execution
 from plannerlab.record.plan import ExecutionFile, Plan
 
 CASE = "continuum_case3"
-
-
-def plannerlab(*argv: str, cwd: Path = ROOT) -> subprocess.CompletedProcess[str]:
-    env = dict(os.environ, MPLBACKEND="Agg", PYTHONPATH=str(ROOT))
-    return subprocess.run(
-        [sys.executable, "-m", "plannerlab", *argv],
-        capture_output=True,
-        text=True,
-        cwd=cwd,
-        env=env,
-        timeout=600,
-    )
 
 
 @pytest.fixture(scope="module")

@@ -8,27 +8,12 @@ for each kind of planner: gradient, gradient.closed_loop (PyBullet in the loop),
 from __future__ import annotations
 
 import json
-import os
-import subprocess
-import sys
 from pathlib import Path
 
 import pytest
-from conftest import PROBLEMS, ROOT
+from conftest import PROBLEMS, plannerlab
 
 POCKET = str(PROBLEMS / "armz_pocket.toml")
-
-
-def plannerlab(*argv: str, cwd: Path = ROOT) -> subprocess.CompletedProcess[str]:
-    env = dict(os.environ, MPLBACKEND="Agg", PYTHONPATH=str(ROOT))
-    return subprocess.run(
-        [sys.executable, "-m", "plannerlab", *argv],
-        capture_output=True,
-        text=True,
-        cwd=cwd,
-        env=env,
-        timeout=600,
-    )
 
 
 def one_json_document(stdout: str):
