@@ -23,21 +23,31 @@ import time
 def main(argv: list[str]) -> int:
     import numpy as np
 
+    import plannerlab.planners.ompl  # noqa: F401 - OMPL loaded once, before any clock
     from plannerlab.collision.fcl_checker import CollisionChecker
+    from plannerlab.errors import PlannerlabError
     from plannerlab.planners import REGISTRY, make_planner
     from plannerlab.problem.catalog import load_problem
     from plannerlab.problem.load import Budget
 
-    import plannerlab.planners.ompl  # noqa: F401 - OMPL loaded once, before any clock
-
-    limit_s = float(argv[0]) if argv else 0.3
+    try:
+        limit_s = float(argv[0]) if argv else 0.3
+    except ValueError:
+        limit_s = float("nan")
+    if not limit_s > 0 or limit_s == float("inf"):
+        print(f"usage: time_limit_bench.py [LIMIT_S > 0] [PROBLEM,...]; got {argv[0]!r}")
+        return 2
     problems = (
         argv[1].split(",") if len(argv) > 1 else ["armz_inspection", "armz_pocket", "irb6_case1"]
     )
     worst = 0.0
     print(f"{'problem':18s} {'planner':32s} {'status':17s} {'wall s':>7s} {'/limit':>7s}")
-    for name_p in problems:
-        problem = load_problem(name_p)
+    try:
+        loaded = [load_problem(name_p) for name_p in problems]
+    except PlannerlabError as exc:
+        print(f"error: {exc}")
+        return 2
+    for name_p, problem in zip(problems, loaded, strict=True):
         CollisionChecker(problem.robot, problem.scene)  # compile / load the core first
         for name, entry in REGISTRY.items():
             if entry.robots is not None and problem.robot.kind not in entry.robots:

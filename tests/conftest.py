@@ -72,6 +72,24 @@ def plannerlab(*argv: str, cwd: Path = ROOT) -> subprocess.CompletedProcess[str]
     )
 
 
+def assert_witness_solves(problem: Problem) -> None:
+    """The problem file's witness path (``[witness] path_rad``) starts at the start, is
+    collision-free at joint_step/4 and ends in leg 0's goal region: a path exists."""
+    from plannerlab.collision.fcl_checker import CollisionChecker
+    from plannerlab.robots.base import joint_difference
+
+    witness = np.array(problem.extras["witness"]["path_rad"], dtype=float)
+    assert witness.ndim == 2 and witness.shape[1] == problem.robot.dof and len(witness) >= 2
+    np.testing.assert_allclose(
+        joint_difference(witness[0], problem.q_start, problem.robot.continuous), 0.0, atol=1e-6
+    )
+    check = CollisionChecker(problem.robot, problem.scene).check_path(
+        witness, problem.joint_step / 4
+    )
+    assert check.valid, f"witness collides on edge {check.first_invalid_edge}: {check.pairs}"
+    assert problem.goal(0).contains(problem.robot, witness[-1])
+
+
 def tiny_problem_text(old: str, new: str) -> str:
     """:data:`TINY_PROBLEM_TOML` with the one occurrence of ``old`` replaced by ``new``."""
     count = TINY_PROBLEM_TOML.count(old)

@@ -259,6 +259,15 @@ def test_out_into_an_impossible_path_fails_before_planning(capsys, tmp_path):
     assert_clean_error(code, err, str(blocker))
 
 
+@pytest.mark.parametrize("flag", ["--out", "--figures"])
+def test_continuum_folder_onto_a_file_fails_before_the_runs(capsys, tmp_path, flag):
+    blocker = tmp_path / "a_file"
+    blocker.write_text("x")
+    # checked before any case is loaded: the bad case name would be the error otherwise
+    code, _, err = run(capsys, "continuum", "no_such_case", "--runs", "1", flag, str(blocker))
+    assert_clean_error(code, err, str(blocker))
+
+
 # --------------------------------------------------------------- plan files
 def _valid_plan(tmp_path: Path) -> dict:
     """A plan of armz_pocket (23 joints) with a short straight path, written by hand."""

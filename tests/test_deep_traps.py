@@ -7,12 +7,12 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from conftest import assert_witness_solves
 
 from plannerlab.collision.fcl_checker import CollisionChecker
 from plannerlab.planners import make_planner
 from plannerlab.planners.base import Status
 from plannerlab.problem.catalog import load_problem
-from plannerlab.robots.base import joint_difference
 from plannerlab.robots.paths import interpolate_edge, path_length
 
 DEEP = ("armz_deep_a", "armz_deep_b", "armz_deep_e")
@@ -24,13 +24,7 @@ def deep(request):
 
 
 def test_witness_is_collision_free_from_the_start_into_the_goal(deep):
-    witness = np.array(deep.extras["witness"]["path_rad"], dtype=float)
-    np.testing.assert_allclose(
-        joint_difference(witness[0], deep.q_start, deep.robot.continuous), 0.0, atol=1e-6
-    )
-    check = CollisionChecker(deep.robot, deep.scene).check_path(witness, deep.joint_step / 4)
-    assert check.valid, f"witness collides on edge {check.first_invalid_edge}: {check.pairs}"
-    assert deep.goal(0).contains(deep.robot, witness[-1])
+    assert_witness_solves(deep)
 
 
 def test_the_straight_line_to_the_witness_end_collides(deep):

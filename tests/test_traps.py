@@ -12,14 +12,12 @@ import dataclasses
 
 import numpy as np
 import pytest
-from conftest import path_digest
+from conftest import assert_witness_solves, path_digest
 
-from plannerlab.collision.fcl_checker import CollisionChecker
 from plannerlab.planners import make_planner
 from plannerlab.planners.base import Status
 from plannerlab.problem.catalog import load_problem
 from plannerlab.problem.scene import Scene
-from plannerlab.robots.base import joint_difference
 
 TRAPS = ("armz_pocket", "armz_window", "armz_cavity", "armz_thin_wall")
 
@@ -44,14 +42,7 @@ def test_trap_is_the_papers_arm_at_the_straight_column(trap):
 
 
 def test_witness_is_collision_free_from_the_start_into_the_goal(trap):
-    witness = np.array(trap.extras["witness"]["path_rad"], dtype=float)
-    assert witness.ndim == 2 and witness.shape[1] == trap.robot.dof and len(witness) >= 2
-    np.testing.assert_allclose(
-        joint_difference(witness[0], trap.q_start, trap.robot.continuous), 0.0, atol=1e-6
-    )
-    check = CollisionChecker(trap.robot, trap.scene).check_path(witness, trap.joint_step / 4)
-    assert check.valid, f"witness collides on edge {check.first_invalid_edge}: {check.pairs}"
-    assert trap.goal(0).contains(trap.robot, witness[-1])
+    assert_witness_solves(trap)
 
 
 def test_faithful_gradient_stalls_far_from_the_goal(trap):

@@ -260,6 +260,9 @@ def cmd_continuum(args: argparse.Namespace, console: Console) -> int:
     overrides = parse_overrides(args.set)
     figures = None if args.no_figures else Path(args.figures)
     out = None if args.out is None else Path(args.out)
+    for folder in (out, figures):  # a folder that cannot exist fails now, not after the runs
+        if folder is not None:
+            folder.mkdir(parents=True, exist_ok=True)
     rows: list[CaseRun] = []
     with console.status("chord_arc") as status, _stdout_to_stderr(args.json):
         for case in args.cases:
