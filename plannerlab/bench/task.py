@@ -1,9 +1,21 @@
-"""Running a planner over the legs of a problem, and the plan file it produces.
+"""Running a planner over the legs of a problem, the plan file it produces, and executing it.
 
 A *task* is every leg of a problem in order; leg ``i`` starts where leg ``i − 1``'s path
 ended (the planned end, or the executed end for closed-loop planners, which execute as
 they plan). :func:`solve_legs` returns a :class:`~plannerlab.record.plan.Plan`, the record
 that plan files hold.
+
+One plan, one verdict: a leg's path has one canonical form, its waypoints
+(:func:`~plannerlab.robots.paths.waypoints`, states inside a straight joint-space segment
+left out; a fixed point). :func:`solve_legs` returns every leg in that form, a plan file
+holds exactly it (JSON writes a float's shortest repr, which reads back bit for bit), and
+:func:`execute_results`, the one road every execution takes (``compare --execute``,
+``plannerlab execute``, :func:`plannerlab.execute`, ``animate``), runs it. (Files used to
+hold waypoints while ``compare`` executed the planner's own states. Executing densifies
+each edge on its own, to a whole number of re-check steps, so a straight run of descent
+steps of shrinking length, 6 × 0.01 + 0.005 + 0.0019 + 0.0014 rad, was 15 re-check
+intervals and the one segment it collapses to 14, at other states: the re-check states
+and the retimed spline's knots differed, and so did what PyBullet did.)
 """
 
 from __future__ import annotations
@@ -24,6 +36,14 @@ from plannerlab.record.execution import Execution
 from plannerlab.record.files import versions
 from plannerlab.record.leg import PlanResult, Status
 from plannerlab.record.plan import Plan, file_sha256
+from plannerlab.robots.paths import waypoints
+
+
+def canonical_result(r: PlanResult) -> PlanResult:
+    """``r`` with its path in the canonical form every road executes and plan files hold:
+    its waypoints (``r`` itself when nothing drops)."""
+    path = waypoints(r.path)
+    return r if len(path) == len(r.path) else r.replace(path=path)
 
 
 def leg_rng(seed: int, leg: int) -> np.random.Generator:
@@ -64,7 +84,9 @@ def solve_legs(
 ) -> Plan:
     """Solve ``legs`` (default: all) in order; each starts where the previous one ended.
 
-    Closed-loop planners get one PyBullet world for the whole task.
+    Closed-loop planners get one PyBullet world for the whole task. Every leg's path comes
+    back in its canonical form (:func:`canonical_result`): the plan in memory is the plan
+    its file holds.
     """
     entry = get_entry(planner_name)
     planner = make_planner(planner_name, overrides)
@@ -95,7 +117,7 @@ def solve_legs(
                 r = planner.solve(
                     problem, leg, budget, leg_rng(seed, leg), q_start=q, stepper=stepper
                 )
-            r = r.replace(seed=seed)
+            r = canonical_result(r.replace(seed=seed))
             results.append(r)
             if on_leg is not None:
                 on_leg(r)
@@ -121,6 +143,10 @@ def execute_results(
 ) -> list[Execution]:
     """Execute planned legs in PyBullet: one :class:`Execution` per leg, in order.
 
+    The one road of every execution. Each leg runs its canonical path
+    (:func:`canonical_result`), so results from :func:`solve_legs`, from a plan file or
+    straight from a planner execute alike.
+
     Ordinary legs run in one world, each from where the previous one really ended
     (:func:`plannerlab.sim.execute.execute_legs`). Legs of a contact-permitting planner
     (``extra["allows_contact"]``: ``chord_arc``, whose paths touch the collision points
@@ -132,6 +158,7 @@ def execute_results(
     """
     if not results:
         raise PlannerlabError("nothing to execute: the plan has no legs")
+    results = [canonical_result(r) for r in results]
     if any(r.extra.get("allows_contact") for r in results):
         from plannerlab.sim.continuum import execute_chord_arc
 

@@ -28,12 +28,10 @@ def cmd_animate(args: argparse.Namespace, console: Console) -> int:
     executions = plan_executions(args.plan)
     note = "with its execution record (PLAN.exec.json)"
     if not executions and not args.no_execute:
-        from plannerlab.sim.execute import execute_legs
+        from plannerlab.bench.task import execute_results
 
         with console.status(f"executing {len(plan.legs)} legs in PyBullet (none recorded)"):
-            executions = execute_legs(
-                problem, [r.path for r in plan.legs], first_leg=plan.legs[0].leg
-            )
+            executions = execute_results(problem, plan.legs)
         note = "executed now (no PLAN.exec.json beside the plan; `plannerlab execute` writes one)"
     elif not executions:
         note = "planned motion only (--no-execute)"

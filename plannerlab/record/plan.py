@@ -90,7 +90,11 @@ class Plan:
         """The plan file's content. Each leg's path is stored as its waypoints
         (:func:`~plannerlab.robots.paths.waypoints`: states inside a straight joint-space
         segment are left out, as executing densifies every segment again), so a plan file
-        stays small (an interpolated OMPL path of 14 000 states is a few dozen corners)."""
+        stays small (an interpolated OMPL path of 14 000 states is a few dozen corners).
+        That is the canonical form every execution runs
+        (:func:`plannerlab.bench.task.execute_results`) and :func:`~plannerlab.bench.task.
+        solve_legs` returns, and JSON's shortest-repr floats read back bit for bit: the
+        file is lossless, it executes as the plan in memory does."""
         return {
             "format": PLAN_FORMAT,
             "problem": self.problem,

@@ -118,6 +118,12 @@ def waypoints(path: Array, tol_rad: float = 1e-9) -> Array:
     states are always kept. Differences are taken as stored (a continuous joint's wrap at
     ±pi is a corner).
 
+    The result is a fixed point (``waypoints(waypoints(p))`` equals ``waypoints(p)`` bit
+    for bit): a pass that drops states is repeated on what it kept until none drops. It is
+    the canonical form of a planned path: what a plan file holds and what every execution
+    runs (:func:`plannerlab.bench.task.execute_results`), so a saved plan executes exactly
+    as the plan in memory did.
+
     Args:
         path: (m, dof) joint path.
         tol_rad: distance from the segment below which a state counts as on it.
@@ -125,7 +131,16 @@ def waypoints(path: Array, tol_rad: float = 1e-9) -> Array:
     Returns:
         (k, dof) with k <= m, the kept states in order (copies).
     """
-    path = np.atleast_2d(np.asarray(path, dtype=float))
+    kept = _waypoints_once(np.atleast_2d(np.asarray(path, dtype=float)), tol_rad)
+    while True:
+        again = _waypoints_once(kept, tol_rad)
+        if len(again) == len(kept):  # nothing dropped: the same states
+            return kept
+        kept = again
+
+
+def _waypoints_once(path: Array, tol_rad: float) -> Array:
+    """One pass of :func:`waypoints`."""
     m = len(path)
     if m <= 2:
         return path.copy()
