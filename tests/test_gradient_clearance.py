@@ -6,7 +6,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from plannerlab.bench.task import solve_legs
+from plannerlab.bench.task import leg_rng, solve_legs
 from plannerlab.collision.fcl_checker import CollisionChecker
 from plannerlab.errors import PlannerlabError
 from plannerlab.planners import make_planner
@@ -79,3 +79,40 @@ def test_the_papers_task_is_done_by_the_clearance_descent_with_detours(seed):
         )
         assert r.status is Status.LOCAL_MINIMUM
         assert r.extra["descent_rad"][0] > 0.5
+
+
+def test_the_random_detour_draws_its_sub_goals_from_the_seed():
+    """On armz_thin_wall the clearance descent stalls once. The random detour escapes on
+    every seed tried, with sub-goals drawn from the leg's generator: the same seed gives
+    the same path, another seed another path; the detour gives one path whatever the seed."""
+    problem = load_problem("armz_thin_wall")
+    budget = problem.budget.replace(max_collision_checks=20_000, time_limit_s=None)
+    checker = CollisionChecker(problem.robot, problem.scene)
+
+    def solve(name: str, seed: int):
+        return make_planner(name).solve(problem, 0, budget, leg_rng(seed, 0))
+
+    drawn = [solve("gradient.clearance+random_detour", s) for s in (0, 1, 0)]
+    for r in drawn:
+        assert r.status is Status.SOLVED, r.reason
+        assert (r.local_minima, r.escapes) == (1, 1)
+        assert r.extra["escapes"][0]["kind"] == "random_detour"
+        assert checker.check_path(r.path, problem.joint_step / 4).valid
+    assert np.array_equal(drawn[0].path, drawn[2].path)
+    assert not np.array_equal(drawn[0].path, drawn[1].path)
+    fixed = [solve("gradient.clearance+detour", s) for s in (0, 1)]
+    assert fixed[0].solved and np.array_equal(fixed[0].path, fixed[1].path)
+
+
+def test_random_retract_depths_step_forward_within_the_body():
+    planner = make_planner("gradient.clearance+random_detour", {"retract_step": 2})
+    assert planner._retract_depths(23, None) == list(range(2, 23, 2))
+    seen = set()
+    for seed in range(20):
+        depths = planner._retract_depths(23, np.random.default_rng(seed))
+        steps = np.diff([0, *depths])
+        assert depths and depths[-1] < 23 and np.all((steps >= 1) & (steps <= 4))
+        seen.add(tuple(depths))
+    assert len(seen) > 1
+    with pytest.raises(PlannerlabError, match="retract_jitter_m"):
+        make_planner("gradient.clearance+random_detour", {"retract_jitter_m": -1.0})

@@ -120,21 +120,30 @@ def _entries() -> dict[str, PlannerEntry]:
             options=_ESCAPE_RRTCONNECT,
         )
     )
-    for name, summary in (
+    for name, summary, uses_rng in (
         (
             "gradient.clearance",
             "the paper's objective plus a smooth clearance term (link distances to the scene "
             "and each other): the descent slides along walls; no escape",
+            False,
         ),
         (
             "gradient.clearance+detour",
             "gradient.clearance; at a stall, sub-goals near the stall (the goal's approach "
             "point, then the tip drawn back along its own body), the descent resumes",
+            False,
+        ),
+        (
+            "gradient.clearance+random_detour",
+            "gradient.clearance+detour with its sub-goals drawn from the seed (random "
+            "retract depths, points jittered round the body), drawn again if none works",
+            True,
         ),
         (
             "gradient.clearance+rrtconnect",
             "gradient.clearance; at a stall, RRT-Connect from the stall to a goal state "
             "found by the clearance descent from the stall",
+            True,
         ),
     ):
         entries.append(
@@ -142,6 +151,7 @@ def _entries() -> dict[str, PlannerEntry]:
                 name,
                 "plannerlab.planners.gradient_clearance:make",
                 summary,
+                uses_rng=uses_rng,
                 options=_ESCAPE_RRTCONNECT,
             )
         )

@@ -26,6 +26,17 @@ after a rejected one (F did not decrease or the state collides). A **stall** is 
 when the best ``f`` has not decreased by ``stall_min_decrease`` in ``stall_window``
 iterations, or the trust radius falls below ``min_step_rad``: status ``local_minimum``
 with ``extra["q_stall"]`` and ``extra["descent_rad"]`` (joint-space distance travelled).
+
+Escapes from a stall (``escape`` setting): ``detour`` (sub-goals near the stall: the tip
+drawn back along its own body, ``retract_step``, ``2 retract_step``, … modules, each
+followed by the leg's descent; deterministic), ``rrtconnect`` (RRT-Connect from the stall
+to a goal state found near it) and ``random_detour``, the detour with its sub-goals drawn
+from the planner's generator: each retract goes back a random ``1 … 2 retract_step``
+modules further than the last and aims at a point drawn uniformly in a ball of
+``retract_jitter_m`` round the body's face there; a detour that finds no way is drawn
+again from the same stall, up to ``max_escapes`` draws. Its seeds are different runs, so
+a success rate over seeds says how often such an escape works (the ``detour``'s seeds are
+one run repeated).
 """
 
 from __future__ import annotations
@@ -51,6 +62,9 @@ from plannerlab.planners.clearance import ClearanceField
 from plannerlab.robots.base import Array, joint_difference, wrap_to_pi
 from plannerlab.robots.paths import path_length
 
+#: the escapes from a stall (``escape`` setting)
+ESCAPES = ("none", "detour", "random_detour", "rrtconnect")
+
 
 @dataclass(frozen=True)
 class ClearanceSettings:
@@ -70,6 +84,13 @@ class ClearanceSettings:
         stall_window: iterations without improvement of the best f that make a stall.
         stall_min_decrease: improvement of the best f that resets the stall window.
         goal_depth: aim at this fraction of the goal tolerances (Gauss-Newton residuals).
+        escape: what to do at a stall: "none", "detour", "random_detour" or "rrtconnect"
+            (see the module docstring); ``max_escapes`` stalls are escaped at most (for
+            ``random_detour`` also the most draws from one stall).
+        retract_step: modules between the detour's retract sub-goals (``random_detour``:
+            its mean step is ``retract_step + 0.5``).
+        retract_jitter_m: radius of the ball round the body's face in which
+            ``random_detour`` draws each retract sub-goal's point [m].
     """
 
     r1: float = 1.0
@@ -94,6 +115,7 @@ class ClearanceSettings:
     retract_step: int = 2
     subgoal_pos_tol_m: float = 0.5
     subgoal_angle_tol_deg: float = 30.0
+    retract_jitter_m: float = 0.5
 
     def __post_init__(self) -> None:
         if self.direction not in ("gradient", "gauss_newton"):
@@ -102,10 +124,12 @@ class ClearanceSettings:
             )
         if not self.margin_m > 0:
             raise PlannerlabError(f"margin_m must be > 0, got {self.margin_m}")
-        if self.escape not in ("none", "detour", "rrtconnect"):
+        if self.escape not in ESCAPES:
             raise PlannerlabError(
-                f"escape setting: 'none', 'detour' or 'rrtconnect', got {self.escape!r}"
+                f"escape setting: one of {', '.join(map(repr, ESCAPES))}, got {self.escape!r}"
             )
+        if not self.retract_jitter_m >= 0:
+            raise PlannerlabError(f"retract_jitter_m must be >= 0, got {self.retract_jitter_m}")
         if self.retract_step < 1:
             raise PlannerlabError(f"retract_step must be >= 1, got {self.retract_step}")
         if self.stall_window < 2:
@@ -394,10 +418,14 @@ class ClearanceDescent:
         checker: CollisionChecker,
         tracker: BudgetTracker,
         used: int,
+        rng: np.random.Generator | None = None,
     ) -> tuple[list[Array], int, str]:
         """Sub-goals near the stall: the tip drawn back along its own body, to the face
         ``retract_step``, ``2 retract_step``, … modules behind the stall's tip (normal
         along the body), each retract followed by the leg's descent (:meth:`leg_descent`).
+        With ``rng`` (``random_detour``) the sub-goals are drawn: each goes back a random
+        1 … ``2 retract_step`` modules further, its point uniform in a ball of
+        ``retract_jitter_m`` round the face.
 
         Returns the kept path from q_stall (its last state is in the goal region when the
         detour succeeded, else just [q_stall]), the iterations and how far it retracted.
@@ -412,13 +440,16 @@ class ClearanceDescent:
         kept = [np.array(q_stall)]
         q = np.array(q_stall)
         last_face = F.shape[0] - 1
-        for back in range(s.retract_step, robot.dof, s.retract_step):
+        for back in self._retract_depths(robot.dof, rng):
             if tracker.exhausted(used + iterations) is not None:
                 break
             face = last_face - back
+            p_sub = F[face, :3, 3]
+            if rng is not None and s.retract_jitter_m > 0:
+                p_sub = p_sub + _in_ball(rng, s.retract_jitter_m)
             sub = GoalRegion(
                 f"retract{back}",
-                F[face, :3, 3],
+                p_sub,
                 F[face, :3, 2],
                 s.subgoal_pos_tol_m,
                 s.subgoal_angle_tol_deg,
@@ -436,6 +467,44 @@ class ClearanceDescent:
             if st2 is Status.SOLVED:
                 return kept + seg2[1:], iterations, f"retract {back} modules"
         return [np.array(q_stall)], iterations, "none"
+
+    def _retract_depths(self, dof: int, rng: np.random.Generator | None) -> list[int]:
+        """Modules the detour's sub-goals go back, in order: every ``retract_step`` below
+        ``dof``, or (with ``rng``) random steps of 1 … ``2 retract_step``."""
+        step = self.settings.retract_step
+        if rng is None:
+            return list(range(step, dof, step))
+        depths: list[int] = []
+        back = int(rng.integers(1, 2 * step + 1))
+        while back < dof:
+            depths.append(back)
+            back += int(rng.integers(1, 2 * step + 1))
+        return depths
+
+    def _random_detours(
+        self,
+        problem,
+        leg: int,
+        q_stall: Array,
+        checker: CollisionChecker,
+        tracker: BudgetTracker,
+        used: int,
+        rng: np.random.Generator,
+    ) -> tuple[list[Array], int, str]:
+        """Randomly drawn detours from the stall (:meth:`_detour` with ``rng``), drawn again
+        while none finds a way, at most ``max_escapes`` draws and within the budget."""
+        iterations = 0
+        how = "none"
+        for draw in range(1, self.settings.max_escapes + 1):
+            if tracker.exhausted(used + iterations) is not None:
+                break
+            esc, it, how = self._detour(
+                problem, leg, q_stall, checker, tracker, used + iterations, rng
+            )
+            iterations += it
+            if len(esc) > 1:
+                return esc, iterations, f"{how} (draw {draw})"
+        return [np.array(q_stall)], iterations, how
 
     def _rrtconnect(
         self,
@@ -544,6 +613,10 @@ class ClearanceDescent:
             c0 = tracker.checks_used
             if s.escape == "detour":
                 esc, it, how = self._detour(problem, leg, q_stall, checker, tracker, iterations)
+            elif s.escape == "random_detour":
+                esc, it, how = self._random_detours(
+                    problem, leg, q_stall, checker, tracker, iterations, rng
+                )
             else:
                 esc, it, how = self._rrtconnect(problem, leg, q_stall, tracker, rng)
             iterations += it
@@ -576,9 +649,17 @@ class ClearanceDescent:
                 )
 
 
+def _in_ball(rng: np.random.Generator, radius_m: float) -> Array:
+    """A point drawn uniformly in the ball of ``radius_m`` round the origin (3,) [m]."""
+    v = rng.normal(size=3)
+    v /= max(float(np.linalg.norm(v)), 1e-12)
+    return v * radius_m * float(rng.uniform()) ** (1.0 / 3.0)
+
+
 VARIANTS: dict[str, dict[str, object]] = {
     "gradient.clearance": {},
     "gradient.clearance+detour": {"escape": "detour"},
+    "gradient.clearance+random_detour": {"escape": "random_detour"},
     "gradient.clearance+rrtconnect": {"escape": "rrtconnect"},
 }
 
