@@ -318,6 +318,34 @@ def test_same_seeds_same_table_whatever_jobs(comparison: dict, tmp_path: Path) -
         assert len(set(hashes.values())) == len(SEEDS), hashes
 
 
+def test_a_planner_whose_seeds_are_one_trial_is_marked_and_gets_no_interval(
+    comparison: dict,
+) -> None:
+    """The gradient methods ignore their generator: their three seeds are one trial, so
+    the row says deterministic and has no interval; RRT-Connect's seeds differ."""
+    records = _lines(comparison["store"])
+    rows = {r["planner"]: r for r in summarise(records)}
+    for name in ("gradient", "gradient.analytic"):
+        row = rows[name]
+        assert row["deterministic"] is True and row["distinct_trials"] == 1, name
+        assert math.isnan(row["ci95_low"]) and math.isnan(row["ci95_high"])
+    if HAVE_OMPL:
+        row = rows["ompl.rrtconnect"]
+        assert row["deterministic"] is False and row["distinct_trials"] == len(SEEDS)
+        assert (row["ci95_low"], row["ci95_high"]) == wilson_interval(row["successes"], row["n"])
+    report = (comparison["folder"] / "report.md").read_text(encoding="utf-8")
+    assert report.count(f"[deterministic: {len(SEEDS)} seeds, one trial]") == 2
+    # a trial that did something else (another path) is another trial: the interval is back
+    grad = [r for r in records if r["planner"] == "gradient"]
+    leg0 = {**grad[0]["legs_run"][0], "path_sha256": "0" * 16}
+    (row,) = summarise([{**grad[0], "legs_run": [leg0]}, *grad[1:]])
+    assert row["deterministic"] is False and row["distinct_trials"] == 2
+    assert (row["ci95_low"], row["ci95_high"]) == wilson_interval(row["successes"], row["n"])
+    # one trial alone is not called deterministic (nothing to compare it with)
+    (row,) = summarise(grad[:1])
+    assert row["deterministic"] is False and row["distinct_trials"] == 1
+
+
 def test_fork_server_children_match_spawned_interpreters(comparison: dict, tmp_path: Path) -> None:
     """A child forked from the warm fork server gives what a fresh interpreter gives."""
     from plannerlab.bench.local import LocalBackend

@@ -71,6 +71,16 @@ ROWS = [
     _row("gradient+rrtconnect", successes=100, errors=0, success_rate=1.0, ci95_high=1.0),
     _row("gradient.multistart", successes=0, success_rate=0.0, ci95_low=0.0),
     _row("ompl.informedrrtstar"),
+    # every seed the same trial: "deterministic" where the interval would be
+    _row(
+        "gradient",
+        n=100,
+        successes=100,
+        errors=0,
+        success_rate=1.0,
+        deterministic=True,
+        distinct_trials=1,
+    ),
 ]
 
 
@@ -121,6 +131,8 @@ def test_compact_columns_are_the_issue_s_and_exec_columns_need_execution() -> No
         pick_columns("planner,chekcs", wide=False, executed=False)
     cell = SUMMARY_COLUMNS["solved"].cell(ROWS[0])
     assert cell == "100/100 [92-100%]"
+    assert SUMMARY_COLUMNS["solved"].cell(ROWS[-1]) == "100/100 [one trial]"
+    assert SUMMARY_COLUMNS["success"].cell(ROWS[-1]) == "100% [deterministic]"
 
 
 @pytest.mark.parametrize("width", WIDTHS)

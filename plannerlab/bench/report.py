@@ -299,8 +299,12 @@ def summary_cells(row: Mapping[str, Any], executed: bool) -> list[str]:
     cells = [
         str(row["planner"]),
         f"{row['successes']}/{row['n']}" + (f" ({row['errors']} err)" if row["errors"] else ""),
-        f"{fmt(100 * row['success_rate'], 3)}% [{fmt(100 * row['ci95_low'], 3)}, "
-        f"{fmt(100 * row['ci95_high'], 3)}]",
+        (
+            f"{fmt(100 * row['success_rate'], 3)}% [deterministic: {row['n']} seeds, one trial]"
+            if row.get("deterministic") is True
+            else f"{fmt(100 * row['success_rate'], 3)}% [{fmt(100 * row['ci95_low'], 3)}, "
+            f"{fmt(100 * row['ci95_high'], 3)}]"
+        ),
         f"{fmt(row['time_median_s'])} / {fmt(row['time_p75_s'])} / {fmt(row['time_p95_s'])}",
         fmt(row["path_length_median"]),
         fmt(row["pos_err_median_m"]),
@@ -333,7 +337,9 @@ EXEC_HEADERS = ("PyBullet ok", "track err rad")
 
 TABLE_NOTES = (
     "solved: trials whose every leg is SOLVED (an `error` trial counts as a failure); "
-    "95% CI: Wilson score interval. time: planning time summed over legs, over trials "
+    "95% CI: Wilson score interval; deterministic: every seed gave the identical trial "
+    "(same statuses, path hashes, counts, tip errors and execution verdict), so the seeds "
+    "are one run and no interval is given. time: planning time summed over legs, over trials "
     "that ran (median / 75th / 95th percentile). path len: joint-space length summed "
     "over legs, median over solved trials. pos/ang err: final tip error of the last "
     "leg, median over trials that ran. checks: collision checks per trial, median. "

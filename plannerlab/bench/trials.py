@@ -35,6 +35,16 @@ Decisions:
   over legs of ``time_s``) and final tip errors are over every trial that did not error
   or time out; path length over successful trials only; 95 % Wilson score interval for
   the success rate.
+* **Deterministic planners.** Seeds mean something only if they change the trial. A row
+  is ``deterministic`` when it has two or more trials and all of them are the same trial:
+  the same :func:`trial_fingerprint` (every leg's status, path hash, counts and tip
+  errors, and the execution's verdict; clocks left out). Its seeds are one run repeated,
+  so it gets no interval (``ci95_low``/``ci95_high`` NaN) and the tables say
+  "deterministic" where the interval would be. This is detected from what the trials did,
+  not read from the registry's ``uses_rng``: a planner that draws from its generator only
+  at a stall (``gradient.clearance+rrtconnect``) runs one trial on every seed of a
+  problem where it never stalls, and its interval would mean as little there.
+  ``distinct_trials`` counts the different trials of a row.
 """
 
 from __future__ import annotations
@@ -708,6 +718,39 @@ def wilson_interval(successes: int, n: int, confidence: float = 0.95) -> tuple[f
     return (float(ci.low), float(ci.high))
 
 
+#: per-leg fields of a trial record that say what the leg did (no clocks)
+_FINGERPRINT_LEG_KEYS = (
+    "leg",
+    "status",
+    "path_points",
+    "path_sha256",
+    "iterations",
+    "collision_checks",
+    "fk_calls",
+    "local_minima",
+    "escapes",
+    "pos_err_m",
+    "angle_err_deg",
+)
+
+
+def trial_fingerprint(rec: Mapping[str, Any]) -> str:
+    """What a trial did, as a string: two trials with the same fingerprint are the same
+    trial (seeds that changed nothing). Its status and error, every leg's
+    :data:`_FINGERPRINT_LEG_KEYS` and the execution's verdict; clocks are left out."""
+    ex = rec.get("execution") or {}
+    return dumps(
+        {
+            "status": rec.get("status"),
+            "error": rec.get("error"),
+            "legs": [
+                {k: leg.get(k) for k in _FINGERPRINT_LEG_KEYS} for leg in rec.get("legs_run") or []
+            ],
+            "execution": {k: ex.get(k) for k in ("success", "max_track_err_rad", "contacts")},
+        }
+    )
+
+
 def _vals(xs: Iterable[Any]) -> np.ndarray:
     return np.array([float(x) for x in xs if x is not None and math.isfinite(float(x))])
 
@@ -726,6 +769,8 @@ SUMMARY_COLUMNS = (
     "success_rate",
     "ci95_low",
     "ci95_high",
+    "deterministic",
+    "distinct_trials",
     "time_median_s",
     "time_p75_s",
     "time_p95_s",
@@ -755,7 +800,10 @@ def summarise(records: Iterable[Mapping[str, Any]]) -> list[dict[str, Any]]:
         n = len(recs)
         ok = [r for r in recs if r.get("success")]
         ran = [r for r in recs if r.get("status") not in (ERROR_STATUS, TIMEOUT_STATUS)]
-        lo, hi = wilson_interval(len(ok), n)
+        distinct = len({trial_fingerprint(r) for r in recs})
+        deterministic = n >= 2 and distinct == 1
+        # the seeds of a deterministic row are one trial: no interval over copies of it
+        lo, hi = (math.nan, math.nan) if deterministic else wilson_interval(len(ok), n)
         t = _vals(r["totals"].get("time_s") for r in ran)
         ex = [r["execution"] for r in recs if r.get("execution")]
         rows.append(
@@ -768,6 +816,8 @@ def summarise(records: Iterable[Mapping[str, Any]]) -> list[dict[str, Any]]:
                 "success_rate": len(ok) / n if n else math.nan,
                 "ci95_low": lo,
                 "ci95_high": hi,
+                "deterministic": deterministic,
+                "distinct_trials": distinct,
                 "time_median_s": _pct(t, 50),
                 "time_p75_s": _pct(t, 75),
                 "time_p95_s": _pct(t, 95),
@@ -809,5 +859,6 @@ __all__ = [
     "run_trial",
     "store_path",
     "summarise",
+    "trial_fingerprint",
     "wilson_interval",
 ]

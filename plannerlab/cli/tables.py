@@ -113,7 +113,26 @@ def _solved(r: Mapping[str, Any]) -> str:
 
 def _solved_ci(r: Mapping[str, Any]) -> str:
     # errors are listed under the table (and counted by ``solved_n``)
+    if r.get("deterministic") is True:
+        return f"{r['successes']}/{r['n']} [{ONE_TRIAL}]"
     return f"{r['successes']}/{r['n']} [{_pct(r['ci95_low'])}-{_pct(r['ci95_high'])}%]"
+
+
+def _success_ci(r: Mapping[str, Any]) -> str:
+    if r.get("deterministic") is True:
+        return f"{_pct(r['success_rate'])}% [{DETERMINISTIC}]"
+    return f"{_pct(r['success_rate'])}% [{_pct(r['ci95_low'])}, {_pct(r['ci95_high'])}]"
+
+
+#: what stands where the interval would be when every seed ran the same trial (the
+#: compact column has room for no more than an interval's width)
+DETERMINISTIC = "deterministic"
+ONE_TRIAL = "one trial"
+_DETERMINISTIC_HELP = (
+    "; [one trial] or [deterministic]: every seed gave the identical trial (same paths, "
+    "counts and verdicts): the planner is deterministic here, the n seeds are one run "
+    "and there is no interval"
+)
 
 
 def _exec_ok(r: Mapping[str, Any]) -> str:
@@ -126,14 +145,15 @@ SUMMARY_COLUMNS: dict[str, SummaryColumn] = {
         "solved\n[95% CI]",
         "num",
         _solved_ci,
-        "trials whose every leg is SOLVED, of n, with the Wilson 95 % interval",
+        "trials whose every leg is SOLVED, of n, with the Wilson 95 % interval"
+        + _DETERMINISTIC_HELP,
     ),
     "solved_n": SummaryColumn("solved", "num", _solved, "solved trials of n"),
     "success": SummaryColumn(
         "success %\n[95% CI]",
         "num",
-        lambda r: f"{_pct(r['success_rate'])}% [{_pct(r['ci95_low'])}, {_pct(r['ci95_high'])}]",
-        "success rate with the Wilson 95 % interval",
+        _success_ci,
+        "success rate with the Wilson 95 % interval" + _DETERMINISTIC_HELP,
     ),
     "time": SummaryColumn(
         "time s\nmedian", "num", lambda r: fmt(r["time_median_s"]), "planning time, median [s]"
