@@ -25,14 +25,18 @@ def test_problems_and_planners_list_as_json(capsys):
     names = {p["name"] for p in json.loads(out)}
     assert code == 0 and {"armz_inspection", "armz_pocket"} <= names
     code, out, _ = run(capsys, "planners", "--json")
-    planners = {p["name"] for p in json.loads(out)}
+    planners = {p["name"]: p for p in json.loads(out)}
     assert {
         "gradient",
         "gradient.closed_loop",
         "gradient.analytic",
+        "gradient.clearance+random_detour",
         "ompl.rrtconnect",
         "ompl.kpiece1",
-    } <= planners
+    } <= set(planners)
+    # which planners draw from their seed
+    assert not planners["gradient.clearance+detour"]["uses_rng"]
+    assert planners["gradient.clearance+random_detour"]["uses_rng"]
 
 
 def test_problems_lists_the_local_folder_first(capsys, tmp_path, monkeypatch):

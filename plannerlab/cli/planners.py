@@ -19,6 +19,7 @@ def cmd_planners(args: argparse.Namespace, console: Console) -> int:
             "name": e.name,
             "summary": e.summary,
             "needs_simulator": e.needs_stepper,
+            "uses_rng": e.uses_rng,
             "robots": list(e.robots) if e.robots else "any",
         }
         for e in REGISTRY.values()
@@ -29,7 +30,8 @@ def cmd_planners(args: argparse.Namespace, console: Console) -> int:
     t = table("planners", [("name", "name"), ("robots", "text"), ("summary", "text")])
     for r in rows:
         robots = r["robots"] if isinstance(r["robots"], str) else ", ".join(r["robots"])
-        t.add_row(r["name"], robots, r["summary"])
+        seeds = "" if r["uses_rng"] else " (deterministic: the seed changes nothing)"
+        t.add_row(r["name"], robots, r["summary"] + seeds)
     console.print(t)
     return 0
 
