@@ -60,8 +60,9 @@ from plannerlab.problem.load import Problem
 from plannerlab.record.execution import ContactRecord, Execution
 from plannerlab.robots.base import Array, as_xyz, joint_difference
 from plannerlab.robots.paths import densify
-from plannerlab.sim.retime import retime, unwrap_path
-from plannerlab.sim.world import SimWorld
+from plannerlab.sim.measure import geometry_deviation_m, sampled_clearance
+from plannerlab.sim.retime import GRID_PER_KNOT, retime, unwrap_path
+from plannerlab.sim.world import DT_S, SimWorld
 
 #: physics steps per densified waypoint (0.1 s)
 STEPS_PER_WAYPOINT: int = 24
@@ -75,6 +76,8 @@ LOG_EVERY_STEPS: int = 12
 #: position error within one step (PyBullet's default 0.1 lags); with the velocity
 #: feed-forward it kept the 24-module arm within 3e-4 rad on a 9.9 rad RRT-Connect path
 TRACK_POSITION_GAIN: float = 1.0
+#: PyBullet's constraint solver for executions (see the module docstring)
+SOLVER: str = "dantzig"
 
 
 # ---------------------------------------------------------------------- running
@@ -102,6 +105,10 @@ def _run(
     contact_tol_m: float,
     track_err_limit_rad: float | None,
     timing: str,
+    *,
+    probe: SimWorld,
+    max_deviation_m: float | None = None,
+    grid_per_knot: int = GRID_PER_KNOT,
 ) -> Execution:
     t0 = time.perf_counter()
     robot = problem.robot
@@ -118,6 +125,13 @@ def _run(
     )
     if not track_limit > 0:
         raise PlannerlabError(f"max_track_err_rad must be positive, got {track_limit}")
+    dev_limit = (
+        float(max_deviation_m)
+        if max_deviation_m is not None
+        else problem.simulation.max_deviation_m
+    )
+    if not dev_limit > 0:
+        raise PlannerlabError(f"max_deviation_m must be positive, got {dev_limit}")
     recheck_step = float(joint_step) if joint_step is not None else problem.joint_step / 4.0
     wp_step = float(waypoint_step) if waypoint_step is not None else problem.joint_step
     if not (recheck_step > 0 and wp_step > 0):
@@ -131,10 +145,15 @@ def _run(
 
     steps0 = world.steps_taken
     seen: dict[tuple[str, str, bool], list[Any]] = {}
+    # Every physics step's simulated state, and the state commanded for it.
+    q_step: list[Array] = []
+    q_step_cmd: list[Array] = []
 
-    def run_steps(n: int) -> None:
+    def run_steps(n: int, q_target: Array) -> None:
         for _ in range(n):
             world.step(1)
+            q_step.append(world.state())
+            q_step_cmd.append(q_target)
             t = (world.steps_taken - steps0) * world.dt_s
             for c in world.contacts(min_depth_m=contact_tol_m):
                 key = (c.link_name, c.other_name, c.other_is_link)
@@ -161,6 +180,7 @@ def _run(
                 effort_limit=world.max_force,
                 inverse_dynamics=world.inverse_dynamics,
                 knot_step=recheck_step,
+                grid_per_knot=grid_per_knot,
             )
             timing_used = "toppra"
         except Exception as exc:  # toppra or the simulator's inverse dynamics
@@ -191,8 +211,8 @@ def _run(
         q_act_list: list[Array] = []
         for k in range(n):
             world.command_urdf(q_urdf[k], qd_urdf[k], position_gain=TRACK_POSITION_GAIN)
-            run_steps(1)
-            q_now = world.state()
+            run_steps(1, q_all[k])
+            q_now = q_step[-1]
             err_all[k] = np.max(np.abs(joint_difference(q_all[k], q_now, cont)), initial=0.0)
             if k == logged[len(q_act_list)]:
                 q_act_list.append(q_now)
@@ -201,7 +221,7 @@ def _run(
         t_s = t_all[logged]
         window_track = np.maximum.reduceat(err_all, [0, *[k + 1 for k in logged[:-1]]])
         world.command_urdf(q_urdf[-1], np.zeros(robot.dof), position_gain=TRACK_POSITION_GAIN)
-        run_steps(settle_steps)
+        run_steps(settle_steps, q_all[-1])
         q_final = world.state()
         duration = traj.duration_s
         steps_logged = LOG_EVERY_STEPS
@@ -213,15 +233,46 @@ def _run(
         t_s = np.empty(M)
         for k in range(M):
             world.command(q_cmd[k])
-            run_steps(steps_per_waypoint)
-            q_act[k] = world.state()
+            run_steps(steps_per_waypoint, q_cmd[k])
+            q_act[k] = q_step[-1]
             t_s[k] = (world.steps_taken - steps0) * world.dt_s
         world.command(q_cmd[-1])
-        run_steps(settle_steps)
+        run_steps(settle_steps, q_cmd[-1])
         q_final = world.state()
         window_track = None
         duration = M * steps_per_waypoint * world.dt_s
         steps_logged = steps_per_waypoint
+
+    # Deviation: every physics step of a retimed trajectory against the state commanded
+    # for it; with "waypoints" timing the arm moves towards each waypoint over its
+    # window, so it is measured where it should have arrived (the window's last step),
+    # and at every settling step.
+    states = np.array(q_step).reshape(len(q_step), robot.dof)
+    targets = np.array(q_step_cmd).reshape(len(q_step), robot.dof)
+    n_moving = len(states) - settle_steps
+    if traj is not None:
+        judged = np.arange(len(states))
+    else:
+        judged = np.concatenate(
+            [
+                np.arange(steps_per_waypoint - 1, n_moving, steps_per_waypoint),
+                np.arange(n_moving, len(states)),
+            ]
+        ).astype(int)
+    dev_steps = geometry_deviation_m(robot, targets[judged], states[judged])
+    worst_dev = int(np.argmax(dev_steps)) if len(dev_steps) else 0
+    max_dev = float(dev_steps[worst_dev]) if len(dev_steps) else 0.0
+    max_dev_t = float((judged[worst_dev] + 1) * world.dt_s) if len(dev_steps) else 0.0
+    # per log sample: the largest deviation since the previous sample (settling excluded)
+    step_of_sample = np.rint(t_s / world.dt_s).astype(int) - 1
+    dev_full = np.zeros(len(states))
+    dev_full[judged] = dev_steps
+    bounds = np.concatenate([[0], step_of_sample[:-1] + 1]) if len(t_s) else np.zeros(0, int)
+    deviation = (
+        np.maximum.reduceat(dev_full, bounds) if len(t_s) else np.zeros(0)
+    )
+    clear = sampled_clearance(robot, probe, states)
+    clear_t = float((clear.index + 1) * world.dt_s)
 
     track = (
         window_track
@@ -275,11 +326,17 @@ def _run(
             f"{goal.angle_tol_deg:g} deg)"
         )
     max_track = float(np.max(track, initial=0.0))
-    if max_track > track_limit:
-        worst_k = int(np.argmax(track))
+    if max_dev > dev_limit:
         problems.append(
-            f"tracking error {max_track:.3g} rad at t = {t_s[worst_k]:.3f} s exceeds the "
-            f"limit {track_limit:g} rad ([simulation] max_track_err_rad)"
+            f"the robot strayed {max_dev * 1e3:.3g} mm from the commanded state at "
+            f"t = {max_dev_t:.3f} s (limit {dev_limit * 1e3:g} mm, [simulation] "
+            "max_deviation_m)"
+        )
+    if clear.clearance_m < 0:
+        a, b = clear.pair or ("?", "?")
+        problems.append(
+            f"simulated clearance {clear.clearance_m * 1e3:.3g} mm ({a} x {b}) at "
+            f"t = {clear_t:.3f} s"
         )
     if problems:
         reason = "; ".join(problems)
@@ -289,7 +346,10 @@ def _run(
             if traj is not None
             else f"executed {len(q_cmd)} waypoints"
         )
-        reason = f"{moved} without contact; max tracking error {max_track:.3g} rad"
+        reason = (
+            f"{moved} without contact; deviation <= {max_dev * 1e3:.3g} mm, clearance >= "
+            f"{clear.clearance_m * 1e3:.3g} mm"
+        )
         if reached:
             reason += f"; final tip {pos_err:.3g} m / {ang_err:.3g} deg from {goal_name!r}"
 
@@ -334,6 +394,15 @@ def _run(
         duration_s=duration,
         trajectory_valid=None if traj_check is None else traj_check.valid,
         spline_dev=math.nan if traj is None else traj.max_dev,
+        deviation_m=deviation,
+        max_deviation_m=max_dev,
+        max_deviation_time_s=max_dev_t,
+        max_deviation_limit_m=dev_limit,
+        min_clearance_m=clear.clearance_m,
+        min_clearance_time_s=clear_t,
+        min_clearance_pair=clear.pair,
+        clearance_samples=clear.samples,
+        solver=world.solver,
     )
 
 
@@ -351,6 +420,11 @@ def execute(
     timing: str = "toppra",
     gui: bool = False,
     leg: int | str | None = None,
+    max_deviation_m: float | None = None,
+    solver: str = SOLVER,
+    solver_iterations: int | None = None,
+    dt_s: float = DT_S,
+    grid_per_knot: int = GRID_PER_KNOT,
 ) -> Execution:
     """Re-check a path with FCL, then execute it in a fresh PyBullet world.
 
@@ -393,7 +467,18 @@ def execute(
     checker = CollisionChecker(problem.robot, problem.scene)
     if gravity_mps2 is None:
         gravity_mps2 = problem.simulation.gravity_mps2
-    with SimWorld(problem.robot, problem.scene, gui=gui, gravity_mps2=gravity_mps2) as world:
+    with (
+        SimWorld(
+            problem.robot,
+            problem.scene,
+            gui=gui,
+            gravity_mps2=gravity_mps2,
+            solver=solver,
+            solver_iterations=solver_iterations,
+            dt_s=dt_s,
+        ) as world,
+        SimWorld(problem.robot, problem.scene) as probe,
+    ):
         return _run(
             world,
             checker,
@@ -408,6 +493,9 @@ def execute(
             contact_tol_m,
             max_track_err_rad,
             timing,
+            probe=probe,
+            max_deviation_m=max_deviation_m,
+            grid_per_knot=grid_per_knot,
         )
 
 
@@ -425,6 +513,11 @@ def execute_legs(
     max_track_err_rad: float | None = None,
     timing: str = "toppra",
     gui: bool = False,
+    max_deviation_m: float | None = None,
+    solver: str = SOLVER,
+    solver_iterations: int | None = None,
+    dt_s: float = DT_S,
+    grid_per_knot: int = GRID_PER_KNOT,
 ) -> list[Execution]:
     """Execute consecutive legs in ONE world, each from where the previous one ended.
 
@@ -442,7 +535,18 @@ def execute_legs(
     out: list[Execution] = []
     if gravity_mps2 is None:
         gravity_mps2 = problem.simulation.gravity_mps2
-    with SimWorld(problem.robot, problem.scene, gui=gui, gravity_mps2=gravity_mps2) as world:
+    with (
+        SimWorld(
+            problem.robot,
+            problem.scene,
+            gui=gui,
+            gravity_mps2=gravity_mps2,
+            solver=solver,
+            solver_iterations=solver_iterations,
+            dt_s=dt_s,
+        ) as world,
+        SimWorld(problem.robot, problem.scene) as probe,
+    ):
         for i, path in enumerate(paths):
             leg = first_leg + i
             out.append(
@@ -460,6 +564,9 @@ def execute_legs(
                     contact_tol_m,
                     max_track_err_rad,
                     timing,
+                    probe=probe,
+                    max_deviation_m=max_deviation_m,
+                    grid_per_knot=grid_per_knot,
                 )
             )
     return out

@@ -59,6 +59,8 @@ from plannerlab.robots.paths import densify
 
 #: share of each joint's effort limit the trajectory may use; the rest is feedback headroom
 TORQUE_FRACTION: float = 0.5
+#: TOPP-RA grid points per knot interval (see the module docstring)
+GRID_PER_KNOT: int = 4
 
 InverseDynamics = Callable[[Array, Array, Array], Array]
 
@@ -134,6 +136,7 @@ def retime(
     inverse_dynamics: InverseDynamics,
     knot_step: float,
     torque_fraction: float = TORQUE_FRACTION,
+    grid_per_knot: int = GRID_PER_KNOT,
 ) -> Trajectory:
     """Time-optimal trajectory along a joint path under velocity and torque limits.
 
@@ -146,6 +149,8 @@ def retime(
         inverse_dynamics: ``(q, q̇, q̈) -> τ`` (dof,) for the robot.
         knot_step: largest per-joint distance between spline knots [rad or m].
         torque_fraction: share of ``effort_limit`` the trajectory may use.
+        grid_per_knot: TOPP-RA grid points per knot interval (>= 1): the constraints
+            hold at the knots and at ``grid_per_knot - 1`` points evenly between them.
 
     Returns:
         the :class:`Trajectory`, starting and ending at rest.
@@ -171,6 +176,8 @@ def retime(
         raise PlannerlabError(f"effort limits must be positive and finite, got {tau}")
     if not knot_step > 0:
         raise PlannerlabError(f"knot_step must be positive, got {knot_step}")
+    if int(grid_per_knot) != grid_per_knot or grid_per_knot < 1:
+        raise PlannerlabError(f"grid_per_knot must be an integer >= 1, got {grid_per_knot}")
     knots = _knots(path, float(knot_step))
     if len(knots) < 2:
         return Trajectory(0.0, knots, 0.0, 0)
@@ -214,14 +221,20 @@ def retime(
             discretization_scheme=constraint.DiscretizationType.Interpolation,
         ),
     ]
-    instance = algo.TOPPRA(constraints, spline, gridpoints=ss, parametrizer="ParametrizeConstAccel")
+    grid = ss
+    if grid_per_knot > 1:
+        f = np.arange(grid_per_knot) / grid_per_knot
+        grid = np.concatenate([(ss[:-1, None] + np.diff(ss)[:, None] * f).ravel(), ss[-1:]])
+    instance = algo.TOPPRA(
+        constraints, spline, gridpoints=grid, parametrizer="ParametrizeConstAccel"
+    )
     traj = instance.compute_trajectory(0.0, 0.0)
     if traj is None:
         raise PlannerlabError(
             "toppra found no time parameterisation within the velocity limits and "
             f"{torque_fraction:g} x the torque left after gravity"
         )
-    return Trajectory(float(traj.duration), knots, max_dev, len(ss), traj)
+    return Trajectory(float(traj.duration), knots, max_dev, len(grid), traj)
 
 
-__all__ = ["TORQUE_FRACTION", "Trajectory", "retime", "unwrap_path"]
+__all__ = ["GRID_PER_KNOT", "TORQUE_FRACTION", "Trajectory", "retime", "unwrap_path"]
