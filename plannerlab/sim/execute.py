@@ -7,9 +7,11 @@
    simulation, and records the verdict and the colliding pairs;
 2. drives the simulated robot along it by position control with the Arm-Z paper's
    parameters (``000_a8ed938e94518caf.txt``: 1/240 s steps, 100 N·m motors, gravity on;
-   see :mod:`plannerlab.sim.world`), logging the state reached at every waypoint, the
-   tracking error and every contact;
-3. measures the final tip error against the leg's goal.
+   see :mod:`plannerlab.sim.world`) on PyBullet's direct constraint solver, logging the
+   state reached at every step, the deviation from the commanded state, the tracking
+   error and every contact;
+3. measures the smallest simulated clearance along the execution, and the final tip
+   error against the leg's goal.
 
 Decisions:
 
@@ -39,10 +41,59 @@ Decisions:
   200-waypoint 24-module path through poses needing up to 285 N·m sagged by 3 rad onto
   the room floor). ``gravity_mps2=(0, 0, 0)`` separates such failures from kinematic ones.
 * **Success** ("executed cleanly") = the path passed the re-check, no contact was
-  recorded, the maximum joint tracking error stayed within the problem's
-  ``[simulation] max_track_err_rad`` (default 0.05 rad) and, when a leg was given, the
-  final state lies inside that leg's goal region. A path that reached its goal while the
-  arm was far off the planned path did not execute *that* path, so it is not clean.
+  recorded, the smallest simulated clearance is >= 0, the largest deviation of the
+  robot's collision geometry from the commanded state stays within the problem's
+  ``[simulation] max_deviation_m`` (default 0.01 m) and, when a leg was given, the final
+  state lies inside that leg's goal region. A path that reached its goal while the arm
+  was far off the planned path did not execute *that* path, so it is not clean. The joint
+  tracking error is still logged (``track_err_rad``), for information only: 0.05 rad at
+  the base of the 16-m Arm-Z moves its tip 0.8 m, so a limit in radians cannot tell a
+  clean run from a crash.
+* **Deviation and clearance** (:mod:`plannerlab.sim.measure`). Every physics step's
+  simulated state is kept; the deviation is the bound of
+  :func:`~plannerlab.sim.measure.geometry_deviation_m` (every capsule's axis end points
+  plus radius × the turn of its axis) between it and the state commanded for that step
+  (the retimed reference at the step's end), settling included: every physics step, so
+  nothing between samples is left to argue about. With ``"waypoints"`` timing the
+  target jumps from waypoint to waypoint and the arm moves towards it over the window, so
+  the deviation is taken where it should have arrived (each window's last step) and at
+  every settling step. The clearance is read from PyBullet's closest points in a second,
+  probe world set kinematically to the executed states, sampled as dense as the
+  clearance requires (no state closer than 1 mm to a collision missed): about 30–220
+  queries per leg of the paper's task instead of 12 000 steps.
+
+**Why the arm strayed, and the design (issue 17).** Before, the 24-module Arm-Z strayed
+up to 0.17 m from the commanded path on the paper's task (leg D, 0.016 rad of joint
+error) and grazed ``wall_right``. Two causes, found by logging every motor's applied
+torque and the reference trajectory's inverse-dynamics torque along leg D:
+
+1. **The iterative constraint solver did not converge.** PyBullet's position motor is a
+   velocity constraint row per joint, solved with the contacts each step. With the
+   default projected Gauss-Seidel (50 iterations) the 23 motor rows of the chain, whose
+   first joints carry the inertia of the whole 16-m arm, are solved only approximately:
+   the arm lags, the motors then saturate at 100 N·m catching up (37 % of the steps of
+   leg D had a saturated joint, joints 0–10). More iterations help (200: 7.6 mm) and cost
+   time; the direct (Dantzig) solver solves the rows exactly, and is *cheaper* per step
+   on this chain (0.39 against 0.49 ms, measured in one process). With an exact solve,
+   a position gain of 1 and the velocity feed-forward, PyBullet's motor is a dead-beat
+   controller: the arm lands on the reference at every step, within the torque limit.
+2. **The retimed trajectory asked for more torque than the motors have, between
+   TOPP-RA's grid points.** TOPP-RA holds the torque budget (half the effort) only at its
+   grid points, which were the spline's knots; between them the cubic spline bends round
+   the path's corners and the reference needed up to 1.33 x (leg D), 1.66 x (leg E) the
+   100 N·m effort, so even an exact solver saturates there (dantzig alone: 11 mm on leg
+   D). With :data:`~plannerlab.sim.retime.GRID_PER_KNOT` = 4 grid points per knot
+   interval the peak is 0.59–0.66 x the effort on legs A, D, E, and the trajectories are
+   *shorter* (leg D 51 s -> 19 s: the coarse grid's interpolated constraints were also
+   conservative), so there are fewer physics steps to run.
+
+Inverse dynamics as feed-forward under an explicit PD loop (torque control, computed
+torque) was tried on leg D too (3 mm at the tip, but it needs one inverse-dynamics call
+per step and gains to tune per robot); a smaller time step (1/960 s) only helped as much
+as more iterations, at 4 x the steps. The executor keeps PyBullet's motors on the direct
+solver (:data:`SOLVER`) and the finer TOPP-RA grid: what each option buys is in
+``bench/execution_bench.py`` (deviation per leg and wall time as a ratio to the old
+settings, measured in one run).
 """
 
 from __future__ import annotations
