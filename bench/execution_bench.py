@@ -5,7 +5,7 @@ Usage (plans are made first, on a fixed seed and collision-check budget):
     PYTHONPATH=. python bench/execution_bench.py                 # solves the default plan
     PYTHONPATH=. python bench/execution_bench.py PLAN.json ...   # any plan files
     PYTHONPATH=. python bench/execution_bench.py --options chosen,pgs PLAN.json
-    PYTHONPATH=. python bench/execution_bench.py --baseline-checkout /work/main PLAN.json
+    PYTHONPATH=. python bench/execution_bench.py --baseline-checkout DIR --rounds 3 PLAN.json
 
 The default plan is the paper's task: ``plannerlab solve armz_inspection --planner
 gradient.clearance+detour --seed 0 --max-checks 100000`` (seven legs). Every option
@@ -19,7 +19,9 @@ settings before issue 17, measured with today's deviation and clearance measurem
 both sides pay for it). ``--baseline-checkout DIR`` also times the executor of another
 checkout (e.g. the main branch) on the same plans, in a subprocess, between the options,
 and prints the ratios to it: the machine is shared and noisy, so only ratios measured in
-one run mean anything.
+one run mean anything; ``--rounds N`` repeats everything and prints the median of the
+per-round ratios. (A checkout is best an exported copy, ``git archive COMMIT | tar -x -C
+DIR``: running it writes caches into it.)
 
 Options (name: settings of ``execute_legs``):
 
@@ -101,6 +103,7 @@ def main(argv: list[str]) -> int:
     ap.add_argument("plans", nargs="*", type=Path)
     ap.add_argument("--options", default=",".join(OPTIONS), help="comma-separated names")
     ap.add_argument("--baseline-checkout", type=Path, default=None)
+    ap.add_argument("--rounds", type=int, default=1, help="repeat everything, ratios per round")
     args = ap.parse_args(argv)
     names = [n for n in args.options.split(",") if n]
     unknown = [n for n in names if n not in OPTIONS]
@@ -135,45 +138,56 @@ def main(argv: list[str]) -> int:
     f0, _, problem0, paths0 = loaded[0]
     execute_legs(problem0, [paths0[0][:2]], first_leg=0)
 
-    walls: dict[str, float] = {}
+    walls: dict[str, list[float]] = {n: [] for n in names}
     base_wall: list[float] = []
-    rows = []
-    for i, name in enumerate(names):
-        if args.baseline_checkout is not None and i == len(names) // 2:
-            t0 = time.perf_counter()
-            base = _baseline(args.baseline_checkout, [p[0] for p in loaded])
-            base_wall.append(sum(b["wall_s"] for b in base))
-            for b in base:
-                tips = " ".join(f"{t:6.1f}" for t in b["tip_mm"])
+    for round_ in range(args.rounds):
+        if args.rounds > 1:
+            print(f"-- round {round_ + 1} of {args.rounds}")
+        for i, name in enumerate(names):
+            if args.baseline_checkout is not None and i == len(names) // 2:
+                base = _baseline(args.baseline_checkout, [p[0] for p in loaded])
+                base_wall.append(sum(b["wall_s"] for b in base))
+                for b in base:
+                    tips = " ".join(f"{t:6.1f}" for t in b["tip_mm"])
+                    print(
+                        f"{'checkout':>14} {Path(b['plan']).name}: wall {b['wall_s']:6.1f} s, "
+                        f"simulated {b['sim_s']:6.1f} s, tip mm [{tips}], clean {b['clean']}",
+                        flush=True,
+                    )
+            wall = 0.0
+            for f, plan, problem, paths in loaded:
+                t0 = time.perf_counter()
+                ex = execute_legs(problem, paths, first_leg=plan.legs[0].leg, **OPTIONS[name])
+                w = time.perf_counter() - t0
+                wall += w
+                devs = " ".join(f"{1e3 * e.max_deviation_m:7.2f}" for e in ex)
+                clears = " ".join(f"{1e3 * e.min_clearance_m:6.1f}" for e in ex)
                 print(
-                    f"{'checkout':>14} {Path(b['plan']).name}: wall {b['wall_s']:6.1f} s, "
-                    f"simulated {b['sim_s']:6.1f} s, tip mm [{tips}], clean {b['clean']}"
+                    f"{name:>14} {f.name}: wall {w:6.1f} s, simulated "
+                    f"{sum(e.sim_time_s for e in ex):6.1f} s, deviation mm [{devs}], "
+                    f"clearance mm [{clears}], clean {[e.success for e in ex]}",
+                    flush=True,
                 )
-        wall = 0.0
-        for f, plan, problem, paths in loaded:
-            t0 = time.perf_counter()
-            ex = execute_legs(problem, paths, first_leg=plan.legs[0].leg, **OPTIONS[name])
-            w = time.perf_counter() - t0
-            wall += w
-            devs = " ".join(f"{1e3 * e.max_deviation_m:7.2f}" for e in ex)
-            clears = " ".join(f"{1e3 * e.min_clearance_m:6.1f}" for e in ex)
-            rows.append((name, f.name, [e.max_deviation_m for e in ex], w))
-            print(
-                f"{name:>14} {f.name}: wall {w:6.1f} s, simulated "
-                f"{sum(e.sim_time_s for e in ex):6.1f} s, deviation mm [{devs}], "
-                f"clearance mm [{clears}], clean {[e.success for e in ex]}",
-                flush=True,
-            )
-        walls[name] = wall
+            walls[name].append(wall)
     first = names[0]
-    print(f"\nwall-time ratio to {first!r}" + (" and to the checkout" if base_wall else ""))
+    print(
+        f"\nwall-time ratio to {first!r}"
+        + (" and to the checkout" if base_wall else "")
+        + (
+            f" (median over {args.rounds} rounds, each ratio within its round)"
+            if args.rounds > 1
+            else ""
+        )
+    )
     for name in names:
-        line = f"{name:>14}: {walls[name]:7.1f} s  {walls[name] / walls[first]:5.2f}x"
+        total = float(np.median(walls[name]))
+        line = f"{name:>14}: {total:7.1f} s  "
+        line += f"{np.median(np.divide(walls[name], walls[first])):5.2f}x"
         if base_wall:
-            line += f"  {walls[name] / base_wall[0]:5.2f}x"
+            line += f"  {np.median(np.divide(walls[name], base_wall)):5.2f}x"
         print(line)
     if base_wall:
-        print(f"{'checkout':>14}: {base_wall[0]:7.1f} s")
+        print(f"{'checkout':>14}: {float(np.median(base_wall)):7.1f} s")
     return 0
 
 

@@ -384,9 +384,7 @@ def test_retimed_small_execution_follows_within_a_millimetre_and_keeps_clear() -
     assert ex.max_deviation_m < 1e-3
     assert len(ex.deviation_m) == len(ex.t_s) and np.max(ex.deviation_m) <= ex.max_deviation_m
     checker = CollisionChecker(robot, WALL)
-    planned = min(
-        checker.clearance(q) for q in q0 + np.linspace(0, 1, 200)[:, None] * (q1 - q0)
-    )
+    planned = min(checker.clearance(q) for q in q0 + np.linspace(0, 1, 200)[:, None] * (q1 - q0))
     assert ex.min_clearance_m == pytest.approx(planned, abs=max(2e-3, planned / 8.0))
     assert ex.clearance_samples >= 2
 
@@ -397,7 +395,9 @@ def test_problem_file_sets_the_tracking_limit(tmp_path) -> None:
     from plannerlab.errors import ProblemError
     from plannerlab.problem.load import parse_problem
 
-    assert parse_problem(write_problem(tmp_path, TINY_PROBLEM_TOML)).simulation.max_deviation_m == 0.01
+    assert (
+        parse_problem(write_problem(tmp_path, TINY_PROBLEM_TOML)).simulation.max_deviation_m == 0.01
+    )
     path = write_problem(tmp_path, TINY_PROBLEM_TOML + "[simulation]\nmax_deviation_m = 0.002\n")
     assert parse_problem(path).simulation.max_deviation_m == 0.002
 

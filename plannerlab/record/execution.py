@@ -260,8 +260,8 @@ class Execution:
         object.__setattr__(self, "gravity_mps2", tuple(float(g) for g in self.gravity_mps2))
         object.__setattr__(self, "extra", dict(self.extra))
         if self.min_clearance_pair is not None:
-            a, b = self.min_clearance_pair
-            object.__setattr__(self, "min_clearance_pair", (str(a), str(b)))
+            link, other = self.min_clearance_pair
+            object.__setattr__(self, "min_clearance_pair", (str(link), str(other)))
         object.__setattr__(self, "clearance_samples", int(self.clearance_samples))
         object.__setattr__(
             self, "recheck_pairs", tuple((str(a), str(b)) for a, b in self.recheck_pairs)

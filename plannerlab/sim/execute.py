@@ -319,9 +319,7 @@ def _run(
     dev_full = np.zeros(len(states))
     dev_full[judged] = dev_steps
     bounds = np.concatenate([[0], step_of_sample[:-1] + 1]) if len(t_s) else np.zeros(0, int)
-    deviation = (
-        np.maximum.reduceat(dev_full, bounds) if len(t_s) else np.zeros(0)
-    )
+    deviation = np.maximum.reduceat(dev_full, bounds) if len(t_s) else np.zeros(0)
     clear = sampled_clearance(robot, probe, states)
     clear_t = float((clear.index + 1) * world.dt_s)
 
@@ -376,7 +374,6 @@ def _run(
             f"{goal.name!r} (tolerance {goal.pos_tol_m:g} m / "
             f"{goal.angle_tol_deg:g} deg)"
         )
-    max_track = float(np.max(track, initial=0.0))
     if max_dev > dev_limit:
         problems.append(
             f"the robot strayed {max_dev * 1e3:.3g} mm from the commanded state at "

@@ -33,17 +33,23 @@ between two links): a plan that keeps a margin larger than the deviation execute
 without contact.
 
 **Clearance sampling.** One closest-point query of the 24-module Arm-Z (scene and every
-link pair) takes about 2 ms, a physics step about 0.25 ms, so the clearance is not read at
-every step. Between two states the clearance to the scene changes by at most the
-deviation between them, and between two links by at most twice it. After a state whose
-clearance is ``c``, :func:`sampled_clearance` takes the next sample at the first state
-whose geometry has moved by more than ``max(resolution_m, c / 8) / 2`` from the sampled
-one (the deviation bound above), and always the last state. So every state between two
-samples has a clearance of at least ``c − max(resolution_m, c / 8)``: no state closer
-than ``resolution_m`` to a collision is missed, a sampled clearance under
-``8 · resolution_m`` is within ``resolution_m`` of the true smallest one (above that,
-within 1/8 of it), and far from everything it samples rarely. Pairs are read up to
-``max_distance_m``; a sample that finds none has a clearance of at least that.
+link pair) takes 1-5 ms, a physics step about 0.4 ms, so the clearance is not read at
+every step. A query at a sampled state gives each link's distance to the scene ``s_l``
+and each pair's distance ``d_lm``. At a later state, where link ``l`` has moved by at
+most ``δ_l`` (the bound above, per link, against the sampled state), the link is at least
+``s_l − δ_l`` from the scene and the pair at least ``d_lm − δ_l − δ_m`` apart.
+:func:`sampled_clearance` takes the next sample at the first state where that lower
+bound falls below ``c − max(resolution_m, c / 8)``, ``c`` the sampled state's smallest
+clearance (and always the last state). So every state between two samples has a
+clearance of at least ``c − max(resolution_m, c / 8)``: no state closer than
+``resolution_m`` to a collision is missed, the reported smallest clearance is within
+``resolution_m`` of the true one below ``8 · resolution_m`` (above that, within 1/7 of
+it), and links that move little near an obstacle (Arm-Z's first module, 5 cm above the
+ground all the time) cost nothing while the far links swing. On the paper's task this is
+27-223 queries per leg of 5 000-12 000 physics steps; on a leg of 12 248 states, querying
+every second state found a smallest clearance of 31.32 mm, the sampling 31.54 mm with 54
+queries. Pairs are read up to ``max_distance_m``; a pair farther apart counts as that
+far.
 
 Pairs: every link not in ``robot.fixed_links`` against every obstacle, and every pair of
 links not in ``robot.excluded_pairs`` (the pairs the collision checker checks).
@@ -229,12 +235,11 @@ def sampled_clearance(
                 break
             lo = hi
         i = j
-    clearance, index, pair, self_pair = best
     return Clearance(
-        clearance_m=float(clearance),
-        index=int(index),
-        pair=pair,
-        self_pair=self_pair,
+        clearance_m=float(best[0]),
+        index=int(best[1]),
+        pair=best[2],
+        self_pair=best[3],
         samples=samples,
         resolution_m=float(resolution_m),
         max_distance_m=float(max_distance_m),
