@@ -167,8 +167,9 @@ class Execution:
         sim_time_s: simulated time of this execution (physics steps × dt) [s].
         wall_time_s: wall-clock time of this execution, re-check included [s].
         reason: why it succeeded or failed, in words.
-        track_err_limit_rad: the largest ``max_track_err_rad`` a clean execution may
-            show [rad] (the problem's ``[simulation] max_track_err_rad``).
+        track_err_limit_rad: the problem's ``[simulation] max_track_err_rad`` [rad]: the
+            verdict's joint tracking limit in records made before ``max_deviation_m``
+            (see :attr:`followed`); recorded, not judged, since.
         timing: ``"toppra"`` (retimed trajectory, position+velocity targets every physics
             step) or ``"waypoints"`` (densified waypoints, position targets held for
             ``steps_per_waypoint`` steps each).

@@ -491,8 +491,18 @@ def execute(
         gravity_mps2: gravity in the world frame [m/s²]; default: the problem's
             ``[simulation] gravity_mps2`` (zero it to separate kinematic from torque-limit
             failures).
-        max_track_err_rad: the largest joint tracking error of a clean execution [rad];
+        max_track_err_rad: the joint tracking limit recorded in the execution
+            (``track_err_limit_rad``; informational, it no longer decides the verdict);
             default: the problem's ``[simulation] max_track_err_rad``.
+        max_deviation_m: the largest deviation of the robot's collision geometry from
+            the commanded state of a clean execution [m]; default: the problem's
+            ``[simulation] max_deviation_m``.
+        solver: PyBullet's constraint solver (:data:`SOLVER`, see the module docstring;
+            "pgs" is PyBullet's default iterative one).
+        solver_iterations: the iterative solver's iterations per step (None: 50).
+        dt_s: physics time step [s].
+        grid_per_knot: TOPP-RA grid points per knot interval
+            (:data:`~plannerlab.sim.retime.GRID_PER_KNOT`).
         timing: ``"toppra"`` (default): the path is time-parameterised under the robot's
             velocity limits and half its torque limits (:mod:`plannerlab.sim.retime`)
             and tracked with position+velocity targets every physics step; when that is
