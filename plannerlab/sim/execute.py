@@ -87,10 +87,28 @@ torque and the reference trajectory's inverse-dynamics torque along leg D:
    *shorter* (leg D 51 s -> 19 s: the coarse grid's interpolated constraints were also
    conservative), so there are fewer physics steps to run.
 
-Inverse dynamics as feed-forward under an explicit PD loop (torque control, computed
-torque) was tried on leg D too (3 mm at the tip, but it needs one inverse-dynamics call
-per step and gains to tune per robot); a smaller time step (1/960 s) only helped as much
-as more iterations, at 4 x the steps. The executor keeps PyBullet's motors on the direct
+What each option buys on the paper's task (``gradient.clearance+detour``, seed 0, the
+seven legs enter, A-E, leave in one world; largest deviation per leg [mm]; wall time as
+a ratio within one run of ``bench/execution_bench.py`` on a shared 2-core machine):
+
+============================  ==========================================  =========
+option                        deviation per leg [mm]                      wall
+============================  ==========================================  =========
+before (pgs, grid at knots)   15.2 48.9 14.5 28.7 171.3 114.0 12.8        1.00
+pgs, 200 iterations           4.3 4.7 4.4 3.8 7.6 7.2 2.2                 0.76
+pgs, dt = 1/960 s             3.0 1.5 1.6 3.4 10.6 22.4 14.0              1.71
+dantzig                       1.6 0.3 0.3 2.9 11.7 2.3 0.9                0.22
+pgs, grid 4 per knot          5.7 33.0 56.0 15.9 11.7 53.7 123.1          0.19
+dantzig, grid 2               0.0 0.0 0.4 0.0 0.0 0.0 0.0                 0.15
+dantzig, grid 4 (chosen)      0.0 0.0 0.0 0.0 0.0 0.0 0.0                 0.16
+============================  ==========================================  =========
+
+(The first run's early options ran under a heavier load; in a later run of two rounds,
+interleaved, the chosen executor took 0.80 x the wall time of the executor before this
+change, run from an exported copy of its commit.) Inverse dynamics as feed-forward under
+an explicit PD loop (torque control, computed torque, ω = 30 rad/s) was tried on leg D
+alone: 3 mm at the tip but joint errors up to 0.076 rad, one inverse-dynamics call per
+step, and gains to tune per robot; not kept. The executor keeps PyBullet's motors on the direct
 solver (:data:`SOLVER`) and the finer TOPP-RA grid: what each option buys is in
 ``bench/execution_bench.py`` (deviation per leg and wall time as a ratio to the old
 settings, measured in one run).
