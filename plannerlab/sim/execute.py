@@ -108,10 +108,8 @@ interleaved, the chosen executor took 0.80 x the wall time of the executor befor
 change, run from an exported copy of its commit.) Inverse dynamics as feed-forward under
 an explicit PD loop (torque control, computed torque, ω = 30 rad/s) was tried on leg D
 alone: 3 mm at the tip but joint errors up to 0.076 rad, one inverse-dynamics call per
-step, and gains to tune per robot; not kept. The executor keeps PyBullet's motors on the direct
-solver (:data:`SOLVER`) and the finer TOPP-RA grid: what each option buys is in
-``bench/execution_bench.py`` (deviation per leg and wall time as a ratio to the old
-settings, measured in one run).
+step, and gains to tune per robot; not kept. The executor keeps PyBullet's motors on
+the direct solver (:data:`SOLVER`) and the finer TOPP-RA grid.
 """
 
 from __future__ import annotations
