@@ -172,7 +172,8 @@ SUMMARY_COLUMNS: dict[str, SummaryColumn] = {
         "executed\ncleanly",
         "num",
         _exec_ok,
-        "executions in PyBullet without contact that reached the goal, of those run",
+        "executions in PyBullet that ran cleanly (no contact, clearance >= 0, deviation "
+        "within max_deviation_m, goal reached), of those run",
         executed=True,
     ),
     "deviation": SummaryColumn(
