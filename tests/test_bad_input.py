@@ -127,6 +127,18 @@ PROBLEM_CASES = {
         TINY_PROBLEM_TOML + "\n[simulation]\ngravity_mps2 = [0, -9.81]\n",
         "simulation.gravity_mps2",
     ),
+    "deviation_limit_negative": (
+        TINY_PROBLEM_TOML + "\n[simulation]\nmax_deviation_m = -0.01\n",
+        "simulation.max_deviation_m",
+    ),
+    "deviation_limit_zero": (
+        TINY_PROBLEM_TOML + "\n[simulation]\nmax_deviation_m = 0\n",
+        "simulation.max_deviation_m",
+    ),
+    "deviation_limit_text": (
+        TINY_PROBLEM_TOML + '\n[simulation]\nmax_deviation_m = "1 cm"\n',
+        "simulation.max_deviation_m",
+    ),
     "witness_wrong_joint_count": (
         TINY_PROBLEM_TOML
         + "\n[witness]\npath_rad = [[3.14, 3.14, 3.14, 3.14, 3.14], [1.0, 2.0]]\n",

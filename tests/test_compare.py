@@ -488,6 +488,9 @@ def test_a_raising_trial_is_recorded_and_execution_summarised(tmp_path: Path) ->
     assert recs[ok.key]["success"], recs[ok.key]["legs_run"]
     ex = recs[ok.key]["execution"]
     assert ex is not None and set(ex) >= {"success", "max_track_err_rad", "contacts"}
+    # the verdict's numbers in metres, per trial and per leg
+    assert 0.0 <= ex["max_deviation_m"] <= 0.01 and ex["min_clearance_m"] > 0.0
+    assert all(leg["max_deviation_limit_m"] == 0.01 for leg in ex["legs"])
     assert len(ex["legs"]) == len(recs[ok.key]["legs_run"]) == recs[ok.key]["executed_legs"]
     # a plan that did not solve its leg is not executed
     assert recs[stalled.key]["execution"] is None and recs[stalled.key]["executed_legs"] == 0
@@ -495,6 +498,8 @@ def test_a_raising_trial_is_recorded_and_execution_summarised(tmp_path: Path) ->
     assert rows["gradient"]["errors"] == 1 and rows["ompl.rrtconnect"]["errors"] == 0
     assert rows["ompl.rrtconnect"]["executed"] == 1
     assert math.isfinite(rows["ompl.rrtconnect"]["exec_track_err_median_rad"])
+    assert 0.0 <= rows["ompl.rrtconnect"]["exec_deviation_median_m"] <= 0.01
+    assert rows["ompl.rrtconnect"]["exec_clearance_min_m"] > 0.0
     assert rows["gradient.analytic"]["executed"] == 0
 
 

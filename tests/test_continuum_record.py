@@ -62,6 +62,10 @@ def test_json_embeds_the_plan_and_execution_records(continuum_run) -> None:
     assert e.extra["executor"] == "chord_arc" and e.extra["collision_points_used"] == [1]
     assert e.success and not e.unexpected_contacts and e.path_valid is None
     assert e.final_pos_err_m < 1e-3
+    # the chain follows its path (measured 0.79 mm at the waypoints' window ends, against
+    # the 1 cm limit); its clearance is not judged: it touches its collision point
+    assert e.max_deviation_m < 2e-3 and e.max_deviation_limit_m == 0.01 and e.followed
+    assert math.isnan(e.min_clearance_m) and e.solver == "dantzig"
 
 
 def test_plannerlab_execute_runs_a_continuum_plan(continuum_run, tmp_path) -> None:

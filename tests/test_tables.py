@@ -214,6 +214,8 @@ def test_execution_table_keeps_obstacle_names_whole(width: int) -> None:
             recheck_pairs=(("module_16", "boulder"),),
             final_pos_err_m=11.8,
             final_angle_err_deg=0.000173,
+            max_deviation_m=0.217,
+            min_clearance_m=-0.0031,
             max_track_err_rad=0.0512,
             contacts=(contact,) * 3,
             unexpected_contacts=(contact,) * 3,
@@ -228,6 +230,8 @@ def test_execution_table_keeps_obstacle_names_whole(width: int) -> None:
             recheck_pairs=(),
             final_pos_err_m=0.000208,
             final_angle_err_deg=1.5,
+            max_deviation_m=1.2e-6,
+            min_clearance_m=0.0384,
             max_track_err_rad=0.00123,
             contacts=(),
             unexpected_contacts=(),
@@ -239,5 +243,6 @@ def test_execution_table_keeps_obstacle_names_whole(width: int) -> None:
     ]
     lines = _render(width, lambda c: c.print(execution_table(legs, executions)))
     _fits(lines, width)
-    _whole(["11.8", "0.000173", "0.0512", "162", "41.9", "0.000208", "0.00123"], lines)
+    _whole(["11.8", "0.000173", "41.9", "0.000208"], lines)
+    _whole(["217", "-3.1", "0.0012", "38.4"], lines)  # deviation and clearance [mm]
     _whole(["module_17 x boulder", "module_16 x boulder", "pocket", "collides"], lines)

@@ -92,6 +92,8 @@ TRIAL_COLUMNS = (
     "escapes",
     "exec_success",
     "exec_path_valid",
+    "exec_max_deviation_m",
+    "exec_min_clearance_m",
     "exec_max_track_err_rad",
     "exec_contacts",
     "exec_final_pos_err_m",
@@ -122,6 +124,8 @@ LEG_COLUMNS = (
     "extra_lengths",
     "exec_success",
     "exec_path_valid",
+    "exec_max_deviation_m",
+    "exec_min_clearance_m",
     "exec_max_track_err_rad",
     "exec_contacts",
     "exec_final_pos_err_m",
@@ -212,6 +216,8 @@ def trial_rows(records: Iterable[Mapping[str, Any]]) -> list[dict[str, Any]]:
                 "final_angle_err_deg": r.get("final_angle_err_deg"),
                 "exec_success": ex.get("success"),
                 "exec_path_valid": ex.get("path_valid"),
+                "exec_max_deviation_m": ex.get("max_deviation_m"),
+                "exec_min_clearance_m": ex.get("min_clearance_m"),
                 "exec_max_track_err_rad": ex.get("max_track_err_rad"),
                 "exec_contacts": ex.get("contacts"),
                 "exec_final_pos_err_m": ex.get("final_pos_err_m"),
@@ -258,6 +264,8 @@ def leg_rows(records: Iterable[Mapping[str, Any]]) -> list[dict[str, Any]]:
                     "extra_lengths": _lengths(x.get("extra") or {}),
                     "exec_success": e.get("success"),
                     "exec_path_valid": e.get("path_valid"),
+                    "exec_max_deviation_m": e.get("max_deviation_m"),
+                    "exec_min_clearance_m": e.get("min_clearance_m"),
                     "exec_max_track_err_rad": e.get("max_track_err_rad"),
                     "exec_contacts": _n_contacts(e.get("contacts")),
                     "exec_final_pos_err_m": e.get("final_pos_err_m"),
@@ -281,6 +289,11 @@ def summary_csv(rows: Iterable[Mapping[str, Any]]) -> str:
 
 
 # ---------------------------------------------------------------------- Markdown
+def mm(x: Any) -> Any:
+    """Metres to millimetres for a table cell (None and NaN pass through)."""
+    return None if x is None else 1e3 * float(x)
+
+
 def fmt(x: Any, digits: int = 3) -> str:
     """A number for a table: 3 significant digits, "-" for missing/NaN."""
     if x is None:
@@ -317,6 +330,8 @@ def summary_cells(row: Mapping[str, Any], executed: bool) -> list[str]:
         cells += [
             f"{row['exec_successes']}/{row['executed']}"
             + (f" ({fmt(100 * rate)}%)" if row["executed"] else ""),
+            fmt(mm(row.get("exec_deviation_median_m"))),
+            fmt(mm(row.get("exec_clearance_min_m"))),
             fmt(row["exec_track_err_median_rad"]),
         ]
     return cells
@@ -333,7 +348,7 @@ TABLE_HEADERS = (
     "checks",
     "minima met / escaped",
 )
-EXEC_HEADERS = ("PyBullet ok", "track err rad")
+EXEC_HEADERS = ("PyBullet ok", "deviation mm", "clearance mm", "track err rad")
 
 TABLE_NOTES = (
     "solved: trials whose every leg is SOLVED (an `error` trial counts as a failure); "
@@ -345,8 +360,12 @@ TABLE_NOTES = (
     "leg, median over trials that ran. checks: collision checks per trial, median. "
     "minima met / escaped: totals over trials. PyBullet ok: of the trials whose plan "
     "solved (only those are executed, solved legs up to the first failure), executions "
-    "with a valid FCL re-check, no contact and the goal reached; track err: median over "
-    "executed trials of the largest joint tracking error."
+    "with a valid FCL re-check, no contact, simulated clearance >= 0, deviation within "
+    "the problem's max_deviation_m and the goal reached; deviation: median over executed "
+    "trials of the largest deviation of any point of the robot's collision geometry from "
+    "the commanded state; clearance: the smallest simulated clearance (PyBullet's closest "
+    "points, scene and links) over executed trials; track err: median over executed "
+    "trials of the largest joint tracking error (informational)."
 )
 
 #: how far a planner may go past its budget, said under every comparison table
@@ -462,6 +481,8 @@ _RUN_PROPERTIES: tuple[tuple[str, str], ...] = (
     ("execution success", "BOOLEAN"),
     ("execution max tracking error", "REAL"),
     ("execution contacts", "INTEGER"),
+    ("execution max deviation", "REAL"),
+    ("execution min clearance", "REAL"),
 )
 
 
@@ -534,6 +555,8 @@ def _run_values(r: Mapping[str, Any]) -> list[str]:
         ex.get("success") if ex else None,
         ex.get("max_track_err_rad") if ex else None,
         ex.get("contacts") if ex else None,
+        ex.get("max_deviation_m") if ex else None,
+        ex.get("min_clearance_m") if ex else None,
     ]
     return [_log_value(v) for v in values]
 
@@ -659,6 +682,7 @@ __all__ = [
     "TABLE_NOTES",
     "TRIAL_COLUMNS",
     "fmt",
+    "mm",
     "leg_rows",
     "legs_csv",
     "log_paths",

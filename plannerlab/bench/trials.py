@@ -252,6 +252,17 @@ def _execution_record(executions: Sequence[Execution]) -> dict[str, Any]:
         "success": bool(executions) and all(e.success for e in executions),
         "path_valid": all(e.path_valid is not False for e in executions),
         "max_track_err_rad": to_data(max((e.max_track_err_rad for e in executions), default=0.0)),
+        "max_deviation_m": to_data(
+            max((e.max_deviation_m for e in executions), default=math.nan)
+            if all(math.isfinite(e.max_deviation_m) for e in executions)
+            else math.nan
+        ),
+        "min_clearance_m": to_data(
+            min(
+                (e.min_clearance_m for e in executions if math.isfinite(e.min_clearance_m)),
+                default=math.nan,
+            )
+        ),
         "contacts": sum(len(e.unexpected_contacts) for e in executions),
         "final_pos_err_m": to_data(last.final_pos_err_m) if last else None,
         "final_angle_err_deg": to_data(last.final_angle_err_deg) if last else None,
@@ -785,6 +796,8 @@ SUMMARY_COLUMNS = (
     "exec_successes",
     "exec_success_rate",
     "exec_track_err_median_rad",
+    "exec_deviation_median_m",
+    "exec_clearance_min_m",
     "exec_contacts",
 )
 
@@ -836,6 +849,8 @@ def summarise(records: Iterable[Mapping[str, Any]]) -> list[dict[str, Any]]:
                 "exec_track_err_median_rad": _pct(
                     _vals(e.get("max_track_err_rad") for e in ex), 50
                 ),
+                "exec_deviation_median_m": _pct(_vals(e.get("max_deviation_m") for e in ex), 50),
+                "exec_clearance_min_m": _pct(_vals(e.get("min_clearance_m") for e in ex), 0),
                 "exec_contacts": int(sum(e.get("contacts") or 0 for e in ex)),
             }
         )

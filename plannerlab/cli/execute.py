@@ -20,9 +20,11 @@ from plannerlab.record.codec import dumps
 
 
 def execution_table(legs: Any, executions: Any) -> Table:
-    """One row per executed leg: FCL re-check, tip errors, tracking, the trajectory's
-    duration, contacts, wall time, verdict; which pairs collided or touched goes in the
-    caption (names never cut)."""
+    """One row per executed leg: FCL re-check, tip errors, the largest deviation of the
+    robot's collision geometry from the commanded state and the smallest simulated
+    clearance [mm], contacts, wall time, verdict (the joint tracking error, informational
+    since the verdict is in metres, and the trajectory's duration are in ``--json``);
+    which pairs collided or touched goes in the caption (names never cut)."""
     t = table(
         "execution in PyBullet",
         [
@@ -31,8 +33,8 @@ def execution_table(legs: Any, executions: Any) -> Table:
             ("FCL", "name"),
             ("pos err\nm", "num"),
             ("ang err\n°", "num"),
-            ("track\nerr rad", "num"),
-            ("motion\ns", "num"),
+            ("devia-\ntion mm", "num"),
+            ("clear-\nance mm", "num"),
             ("con-\ntacts", "num"),
             ("wall s", "num"),
             ("ok", "name"),
@@ -59,8 +61,8 @@ def execution_table(legs: Any, executions: Any) -> Table:
             {True: "valid", False: "[red]collides[/red]", None: "contact plan"}[e.path_valid],
             fmt(e.final_pos_err_m),
             fmt(e.final_angle_err_deg),
-            fmt(e.max_track_err_rad),
-            fmt(e.duration_s),
+            fmt(1e3 * e.max_deviation_m),
+            fmt(1e3 * e.min_clearance_m),
             str(len(names)),
             fmt(e.wall_time_s),
             "[green]yes[/green]" if e.success else "[red]no[/red]",

@@ -24,7 +24,7 @@ from rich.console import Console
 from rich.markup import escape
 from rich.table import Table
 
-from plannerlab.bench.report import fmt
+from plannerlab.bench.report import fmt, mm
 from plannerlab.errors import UnknownNameError
 
 #: width of piped output when neither COLUMNS nor a terminal says otherwise
@@ -192,14 +192,30 @@ SUMMARY_COLUMNS: dict[str, SummaryColumn] = {
         "executed\ncleanly",
         "num",
         _exec_ok,
-        "executions in PyBullet without contact that reached the goal, of those run",
+        "executions in PyBullet that ran cleanly (no contact, clearance >= 0, deviation "
+        "within max_deviation_m, goal reached), of those run",
+        executed=True,
+    ),
+    "deviation": SummaryColumn(
+        "deviation\nmm",
+        "num",
+        lambda r: fmt(mm(r.get("exec_deviation_median_m"))),
+        "largest deviation of the robot's collision geometry from the commanded state in "
+        "PyBullet, median [mm]",
+        executed=True,
+    ),
+    "clearance": SummaryColumn(
+        "clearance\nmm",
+        "num",
+        lambda r: fmt(mm(r.get("exec_clearance_min_m"))),
+        "smallest simulated clearance (PyBullet's closest points) over the executions [mm]",
         executed=True,
     ),
     "track_err": SummaryColumn(
         "track\nerr rad",
         "num",
         lambda r: fmt(r["exec_track_err_median_rad"]),
-        "largest joint tracking error in PyBullet, median [rad]",
+        "largest joint tracking error in PyBullet, median [rad] (informational)",
         executed=True,
     ),
 }
@@ -218,6 +234,8 @@ WIDE_COLUMNS = (
     "checks",
     "minima",
     "exec_ok",
+    "deviation",
+    "clearance",
     "track_err",
 )
 

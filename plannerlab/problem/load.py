@@ -16,7 +16,8 @@ File layout (every key is documented in ``docs/problem-format.md``)::
     [[goals]]   name, p_m, n, pos_tol_m, angle_tol_deg     (one per leg, in order)
     [budget]    max_iterations, max_collision_checks, time_limit_s
     [checking]  joint_step       (largest joint step between checked states on an edge)
-    [simulation] gravity_mps2 (default: Arm-Z off, others -9.81 along -z), max_track_err_rad
+    [simulation] gravity_mps2 (default: Arm-Z off, others -9.81 along -z), max_deviation_m,
+                max_track_err_rad
     [witness]   path_rad        (a known collision-free path, for tests)
     [continuum] collision_points_m, guide_obstacles   (continuum planners)
     [ik_expected] free-form     (what tests expect of the IRb-6 analytic IK)
@@ -96,13 +97,17 @@ class SimSettings:
 
     Attributes:
         gravity_mps2: gravity in the world frame [m/s²].
-        max_track_err_rad: largest joint tracking error [rad] (max over joints and over
-            the execution of the wrapped |commanded − actual|) an execution may show and
-            still count as executed cleanly.
+        max_track_err_rad: the joint tracking limit of execution records made before
+            ``max_deviation_m`` [rad]; kept for old problem files, it no longer decides
+            the verdict (the joint error is reported for information).
+        max_deviation_m: largest deviation [m] of any point of the robot's collision
+            geometry between the commanded and the simulated state, over the whole
+            execution, that an execution may show and still count as executed cleanly.
     """
 
     gravity_mps2: tuple[float, float, float] = (0.0, 0.0, -9.81)
     max_track_err_rad: float = 0.05
+    max_deviation_m: float = 0.01
     #: where the setting came from, in words (shown by ``execute``)
     origin: str = "default"
 
@@ -418,7 +423,7 @@ def _simulation(top: TableReader, robot: Robot) -> SimSettings:
             )
         return SimSettings(origin="gravity -9.81 m/s² along -z: the default")
     sim = TableReader(top.source, "simulation", top.raw("simulation"))
-    sim.unknown_keys(("gravity_mps2", "max_track_err_rad", "note"))
+    sim.unknown_keys(("gravity_mps2", "max_track_err_rad", "max_deviation_m", "note"))
     if not sim.has("gravity_mps2"):
         default = _simulation(TableReader(top.source, "", {}), robot)
         g = np.array(default.gravity_mps2)
@@ -429,6 +434,7 @@ def _simulation(top: TableReader, robot: Robot) -> SimSettings:
     return SimSettings(
         gravity_mps2=(float(g[0]), float(g[1]), float(g[2])),
         max_track_err_rad=sim.number("max_track_err_rad", 0.05, positive=True),
+        max_deviation_m=sim.number("max_deviation_m", 0.01, positive=True),
         origin=origin,
     )
 

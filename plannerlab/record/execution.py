@@ -92,11 +92,19 @@ _ARRAY_FIELDS = (
     "q_actual_rad",
     "track_err_rad",
     "tip_track_err_m",
+    "deviation_m",
     "q_start_rad",
     "q_final_rad",
 )
 #: the per-waypoint log, left out of a trial store's copy
-_LOG_FIELDS = ("t_s", "q_cmd_rad", "q_actual_rad", "track_err_rad", "tip_track_err_m")
+_LOG_FIELDS = (
+    "t_s",
+    "q_cmd_rad",
+    "q_actual_rad",
+    "track_err_rad",
+    "tip_track_err_m",
+    "deviation_m",
+)
 _FLOAT_FIELDS = (
     "final_pos_err_m",
     "final_angle_err_deg",
@@ -106,6 +114,11 @@ _FLOAT_FIELDS = (
     "duration_s",
     "spline_dev",
     "recheck_joint_step",
+    "max_deviation_m",
+    "max_deviation_time_s",
+    "max_deviation_limit_m",
+    "min_clearance_m",
+    "min_clearance_time_s",
 )
 
 
@@ -154,8 +167,9 @@ class Execution:
         sim_time_s: simulated time of this execution (physics steps × dt) [s].
         wall_time_s: wall-clock time of this execution, re-check included [s].
         reason: why it succeeded or failed, in words.
-        track_err_limit_rad: the largest ``max_track_err_rad`` a clean execution may
-            show [rad] (the problem's ``[simulation] max_track_err_rad``).
+        track_err_limit_rad: the problem's ``[simulation] max_track_err_rad`` [rad]: the
+            verdict's joint tracking limit in records made before ``max_deviation_m``
+            (see :attr:`followed`); recorded, not judged, since.
         timing: ``"toppra"`` (retimed trajectory, position+velocity targets every physics
             step) or ``"waypoints"`` (densified waypoints, position targets held for
             ``steps_per_waypoint`` steps each).
@@ -164,6 +178,27 @@ class Execution:
             (None for ``"waypoints"``, whose commands are the densified path itself).
         spline_dev: largest distance between the retimed spline and the path's
             polyline at the knot-interval midpoints [rad or m] (NaN for ``"waypoints"``).
+        deviation_m: (M,) per logged sample, the largest deviation of the robot's
+            collision geometry from the commanded state since the previous sample [m]
+            (settling excluded; empty in records made before it existed).
+        max_deviation_m: largest displacement of any point of the robot's collision
+            geometry (every link's capsule) between the commanded and the simulated
+            state over the whole execution, settling included [m]; see
+            :mod:`plannerlab.sim.measure` for the bound and the states measured (NaN in
+            records made before it existed).
+        max_deviation_time_s: when it was met, from the leg's start [s].
+        max_deviation_limit_m: the problem's ``[simulation] max_deviation_m`` that the
+            verdict applied [m] (NaN in older records, judged by the joint tracking
+            limit ``track_err_limit_rad`` instead).
+        min_clearance_m: smallest simulated clearance (PyBullet's closest points) of the
+            robot to the scene and between its non-excluded links over the execution,
+            sampled as :mod:`plannerlab.sim.measure` says [m]; negative: penetration
+            (NaN when not measured: older records, and contact-permitting plans, which
+            touch by design; their closest approaches are in ``extra``).
+        min_clearance_time_s: when it was met [s].
+        min_clearance_pair: (robot link, obstacle or other link) of that clearance.
+        clearance_samples: states whose clearance was queried.
+        solver: PyBullet's constraint solver ("pgs", "dantzig"; "" when not recorded).
     """
 
     problem: str
@@ -203,6 +238,15 @@ class Execution:
     duration_s: float = math.nan
     trajectory_valid: bool | None = None
     spline_dev: float = math.nan
+    deviation_m: Array = field(default_factory=lambda: np.zeros(0))
+    max_deviation_m: float = math.nan
+    max_deviation_time_s: float = math.nan
+    max_deviation_limit_m: float = math.nan
+    min_clearance_m: float = math.nan
+    min_clearance_time_s: float = math.nan
+    min_clearance_pair: tuple[str, str] | None = None
+    clearance_samples: int = 0
+    solver: str = ""
     extra: Mapping[str, Any] = field(default_factory=dict)
 
     def __post_init__(self) -> None:
@@ -216,6 +260,10 @@ class Execution:
             object.__setattr__(self, name, read_float(getattr(self, name)))
         object.__setattr__(self, "gravity_mps2", tuple(float(g) for g in self.gravity_mps2))
         object.__setattr__(self, "extra", dict(self.extra))
+        if self.min_clearance_pair is not None:
+            link, other = self.min_clearance_pair
+            object.__setattr__(self, "min_clearance_pair", (str(link), str(other)))
+        object.__setattr__(self, "clearance_samples", int(self.clearance_samples))
         object.__setattr__(
             self, "recheck_pairs", tuple((str(a), str(b)) for a, b in self.recheck_pairs)
         )
@@ -230,8 +278,23 @@ class Execution:
 
     @property
     def tracked(self) -> bool:
-        """The maximum joint tracking error stayed within ``track_err_limit_rad``."""
+        """The maximum joint tracking error stayed within ``track_err_limit_rad`` (the
+        verdict of records made before ``max_deviation_m``; informational since)."""
         return self.max_track_err_rad <= self.track_err_limit_rad
+
+    @property
+    def followed(self) -> bool:
+        """The robot followed the commanded motion: ``max_deviation_m`` within
+        ``max_deviation_limit_m``; a record made before the deviation was measured is
+        judged by its joint tracking limit (:attr:`tracked`), as it was then."""
+        if math.isnan(self.max_deviation_limit_m):
+            return self.tracked
+        return self.max_deviation_m <= self.max_deviation_limit_m
+
+    @property
+    def clear(self) -> bool:
+        """The simulated clearance never fell below 0 (True when it was not measured)."""
+        return not self.min_clearance_m < 0
 
     @property
     def expected_contacts(self) -> tuple[ContactRecord, ...]:
@@ -245,13 +308,15 @@ class Execution:
 
     @property
     def success(self) -> bool:
-        """Executed cleanly: re-check not failed, no unexpected contact, tracking error
-        within the limit, and (with a leg) the final state in the goal."""
+        """Executed cleanly: re-check not failed, no unexpected contact, smallest
+        simulated clearance >= 0, largest deviation within the limit (:attr:`followed`)
+        and (with a leg) the final state in the goal."""
         return (
             self.path_valid is not False
             and self.trajectory_valid is not False
             and not self.unexpected_contacts
-            and self.tracked
+            and self.clear
+            and self.followed
             and self.goal_reached is not False
         )
 
@@ -275,9 +340,10 @@ class Execution:
 
         Args:
             include_log: False leaves out the per-waypoint log (``t_s``, ``q_cmd_rad``,
-                ``q_actual_rad``, ``track_err_rad``, ``tip_track_err_m``: a trial store
-                keeps hundreds of legs) and writes ``log_points``, ``success``,
-                ``max_track_err_rad`` and ``max_tip_track_err_m`` instead.
+                ``q_actual_rad``, ``track_err_rad``, ``tip_track_err_m``,
+                ``deviation_m``: a trial store keeps hundreds of legs) and writes
+                ``log_points``, ``success``, ``max_track_err_rad`` and
+                ``max_tip_track_err_m`` instead.
         """
         out = {f.name: getattr(self, f.name) for f in dataclasses.fields(self)}
         out["contacts"] = [c.to_dict() for c in self.contacts]
@@ -302,7 +368,8 @@ class Execution:
             values = {
                 f.name: data[f.name]
                 for f in fields
-                if f.name in data or f.default is dataclasses.MISSING
+                if f.name in data
+                or (f.default is dataclasses.MISSING and f.default_factory is dataclasses.MISSING)
             }
             for k in ("sim_time_s", "wall_time_s", "dt_s", "contact_tol_m"):
                 values[k] = read_float(values[k])

@@ -7,9 +7,11 @@
    simulation, and records the verdict and the colliding pairs;
 2. drives the simulated robot along it by position control with the Arm-Z paper's
    parameters (``000_a8ed938e94518caf.txt``: 1/240 s steps, 100 N·m motors, gravity on;
-   see :mod:`plannerlab.sim.world`), logging the state reached at every waypoint, the
-   tracking error and every contact;
-3. measures the final tip error against the leg's goal.
+   see :mod:`plannerlab.sim.world`) on PyBullet's direct constraint solver, logging the
+   state reached at every step, the deviation from the commanded state, the tracking
+   error and every contact;
+3. measures the smallest simulated clearance along the execution, and the final tip
+   error against the leg's goal.
 
 Decisions:
 
@@ -39,10 +41,75 @@ Decisions:
   200-waypoint 24-module path through poses needing up to 285 N·m sagged by 3 rad onto
   the room floor). ``gravity_mps2=(0, 0, 0)`` separates such failures from kinematic ones.
 * **Success** ("executed cleanly") = the path passed the re-check, no contact was
-  recorded, the maximum joint tracking error stayed within the problem's
-  ``[simulation] max_track_err_rad`` (default 0.05 rad) and, when a leg was given, the
-  final state lies inside that leg's goal region. A path that reached its goal while the
-  arm was far off the planned path did not execute *that* path, so it is not clean.
+  recorded, the smallest simulated clearance is >= 0, the largest deviation of the
+  robot's collision geometry from the commanded state stays within the problem's
+  ``[simulation] max_deviation_m`` (default 0.01 m) and, when a leg was given, the final
+  state lies inside that leg's goal region. A path that reached its goal while the arm
+  was far off the planned path did not execute *that* path, so it is not clean. The joint
+  tracking error is still logged (``track_err_rad``), for information only: 0.05 rad at
+  the base of the 16-m Arm-Z moves its tip 0.8 m, so a limit in radians cannot tell a
+  clean run from a crash.
+* **Deviation and clearance** (:mod:`plannerlab.sim.measure`). Every physics step's
+  simulated state is kept; the deviation is the bound of
+  :func:`~plannerlab.sim.measure.geometry_deviation_m` (every capsule's axis end points
+  plus radius × the turn of its axis) between it and the state commanded for that step
+  (the retimed reference at the step's end), settling included: every physics step, so
+  nothing between samples is left to argue about. With ``"waypoints"`` timing the
+  target jumps from waypoint to waypoint and the arm moves towards it over the window, so
+  the deviation is taken where it should have arrived (each window's last step) and at
+  every settling step. The clearance is read from PyBullet's closest points in a second,
+  probe world set kinematically to the executed states, sampled as dense as the
+  clearance requires (no state closer than 1 mm to a collision missed): about 30–220
+  queries per leg of the paper's task instead of 12 000 steps.
+
+**Why the arm strayed, and the design (issue 17).** Before, the 24-module Arm-Z strayed
+up to 0.17 m from the commanded path on the paper's task (leg D, 0.016 rad of joint
+error) and grazed ``wall_right``. Two causes, found by logging every motor's applied
+torque and the reference trajectory's inverse-dynamics torque along leg D:
+
+1. **The iterative constraint solver did not converge.** PyBullet's position motor is a
+   velocity constraint row per joint, solved with the contacts each step. With the
+   default projected Gauss-Seidel (50 iterations) the 23 motor rows of the chain, whose
+   first joints carry the inertia of the whole 16-m arm, are solved only approximately:
+   the arm lags, the motors then saturate at 100 N·m catching up (37 % of the steps of
+   leg D had a saturated joint, joints 0–10). More iterations help (200: 7.6 mm) and cost
+   time; the direct (Dantzig) solver solves the rows exactly, and is *cheaper* per step
+   on this chain (0.39 against 0.49 ms, measured in one process). With an exact solve,
+   a position gain of 1 and the velocity feed-forward, PyBullet's motor is a dead-beat
+   controller: the arm lands on the reference at every step, within the torque limit.
+2. **The retimed trajectory asked for more torque than the motors have, between
+   TOPP-RA's grid points.** TOPP-RA holds the torque budget (half the effort) only at its
+   grid points, which were the spline's knots; between them the cubic spline bends round
+   the path's corners and the reference needed up to 1.33 x (leg D), 1.66 x (leg E) the
+   100 N·m effort, so even an exact solver saturates there (dantzig alone: 11 mm on leg
+   D). With :data:`~plannerlab.sim.retime.GRID_PER_KNOT` = 4 grid points per knot
+   interval the peak is 0.59–0.66 x the effort on legs A, D, E, and the trajectories are
+   *shorter* (leg D 51 s -> 19 s: the coarse grid's interpolated constraints were also
+   conservative), so there are fewer physics steps to run.
+
+What each option buys on the paper's task (``gradient.clearance+detour``, seed 0, the
+seven legs enter, A-E, leave in one world; largest deviation per leg [mm]; wall time as
+a ratio within one run of ``bench/execution_bench.py`` on a shared 2-core machine):
+
+============================  ==========================================  =========
+option                        deviation per leg [mm]                      wall
+============================  ==========================================  =========
+before (pgs, grid at knots)   15.2 48.9 14.5 28.7 171.3 114.0 12.8        1.00
+pgs, 200 iterations           4.3 4.7 4.4 3.8 7.6 7.2 2.2                 0.76
+pgs, dt = 1/960 s             3.0 1.5 1.6 3.4 10.6 22.4 14.0              1.71
+dantzig                       1.6 0.3 0.3 2.9 11.7 2.3 0.9                0.22
+pgs, grid 4 per knot          5.7 33.0 56.0 15.9 11.7 53.7 123.1          0.19
+dantzig, grid 2               0.0 0.0 0.4 0.0 0.0 0.0 0.0                 0.15
+dantzig, grid 4 (chosen)      0.0 0.0 0.0 0.0 0.0 0.0 0.0                 0.16
+============================  ==========================================  =========
+
+(The first run's early options ran under a heavier load; in a later run of two rounds,
+interleaved, the chosen executor took 0.80 x the wall time of the executor before this
+change, run from an exported copy of its commit.) Inverse dynamics as feed-forward under
+an explicit PD loop (torque control, computed torque, ω = 30 rad/s) was tried on leg D
+alone: 3 mm at the tip but joint errors up to 0.076 rad, one inverse-dynamics call per
+step, and gains to tune per robot; not kept. The executor keeps PyBullet's motors on
+the direct solver (:data:`SOLVER`) and the finer TOPP-RA grid.
 """
 
 from __future__ import annotations
@@ -60,8 +127,9 @@ from plannerlab.problem.load import Problem
 from plannerlab.record.execution import ContactRecord, Execution
 from plannerlab.robots.base import Array, as_xyz, joint_difference
 from plannerlab.robots.paths import densify
-from plannerlab.sim.retime import retime, unwrap_path
-from plannerlab.sim.world import SimWorld
+from plannerlab.sim.measure import geometry_deviation_m, sampled_clearance
+from plannerlab.sim.retime import GRID_PER_KNOT, retime, unwrap_path
+from plannerlab.sim.world import DT_S, SimWorld
 
 #: physics steps per densified waypoint (0.1 s)
 STEPS_PER_WAYPOINT: int = 24
@@ -75,6 +143,8 @@ LOG_EVERY_STEPS: int = 12
 #: position error within one step (PyBullet's default 0.1 lags); with the velocity
 #: feed-forward it kept the 24-module arm within 3e-4 rad on a 9.9 rad RRT-Connect path
 TRACK_POSITION_GAIN: float = 1.0
+#: PyBullet's constraint solver for executions (see the module docstring)
+SOLVER: str = "dantzig"
 
 
 # ---------------------------------------------------------------------- running
@@ -102,6 +172,10 @@ def _run(
     contact_tol_m: float,
     track_err_limit_rad: float | None,
     timing: str,
+    *,
+    probe: SimWorld,
+    max_deviation_m: float | None = None,
+    grid_per_knot: int = GRID_PER_KNOT,
 ) -> Execution:
     t0 = time.perf_counter()
     robot = problem.robot
@@ -118,6 +192,13 @@ def _run(
     )
     if not track_limit > 0:
         raise PlannerlabError(f"max_track_err_rad must be positive, got {track_limit}")
+    dev_limit = (
+        float(max_deviation_m)
+        if max_deviation_m is not None
+        else problem.simulation.max_deviation_m
+    )
+    if not dev_limit > 0:
+        raise PlannerlabError(f"max_deviation_m must be positive, got {dev_limit}")
     recheck_step = float(joint_step) if joint_step is not None else problem.joint_step / 4.0
     wp_step = float(waypoint_step) if waypoint_step is not None else problem.joint_step
     if not (recheck_step > 0 and wp_step > 0):
@@ -131,10 +212,15 @@ def _run(
 
     steps0 = world.steps_taken
     seen: dict[tuple[str, str, bool], list[Any]] = {}
+    # Every physics step's simulated state, and the state commanded for it.
+    q_step: list[Array] = []
+    q_step_cmd: list[Array] = []
 
-    def run_steps(n: int) -> None:
+    def run_steps(n: int, q_target: Array) -> None:
         for _ in range(n):
             world.step(1)
+            q_step.append(world.state())
+            q_step_cmd.append(q_target)
             t = (world.steps_taken - steps0) * world.dt_s
             for c in world.contacts(min_depth_m=contact_tol_m):
                 key = (c.link_name, c.other_name, c.other_is_link)
@@ -161,6 +247,7 @@ def _run(
                 effort_limit=world.max_force,
                 inverse_dynamics=world.inverse_dynamics,
                 knot_step=recheck_step,
+                grid_per_knot=grid_per_knot,
             )
             timing_used = "toppra"
         except Exception as exc:  # toppra or the simulator's inverse dynamics
@@ -191,8 +278,8 @@ def _run(
         q_act_list: list[Array] = []
         for k in range(n):
             world.command_urdf(q_urdf[k], qd_urdf[k], position_gain=TRACK_POSITION_GAIN)
-            run_steps(1)
-            q_now = world.state()
+            run_steps(1, q_all[k])
+            q_now = q_step[-1]
             err_all[k] = np.max(np.abs(joint_difference(q_all[k], q_now, cont)), initial=0.0)
             if k == logged[len(q_act_list)]:
                 q_act_list.append(q_now)
@@ -201,7 +288,7 @@ def _run(
         t_s = t_all[logged]
         window_track = np.maximum.reduceat(err_all, [0, *[k + 1 for k in logged[:-1]]])
         world.command_urdf(q_urdf[-1], np.zeros(robot.dof), position_gain=TRACK_POSITION_GAIN)
-        run_steps(settle_steps)
+        run_steps(settle_steps, q_all[-1])
         q_final = world.state()
         duration = traj.duration_s
         steps_logged = LOG_EVERY_STEPS
@@ -213,15 +300,44 @@ def _run(
         t_s = np.empty(M)
         for k in range(M):
             world.command(q_cmd[k])
-            run_steps(steps_per_waypoint)
-            q_act[k] = world.state()
+            run_steps(steps_per_waypoint, q_cmd[k])
+            q_act[k] = q_step[-1]
             t_s[k] = (world.steps_taken - steps0) * world.dt_s
         world.command(q_cmd[-1])
-        run_steps(settle_steps)
+        run_steps(settle_steps, q_cmd[-1])
         q_final = world.state()
         window_track = None
         duration = M * steps_per_waypoint * world.dt_s
         steps_logged = steps_per_waypoint
+
+    # Deviation: every physics step of a retimed trajectory against the state commanded
+    # for it; with "waypoints" timing the arm moves towards each waypoint over its
+    # window, so it is measured where it should have arrived (the window's last step),
+    # and at every settling step.
+    states = np.array(q_step).reshape(len(q_step), robot.dof)
+    targets = np.array(q_step_cmd).reshape(len(q_step), robot.dof)
+    n_moving = len(states) - settle_steps
+    if traj is not None:
+        judged = np.arange(len(states))
+    else:
+        judged = np.concatenate(
+            [
+                np.arange(steps_per_waypoint - 1, n_moving, steps_per_waypoint),
+                np.arange(n_moving, len(states)),
+            ]
+        ).astype(int)
+    dev_steps = geometry_deviation_m(robot, targets[judged], states[judged])
+    worst_dev = int(np.argmax(dev_steps)) if len(dev_steps) else 0
+    max_dev = float(dev_steps[worst_dev]) if len(dev_steps) else 0.0
+    max_dev_t = float((judged[worst_dev] + 1) * world.dt_s) if len(dev_steps) else 0.0
+    # per log sample: the largest deviation since the previous sample (settling excluded)
+    step_of_sample = np.rint(t_s / world.dt_s).astype(int) - 1
+    dev_full = np.zeros(len(states))
+    dev_full[judged] = dev_steps
+    bounds = np.concatenate([[0], step_of_sample[:-1] + 1]) if len(t_s) else np.zeros(0, int)
+    deviation = np.maximum.reduceat(dev_full, bounds) if len(t_s) else np.zeros(0)
+    clear = sampled_clearance(robot, probe, states)
+    clear_t = float((clear.index + 1) * world.dt_s)
 
     track = (
         window_track
@@ -274,12 +390,17 @@ def _run(
             f"{goal.name!r} (tolerance {goal.pos_tol_m:g} m / "
             f"{goal.angle_tol_deg:g} deg)"
         )
-    max_track = float(np.max(track, initial=0.0))
-    if max_track > track_limit:
-        worst_k = int(np.argmax(track))
+    if max_dev > dev_limit:
         problems.append(
-            f"tracking error {max_track:.3g} rad at t = {t_s[worst_k]:.3f} s exceeds the "
-            f"limit {track_limit:g} rad ([simulation] max_track_err_rad)"
+            f"the robot strayed {max_dev * 1e3:.3g} mm from the commanded state at "
+            f"t = {max_dev_t:.3f} s (limit {dev_limit * 1e3:g} mm, [simulation] "
+            "max_deviation_m)"
+        )
+    if clear.clearance_m < 0:
+        a, b = clear.pair or ("?", "?")
+        problems.append(
+            f"simulated clearance {clear.clearance_m * 1e3:.3g} mm ({a} x {b}) at "
+            f"t = {clear_t:.3f} s"
         )
     if problems:
         reason = "; ".join(problems)
@@ -289,7 +410,10 @@ def _run(
             if traj is not None
             else f"executed {len(q_cmd)} waypoints"
         )
-        reason = f"{moved} without contact; max tracking error {max_track:.3g} rad"
+        reason = (
+            f"{moved} without contact; deviation <= {max_dev * 1e3:.3g} mm, clearance >= "
+            f"{clear.clearance_m * 1e3:.3g} mm"
+        )
         if reached:
             reason += f"; final tip {pos_err:.3g} m / {ang_err:.3g} deg from {goal_name!r}"
 
@@ -334,6 +458,15 @@ def _run(
         duration_s=duration,
         trajectory_valid=None if traj_check is None else traj_check.valid,
         spline_dev=math.nan if traj is None else traj.max_dev,
+        deviation_m=deviation,
+        max_deviation_m=max_dev,
+        max_deviation_time_s=max_dev_t,
+        max_deviation_limit_m=dev_limit,
+        min_clearance_m=clear.clearance_m,
+        min_clearance_time_s=clear_t,
+        min_clearance_pair=clear.pair,
+        clearance_samples=clear.samples,
+        solver=world.solver,
     )
 
 
@@ -351,6 +484,11 @@ def execute(
     timing: str = "toppra",
     gui: bool = False,
     leg: int | str | None = None,
+    max_deviation_m: float | None = None,
+    solver: str = SOLVER,
+    solver_iterations: int | None = None,
+    dt_s: float = DT_S,
+    grid_per_knot: int = GRID_PER_KNOT,
 ) -> Execution:
     """Re-check a path with FCL, then execute it in a fresh PyBullet world.
 
@@ -369,8 +507,18 @@ def execute(
         gravity_mps2: gravity in the world frame [m/s²]; default: the problem's
             ``[simulation] gravity_mps2`` (zero it to separate kinematic from torque-limit
             failures).
-        max_track_err_rad: the largest joint tracking error of a clean execution [rad];
+        max_track_err_rad: the joint tracking limit recorded in the execution
+            (``track_err_limit_rad``; informational, it no longer decides the verdict);
             default: the problem's ``[simulation] max_track_err_rad``.
+        max_deviation_m: the largest deviation of the robot's collision geometry from
+            the commanded state of a clean execution [m]; default: the problem's
+            ``[simulation] max_deviation_m``.
+        solver: PyBullet's constraint solver (:data:`SOLVER`, see the module docstring;
+            "pgs" is PyBullet's default iterative one).
+        solver_iterations: the iterative solver's iterations per step (None: 50).
+        dt_s: physics time step [s].
+        grid_per_knot: TOPP-RA grid points per knot interval
+            (:data:`~plannerlab.sim.retime.GRID_PER_KNOT`).
         timing: ``"toppra"`` (default): the path is time-parameterised under the robot's
             velocity limits and half its torque limits (:mod:`plannerlab.sim.retime`)
             and tracked with position+velocity targets every physics step; when that is
@@ -393,7 +541,18 @@ def execute(
     checker = CollisionChecker(problem.robot, problem.scene)
     if gravity_mps2 is None:
         gravity_mps2 = problem.simulation.gravity_mps2
-    with SimWorld(problem.robot, problem.scene, gui=gui, gravity_mps2=gravity_mps2) as world:
+    with (
+        SimWorld(
+            problem.robot,
+            problem.scene,
+            gui=gui,
+            gravity_mps2=gravity_mps2,
+            solver=solver,
+            solver_iterations=solver_iterations,
+            dt_s=dt_s,
+        ) as world,
+        SimWorld(problem.robot, problem.scene) as probe,
+    ):
         return _run(
             world,
             checker,
@@ -408,6 +567,9 @@ def execute(
             contact_tol_m,
             max_track_err_rad,
             timing,
+            probe=probe,
+            max_deviation_m=max_deviation_m,
+            grid_per_knot=grid_per_knot,
         )
 
 
@@ -425,6 +587,11 @@ def execute_legs(
     max_track_err_rad: float | None = None,
     timing: str = "toppra",
     gui: bool = False,
+    max_deviation_m: float | None = None,
+    solver: str = SOLVER,
+    solver_iterations: int | None = None,
+    dt_s: float = DT_S,
+    grid_per_knot: int = GRID_PER_KNOT,
 ) -> list[Execution]:
     """Execute consecutive legs in ONE world, each from where the previous one ended.
 
@@ -442,7 +609,18 @@ def execute_legs(
     out: list[Execution] = []
     if gravity_mps2 is None:
         gravity_mps2 = problem.simulation.gravity_mps2
-    with SimWorld(problem.robot, problem.scene, gui=gui, gravity_mps2=gravity_mps2) as world:
+    with (
+        SimWorld(
+            problem.robot,
+            problem.scene,
+            gui=gui,
+            gravity_mps2=gravity_mps2,
+            solver=solver,
+            solver_iterations=solver_iterations,
+            dt_s=dt_s,
+        ) as world,
+        SimWorld(problem.robot, problem.scene) as probe,
+    ):
         for i, path in enumerate(paths):
             leg = first_leg + i
             out.append(
@@ -460,6 +638,9 @@ def execute_legs(
                     contact_tol_m,
                     max_track_err_rad,
                     timing,
+                    probe=probe,
+                    max_deviation_m=max_deviation_m,
+                    grid_per_knot=grid_per_knot,
                 )
             )
     return out

@@ -59,6 +59,12 @@ from plannerlab.robots.base import Array, Robot, as_xyz, joint_difference
 DT_S: float = 1.0 / 240.0
 #: gravity along world z [m/s^2]
 GRAVITY_MPS2: tuple[float, float, float] = (0.0, 0.0, -9.81)
+#: PyBullet's constraint solvers by name: "pgs" (its default, iterative projected
+#: Gauss-Seidel) and "dantzig" (a direct solver of the mixed LCP)
+SOLVERS: dict[str, int] = {
+    "pgs": pybullet.CONSTRAINT_SOLVER_LCP_SI,
+    "dantzig": pybullet.CONSTRAINT_SOLVER_LCP_DANTZIG,
+}
 
 
 @dataclass(frozen=True)
@@ -113,6 +119,12 @@ class SimWorld:
             PyBullet's defaults (0.1 and 1.0); the paper names no gains.
         max_force: motor force/torque limit per joint [N·m or N] overriding the URDF's
             effort limits (a scalar or one value per joint).
+        solver: PyBullet's constraint solver, a key of :data:`SOLVERS`: ``"pgs"``
+            (PyBullet's default, iterative projected Gauss-Seidel) or ``"dantzig"`` (a
+            direct solver of the mixed LCP: the motors' constraint rows solved exactly;
+            what the executors use, see :mod:`plannerlab.sim.execute`).
+        solver_iterations: the iterative solver's iterations per step (None: PyBullet's
+            default, 50).
 
     Raises:
         PlannerlabError: a joint of ``robot.joint_names`` is missing from the URDF, or a
@@ -130,6 +142,8 @@ class SimWorld:
         position_gain: float | None = None,
         velocity_gain: float | None = None,
         max_force: float | Array | None = None,
+        solver: str = "pgs",
+        solver_iterations: int | None = None,
     ) -> None:
         self.robot = robot
         self.scene = scene if scene is not None else Scene()
@@ -140,12 +154,19 @@ class SimWorld:
             float(gravity_mps2[2]),
         )
         self.steps_taken = 0
+        if solver not in SOLVERS:
+            raise PlannerlabError(f"solver must be one of {', '.join(SOLVERS)}, got {solver!r}")
+        self.solver = solver
         self._continuous = np.asarray(robot.continuous, dtype=bool)
         self._client: BulletClient | None = BulletClient(
             connection_mode=pybullet.GUI if gui else pybullet.DIRECT
         )
         try:
             self._build(max_force)
+            if solver != "pgs":
+                self.client.setPhysicsEngineParameter(constraintSolverType=SOLVERS[solver])
+            if solver_iterations is not None:
+                self.client.setPhysicsEngineParameter(numSolverIterations=int(solver_iterations))
         except BaseException:
             self.close()
             raise
@@ -241,6 +262,12 @@ class SimWorld:
         )
 
         # Self-collision filters: the pairs the FCL checker never checks.
+        self._excluded_pairs = robot.excluded_pairs
+        n_links = len(robot_links)
+        #: (L, L) True for a link with itself and for excluded pairs
+        self._unchecked_pairs = np.eye(n_links, dtype=bool)
+        for i, j in self._excluded_pairs:
+            self._unchecked_pairs[i, j] = self._unchecked_pairs[j, i] = True
         for i, j in robot.excluded_pairs:
             a, b = self._pb_of_robot_link.get(i), self._pb_of_robot_link.get(j)
             if a is not None and b is not None:
@@ -485,6 +512,52 @@ class SimWorld:
             return self.urdf_link_names[pb_link], None
         return self.robot.link_names[i], i
 
+    def set_state(self, q_rad: Array) -> None:
+        """Put the joints at q (dof,) kinematically (no motor command, no physics step):
+        for closest-point queries of a probe world (:mod:`plannerlab.sim.measure`)."""
+        q = self._q(q_rad)
+        c = self.client
+        for j, v in zip(self._joints, self._to_urdf(q), strict=True):
+            c.resetJointState(self.body, j, float(v), 0.0)
+
+    def link_distances(self, max_distance_m: float) -> tuple[Array, list[str], Array]:
+        """Closest distances of the robot's current state, from PyBullet's closest points
+        (``getClosestPoints``) up to ``max_distance_m``: every robot link not in
+        ``robot.fixed_links`` against every obstacle, and every pair of robot links not
+        in ``robot.excluded_pairs`` (the pairs the collision checker checks).
+
+        Returns:
+            ``scene_m`` (L,): per robot link, the distance to the nearest obstacle [m]
+            (negative: penetration; ``max_distance_m`` when none is that close, inf for a
+            fixed link); ``obstacle``: that obstacle's name per link ("" when none);
+            ``self_m`` (L, L): symmetric, the distance between two links [m]
+            (``max_distance_m`` when farther, inf for a link with itself and for an
+            excluded pair).
+        """
+        c = self.client
+        robot = self.robot
+        L = len(robot.link_names)
+        dmax = float(max_distance_m)
+        scene = np.full(L, dmax)
+        scene[list(robot.fixed_links)] = np.inf
+        names = [""] * L
+        for uid, name in self.obstacle_names.items():
+            for pt in c.getClosestPoints(self.body, uid, dmax):
+                i = self._robot_link.get(pt[3])
+                d = float(pt[8])
+                if i is not None and i not in robot.fixed_links and d < scene[i]:
+                    scene[i] = d
+                    names[i] = name
+        pair = np.where(self._unchecked_pairs, np.inf, dmax)
+        for pt in c.getClosestPoints(self.body, self.body, dmax):
+            i, k = self._robot_link.get(pt[3]), self._robot_link.get(pt[4])
+            if i is None or k is None or self._unchecked_pairs[i, k]:
+                continue
+            d = float(pt[8])
+            if d < pair[i, k]:
+                pair[i, k] = pair[k, i] = d
+        return scene, names, pair
+
     def contacts(self, min_depth_m: float = 0.0) -> list[Contact]:
         """Contact points of the robot from the last physics step (or reset).
 
@@ -498,7 +571,7 @@ class SimWorld:
             robot link as ``link_name``. Excluded pairs never appear.
         """
         out: list[Contact] = []
-        excluded = self.robot.excluded_pairs
+        excluded = self._excluded_pairs
         fixed = self.robot.fixed_links
         for pt in self.client.getContactPoints(bodyA=self.body):
             a, b, la, lb = pt[1], pt[2], pt[3], pt[4]
