@@ -350,7 +350,7 @@ def clearance_ik(
     pos_scale = 1.0 / goal.pos_tol_m
     ang_scale = 1.0 / math.radians(goal.angle_tol_deg)
     want = min_clearance_m + 0.02
-    best = WitnessResult(q, False, -math.inf, math.inf, math.inf, 0)
+    d_min = pos_e = ang_e = math.inf
     for it in range(max_iterations + 1):
         F = robot.fk(q)
         p, n = F[-1, :3, 3], F[-1, :3, 2]
@@ -497,9 +497,11 @@ def _header(spec: VariantSpec, name: str, command: str, min_clearance_m: float) 
         f"{r.y1:.3f}], z in [{r.z0:.3f}, {r.z1:.3f}]; walls {WALL_M} m thick; window in the\n"
         f"near wall x in [{r.wx0:.3f}, {r.wx1:.3f}], z in [{r.wz0:.3f}, {r.wz1:.3f}].\n"
         f"Goals as in the paper: enter 1.5 m inside the window's centre; A, B, D at rho = "
-        f"{RHO_M} m from two walls;\nC mid far wall; E 1.1 m from the right wall, 1 m inside "
+        f"{RHO_M} m from two walls;\nC mid far wall; E 1.1 m from the right wall, 1 m "
+        "inside "
         f"the near wall; leave at the rest pose's tip.\n"
-        f"[witness] goal_states_rad: one state per goal from a clearance-aware IK (not a planner),\n"
+        "[witness] goal_states_rad: one state per goal from a clearance-aware IK "
+        "(not a planner),\n"
         f"collision-free with at least {min_clearance_m} m of clearance (collision checker's "
         f"signed distances)."
     )
@@ -559,7 +561,8 @@ def generate(
         raise VariantError(f"--count: a number of variants >= 1, got {count}")
     if not (0.0 <= min_clearance_m < 0.75):
         raise VariantError(
-            f"--min-clearance: a clearance in [0, 0.75) m (the module radius), got {min_clearance_m}"
+            "--min-clearance: a clearance in [0, 0.75) m (the module radius), "
+            f"got {min_clearance_m}"
         )
     max_draws = max_draws or 3 * count
     kept: list[Variant] = []

@@ -142,7 +142,8 @@ PROBLEM_CASES = {
     ),
     "witness_goal_states_wrong_count": (
         TINY_PROBLEM_TOML
-        + "\n[witness]\ngoal_states_rad = [[3.14, 3.14, 3.14, 3.14, 3.14], [3.14, 3.14, 3.14, 3.14, 3.14]]\n",
+        + "\n[witness]\ngoal_states_rad = [[3.14, 3.14, 3.14, 3.14, 3.14],"
+        + " [3.14, 3.14, 3.14, 3.14, 3.14]]\n",
         "witness.goal_states_rad",
     ),
     "witness_goal_state_wrong_joint_count": (
