@@ -512,7 +512,17 @@ def test_problem_names_resolve_from_the_working_directory_first(tmp_path, monkey
     assert resolve_problem_path("armz_pocket").resolve() == mine.resolve()
 
 
-SUBCOMMANDS = ("problems", "planners", "solve", "execute", "plot", "ik", "compare", "continuum")
+SUBCOMMANDS = (
+    "problems",
+    "planners",
+    "solve",
+    "execute",
+    "plot",
+    "ik",
+    "compare",
+    "continuum",
+    "variants",
+)
 
 
 def test_help_lists_every_subcommand_and_has_no_markup(capsys):

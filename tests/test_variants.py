@@ -89,3 +89,27 @@ def test_generate_keeps_the_count_and_reports_each_draw():
     kept = generate(1, np.random.default_rng(SEED_KEPT_FIRST), progress=lines.append)
     assert [v.name for v in kept] == ["armz_inspection_v00"]
     assert len(lines) == 1 and "kept armz_inspection_v00" in lines[0]
+
+
+def test_a_committed_variant_is_solved_and_executed_end_to_end():
+    """``armz_inspection_v00`` (24 modules, the room x0.94 and shifted, the window moved):
+    the best gradient-based planner with default settings does all seven legs within
+    20 000 checks per leg, every path valid at a quarter of joint_step, and PyBullet
+    executes every leg without contact with the tip in every goal region."""
+    from plannerlab.bench.task import execute_plan, solve_legs
+    from plannerlab.record.leg import Status
+
+    problem = load_problem(PROBLEMS / "variants" / "armz_inspection_v00.toml")
+    budget = problem.budget.replace(max_collision_checks=20_000, time_limit_s=None)
+    plan = solve_legs(problem, "gradient.clearance+detour", 0, budget=budget)
+    assert [r.goal for r in plan.legs] == ["enter", "A", "B", "C", "D", "E", "leave"]
+    checker = CollisionChecker(problem.robot, problem.scene)
+    for r in plan.legs:
+        assert r.status is Status.SOLVED, f"{r.goal}: {r.reason}"
+        assert r.collision_checks <= 20_000
+        assert checker.check_path(r.path, problem.joint_step / 4).valid, r.goal
+    executions = execute_plan(plan, problem)
+    for e in executions:
+        assert e.path_valid, e.goal
+        assert not e.contacts, (e.goal, e.contacts)
+        assert e.goal_reached, (e.goal, e.final_pos_err_m, e.final_angle_err_deg)
