@@ -148,6 +148,32 @@ PROBLEM_CASES = {
         TINY_PROBLEM_TOML + "\n[witness]\npath_rad = [[3.14, 3.14, 3.14, 3.14, 3.14]]\n",
         "witness.path_rad",
     ),
+    "witness_neither_path_nor_states": (
+        TINY_PROBLEM_TOML + '\n[witness]\nnote = "empty"\n',
+        "witness.path_rad",
+    ),
+    "witness_goal_states_wrong_count": (
+        TINY_PROBLEM_TOML
+        + "\n[witness]\ngoal_states_rad = [[3.14, 3.14, 3.14, 3.14, 3.14],"
+        + " [3.14, 3.14, 3.14, 3.14, 3.14]]\n",
+        "witness.goal_states_rad",
+    ),
+    "witness_goal_state_wrong_joint_count": (
+        TINY_PROBLEM_TOML + "\n[witness]\ngoal_states_rad = [[3.14, 3.14]]\n",
+        "witness.goal_states_rad[0]",
+    ),
+    "witness_goal_state_outside_its_goal": (
+        # the straight column's tip is 3.6 m up, not at the goal (0.5, 0, 3)
+        TINY_PROBLEM_TOML
+        + "\n[witness]\ngoal_states_rad = [[3.1416, 3.1416, 3.1416, 3.1416, 3.1416]]\n",
+        "witness.goal_states_rad[0]",
+    ),
+    "witness_negative_clearance": (
+        TINY_PROBLEM_TOML
+        + "\n[witness]\npath_rad = [[3.14, 3.14, 3.14, 3.14, 3.14], [3.1, 3.1, 3.1, 3.1, 3.1]]\n"
+        + "min_clearance_m = -0.1\n",
+        "witness.min_clearance_m",
+    ),
     "continuum_nan_point": (
         TINY_PROBLEM_TOML + "\n[continuum]\ncollision_points_m = [[0.1, 0.2], [nan, 0.2]]\n",
         "continuum.collision_points_m[1]",
@@ -261,6 +287,52 @@ def test_bad_compare_command_line(capsys, tmp_path, extra, name):
         capsys, "compare", POCKET, "--planners", "gradient", "--out", str(tmp_path), *extra
     )
     assert_clean_error(code, err, name)
+
+
+@pytest.mark.parametrize(
+    "extra,name",
+    [
+        (["--count", "0"], "--count"),
+        (["--seed", "-3"], "--seed"),
+        (["--min-clearance", "-0.01"], "--min-clearance"),
+        (["--min-clearance", "0.8"], "--min-clearance"),
+        (["--max-draws", "0"], "--max-draws"),
+    ],
+    ids=["count_zero", "seed_negative", "clearance_negative", "clearance_too_big", "draws_zero"],
+)
+def test_bad_variants_command_line(capsys, tmp_path, extra, name):
+    code, _, err = run(capsys, "variants", "armz_inspection", "--out", str(tmp_path), *extra)
+    assert_clean_error(code, err, name)
+
+
+def test_variants_of_an_unknown_task_and_onto_a_file_are_refused(capsys, tmp_path):
+    code, _, err = run(capsys, "variants", "armz_pocket", "--out", str(tmp_path))
+    assert_clean_error(code, err, "armz_inspection")
+    blocker = tmp_path / "a_file"
+    blocker.write_text("x")
+    code, _, err = run(capsys, "variants", "armz_inspection", "--count", "1", "--out", str(blocker))
+    assert_clean_error(code, err, "--out", str(blocker))
+    assert blocker.read_text() == "x"
+
+
+def test_variants_that_cannot_all_be_kept_fail_with_the_count(capsys, tmp_path):
+    # a clearance no witness of this room keeps: every draw is dropped, and the error says so
+    code, _, err = run(
+        capsys,
+        "variants",
+        "armz_inspection",
+        "--count",
+        "1",
+        "--max-draws",
+        "1",
+        "--min-clearance",
+        "0.7",
+        "--out",
+        str(tmp_path / "v"),
+    )
+    assert_clean_error(code, err, "0 of 1 variants kept in 1 draws")
+    assert "dropped" in err
+    assert not (tmp_path / "v").exists()
 
 
 def test_out_into_an_impossible_path_fails_before_planning(capsys, tmp_path):
@@ -452,7 +524,17 @@ def test_problem_names_resolve_from_the_working_directory_first(tmp_path, monkey
     assert resolve_problem_path("armz_pocket").resolve() == mine.resolve()
 
 
-SUBCOMMANDS = ("problems", "planners", "solve", "execute", "plot", "ik", "compare", "continuum")
+SUBCOMMANDS = (
+    "problems",
+    "planners",
+    "solve",
+    "execute",
+    "plot",
+    "ik",
+    "compare",
+    "continuum",
+    "variants",
+)
 
 
 def test_help_lists_every_subcommand_and_has_no_markup(capsys):

@@ -91,6 +91,11 @@ class ClearanceSettings:
             its mean step is ``retract_step + 0.5``).
         retract_jitter_m: radius of the ball round the body's face in which
             ``random_detour`` draws each retract sub-goal's point [m].
+        hold_clearance: when a step would take a pair below ``min_clearance_m``, try
+            once the same step with the part that closes such pairs taken out
+            (:meth:`ClearanceDescent._hold_clearance`) before shrinking the step; without
+            it the descent stalls against the clearance floor (measured on room
+            variants: the leave leg stalled at iteration 7 and no retract got out).
     """
 
     r1: float = 1.0
@@ -116,6 +121,7 @@ class ClearanceSettings:
     subgoal_pos_tol_m: float = 0.5
     subgoal_angle_tol_deg: float = 30.0
     retract_jitter_m: float = 0.5
+    hold_clearance: bool = True
 
     def __post_init__(self) -> None:
         if self.direction not in ("gradient", "gauss_newton"):
@@ -209,6 +215,37 @@ class ClearanceDescent:
             g[is_self] -= np.einsum("ck,ckj->cj", n[is_self], J[b[is_self]])
         return g
 
+    def _hold_clearance(self, field: ClearanceField, q: Array, direction: Array) -> Array:
+        """The step ``direction`` (dof,) changed as little as possible so that no sphere
+        pair within 1 cm of ``min_clearance_m`` comes closer (to first order: it moves
+        away at a small angle, 0.1 of its gradient's full rate), so the descent slides
+        along the clearance floor instead of stalling against it (a step that would take
+        such a pair closer is refused, and the descent otherwise only shrinks its step).
+        Active-set projection, at most 10 rounds."""
+        s = self.settings
+        p, J = field._centres_and_jacobians(q)
+        d, n, a, b = field._pairs(p)
+        active = np.flatnonzero(d < s.min_clearance_m + 0.01)
+        if active.size == 0:
+            return direction
+        G = np.einsum("ck,ckj->cj", n[active], J[a[active]])
+        is_self = b[active] >= 0
+        if is_self.any():
+            G[is_self] -= np.einsum("ck,ckj->cj", n[active][is_self], J[b[active][is_self]])
+        norms = np.linalg.norm(G, axis=1)
+        want = 0.1 * norms * float(np.linalg.norm(direction))
+        chosen = np.zeros(len(active), dtype=bool)
+        dq = direction
+        for _ in range(10):
+            short = (G @ dq) < want - 1e-12
+            if not short.any():
+                break
+            chosen |= short
+            Gs = G[chosen]
+            lam = np.linalg.solve(Gs @ Gs.T + 1e-9 * np.eye(len(Gs)), want[chosen] - Gs @ direction)
+            dq = direction + Gs.T @ lam
+        return dq
+
     def _settle(
         self,
         robot,
@@ -283,6 +320,7 @@ class ClearanceDescent:
         inside_since = 0
         d_now = field(q).distances_m
         direction, F_now = self._direction(robot, goal, field, q)
+        held = False
         while True:
             pos_err, ang_err = goal.errors(robot, q)
             inside = pos_err <= goal.pos_tol_m and ang_err <= goal.angle_tol_deg
@@ -346,6 +384,11 @@ class ClearanceDescent:
                 radius = min(radius * 1.5, max_step)
                 direction, F_now = self._direction(robot, goal, field, q)
                 f_now = self._f(robot, goal, q)
+                held = False
+            elif not spacious and not held and s.hold_clearance:
+                # the step takes a pair below min_clearance_m: slide along it instead
+                direction = self._hold_clearance(field, q, direction)
+                held = True
             else:
                 radius *= 0.5
             trace.append(f_now)

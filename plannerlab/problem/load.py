@@ -18,7 +18,8 @@ File layout (every key is documented in ``docs/problem-format.md``)::
     [checking]  joint_step       (largest joint step between checked states on an edge)
     [simulation] gravity_mps2 (default: Arm-Z off, others -9.81 along -z), max_deviation_m,
                 max_track_err_rad
-    [witness]   path_rad        (a known collision-free path, for tests)
+    [witness]   path_rad        (a known collision-free path, for tests), goal_states_rad
+                (one collision-free state per goal, in leg order), min_clearance_m
     [continuum] collision_points_m, guide_obstacles   (continuum planners)
     [ik_expected] free-form     (what tests expect of the IRb-6 analytic IK)
     Any other table or key is an error ("did you mean ...").
@@ -369,14 +370,42 @@ def _check_tables(top: TableReader) -> None:
             )
 
 
-def _witness(reader: TableReader, robot: Robot) -> None:
-    reader.unknown_keys(("path_rad", "note"))
-    raw = reader.raw("path_rad")
-    if not isinstance(raw, list) or len(raw) < 2:
-        raise reader.fail("path_rad", f"a list of at least 2 waypoints, got {raw!r:.80}")
-    for i, _ in enumerate(raw):
-        row = TableReader(reader.source, reader.prefix, {f"path_rad[{i}]": raw[i]})
-        row.vector(f"path_rad[{i}]", robot.dof)
+def _witness(reader: TableReader, robot: Robot, goals: tuple[GoalRegion, ...]) -> None:
+    reader.unknown_keys(("path_rad", "goal_states_rad", "min_clearance_m", "note"))
+    if not (reader.has("path_rad") or reader.has("goal_states_rad")):
+        raise reader.fail(
+            "path_rad",
+            "a witness path (path_rad) or one witness state per goal (goal_states_rad); "
+            "the table has neither",
+        )
+    if reader.has("path_rad"):
+        raw = reader.raw("path_rad")
+        if not isinstance(raw, list) or len(raw) < 2:
+            raise reader.fail("path_rad", f"a list of at least 2 waypoints, got {raw!r:.80}")
+        for i, _ in enumerate(raw):
+            row = TableReader(reader.source, reader.prefix, {f"path_rad[{i}]": raw[i]})
+            row.vector(f"path_rad[{i}]", robot.dof)
+    if reader.has("goal_states_rad"):
+        raw = reader.raw("goal_states_rad")
+        if not isinstance(raw, list) or len(raw) != len(goals):
+            raise reader.fail(
+                "goal_states_rad",
+                f"a list of {len(goals)} states, one per goal in leg order "
+                f"({', '.join(g.name for g in goals)}), got {raw!r:.80}",
+            )
+        for i, goal in enumerate(goals):
+            key = f"goal_states_rad[{i}]"
+            q = TableReader(reader.source, reader.prefix, {key: raw[i]}).vector(key, robot.dof)
+            pos_err, ang_err = (float(v) for v in goal.errors(robot, q))
+            if pos_err > goal.pos_tol_m or ang_err > goal.angle_tol_deg:
+                raise reader.fail(
+                    key,
+                    f"a state inside goal {goal.name!r} (within {goal.pos_tol_m:g} m and "
+                    f"{goal.angle_tol_deg:g} deg); its tip is {pos_err:.3g} m and "
+                    f"{ang_err:.3g} deg off",
+                )
+    if reader.has("min_clearance_m"):
+        reader.number("min_clearance_m", nonnegative=True)
 
 
 def _continuum(reader: TableReader, obstacle_names: list[str]) -> None:
@@ -597,7 +626,7 @@ def problem_from_dict(data: Mapping[str, Any], source: str) -> Problem:
 
     extras = {k: v for k, v in data.items() if k in EXTRA_TABLES}
     if "witness" in extras:
-        _witness(TableReader(source, "witness", extras["witness"]), robot)
+        _witness(TableReader(source, "witness", extras["witness"]), robot, goals)
     if "continuum" in extras:
         _continuum(TableReader(source, "continuum", extras["continuum"]), names)
     if "ik_expected" in extras:

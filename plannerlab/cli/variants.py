@@ -1,0 +1,106 @@
+"""``plannerlab variants``: variants of the Arm-Z paper's task on rooms it has never seen.
+
+    plannerlab variants armz_inspection --count 20 --seed 0 --out problems/variants/
+
+Draws rooms (scaled, shifted, mirrored; the window moved and resized; 20-32 modules),
+places the goals relative to the walls as in the paper, finds a collision-free witness
+state with ``--min-clearance`` of clearance for every goal (a clearance-aware IK, no
+planner) and writes the kept variants as problem files (``<out>/armz_inspection_vNN.toml``,
+each written atomically). A draw without a witness for some goal is dropped (reported on
+stderr) and the next draw is taken. The same seed gives the same files.
+
+Argument parsing and printing only; the generator is :mod:`plannerlab.variants`.
+"""
+
+from __future__ import annotations
+
+import argparse
+import shlex
+import sys
+from typing import Any
+
+from rich.console import Console
+
+from plannerlab.cli.common import positive_int, seed_int
+
+#: tasks the generator knows how to vary
+TEMPLATES = ("armz_inspection",)
+
+
+def _clearance(text: str) -> float:
+    try:
+        v = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"a clearance in metres, got {text!r}") from None
+    if not (0.0 <= v < 0.75):
+        raise argparse.ArgumentTypeError(f"a clearance in [0, 0.75) m, got {text!r}")
+    return v
+
+
+def add_parser(subparsers: Any) -> argparse.ArgumentParser:
+    p = subparsers.add_parser(
+        "variants",
+        help="generate variants of the paper's task, each goal with a witness state",
+        description=__doc__,
+    )
+    p.add_argument("task", choices=TEMPLATES, help="the task to vary")
+    p.add_argument("--count", type=positive_int, default=20, help="variants to keep")
+    p.add_argument("--seed", type=seed_int, default=0, help="seed of the numpy Generator")
+    p.add_argument(
+        "--out", default="problems/variants", metavar="DIR", help="folder for the problem files"
+    )
+    p.add_argument(
+        "--min-clearance",
+        type=_clearance,
+        default=0.04,
+        metavar="M",
+        help="clearance every witness state keeps [m]",
+    )
+    p.add_argument(
+        "--max-draws",
+        type=positive_int,
+        default=None,
+        metavar="N",
+        help="give up after N draws (default: 3 x --count)",
+    )
+    p.set_defaults(func=cmd_variants)
+    return p
+
+
+def cmd_variants(args: argparse.Namespace, console: Console) -> int:
+    import numpy as np
+
+    from plannerlab.variants import VariantError, generate, write_variants
+
+    out = args.out
+    from pathlib import Path
+
+    if Path(out).exists() and not Path(out).is_dir():
+        raise VariantError(f"--out {out}: a folder, but a file is in the way")
+    command = "plannerlab variants " + " ".join(
+        shlex.quote(a)
+        for a in [
+            args.task,
+            "--count",
+            str(args.count),
+            "--seed",
+            str(args.seed),
+            "--min-clearance",
+            f"{args.min_clearance:g}",
+        ]
+    )
+
+    def progress(line: str) -> None:
+        print(line, file=sys.stderr, flush=True)
+
+    kept = generate(
+        args.count,
+        np.random.default_rng(args.seed),
+        min_clearance_m=args.min_clearance,
+        max_draws=args.max_draws,
+        command=command,
+        progress=progress,
+    )
+    for path in write_variants(kept, out):
+        print(path)
+    return 0
