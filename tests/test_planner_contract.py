@@ -45,13 +45,13 @@ from plannerlab.robots.paths import path_length
 SEED = 7
 #: planning budget of the contract solve [collision checks]; asymptotically optimal
 #: planners spend all of it, so it is kept small where they are slow per check
-CHECKS = 6_000
+CHECKS = 12_000
 BUDGETS: dict[str, int] = {
-    "ompl.prm": 20_000,  # long roadmap edges: ~12k checks to connect start and goal
-    "ompl.prmstar": 20_000,
-    "ompl.fmt": 20_000,
-    "ompl.bfmt": 20_000,
-    "ompl.informedrrtstar": 3_000,  # informed sampling calls the Python goal heuristic
+    "ompl.prm": 400_000,  # long roadmap edges: ~12k checks to connect start and goal
+    "ompl.prmstar": 400_000,
+    "ompl.fmt": 100_000,
+    "ompl.bfmt": 100_000,
+    "ompl.informedrrtstar": 10_000,  # informed sampling calls the Python goal heuristic
 }
 #: known failures (strict xfail: a fix makes the suite say so). ompl.sorrtstar and
 #: ompl.aorrtc are not registered at all (README, "Planners left out").

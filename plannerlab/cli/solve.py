@@ -36,6 +36,7 @@ def leg_table(plan: Any, title: str) -> Table:
             ("checks", "num"),
             ("pos err m", "num"),
             ("ang err °", "num"),
+            ("clear m", "num"),
         ],
         compact=True,
     )
@@ -51,6 +52,7 @@ def leg_table(plan: Any, title: str) -> Table:
             str(r.collision_checks),
             fmt(r.pos_err_m),
             fmt(r.angle_err_deg),
+            fmt(r.min_clearance_m),
         )
         reasons.append(f"{r.leg} {r.goal}: {r.reason}")
     t.caption = "\n".join(reasons)

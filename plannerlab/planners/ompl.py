@@ -109,7 +109,7 @@ import ompl.base as ob
 import ompl.geometric as og
 import ompl.util as ou
 
-from plannerlab.collision.fcl_checker import CollisionChecker
+from plannerlab.collision.fcl_checker import CollisionChecker, problem_checker
 from plannerlab.errors import PlannerlabError
 from plannerlab.planners.base import (
     BudgetTracker,
@@ -392,15 +392,14 @@ def _ompl_logging(logger: logging.Logger) -> Iterator[None]:
 
 
 # ---------------------------------------------------------------------------- helpers
-def _recheck_cost(path: Array, joint_step: float, continuous: np.ndarray) -> int:
+def _recheck_cost(path: Array, joint_step: float, checker: CollisionChecker) -> int:
     """Collision checks ``checker.check_path(path, joint_step)`` will make (all states of
-    the densified path), computed without checking anything."""
+    the path as the checker densifies it, metric edge resolution included), computed
+    without checking anything."""
     path = np.atleast_2d(np.asarray(path, dtype=float))
     if len(path) < 2:
         return len(path)
-    d = np.abs(joint_difference(path[1:], path[:-1], continuous))
-    steps = np.maximum(1, np.ceil(np.max(d, axis=1) / joint_step - 1e-12))
-    return int(1 + np.sum(steps))
+    return len(checker.densify(path, joint_step)[0])
 
 
 def _goal_chain(data: Any, space: _Space) -> Array | None:
@@ -753,7 +752,7 @@ class OMPLPlanner:
         q_start: Array | None,
         ompl_seed: int,
     ) -> PlanResult:
-        checker = CollisionChecker(problem.robot, problem.scene)
+        checker = problem_checker(problem)
         guard = _Guard(checker, BudgetTracker(budget, checker))
         try:
             return self._plan(problem, leg, rng, q_start, ompl_seed, guard)
@@ -911,7 +910,7 @@ class OMPLPlanner:
             return Q
 
         def recheck_cost(ompl_path: Any) -> int:
-            return _recheck_cost(rows_of(ompl_path), recheck_step, robot.continuous)
+            return _recheck_cost(rows_of(ompl_path), recheck_step, checker)
 
         def ompl_path_of(Q: Array) -> Any:
             """An OMPL path through the waypoints Q (k, dof) (states copied in)."""
@@ -977,9 +976,10 @@ class OMPLPlanner:
             elif hasattr(planner, "bestCost"):
                 best = float(planner.bestCost().value())
                 if math.isfinite(best) and best < best_seen[0] and due:
+                    best_seen[0] = best  # read the tree once per improvement
                     Q = tree_best_path()
-                    if Q is not None and hold(Q):
-                        best_seen[0] = best
+                    if Q is not None:
+                        hold(Q)
             elif pdef.hasSolution() and due:
                 hold(waypoints_of(og.PathGeometric(pdef.getSolutionPath())))
             if held[0] is None:
@@ -1142,7 +1142,7 @@ class OMPLPlanner:
         path[0] = q0  # exact copy (removes float noise of the OMPL round trip)
         extra["path_length_rad"] = path_length(path, robot.continuous)
 
-        cost = _recheck_cost(path, recheck_step, robot.continuous)
+        cost = _recheck_cost(path, recheck_step, checker)
         if max_checks is not None:
             left = max_checks + max_checks // 100 - tracker.checks_used
             if cost > left:
