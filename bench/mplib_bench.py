@@ -24,8 +24,12 @@ SRDF disables exactly the link pairs plannerlab excludes; its joints are revolut
 [-π, π] (MPlib refuses continuous joints), while plannerlab's turn freely. Both planners
 get the same range number; the metrics differ (MPlib: Euclidean in R^11; plannerlab:
 OMPL's compound SO(2) metric, the L1 sum of joint angle changes, so the same number
-means shorter steps for plannerlab). Edges: plannerlab checks every ``joint_step``
-(0.05 rad) of the largest joint change; MPlib at its OMPL default resolution.
+means shorter steps for plannerlab). Edges: plannerlab keeps the problem's default
+clearance margin (``[planning] safety_margin_m``, 1 cm: capsules inflated by it) and
+checks its edges, while planning and in the re-check alike, so that no point of the arm
+moves more than that centimetre between checked states (and no joint more than
+``joint_step``, 0.05 rad); MPlib checks no margin, at its OMPL default resolution in
+joint space. ``--margin 0`` gives plannerlab's former setting (no margin, radian steps).
 """
 
 from __future__ import annotations
@@ -165,7 +169,9 @@ def scenario(seed: int = 0):
             return robot, scene, qs, qg
 
 
-def plannerlab_runs(robot, scene, qs, qg, seeds: int, rrt_range: float, time_limit_s: float):
+def plannerlab_runs(
+    robot, scene, qs, qg, seeds: int, rrt_range: float, time_limit_s: float, margin_m: float
+):
     import numpy as np
 
     import plannerlab.planners.ompl as pl_ompl
@@ -175,7 +181,9 @@ def plannerlab_runs(robot, scene, qs, qg, seeds: int, rrt_range: float, time_lim
 
     p_goal, n_goal = robot.tip(qg)
     goal = GoalRegion("qg", p_goal, n_goal, pos_tol_m=1e-3, angle_tol_deg=0.1)
-    problem = Problem("mplib_bench", robot, scene, qs, (goal,), joint_step=0.05)
+    problem = Problem(
+        "mplib_bench", robot, scene, qs, (goal,), joint_step=0.05, safety_margin_m=margin_m
+    )
     planner = make_planner("ompl.rrtconnect", {"range": rrt_range, "goal_samples": 1})
     budget = Budget(time_limit_s=time_limit_s)
 
@@ -214,6 +222,12 @@ def plannerlab_runs(robot, scene, qs, qg, seeds: int, rrt_range: float, time_lim
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__)
     ap.add_argument("--seeds", type=int, default=10)
+    ap.add_argument(
+        "--margin",
+        type=float,
+        default=0.01,
+        help="plannerlab's clearance margin [m] (also its edge resolution; 0: none)",
+    )
     ap.add_argument("--range", type=float, default=0.1, help="RRT-Connect range (MPlib: 0.1)")
     ap.add_argument("--time-limit", type=float, default=20.0)
     ap.add_argument("--mplib-python", default=str(ROOT / ".venv-mplib" / "bin" / "python"))
@@ -229,8 +243,11 @@ def main() -> None:
     print(f"Arm-Z {N_MODULES} modules ({robot.dof} joints), box {BOX_SIZE_M} m at {BOX_CENTER_M}")
     print(f"start  {np.array2string(qs, precision=3)}")
     print(f"goal   {np.array2string(qg, precision=3)}")
-    print(f"range {args.range}, {args.seeds} seeds, time limit {args.time_limit} s each")
-    pl = plannerlab_runs(robot, scene, qs, qg, args.seeds, args.range, args.time_limit)
+    print(
+        f"range {args.range}, {args.seeds} seeds, time limit {args.time_limit} s each, "
+        f"plannerlab margin {args.margin} m"
+    )
+    pl = plannerlab_runs(robot, scene, qs, qg, args.seeds, args.range, args.time_limit, args.margin)
     rows = [("plannerlab ompl.rrtconnect", pl)]
     py = Path(args.mplib_python)
     if not py.exists():

@@ -123,6 +123,26 @@ PROBLEM_CASES = {
         tiny_problem_text("joint_step = 0.05", "joint_step = 10.0"),
         "checking.joint_step",
     ),
+    "negative_safety_margin": (
+        TINY_PROBLEM_TOML + "\n[planning]\nsafety_margin_m = -0.01\n",
+        "planning.safety_margin_m",
+    ),
+    "tiny_safety_margin": (
+        TINY_PROBLEM_TOML + "\n[planning]\nsafety_margin_m = 1e-6\n",
+        "planning.safety_margin_m",
+    ),
+    "huge_safety_margin": (
+        TINY_PROBLEM_TOML + "\n[planning]\nsafety_margin_m = 2.0\n",
+        "planning.safety_margin_m",
+    ),
+    "text_safety_margin": (
+        TINY_PROBLEM_TOML + '\n[planning]\nsafety_margin_m = "1 cm"\n',
+        "planning.safety_margin_m",
+    ),
+    "unknown_planning_key": (
+        TINY_PROBLEM_TOML + "\n[planning]\nmargin_m = 0.01\n",
+        "planning.margin_m",
+    ),
     "gravity_two_numbers": (
         TINY_PROBLEM_TOML + "\n[simulation]\ngravity_mps2 = [0, -9.81]\n",
         "simulation.gravity_mps2",
@@ -204,6 +224,12 @@ def test_misspelled_table_suggests_the_right_one(capsys, tmp_path):
     path = write_problem(tmp_path, PROBLEM_CASES["misspelled_table"][0])
     code, _, err = run(capsys, "solve", str(path), "--planner", "gradient")
     assert_clean_error(code, err, "did you mean 'simulation'")
+
+
+def test_tiny_safety_margin_is_refused_with_the_cost(capsys, tmp_path):
+    path = write_problem(tmp_path, PROBLEM_CASES["tiny_safety_margin"][0])
+    code, _, err = run(capsys, "solve", str(path), "--planner", "gradient")
+    assert_clean_error(code, err, "collision checks", "0 (no margin)")
 
 
 def test_huge_robot_is_refused_with_the_cost(capsys, tmp_path):

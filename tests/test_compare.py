@@ -476,7 +476,7 @@ def test_a_raising_trial_is_recorded_and_execution_summarised(tmp_path: Path) ->
     path = resolve_problem_path(PROBLEM).resolve()
     bad = Trial.make(PROBLEM, tmp_path / "missing.toml", "gradient", 0)
     ok = Trial.make(
-        PROBLEM, path, "ompl.rrtconnect", 0, budget={"max_collision_checks": 30000}, execute=True
+        PROBLEM, path, "ompl.rrtconnect", 0, budget={"max_collision_checks": 400_000}, execute=True
     )
     stalled = Trial.make(
         PROBLEM, path, "gradient.analytic", 0, budget={"max_collision_checks": 100}, execute=True

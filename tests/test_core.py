@@ -196,7 +196,7 @@ def test_edge_states_are_bit_identical_to_interpolate_edge():
         a, b = rng.uniform(-4.0, 4.0, (2, dof))
         cont = rng.random(dof) < 0.5
         step = float(rng.choice([0.05, 0.3, 2.0]))
-        n, Q = edge_states(a, b, step, cont, 2**62, 2**62)
+        n, Q = edge_states(a, b, step, cont, 2**62, 2**62, np.zeros(dof))
         ref = interpolate_edge(a, b, step, cont)[1:]
         assert n == len(ref) and np.array_equal(Q, ref)
 

@@ -14,6 +14,10 @@ result survives a JSON round trip.
 
 Budget slack (documented): a planner may exceed ``max_collision_checks`` by at most 1 %
 (the final fine re-validation of a path it found) plus one (the start-state check).
+The tests assert behaviour, not how a planner spends its budget: "solves" needs only that
+the contract budget is ample for a first path (OMPL planners hold back the re-check of the
+first path whose re-check fits, so spending the rest, however the machine's floating point
+steers it, cannot cost the solve; test_ompl_planners sweeps budgets and seeds for that).
 
 OMPL seeds are process-global and take effect only before OMPL's first generator exists,
 so the OMPL determinism check runs each of the two trials in a fresh ``spawn`` process.
@@ -41,13 +45,13 @@ from plannerlab.robots.paths import path_length
 SEED = 7
 #: planning budget of the contract solve [collision checks]; asymptotically optimal
 #: planners spend all of it, so it is kept small where they are slow per check
-CHECKS = 6_000
+CHECKS = 12_000
 BUDGETS: dict[str, int] = {
-    "ompl.prm": 20_000,  # long roadmap edges: ~12k checks to connect start and goal
-    "ompl.prmstar": 20_000,
-    "ompl.fmt": 20_000,
-    "ompl.bfmt": 20_000,
-    "ompl.informedrrtstar": 3_000,  # informed sampling calls the Python goal heuristic
+    "ompl.prm": 400_000,  # long roadmap edges: ~12k checks to connect start and goal
+    "ompl.prmstar": 400_000,
+    "ompl.fmt": 100_000,
+    "ompl.bfmt": 100_000,
+    "ompl.informedrrtstar": 20_000,  # informed sampling calls the Python goal heuristic
 }
 #: known failures (strict xfail: a fix makes the suite say so). ompl.sorrtstar and
 #: ompl.aorrtc are not registered at all (README, "Planners left out").

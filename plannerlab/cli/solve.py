@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import math
 from pathlib import Path
 from typing import Any
 
@@ -52,7 +53,9 @@ def leg_table(plan: Any, title: str) -> Table:
             fmt(r.pos_err_m),
             fmt(r.angle_err_deg),
         )
-        reasons.append(f"{r.leg} {r.goal}: {r.reason}")
+        clearance = r.min_clearance_m
+        shown = f"; planned clearance {fmt(clearance)} m" if math.isfinite(clearance) else ""
+        reasons.append(f"{r.leg} {r.goal}: {r.reason}{shown}")
     t.caption = "\n".join(reasons)
     return t
 

@@ -207,7 +207,21 @@ def _node_boxes(tree, lo, hi, nlo, nhi):
 
 @njit(cache=True, nogil=True)
 def _state_hits(
-    seg, radii, moving, allowed, tree, kinds, Rs, cs, hs, olo, ohi, buf, first_only, out_pairs
+    seg,
+    radii,
+    radii_self,
+    moving,
+    allowed,
+    tree,
+    kinds,
+    Rs,
+    cs,
+    hs,
+    olo,
+    ohi,
+    buf,
+    first_only,
+    out_pairs,
 ):
     """Colliding pairs of one state; returns how many were written to out_pairs (m, 3).
 
@@ -274,7 +288,7 @@ def _state_hits(
             p = min(start[a], start[b])
             q = max(start[a], start[b])
             d2, _, _ = seg_seg(seg[p, 0], seg[p, 1], seg[q, 0], seg[q, 1])
-            rr = radii[p] + radii[q]
+            rr = radii_self[p] + radii_self[q]
             if d2 <= rr * rr:
                 out_pairs[m, 0] = p
                 out_pairs[m, 1] = q
@@ -312,35 +326,65 @@ def _scratch(L):
 
 
 @njit(cache=True, nogil=True)
-def valid_batch(segs, radii, moving, allowed, tree, kinds, Rs, cs, hs, olo, ohi, out):
+def valid_batch(segs, radii, radii_self, moving, allowed, tree, kinds, Rs, cs, hs, olo, ohi, out):
     """Validity of every state: segs (k, L, 2, 3) → out (k,) bool."""
     k, L = segs.shape[0], segs.shape[1]
     buf = _scratch(L)
     pairs = np.empty((1, 3), dtype=np.int64)
     for s in range(k):
         m = _state_hits(
-            segs[s], radii, moving, allowed, tree, kinds, Rs, cs, hs, olo, ohi, buf, True, pairs
+            segs[s],
+            radii,
+            radii_self,
+            moving,
+            allowed,
+            tree,
+            kinds,
+            Rs,
+            cs,
+            hs,
+            olo,
+            ohi,
+            buf,
+            True,
+            pairs,
         )
         out[s] = m == 0
     return out
 
 
 @njit(cache=True, nogil=True)
-def first_invalid(segs, radii, moving, allowed, tree, kinds, Rs, cs, hs, olo, ohi):
+def first_invalid(segs, radii, radii_self, moving, allowed, tree, kinds, Rs, cs, hs, olo, ohi):
     """Index of the first invalid state of segs (k, L, 2, 3), or -1."""
     k, L = segs.shape[0], segs.shape[1]
     buf = _scratch(L)
     pairs = np.empty((1, 3), dtype=np.int64)
     for s in range(k):
         if _state_hits(
-            segs[s], radii, moving, allowed, tree, kinds, Rs, cs, hs, olo, ohi, buf, True, pairs
+            segs[s],
+            radii,
+            radii_self,
+            moving,
+            allowed,
+            tree,
+            kinds,
+            Rs,
+            cs,
+            hs,
+            olo,
+            ohi,
+            buf,
+            True,
+            pairs,
         ):
             return s
     return -1
 
 
 @njit(cache=True, nogil=True)
-def armz_first_invalid(Q, T0, T1, M, radii, moving, allowed, tree, kinds, Rs, cs, hs, olo, ohi):
+def armz_first_invalid(
+    Q, T0, T1, M, radii, radii_self, moving, allowed, tree, kinds, Rs, cs, hs, olo, ohi
+):
     """As :func:`first_invalid` with Arm-Z kinematics fused in: no FK past the first hit."""
     k, dof = Q.shape
     L = dof + 1
@@ -350,27 +394,47 @@ def armz_first_invalid(Q, T0, T1, M, radii, moving, allowed, tree, kinds, Rs, cs
     for s in range(k):
         armz_segments(Q[s : s + 1], T0, T1, M, seg)
         if _state_hits(
-            seg[0], radii, moving, allowed, tree, kinds, Rs, cs, hs, olo, ohi, buf, True, pairs
+            seg[0],
+            radii,
+            radii_self,
+            moving,
+            allowed,
+            tree,
+            kinds,
+            Rs,
+            cs,
+            hs,
+            olo,
+            ohi,
+            buf,
+            True,
+            pairs,
         ):
             return s
     return -1
 
 
 @njit(cache=True, nogil=True)
-def edge_states(q_a, q_b, joint_step, continuous, limit, cap):
+def edge_states(q_a, q_b, joint_step, continuous, limit, cap, weights):
     """The states of ``interpolate_edge(q_a, q_b, joint_step)[1:]``, bit for bit, at most
     ``limit`` of them: (n, Q (min(n, limit), dof)), n the edge's full count; an edge of
-    more than ``cap`` states gives (cap + 1, no states)."""
+    more than ``cap`` states gives (cap + 1, no states).
+
+    ``weights`` (dof,) adds a metric bound: at least ``ceil(sum_i weights_i |d_i|)``
+    steps (weights = reach_i / step_m: no point moves more than step_m per step); zeros
+    leave the count of ``interpolate_edge``."""
     dof = q_a.shape[0]
     d = np.empty(dof)
     span = 0.0
+    metric = 0.0
     for i in range(dof):
         x = q_b[i] - q_a[i]
         if continuous[i]:
             x = (x + np.pi) % (2.0 * np.pi) - np.pi
         d[i] = x
         span = max(span, abs(x))
-    n_f = max(1.0, math.ceil(span / joint_step - 1e-12))
+        metric += weights[i] * abs(x)
+    n_f = max(1.0, math.ceil(span / joint_step - 1e-12), math.ceil(metric - 1e-12))
     if n_f > cap:  # refused: the caller raises
         return cap + 1, np.empty((0, dof))
     n = int(n_f)
@@ -392,10 +456,12 @@ def armz_edge_first_invalid(
     continuous,
     limit,
     cap,
+    weights,
     T0,
     T1,
     M,
     radii,
+    radii_self,
     moving,
     allowed,
     tree,
@@ -408,28 +474,44 @@ def armz_edge_first_invalid(
 ):
     """An Arm-Z edge checked in order, interpolation and kinematics fused in: (n, first bad
     index among the first min(n, limit) states or -1)."""
-    n, Q = edge_states(q_a, q_b, joint_step, continuous, limit, cap)
+    n, Q = edge_states(q_a, q_b, joint_step, continuous, limit, cap, weights)
     if n > cap:
         return n, -1
     bad = armz_first_invalid(
-        Q, T0, T1, M, radii, moving, allowed, tree, kinds, Rs, cs, hs, olo, ohi
+        Q, T0, T1, M, radii, radii_self, moving, allowed, tree, kinds, Rs, cs, hs, olo, ohi
     )
     return n, bad
 
 
 @njit(cache=True, nogil=True)
-def all_hits(seg, radii, moving, allowed, tree, kinds, Rs, cs, hs, olo, ohi):
+def all_hits(seg, radii, radii_self, moving, allowed, tree, kinds, Rs, cs, hs, olo, ohi):
     """Every colliding pair of one state (L, 2, 3): (m, 3) rows (link, other, other_is_link)."""
     L = seg.shape[0]
     out = np.empty((L * kinds.shape[0] + L * L, 3), dtype=np.int64)
     m = _state_hits(
-        seg, radii, moving, allowed, tree, kinds, Rs, cs, hs, olo, ohi, _scratch(L), False, out
+        seg,
+        radii,
+        radii_self,
+        moving,
+        allowed,
+        tree,
+        kinds,
+        Rs,
+        cs,
+        hs,
+        olo,
+        ohi,
+        _scratch(L),
+        False,
+        out,
     )
     return out[:m].copy()
 
 
 @njit(cache=True, nogil=True)
-def pair_distances_kernel(seg, radii, moving, allowed, tree, kinds, Rs, cs, hs, olo, ohi, margin):
+def pair_distances_kernel(
+    seg, radii, radii_self, moving, allowed, tree, kinds, Rs, cs, hs, olo, ohi, margin
+):
     """Every checked pair of one state whose signed distance is below ``margin`` [m].
 
     Returns (idx (m, 3) int: link, other, other_is_link; d (m,); t_link (m,);
@@ -476,7 +558,7 @@ def pair_distances_kernel(seg, radii, moving, allowed, tree, kinds, Rs, cs, hs, 
                 continue
             d2, s, t = seg_seg(seg[i, 0], seg[i, 1], seg[j, 0], seg[j, 1])
             dist_axis = math.sqrt(d2)
-            dist = dist_axis - radii[i] - radii[j]
+            dist = dist_axis - radii_self[i] - radii_self[j]
             if dist < margin:
                 idx[m, 0] = i
                 idx[m, 1] = j
@@ -546,12 +628,27 @@ class Core:
     """Compiled validity and distances for one robot in one scene (no check counter:
     :class:`~plannerlab.collision.fcl_checker.CollisionChecker` counts)."""
 
-    def __init__(self, robot: Robot, scene: Scene) -> None:
+    def __init__(
+        self,
+        robot: Robot,
+        scene: Scene,
+        margin_m: float = 0.0,
+        edge_weights: Array | None = None,
+    ) -> None:
         if not supports(scene):
             raise ValueError("the core tests boxes, cylinders and spheres only")
         self.robot = robot
         self.scene = scene
-        self.radii = np.ascontiguousarray(robot.link_radii_m, dtype=float)
+        self.margin_m = float(margin_m)
+        r = np.asarray(robot.link_radii_m, dtype=float)
+        #: capsule radii against the scene: inflated by the whole margin
+        self.radii = np.ascontiguousarray(r + self.margin_m)
+        #: capsule radii against each other: by half of it (a pair keeps one margin)
+        self.radii_self = np.ascontiguousarray(r + self.margin_m / 2.0)
+        #: metric edge bound (see :func:`edge_states`); zeros: radian steps only
+        self.edge_weights = np.ascontiguousarray(
+            np.zeros(robot.dof) if edge_weights is None else edge_weights, dtype=float
+        )
         L = len(self.radii)
         self.n_links = L
         self.moving = np.array([i not in robot.fixed_links for i in range(L)])
@@ -586,6 +683,7 @@ class Core:
         self.tree = chain_tree(allowed)
         self._geo = (
             self.radii,
+            self.radii_self,
             self.moving,
             self.allowed,
             self.tree,
@@ -700,13 +798,16 @@ class Core:
                 self._continuous,
                 lim,
                 MAX_EDGE_STATES,
+                self.edge_weights,
                 self._T0,
                 self._T1,
                 self._M,
                 *self._geo,
             )
         else:
-            n, Q = edge_states(qa, qb, step, self._continuous, lim, MAX_EDGE_STATES)
+            n, Q = edge_states(
+                qa, qb, step, self._continuous, lim, MAX_EDGE_STATES, self.edge_weights
+            )
             bad = (
                 -1
                 if n > MAX_EDGE_STATES or len(Q) == 0
@@ -714,7 +815,7 @@ class Core:
             )
         if n > MAX_EDGE_STATES:
             span = float(np.max(np.abs(joint_difference(qb, qa, self._continuous))))
-            raise edge_too_long(span, step, edge_steps(qa, qb, step, self._continuous))
+            raise edge_too_long(span, step, max(n, edge_steps(qa, qb, step, self._continuous)))
         return int(n), int(bad)
 
     def hits(self, q: Array) -> np.ndarray:

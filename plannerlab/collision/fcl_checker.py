@@ -21,15 +21,22 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from dataclasses import dataclass
+from typing import Any
 
 import fcl
 import numpy as np
 
 from plannerlab.collision.core import Core, PairDistances
 from plannerlab.collision.core import supports as core_supports
+from plannerlab.collision.reach import joint_reach_m
 from plannerlab.problem.scene import Box, Cylinder, Scene, Sphere
-from plannerlab.robots.base import Array, Robot
-from plannerlab.robots.paths import densify, interpolate_edge
+from plannerlab.robots.base import Array, Robot, joint_difference
+from plannerlab.robots.paths import (
+    MAX_EDGE_STATES,
+    densify,
+    edge_too_long,
+    require_joint_step,
+)
 
 
 @dataclass(frozen=True)
@@ -76,20 +83,35 @@ class CollisionChecker:
             ``"fcl"``.
     """
 
-    def __init__(self, robot: Robot, scene: Scene, backend: str = "auto") -> None:
+    def __init__(
+        self, robot: Robot, scene: Scene, backend: str = "auto", margin_m: float = 0.0
+    ) -> None:
         if backend not in ("auto", "core", "fcl"):
             raise ValueError(f"backend must be 'auto', 'core' or 'fcl', got {backend!r}")
         if backend == "core" and not core_supports(scene):
             raise ValueError("backend 'core' covers boxes, cylinders and spheres only")
+        if not (margin_m >= 0.0 and np.isfinite(margin_m)):
+            raise ValueError(f"margin_m must be a finite number >= 0, got {margin_m!r}")
+        #: clearance margin [m]: capsules are inflated by it against the scene, by half of
+        #: it against each other (a pair of links keeps one margin between them)
+        self.margin_m = float(margin_m)
+        #: per joint, how fast the geometry moves [m per rad or m] (see reach.py); with a
+        #: margin, edges are checked so that no point moves more than the margin between
+        #: two checked states (on top of the radian step asked for)
+        self.reach_m: np.ndarray | None = joint_reach_m(robot) if margin_m > 0 else None
+        self.edge_weights: np.ndarray | None = (
+            None if self.reach_m is None else self.reach_m / self.margin_m
+        )
         self._core: Core | None = None
         if backend == "core" or (backend == "auto" and core_supports(scene)):
-            self._core = Core(robot, scene)
+            self._core = Core(robot, scene, self.margin_m, self.edge_weights)
         #: which backend answers the queries: "core" or "fcl"
         self.backend = "core" if self._core is not None else "fcl"
         self.robot = robot
         self.scene = scene
         self.checks = 0
-        self._radii = np.asarray(robot.link_radii_m, dtype=float)
+        self._radii = np.asarray(robot.link_radii_m, dtype=float) + self.margin_m
+        self._radii_self = np.asarray(robot.link_radii_m, dtype=float) + self.margin_m / 2.0
         L = len(self._radii)
         self._n_links = L
         self._link_names = tuple(robot.link_names)
@@ -100,6 +122,15 @@ class CollisionChecker:
             fcl.CollisionObject(fcl.Capsule(float(r), float(max(ln, 1e-9))), fcl.Transform())
             for r, ln in zip(self._radii, self._lengths, strict=True)
         ]
+        # the same capsules for link pairs (half the margin each)
+        self._links_self = (
+            self._links
+            if self.margin_m == 0.0
+            else [
+                fcl.CollisionObject(fcl.Capsule(float(r), float(max(ln, 1e-9))), fcl.Transform())
+                for r, ln in zip(self._radii_self, self._lengths, strict=True)
+            ]
+        )
         self._obstacles = [self._make_obstacle(o) for o in scene.obstacles]
         self._obs_lo, self._obs_hi = scene.aabbs()
         moving = np.array([i not in robot.fixed_links for i in range(L)])
@@ -143,8 +174,16 @@ class CollisionChecker:
             self._links[i] = fcl.CollisionObject(
                 fcl.Capsule(float(self._radii[i]), float(max(lengths[i], 1e-9))), fcl.Transform()
             )
+            if self._links_self is not self._links:
+                self._links_self[i] = fcl.CollisionObject(
+                    fcl.Capsule(float(self._radii_self[i]), float(max(lengths[i], 1e-9))),
+                    fcl.Transform(),
+                )
         for k, obj in enumerate(self._links):
-            obj.setTransform(fcl.Transform(R[k], centres[k]))
+            tf = fcl.Transform(R[k], centres[k])
+            obj.setTransform(tf)
+            if self._links_self is not self._links:
+                self._links_self[k].setTransform(tf)
 
     # ------------------------------------------------------------------ pre-test
     def _candidates(self, segs: Array) -> tuple[Array, Array]:
@@ -190,7 +229,7 @@ class CollisionChecker:
                     return hits
         for p in np.flatnonzero(selfc):
             i, j = self._self_pairs[p]
-            if self._collide(self._links[i], self._links[j]):
+            if self._collide(self._links_self[i], self._links_self[j]):
                 hits.append((int(i), int(j), True))
                 if first_only:
                     return hits
@@ -255,7 +294,7 @@ class CollisionChecker:
             m = n if max_states is None else min(n, max(int(max_states), 0))
             self.checks += m if bad < 0 else bad + 1
             return n, (None if bad < 0 else bad)
-        states = interpolate_edge(q_a, q_b, joint_step, self.robot.continuous)[1:]
+        states = self.densify(np.array([q_a, q_b], dtype=float), joint_step)[0][1:]
         m = len(states) if max_states is None else min(len(states), max(int(max_states), 0))
         return len(states), (self.first_invalid(states[:m]) if m > 0 else None)
 
@@ -294,7 +333,7 @@ class CollisionChecker:
                 best = min(best, self._signed_distance(self._links[li], obj))
         if include_self:
             for i, j in self._self_pairs:
-                best = min(best, self._signed_distance(self._links[i], self._links[j]))
+                best = min(best, self._signed_distance(self._links_self[i], self._links_self[j]))
         self.checks += 1
         return float(best)
 
@@ -316,8 +355,10 @@ class CollisionChecker:
         self._place(self.robot.link_segments(np.asarray(q, dtype=float)))
         out = np.empty(len(link))
         for k, (a, b, is_link) in enumerate(zip(link, other, other_is_link, strict=True)):
-            o2 = self._links[b] if is_link else self._obstacles[b]
-            out[k] = self._signed_distance(self._links[a], o2)
+            if is_link:
+                out[k] = self._signed_distance(self._links_self[a], self._links_self[b])
+            else:
+                out[k] = self._signed_distance(self._links[a], self._obstacles[b])
         return out
 
     def _signed_distance(self, o1: fcl.CollisionObject, o2: fcl.CollisionObject) -> float:
@@ -325,6 +366,41 @@ class CollisionChecker:
         if fcl.collide(o1, o2, self._contact_request, res) > 0:
             return -max((c.penetration_depth for c in res.contacts), default=0.0)
         return float(fcl.distance(o1, o2, self._distance_request, fcl.DistanceResult()))
+
+    def densify(self, path: Array, joint_step: float) -> tuple[Array, Array]:
+        """The states this checker checks on a path: :func:`~plannerlab.robots.paths.densify`
+        at ``joint_step``, and with a margin each edge cut finer where needed so that no
+        point of the robot moves more than the margin between two states (the bound
+        ``Σ |Δq_i| · reach_i``). Returns (states, owning edge of each)."""
+        if self.edge_weights is None:
+            return densify(path, joint_step, self.robot.continuous)
+        path = np.atleast_2d(np.asarray(path, dtype=float))
+        if len(path) == 1:
+            return path.copy(), np.zeros(1, dtype=int)
+        require_joint_step(joint_step)
+        d = joint_difference(path[1:], path[:-1], self.robot.continuous)
+        span = np.max(np.abs(d), axis=1, initial=0.0)
+        metric = np.abs(d) @ self.edge_weights
+        n_f = np.maximum.reduce(
+            [
+                np.ones(len(d)),
+                np.ceil(span / joint_step - 1e-12),
+                np.ceil(metric - 1e-12),
+            ]
+        )
+        worst = int(np.argmax(n_f))
+        if n_f[worst] > MAX_EDGE_STATES:
+            raise edge_too_long(float(span[worst]), joint_step, int(min(n_f[worst], 2**62)))
+        n = n_f.astype(int)
+        owners = np.repeat(np.arange(len(d)), n)
+        j = np.arange(len(owners)) - np.repeat(np.cumsum(n) - n, n) + 1  # 1 .. n_i
+        n_of = n[owners]
+        t = np.where(j == n_of, 1.0, j * (1.0 / n_of))
+        states = path[:-1][owners] + t[:, None] * d[owners]
+        return (
+            np.concatenate([path[:1], states]),
+            np.concatenate([np.zeros(1, dtype=int), owners]),
+        )
 
     def check_path(
         self,
@@ -339,7 +415,7 @@ class CollisionChecker:
         True the check ends, incomplete (``complete`` False). The same states are checked,
         and counted, as without it.
         """
-        states, owners = densify(path, joint_step, self.robot.continuous)
+        states, owners = self.densify(path, joint_step)
         step = len(states) if stop is None else max(int(chunk), 1)
         bad = None
         for i in range(0, len(states), max(step, 1)):
@@ -362,3 +438,11 @@ class CollisionChecker:
             pairs=self.colliding_pairs(q_bad),
             backend=self.backend,
         )
+
+
+def problem_checker(problem: Any, backend: str = "auto") -> CollisionChecker:
+    """The checker of a problem: its robot and scene, with the problem's clearance margin
+    (``[planning] safety_margin_m``) and the metric edge resolution it implies."""
+    return CollisionChecker(
+        problem.robot, problem.scene, backend, margin_m=float(problem.safety_margin_m)
+    )

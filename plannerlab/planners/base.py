@@ -171,6 +171,21 @@ def start_collision(checker: Any, q_start: Array) -> str | None:
     return f"the start state collides: {pairs}"
 
 
+def planned_clearance_m(checker: Any, path: Array) -> float:
+    """Smallest clearance [m] of the robot's true capsules (the checker's margin added
+    back) over the states of ``path``: to the scene and between checked link pairs.
+    Not counted as collision checks (a measurement of the result, not planning); NaN
+    without a checker that measures clearance."""
+    if checker is None or not hasattr(checker, "clearance"):
+        return math.nan
+    checks = checker.checks
+    try:
+        inflated = min(checker.clearance(q) for q in np.atleast_2d(path))
+    finally:
+        checker.checks = checks
+    return float(inflated + getattr(checker, "margin_m", 0.0))
+
+
 class BudgetTracker:
     """The budget bookkeeping of one solve: time, collision checks and iterations used,
     against a :class:`~plannerlab.problem.load.Budget`. The one tracker every planner uses.
@@ -346,6 +361,11 @@ class LegRun:
                 float(self.goal.distance(self.robot, P[-1])), self.cost(status, P)
             )
         t = self.tracker
+        elapsed_s = t.elapsed_s if t is not None else 0.0
+        checks_used = t.checks_used if t is not None else 0
+        clearance = math.nan
+        if status in (Status.SOLVED, Status.APPROXIMATE) and t is not None:
+            clearance = planned_clearance_m(t.checker, P)
         return PlanResult(
             planner=self.planner,
             problem=self.problem.name,
@@ -354,12 +374,13 @@ class LegRun:
             status=status,
             reason=reason,
             path=P,
-            time_s=t.elapsed_s if t is not None else 0.0,
+            time_s=elapsed_s,
             iterations=iterations,
-            collision_checks=t.checks_used if t is not None else 0,
+            collision_checks=checks_used,
             fk_calls=fk_calls,
             pos_err_m=float(pos_err),
             angle_err_deg=float(ang_err),
+            min_clearance_m=clearance,
             trace=np.zeros(0) if trace is None else np.asarray(trace, dtype=float),
             progress=(
                 np.zeros((0, len(PROGRESS_COLUMNS))) if progress_rows is None else progress_rows

@@ -39,7 +39,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.optimize import approx_fprime
 
-from plannerlab.collision.fcl_checker import CollisionChecker
+from plannerlab.collision.fcl_checker import CollisionChecker, problem_checker
 from plannerlab.errors import PlannerlabError
 from plannerlab.planners.base import (
     BudgetTracker,
@@ -166,7 +166,7 @@ class GradientPlanner:
         s = self.settings
         robot = problem.robot
         goal = problem.goal(leg)
-        checker = CollisionChecker(robot, problem.scene)
+        checker = problem_checker(problem)
         tracker = BudgetTracker(budget, checker)
         run = LegRun(self.name, s, problem, leg, tracker)
         q = np.array(problem.q_start if q_start is None else q_start, dtype=float)

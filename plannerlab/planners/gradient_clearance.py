@@ -47,7 +47,7 @@ from typing import Any
 
 import numpy as np
 
-from plannerlab.collision.fcl_checker import CollisionChecker
+from plannerlab.collision.fcl_checker import CollisionChecker, problem_checker
 from plannerlab.errors import PlannerlabError
 from plannerlab.planners.base import (
     BudgetTracker,
@@ -590,7 +590,7 @@ class ClearanceDescent:
         s = self.settings
         robot = problem.robot
         goal = problem.goal(leg)
-        checker = CollisionChecker(robot, problem.scene)
+        checker = problem_checker(problem)
         q0 = np.array(problem.q_start if q_start is None else q_start, dtype=float)
         tracker = BudgetTracker(budget, checker)
         run = LegRun(self.name, s, problem, leg, tracker)

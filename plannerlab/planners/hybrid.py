@@ -30,7 +30,7 @@ from typing import Any
 
 import numpy as np
 
-from plannerlab.collision.fcl_checker import CollisionChecker
+from plannerlab.collision.fcl_checker import CollisionChecker, problem_checker
 from plannerlab.errors import PlannerlabError
 from plannerlab.planners.base import (
     BudgetTracker,
@@ -121,7 +121,7 @@ class HybridPlanner:
         del stepper
         s = self.settings
         robot = problem.robot
-        checker = CollisionChecker(robot, problem.scene)  # the restarts' edges
+        checker = problem_checker(problem)  # the restarts' edges
         tracker = BudgetTracker(budget, checker)  # and the sub-solves' results, charged
         run = LegRun(self.name, s, problem, leg, tracker)
         progress = run.progress

@@ -46,11 +46,20 @@ Design (measured on ``armz_inspection``, 23 continuous joints):
   (``numIterations`` of the RRT* family and BIT*, ``milestoneCount`` of PRM), else the
   number of termination-condition polls (one per loop iteration of RRT, RRT-Connect,
   KPIECE, …). The final fine re-validation of a found path (below) is part of the
-  budget: once a path exists, planning and simplification stop when the checks left are
-  just enough to re-check it (recomputed every few polls while an optimizing planner
-  improves it); if they are not, the leg is BUDGET_EXHAUSTED with the numbers, and the
-  path is not trusted. Slack: the re-check may end at most 1 % over
-  ``max_collision_checks`` (its cost is known exactly only once the path is final).
+  budget, and its reserve is sound: as soon as a path exists whose re-check fits the
+  checks not yet spent, that path (its waypoints) is *held* and its exact re-check cost
+  is reserved: the validity checker and motion validator refuse to spend the reserve, so
+  whatever planning and simplification do afterwards, the held path can still be
+  re-checked within ``max_collision_checks``. The held path is replaced by a better one
+  (every few polls) when that one's re-check fits too: optimizing planners (RRT*,
+  Informed RRT*, BIT*) hand their path to the problem definition only when they stop, so
+  it is read from their tree (``getPlannerData``: the chain of parents from the goal
+  vertex); other planners' from the problem definition. After planning, the path
+  re-checked is the simplified one if its re-check fits, else the held one; a path found
+  whose re-check never fitted (found with fewer checks left than its re-check needs, and
+  not simplified down to fit) is BUDGET_EXHAUSTED with the numbers, not trusted. How a
+  planner spends its budget (which varies with the machine's floating point) thus never
+  decides whether a found path can be re-checked.
   The time limit is held the same way: once a path exists, planning stops early enough
   to re-check it at the rate measured so far (seconds per check), and the steps after
   planning (interpolation, conversion, the re-check) stop at ``time_limit_s`` + 1 %;
@@ -100,7 +109,7 @@ import ompl.base as ob
 import ompl.geometric as og
 import ompl.util as ou
 
-from plannerlab.collision.fcl_checker import CollisionChecker
+from plannerlab.collision.fcl_checker import CollisionChecker, problem_checker
 from plannerlab.errors import PlannerlabError
 from plannerlab.planners.base import (
     BudgetTracker,
@@ -283,12 +292,19 @@ _SETTERS: Mapping[str, str] = {
 
 _KPIECE = frozenset({"KPIECE1", "BKPIECE1", "LBKPIECE1"})
 _ROADMAP = frozenset({"PRM", "PRMstar"})
+#: optimizing planners that are made to return on their first path, which is then held and
+#: the search resumed (BIT*: reading its tree through ``getPlannerData`` leaks its space
+#: information in the wheel, and once it has a path, ``stopOnSolnImprovement`` makes every
+#: later solve return at once); later improvements are not held: if the final path's
+#: re-check does not fit, the first one is re-checked
+_STOP_ON_FIRST = frozenset({"BITstar"})
 #: planners whose informed samplers need a RealVector space (see ``_Space``)
-#: how often (termination polls) the check reserve for re-checking the best path so far
-#: is recomputed while an optimizing planner improves it
+#: how often (termination polls) a better path is looked for to hold (its re-check's
+#: checks reserved) while an optimizing planner improves it
 _RESERVE_EVERY_POLLS = 8
-#: the reserve is this many times the re-check's cost: planners and the simplifier poll
-#: their termination condition between steps that use checks, so they stop a little late
+#: the *time* reserve is this many times the held path's re-check at the solve's rate:
+#: planners poll their termination condition between steps, so they stop a little late
+#: (the check reserve needs no factor: the guard refuses to spend it)
 _RESERVE_FACTOR = 1.25
 #: the steps after planning (the fine re-check) may run this fraction past the time limit
 _TIME_SLACK = 0.01
@@ -376,15 +392,32 @@ def _ompl_logging(logger: logging.Logger) -> Iterator[None]:
 
 
 # ---------------------------------------------------------------------------- helpers
-def _recheck_cost(path: Array, joint_step: float, continuous: np.ndarray) -> int:
+def _recheck_cost(path: Array, joint_step: float, checker: CollisionChecker) -> int:
     """Collision checks ``checker.check_path(path, joint_step)`` will make (all states of
-    the densified path), computed without checking anything."""
+    the path as the checker densifies it, metric edge resolution included), computed
+    without checking anything."""
     path = np.atleast_2d(np.asarray(path, dtype=float))
     if len(path) < 2:
         return len(path)
-    d = np.abs(joint_difference(path[1:], path[:-1], continuous))
-    steps = np.maximum(1, np.ceil(np.max(d, axis=1) / joint_step - 1e-12))
-    return int(1 + np.sum(steps))
+    return len(checker.densify(path, joint_step)[0])
+
+
+def _goal_chain(data: Any, space: _Space) -> Array | None:
+    """The chain of parents from the first goal vertex of OMPL planner data to a start
+    vertex, as joint vectors (start first); None if there is none."""
+    if data.numGoalVertices() == 0 or data.numStartVertices() == 0:
+        return None
+    v = int(data.getGoalIndex(0))
+    chain = [v]
+    seen = {v}
+    while not data.isStartVertex(v):
+        parents = data.getIncomingEdges(v)
+        if not parents or parents[0] in seen:
+            return None  # not a tree chain
+        v = int(parents[0])
+        seen.add(v)
+        chain.append(v)
+    return np.array([space.to_q(data.getVertex(i).getState()) for i in reversed(chain)])
 
 
 def _reach_m(robot: Robot, q: Array) -> float:
@@ -514,6 +547,9 @@ class _Guard:
         #: raise _TimeUp past the time limit (set while an OMPL solve runs, for planners
         #: with loops that poll nothing, see _HARD_STOP)
         self.hard_stop = False
+        #: checks held back for the re-check of the best path found so far: the checker
+        #: refuses to spend them, so that path's re-check always fits the budget
+        self.reserve = 0
 
     def iterations(self) -> int:
         return self.iteration_source() if self.iteration_source is not None else self.polls
@@ -544,8 +580,13 @@ class _Guard:
             return True
         return False
 
-    def is_valid(self, q: Array) -> bool:
+    def checks_left(self) -> int | None:
+        """Checks the planning may still spend: the budget's, less the reserve."""
         left = self.tracker.checks_left()
+        return None if left is None else max(left - self.reserve, 0)
+
+    def is_valid(self, q: Array) -> bool:
+        left = self.checks_left()
         if left is not None and left <= 0:
             self.refused += 1
             return False
@@ -561,7 +602,7 @@ class _Guard:
         """
         if self._out_of_time():
             return False
-        left = self.tracker.checks_left()
+        left = self.checks_left()
         n, bad = self.checker.check_edge(q_a, q_b, joint_step, left)
         if left is not None and left < n:
             self.refused += 1
@@ -711,7 +752,7 @@ class OMPLPlanner:
         q_start: Array | None,
         ompl_seed: int,
     ) -> PlanResult:
-        checker = CollisionChecker(problem.robot, problem.scene)
+        checker = problem_checker(problem)
         guard = _Guard(checker, BudgetTracker(budget, checker))
         try:
             return self._plan(problem, leg, rng, q_start, ompl_seed, guard)
@@ -855,15 +896,66 @@ class OMPLPlanner:
 
         recheck_step = problem.joint_step / 4.0
 
-        def recheck_cost(ompl_path: Any) -> int:
-            if s.interpolate:  # the path that will be re-checked is the interpolated one
+        def rows_of(ompl_path: Any) -> Array:
+            """The path that will be re-checked: interpolated (if set), wrapped, from q0."""
+            if s.interpolate:
                 ompl_path = og.PathGeometric(ompl_path)
                 ompl_path.interpolate()
             n = ompl_path.getStateCount()
-            Q = np.array([space.to_q(ompl_path.getState(i)) for i in range(n)])
-            return _recheck_cost(Q, recheck_step, robot.continuous)
+            Q = wrap_to_pi(
+                np.array([space.to_q(ompl_path.getState(i)) for i in range(n)]), robot.continuous
+            )
+            if len(Q):
+                Q[0] = q0
+            return Q
 
-        reserve = [0]
+        def recheck_cost(ompl_path: Any) -> int:
+            return _recheck_cost(rows_of(ompl_path), recheck_step, checker)
+
+        def ompl_path_of(Q: Array) -> Any:
+            """An OMPL path through the waypoints Q (k, dof) (states copied in)."""
+            p = og.PathGeometric(si)
+            st = space.space.allocState()
+            for q in Q:
+                space.set_state(st, q)
+                p.append(st)  # appends a copy
+            return p
+
+        #: the path the check reserve holds (waypoints, start first) and its re-check cost
+        held: list[Any] = [None, 0]
+
+        def hold(Q: Array) -> bool:
+            """Hold back the re-check cost of the path through Q, if it fits the checks not
+            yet spent: from now on planning cannot spend them (the guard refuses), so this
+            path (or a better one that fits) can always be re-checked within the budget."""
+            cost = recheck_cost(ompl_path_of(Q))
+            left = tracker.checks_left()
+            if left is not None and cost > left:
+                return False
+            held[0], held[1] = Q, cost
+            guard.reserve = cost if left is not None else 0
+            extra.setdefault("reserve_held_at_checks", tracker.checks_used)
+            extra["reserve_checks"] = cost
+            return True
+
+        def waypoints_of(ompl_path: Any) -> Array:
+            return np.array(
+                [space.to_q(ompl_path.getState(i)) for i in range(ompl_path.getStateCount())]
+            )
+
+        def tree_best_path() -> Array | None:
+            """The best path of an optimizing planner's tree (RRT*, Informed RRT*, BIT*:
+            they hand their path to the problem definition only when they stop): the chain
+            of parents from its goal vertex to the start, from OMPL's planner data."""
+            data = ob.PlannerData(si)
+            try:
+                planner.getPlannerData(data)
+                return _goal_chain(data, space)
+            finally:
+                data.clear()
+
+        best_seen = [math.inf]
+
         time_limit = tracker.budget.time_limit_s
 
         def past_time() -> bool:
@@ -871,39 +963,47 @@ class OMPLPlanner:
             return time_limit is not None and tracker.elapsed_s > time_limit * (1.0 + _TIME_SLACK)
 
         def planning_done() -> bool:
-            """Any limit reached, or a path was found and the checks left are just enough
-            to re-check it (asymptotically optimal planners would otherwise spend the
-            whole budget improving it and leave nothing for its re-check)."""
+            """Any limit reached, or a path is held and the checks left are its reserve
+            (asymptotically optimal planners would otherwise spend the whole budget
+            improving it)."""
             if guard.poll():
                 return True
             if max_checks is None and time_limit is None:
                 return False
-            if hasattr(planner, "bestCost"):
-                # RRT*, Informed RRT*, BIT* add their path to the problem definition only
-                # when they stop; their best cost is a path length L in the planning space
-                # (L2 or a sum over joints, either >= the largest joint motion), so the
-                # re-check needs at most L / (joint_step/4) + L / joint_step (interpolated
-                # waypoints) + a few checks
+            due = held[0] is None or guard.polls % _RESERVE_EVERY_POLLS == 0
+            if self.ompl_class in _STOP_ON_FIRST:
+                pass  # its first path is held when its first solve returns (below)
+            elif hasattr(planner, "bestCost"):
                 best = float(planner.bestCost().value())
-                if math.isfinite(best):
-                    reserve[0] = int(5.0 * best / problem.joint_step) + 16
-            elif pdef.hasSolution() and (
-                reserve[0] == 0 or guard.polls % _RESERVE_EVERY_POLLS == 0
-            ):
-                reserve[0] = recheck_cost(og.PathGeometric(pdef.getSolutionPath()))
-            if reserve[0] == 0:
+                if math.isfinite(best) and best < best_seen[0] and due:
+                    best_seen[0] = best  # read the tree once per improvement
+                    Q = tree_best_path()
+                    if Q is not None:
+                        hold(Q)
+            elif pdef.hasSolution() and due:
+                hold(waypoints_of(og.PathGeometric(pdef.getSolutionPath())))
+            if held[0] is None:
                 return False
             if time_limit is not None:
                 # the re-check's time at this solve's own rate (planning overhead included)
                 used = tracker.checks_used
                 rate_s = tracker.elapsed_s / max(used, 1)
-                if tracker.elapsed_s + _RESERVE_FACTOR * reserve[0] * rate_s >= time_limit:
+                if tracker.elapsed_s + _RESERVE_FACTOR * held[1] * rate_s >= time_limit:
                     return True
-            if max_checks is None:
-                return False
-            return tracker.checks_used + _RESERVE_FACTOR * reserve[0] >= max_checks
+            left = guard.checks_left()
+            return left is not None and left <= 0
 
-        ptc = ob.PlannerTerminationCondition(planning_done)
+        stopped = [False]
+
+        def planning_done_once() -> bool:
+            """:func:`planning_done`, remembered (a planner that returns on an improvement
+            is resumed only if its termination condition did not stop it)."""
+            stopped[0] = stopped[0] or planning_done()
+            return stopped[0]
+
+        if self.ompl_class in _STOP_ON_FIRST:
+            planner.setStopOnSolnImprovement(True)
+        ptc = ob.PlannerTerminationCondition(planning_done_once)
         if self.ompl_class in _ROADMAP:
             ompl_path, exact, status_text = self._roadmap_solve(
                 planner, si, space, guard, pool, q0, goal, robot, problem.joint_step
@@ -912,6 +1012,16 @@ class OMPLPlanner:
             guard.hard_stop = self.ompl_class in _HARD_STOP
             try:
                 status = planner.solve(ptc)
+                if (
+                    self.ompl_class in _STOP_ON_FIRST
+                    and status.getStatus() == ob.PlannerStatus.PlannerStatusType.EXACT_SOLUTION
+                    and pdef.hasSolution()
+                    and not stopped[0]
+                ):
+                    # it returned on its first path: hold it, then resume the search
+                    hold(waypoints_of(og.PathGeometric(pdef.getSolutionPath())))
+                    planner.setStopOnSolnImprovement(False)
+                    status = planner.solve(ptc)
             except _TimeUp:
                 return result(
                     Status.BUDGET_EXHAUSTED,
@@ -961,26 +1071,50 @@ class OMPLPlanner:
 
         extra["length_raw"] = float(ompl_path.length())
         extra["waypoints_raw"] = int(ompl_path.getStateCount())
-        fits = [False]
+        if max_checks is not None:
+            # the path to re-check: the final one if its re-check fits the checks left, else
+            # the best one held during planning (whose re-check always fits)
+            hold(waypoints_of(ompl_path))
+            if held[0] is not None:
+                ompl_path = ompl_path_of(held[0])
+        simplified = og.PathGeometric(ompl_path)
 
         def simplify_done() -> bool:
-            """Stop simplifying at any limit, or once the checks left are just enough to
-            re-check the path (a path too long to re-check is simplified until it fits or
-            the budget is spent)."""
+            """Stop simplifying at any limit, or once only the held path's reserve is left;
+            with no path held yet (its re-check did not fit), once the simplified path's
+            re-check fits, it is held."""
             if guard.poll():
                 return True
             if max_checks is None:
                 return False
-            margin = max_checks - tracker.checks_used - _RESERVE_FACTOR * recheck_cost(ompl_path)
-            if margin > 0:
-                fits[0] = True
-            return fits[0] and margin <= 0
+            if held[0] is None:
+                hold(waypoints_of(simplified))
+            left = guard.checks_left()
+            return left is not None and left <= 0
 
         if s.simplify and guard.exhausted() is None:
             simplifier = og.PathSimplifier(si, goal_obj)
             c0 = checker.checks
-            simplifier.simplify(ompl_path, ob.PlannerTerminationCondition(simplify_done))
+            simplifier.simplify(simplified, ob.PlannerTerminationCondition(simplify_done))
             extra["simplify_checks"] = checker.checks - c0
+        left = tracker.checks_left()
+        if left is None or recheck_cost(simplified) <= left:
+            ompl_path = simplified
+        elif held[0] is not None:  # simplifying made the re-check dearer: re-check the held
+            ompl_path = ompl_path_of(held[0])
+            extra["simplified_path_dropped"] = True
+        else:
+            cost = recheck_cost(simplified)
+            extra["validation_checks"] = 0
+            return result(
+                Status.BUDGET_EXHAUSTED,
+                f"{self.ompl_class} found a path ({status_text}) but re-checking it at "
+                f"joint_step/4 needs {cost} collision checks and the budget of "
+                f"{max_checks} leaves {left}: the path is not trusted; give a larger "
+                "--max-checks",
+                waypoints_of(simplified),
+                iterations,
+            )
         extra["length_simplified"] = float(ompl_path.length())
         extra["waypoints_simplified"] = int(ompl_path.getStateCount())
         waypoints = wrap_to_pi(
@@ -1008,7 +1142,7 @@ class OMPLPlanner:
         path[0] = q0  # exact copy (removes float noise of the OMPL round trip)
         extra["path_length_rad"] = path_length(path, robot.continuous)
 
-        cost = _recheck_cost(path, recheck_step, robot.continuous)
+        cost = _recheck_cost(path, recheck_step, checker)
         if max_checks is not None:
             left = max_checks + max_checks // 100 - tracker.checks_used
             if cost > left:

@@ -16,6 +16,7 @@ File layout (every key is documented in ``docs/problem-format.md``)::
     [[goals]]   name, p_m, n, pos_tol_m, angle_tol_deg     (one per leg, in order)
     [budget]    max_iterations, max_collision_checks, time_limit_s
     [checking]  joint_step       (largest joint step between checked states on an edge)
+    [planning]  safety_margin_m  (clearance every plan keeps; edge resolution in metres)
     [simulation] gravity_mps2 (default: Arm-Z off, others -9.81 along -z), max_deviation_m,
                 max_track_err_rad
     [witness]   path_rad        (a known collision-free path, for tests), goal_states_rad
@@ -52,6 +53,7 @@ KNOWN_TABLES = (
     "goals",
     "budget",
     "checking",
+    "planning",
     "simulation",
 )
 #: tables kept in ``Problem.extras`` (validated here, used by tests and some planners)
@@ -60,6 +62,14 @@ EXTRA_TABLES = ("witness", "continuum", "ik_expected")
 #: smallest ``[checking] joint_step`` [rad]: edges are checked every joint_step and
 #: re-checked every joint_step / 4, so the cost grows as 1 / joint_step
 MIN_JOINT_STEP_RAD = 1e-3
+#: default ``[planning] safety_margin_m`` [m]: at least the execution's deviation limit
+#: (``[simulation] max_deviation_m``, 0.01 m), so a plan leaves the executor its centimetre
+DEFAULT_SAFETY_MARGIN_M = 0.01
+#: smallest positive ``[planning] safety_margin_m`` [m]: edges are checked so that no point
+#: moves more than the margin between two checked states, so the cost grows as 1 / margin
+MIN_SAFETY_MARGIN_M = 1e-3
+#: largest ``[planning] safety_margin_m`` [m]
+MAX_SAFETY_MARGIN_M = 0.5
 #: largest goal angle tolerance [deg]: the angle between two directions is at most 180°
 MAX_ANGLE_TOL_DEG = 180.0
 
@@ -125,6 +135,9 @@ class Problem:
     goals: tuple[GoalRegion, ...]
     budget: Budget = field(default_factory=Budget)
     joint_step: float = 0.05
+    #: clearance margin [m] of every planner's validity check and of the final re-check;
+    #: also the edge resolution in metres (0: no margin, radian steps only)
+    safety_margin_m: float = DEFAULT_SAFETY_MARGIN_M
     description: str = ""
     simulation: SimSettings = field(default_factory=SimSettings)
     source: str = "<memory>"
@@ -622,6 +635,23 @@ def problem_from_dict(data: Mapping[str, Any], source: str) -> Problem:
             "joint_step", f"a step <= pi rad, got {joint_step:g} (edges would go unchecked)"
         )
 
+    pl = TableReader(source, "planning", top.raw("planning", {}))
+    pl.unknown_keys(("safety_margin_m", "note"))
+    safety_margin_m = pl.number(
+        "safety_margin_m",
+        DEFAULT_SAFETY_MARGIN_M,
+        nonnegative=True,
+        maximum=MAX_SAFETY_MARGIN_M,
+        why_maximum="a margin that wide closes every passage",
+    )
+    if 0.0 < safety_margin_m < MIN_SAFETY_MARGIN_M:
+        raise pl.fail(
+            "safety_margin_m",
+            f"0 (no margin) or a margin >= {MIN_SAFETY_MARGIN_M:g} m, got {safety_margin_m:g}: "
+            "edges are checked so that no point moves more than the margin between two "
+            "checked states, so a finer margin multiplies the collision checks",
+        )
+
     simulation = _simulation(top, robot)
 
     extras = {k: v for k, v in data.items() if k in EXTRA_TABLES}
@@ -639,6 +669,7 @@ def problem_from_dict(data: Mapping[str, Any], source: str) -> Problem:
         goals=goals,
         budget=budget,
         joint_step=joint_step,
+        safety_margin_m=safety_margin_m,
         description=description,
         simulation=simulation,
         source=source,

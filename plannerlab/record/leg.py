@@ -47,7 +47,7 @@ def settings_dict(settings: Any) -> dict[str, Any]:
 PROGRESS_COLUMNS = ("time_s", "collision_checks", "best_goal_dist", "best_cost")
 
 #: float fields of :class:`PlanResult` (``null`` in a file reads back as NaN)
-_FLOAT_FIELDS = ("time_s", "pos_err_m", "angle_err_deg")
+_FLOAT_FIELDS = ("time_s", "pos_err_m", "angle_err_deg", "min_clearance_m")
 
 
 @dataclass(frozen=True, eq=False)
@@ -65,6 +65,10 @@ class PlanResult:
         collision_checks: states checked for collision during planning.
         fk_calls: forward-kinematics evaluations (states), where the planner counts them.
         pos_err_m, angle_err_deg: tip errors of the path's last state.
+        min_clearance_m: smallest planned clearance [m]: the least signed distance of the
+            robot's true capsules (no margin) to the scene and between its checked link
+            pairs over the states of the returned path (NaN when not computed). A plan
+            that passed with ``[planning] safety_margin_m`` keeps at least that margin.
         trace: objective (or best goal distance) per iteration, for plots.
         progress: (k, 4) rows ``(time_s, collision_checks, best_goal_dist, best_cost)``
             (:data:`PROGRESS_COLUMNS`), one whenever the best goal distance or the best
@@ -90,6 +94,7 @@ class PlanResult:
     fk_calls: int = 0
     pos_err_m: float = math.nan
     angle_err_deg: float = math.nan
+    min_clearance_m: float = math.nan
     trace: Array = field(default_factory=lambda: np.zeros(0))
     progress: Array = field(default_factory=lambda: np.zeros((0, 4)))
     local_minima: int = 0

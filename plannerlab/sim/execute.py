@@ -121,7 +121,7 @@ from typing import Any
 
 import numpy as np
 
-from plannerlab.collision.fcl_checker import CollisionChecker
+from plannerlab.collision.fcl_checker import CollisionChecker, problem_checker
 from plannerlab.errors import PlannerlabError
 from plannerlab.problem.load import Problem
 from plannerlab.record.execution import ContactRecord, Execution
@@ -538,7 +538,7 @@ def execute(
     """
     path = _check_path(problem, path)
     leg_i = problem.resolve_leg(leg) if leg is not None else None
-    checker = CollisionChecker(problem.robot, problem.scene)
+    checker = problem_checker(problem)
     if gravity_mps2 is None:
         gravity_mps2 = problem.simulation.gravity_mps2
     with (
@@ -605,7 +605,7 @@ def execute_legs(
         one :class:`Execution` per path, in order.
     """
     paths = [_check_path(problem, p) for p in leg_paths]
-    checker = CollisionChecker(problem.robot, problem.scene)
+    checker = problem_checker(problem)
     out: list[Execution] = []
     if gravity_mps2 is None:
         gravity_mps2 = problem.simulation.gravity_mps2

@@ -1,0 +1,95 @@
+"""How far the robot's geometry can move per unit of joint motion: the metric edge bound.
+
+Between two states ``q`` and ``q + Δ`` on a straight joint-space edge, no point of the
+robot's collision geometry (every capsule, radius included) moves further than
+``Σ_i |Δ_i| · r_i`` [m], where ``r_i`` is :func:`joint_reach_m`'s bound for joint ``i``:
+
+* a revolute joint turns the links beyond it about its axis, so a point moves at most
+  ``|Δ_i| · (its distance from the axis)``; that distance is at most the distance of the
+  first moved link's start from the axis, plus the lengths of the moved links and the
+  gaps between them (the moved links form a chain), plus the largest moved capsule
+  radius: ``r_i`` is that sum, whatever the other joints are;
+* a prismatic joint translates them: ``r_i`` is their speed (1 m per m).
+
+This holds for every robot family through the Robot contract only (``link_segments``):
+per joint, which links move, the axis and the speed come from a finite difference of the
+capsule axes, taken at the start of the joint range and at a fixed set of states (its
+own seeded generator; link lengths and gaps of prismatic chains vary with q, so the
+largest seen is used). The sum over joints is the bound a planner's edge resolution in
+metres needs (:class:`~plannerlab.collision.fcl_checker.CollisionChecker` with a margin).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from plannerlab.robots.base import Array, Robot
+
+#: states the bound is taken at besides the start of the range (seeded, fixed)
+_SAMPLES = 16
+#: finite-difference step [rad or m]
+_H = 1e-6
+#: a link whose capsule axis moves slower than this per unit of the joint does not move
+_MOVES = 1e-6
+
+
+def _skew(p: Array) -> Array:
+    """(k, 3) vectors → (k, 3, 3) matrices of ``x ↦ p × x``."""
+    z = np.zeros(len(p))
+    return np.stack(
+        [
+            np.stack([z, -p[:, 2], p[:, 1]], axis=-1),
+            np.stack([p[:, 2], z, -p[:, 0]], axis=-1),
+            np.stack([-p[:, 1], p[:, 0], z], axis=-1),
+        ],
+        axis=1,
+    )
+
+
+def joint_reach_m(robot: Robot) -> Array:
+    """Per joint, an upper bound [m per rad, or m per m] of how fast any point of the
+    robot's collision geometry moves when that joint moves alone (see the module)."""
+    dof = robot.dof
+    cont = np.asarray(robot.continuous, dtype=bool)
+    lo = np.where(cont, -np.pi, robot.lower)
+    hi = np.where(cont, np.pi, robot.upper)
+    rng = np.random.default_rng(0)
+    states = np.vstack(
+        [np.clip(np.zeros(dof), robot.lower, robot.upper), rng.uniform(lo, hi, (_SAMPLES, dof))]
+    )
+    radii = np.asarray(robot.link_radii_m, dtype=float)
+    reach = np.zeros(dof)
+    for q in states:
+        S = np.asarray(robot.link_segments(q), dtype=float)  # (L, 2, 3)
+        lengths = np.linalg.norm(S[:, 1] - S[:, 0], axis=-1)
+        for i in range(dof):
+            h = _H if q[i] + _H <= hi[i] else -_H
+            qp = q.copy()
+            qp[i] += h
+            V = (np.asarray(robot.link_segments(qp), dtype=float) - S) / h  # (L, 2, 3)
+            speed = np.linalg.norm(V, axis=-1)  # (L, 2)
+            moved = np.flatnonzero(speed.max(axis=1) > _MOVES)
+            if len(moved) == 0:
+                continue
+            f = int(moved[0])
+            # rigid motion of the moved links: v(p) = ω × (p − a_f) + v(a_f)
+            P = S[moved].reshape(-1, 3) - S[f, 0]
+            Vr = V[moved].reshape(-1, 3) - V[f, 0]
+            A = -_skew(P).reshape(-1, 3)
+            omega = np.linalg.lstsq(A, Vr.reshape(-1), rcond=None)[0]
+            w = float(np.linalg.norm(omega))
+            if w < 1e-6:  # a translation: every moved point at the same speed
+                bound = float(speed[moved].max())
+            else:
+                gaps = np.linalg.norm(S[moved[1:], 0] - S[moved[:-1], 1], axis=-1)
+                chain = (
+                    float(np.linalg.norm(V[f, 0])) / w  # a_f's distance from the axis
+                    + float(lengths[moved].sum())
+                    + float(gaps.sum())
+                    + float(radii[moved].max())
+                )
+                # a rotation about an axis that also slides (none here) adds its speed
+                along = abs(float(np.dot(V[f, 0], omega))) / w
+                bound = w * chain + along
+            reach[i] = max(reach[i], bound)
+    return reach
