@@ -26,7 +26,7 @@ case "$job" in
     # the paper's whole experiment: enter, A-E, leave; each trial stops at its first
     # failed leg, solved legs are executed in PyBullet
     exec "$VENV/bin/plannerlab" compare armz_inspection \
-      --planners gradient.clearance+detour,gradient.clearance,gradient \
+      --planners gradient.clearance+detour,gradient.clearance+random_detour,gradient.clearance,gradient \
       --seeds 0-1 --max-checks 100000 --execute --jobs 2 --out results/runs --name main "$@" ;;
   test)
     exec "$VENV/bin/python" -m pytest -q "$@" ;;
