@@ -30,12 +30,9 @@ from plannerlab.collision.core import Core, PairDistances
 from plannerlab.collision.core import supports as core_supports
 from plannerlab.collision.reach import joint_reach_m
 from plannerlab.problem.scene import Box, Cylinder, Scene, Sphere
-from plannerlab.robots.base import Array, Robot, joint_difference
+from plannerlab.robots.base import Array, Robot
 from plannerlab.robots.paths import (
-    MAX_EDGE_STATES,
     densify,
-    edge_too_long,
-    require_joint_step,
 )
 
 
@@ -372,35 +369,7 @@ class CollisionChecker:
         at ``joint_step``, and with a margin each edge cut finer where needed so that no
         point of the robot moves more than the margin between two states (the bound
         ``Σ |Δq_i| · reach_i``). Returns (states, owning edge of each)."""
-        if self.edge_weights is None:
-            return densify(path, joint_step, self.robot.continuous)
-        path = np.atleast_2d(np.asarray(path, dtype=float))
-        if len(path) == 1:
-            return path.copy(), np.zeros(1, dtype=int)
-        require_joint_step(joint_step)
-        d = joint_difference(path[1:], path[:-1], self.robot.continuous)
-        span = np.max(np.abs(d), axis=1, initial=0.0)
-        metric = np.abs(d) @ self.edge_weights
-        n_f = np.maximum.reduce(
-            [
-                np.ones(len(d)),
-                np.ceil(span / joint_step - 1e-12),
-                np.ceil(metric - 1e-12),
-            ]
-        )
-        worst = int(np.argmax(n_f))
-        if n_f[worst] > MAX_EDGE_STATES:
-            raise edge_too_long(float(span[worst]), joint_step, int(min(n_f[worst], 2**62)))
-        n = n_f.astype(int)
-        owners = np.repeat(np.arange(len(d)), n)
-        j = np.arange(len(owners)) - np.repeat(np.cumsum(n) - n, n) + 1  # 1 .. n_i
-        n_of = n[owners]
-        t = np.where(j == n_of, 1.0, j * (1.0 / n_of))
-        states = path[:-1][owners] + t[:, None] * d[owners]
-        return (
-            np.concatenate([path[:1], states]),
-            np.concatenate([np.zeros(1, dtype=int), owners]),
-        )
+        return densify(path, joint_step, self.robot.continuous, self.edge_weights)
 
     def check_path(
         self,

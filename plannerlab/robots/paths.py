@@ -55,11 +55,19 @@ def interpolate_edge(q_a: Array, q_b: Array, joint_step: float, continuous: np.n
     return np.asarray(q_a, dtype=float)[None, :] + t * d[None, :]
 
 
-def densify(path: Array, joint_step: float, continuous: np.ndarray) -> tuple[Array, Array]:
+def densify(
+    path: Array,
+    joint_step: float,
+    continuous: np.ndarray,
+    edge_weights: Array | None = None,
+) -> tuple[Array, Array]:
     """A path (m, dof) densified edge by edge, in one vectorised pass (no loop per edge).
 
     Edge ``i`` contributes the states of :func:`interpolate_edge` after its first, bit for
     bit (``t = j * (1 / n)`` as :func:`numpy.linspace` computes it, the last ``t`` exactly 1).
+    With ``edge_weights`` (dof,), an edge ``Δq`` is also cut into at least
+    ``ceil(Σ |Δq_i| · edge_weights_i)`` steps (the collision checker's edges in metres:
+    weights = reach per joint / margin).
 
     Returns:
         states (M, dof) and, for each, the index of the waypoint edge it belongs to.
@@ -74,6 +82,8 @@ def densify(path: Array, joint_step: float, continuous: np.ndarray) -> tuple[Arr
     d = joint_difference(path[1:], path[:-1], continuous)  # (m - 1, dof)
     span = np.max(np.abs(d), axis=1, initial=0.0)
     n_f = np.maximum(1.0, np.ceil(span / joint_step - 1e-12))  # steps per edge
+    if edge_weights is not None:
+        n_f = np.maximum(n_f, np.ceil(np.abs(d) @ np.asarray(edge_weights) - 1e-12))
     worst = int(np.argmax(n_f))
     if n_f[worst] > MAX_EDGE_STATES:
         raise edge_too_long(float(span[worst]), joint_step, int(min(n_f[worst], 2**62)))
