@@ -20,7 +20,8 @@ from pathlib import Path
 
 import pytest
 
-from plannerlab.bench.trials import (
+from plannerlab.cli.main import main
+from plannerlab.comparison.trials import (
     ERROR_STATUS,
     Trial,
     TrialStore,
@@ -30,7 +31,6 @@ from plannerlab.bench.trials import (
     summarise,
     wilson_interval,
 )
-from plannerlab.cli.main import main
 from plannerlab.errors import PlannerlabError
 from plannerlab.problem.catalog import resolve_problem_path
 
@@ -349,7 +349,7 @@ def test_a_planner_whose_seeds_are_one_trial_is_marked_and_gets_no_interval(
 
 def test_fork_server_children_match_spawned_interpreters(comparison: dict, tmp_path: Path) -> None:
     """A child forked from the warm fork server gives what a fresh interpreter gives."""
-    from plannerlab.bench.local import LocalBackend
+    from plannerlab.comparison.local import LocalBackend
 
     first = {r["key"]: r for r in _lines(comparison["store"])}
     pick = [t for t in _trials() if t.seed == 2]
@@ -366,7 +366,7 @@ def test_fork_server_children_match_spawned_interpreters(comparison: dict, tmp_p
 def test_a_trial_past_its_time_limit_is_killed_and_recorded(tmp_path: Path) -> None:
     """A planner that overruns the per-trial limit is killed, recorded as timeout, and the
     comparison goes on with the next trial."""
-    from plannerlab.bench.trials import TIMEOUT_STATUS
+    from plannerlab.comparison.trials import TIMEOUT_STATUS
 
     path = resolve_problem_path(PROBLEM).resolve()
     slow = Trial.make(PROBLEM, path, "gradient", 0)  # default budget: seconds

@@ -26,12 +26,12 @@ from concurrent.futures import ProcessPoolExecutor
 import numpy as np
 import pytest
 
-from plannerlab.bench.task import leg_rng
 from plannerlab.planners import make_planner
 from plannerlab.planners.base import PlanResult, Status
 from plannerlab.planners.chord_arc import PAPER_TABLE
 from plannerlab.problem.catalog import load_problem
 from plannerlab.problem.load import Budget
+from plannerlab.run.pipeline import leg_rng
 
 CASES = (1, 2, 3)
 #: zero-thickness solution counts: the paper's Table I
@@ -70,7 +70,7 @@ _RRT = """
 import json, sys
 from plannerlab.problem.catalog import load_problem
 from plannerlab.planners import make_planner
-from plannerlab.bench.task import leg_rng
+from plannerlab.run.pipeline import leg_rng
 p = load_problem(sys.argv[1])
 r = make_planner("ompl.rrtconnect").solve(
     p, 0, p.budget.replace(max_collision_checks=int(sys.argv[2])), leg_rng(0, 0))

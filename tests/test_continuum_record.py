@@ -96,10 +96,10 @@ def test_plannerlab_plot_reads_a_continuum_plan(continuum_run, tmp_path) -> None
 
 
 def test_densify_restores_the_planner_steps_and_keeps_a_sampled_path() -> None:
-    from plannerlab.bench.task import leg_rng, solve_legs
     from plannerlab.planners import make_planner
     from plannerlab.problem.catalog import load_problem
     from plannerlab.robots.paths import waypoints
+    from plannerlab.run.pipeline import leg_rng, solve_legs
     from plannerlab.sim.continuum import densify_chord_arc_path
 
     problem = load_problem("continuum_case2")

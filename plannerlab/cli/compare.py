@@ -21,7 +21,7 @@ CSV, Markdown and OMPL benchmark logs in ``DIR/NAME/`` (load a log with
 
 Budgets are per leg; use ``--max-checks`` or ``--max-iterations`` for reproducible
 numbers, ``--time-limit`` for benchmarks. Argument parsing and printing only: the work
-is :mod:`plannerlab.bench.trials` and :mod:`plannerlab.bench.report`.
+is :mod:`plannerlab.comparison.trials` and :mod:`plannerlab.comparison.report`.
 """
 
 from __future__ import annotations
@@ -199,8 +199,8 @@ def _json_safe(x: Any) -> Any:
 
 # ---------------------------------------------------------------------- command
 def cmd_compare(args: argparse.Namespace, console: Console) -> int:
-    from plannerlab.bench.report import machine_info, write_reports
-    from plannerlab.bench.trials import (
+    from plannerlab.comparison.report import machine_info, write_reports
+    from plannerlab.comparison.trials import (
         ERROR_STATUS,
         TIMEOUT_STATUS,
         Trial,
@@ -443,6 +443,6 @@ def _print_tables(console: Console, rows: list[dict[str, Any]], columns: list[st
         "checks summed over legs. All columns: --wide, report.md, summary.csv.[/dim]",
         highlight=False,
     )
-    from plannerlab.bench.report import BUDGET_NOTE
+    from plannerlab.comparison.report import BUDGET_NOTE
 
     console.print(f"[dim]{escape(BUDGET_NOTE)}[/dim]", highlight=False)

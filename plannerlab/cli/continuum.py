@@ -15,7 +15,7 @@ runs the chosen solution in PyBullet (:func:`plannerlab.sim.continuum.execute_ch
 and shows the tip error and the expected / unexpected contacts.
 
 The data behind each row are the house's records: the first run is planned by
-:func:`plannerlab.bench.task.solve_legs` (seed 0) into a :class:`~plannerlab.record.plan.Plan`
+:func:`plannerlab.run.pipeline.solve_legs` (seed 0) into a :class:`~plannerlab.record.plan.Plan`
 whose one :class:`~plannerlab.record.leg.PlanResult` gives the row, and the execution is
 an :class:`~plannerlab.record.execution.Execution`. ``--out DIR`` writes them as any
 ``solve`` / ``execute`` would: ``DIR/<case>.plan.json`` and ``DIR/<case>.plan.exec.json``
@@ -165,7 +165,7 @@ class CaseRun:
     """One case of the table: the records behind its row and the timing summary.
 
     Attributes:
-        plan: the first (warm-up) run as a plan (:func:`plannerlab.bench.task.solve_legs`,
+        plan: the first (warm-up) run as a plan (:func:`plannerlab.run.pipeline.solve_legs`,
             seed 0): its one leg's :class:`~plannerlab.record.leg.PlanResult` is the row.
         execution: the chosen solution executed in PyBullet (``--execute``), or None.
         timing: ``runs``, ``search_median_s``, ``solve_median_s``, ``same_every_run``,
@@ -203,12 +203,12 @@ def run_case(
     out: Path | None = None,
 ) -> CaseRun:
     """One row of the table: the plan record, the timed runs, the execution record."""
-    from plannerlab.bench.task import execute_results, leg_rng, solve_legs
     from plannerlab.planners import make_planner
     from plannerlab.planners.chord_arc import PAPER_TABLE, guide_obstacles
     from plannerlab.problem.catalog import load_problem
     from plannerlab.record.files import versions
     from plannerlab.record.plan import ExecutionFile, execution_path
+    from plannerlab.run.pipeline import execute_results, leg_rng, solve_legs
 
     problem = load_problem(_case_name(case))
     planner = make_planner("chord_arc", overrides)

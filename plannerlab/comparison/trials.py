@@ -13,9 +13,9 @@ and an interrupted run loses only the trials that were still running.
 Decisions:
 
 * **One fresh process per trial**, at most ``jobs`` running, on a *backend*:
-  :mod:`plannerlab.bench.local` (default: children forked from a fork server that has
+  :mod:`plannerlab.comparison.local` (default: children forked from a fork server that has
   imported numpy, FCL, PyBullet and OMPL's modules but created no OMPL object) or
-  :mod:`plannerlab.bench.ray_backend` (Ray tasks, one fresh worker process each). A
+  :mod:`plannerlab.comparison.ray_backend` (Ray tasks, one fresh worker process each). A
   trial whose process dies is recorded as an ``error`` for *that* trial; a trial past
   its wall-clock limit (``trial_timeout_s``; :func:`default_trial_timeout_s` derives one
   from the budget) is killed and recorded as ``timeout``; on Ctrl-C the running trials
@@ -23,7 +23,7 @@ Decisions:
   writer, and the store, resuming and ``on_done`` are the same whatever the backend.
 * **Seeding.** The child seeds OMPL (``seed_ompl(seed)``) before anything else whenever
   :mod:`plannerlab.planners.ompl` imports, whatever the planner (a planner may use OMPL
-  inside); numpy generators come from :func:`plannerlab.bench.task.leg_rng`.
+  inside); numpy generators come from :func:`plannerlab.run.pipeline.leg_rng`.
 * **Trial key.** ``problem/planner/s<seed>/<hash>`` where the hash (sha256, 10 hex) covers
   the budget and settings overrides, the legs and the execute flag, so one store can hold
   runs of the same grid under different budgets without mixing them.
@@ -308,8 +308,8 @@ def run_trial(trial: Trial) -> dict[str, Any]:
         "ompl_seeded": ompl_seeded,
     }
     try:
-        from plannerlab.bench.task import solve_legs
         from plannerlab.problem.catalog import load_problem
+        from plannerlab.run.pipeline import solve_legs
 
         problem = load_problem(trial.problem_file)
         budget = problem.budget.replace(**dict(trial.budget))
@@ -341,7 +341,7 @@ def run_trial(trial: Trial) -> dict[str, Any]:
             solved_prefix += 1
         rec["executed_legs"] = solved_prefix if trial.execute else 0
         if trial.execute and solved_prefix:
-            from plannerlab.bench.task import execute_results
+            from plannerlab.run.pipeline import execute_results
 
             executions = execute_results(problem, plan.legs[:solved_prefix])
             rec["execution"] = _execution_record(executions)
@@ -527,8 +527,8 @@ def _timeout_record(trial: Trial, limit_s: float, elapsed_s: float) -> dict[str,
 
 
 def make_backend(name: str, work_dir: str | Path, *, address: str | None = None) -> Any:
-    """A trial backend by name: ``"local"`` (:class:`plannerlab.bench.local.LocalBackend`,
-    fork server) or ``"ray"`` (:class:`plannerlab.bench.ray_backend.RayBackend`).
+    """A trial backend by name: ``"local"`` (:class:`plannerlab.comparison.local.LocalBackend`,
+    fork server) or ``"ray"`` (:class:`plannerlab.comparison.ray_backend.RayBackend`).
 
     Raises:
         PlannerlabError: unknown name, ``address`` without Ray, or Ray not installed.
@@ -536,11 +536,11 @@ def make_backend(name: str, work_dir: str | Path, *, address: str | None = None)
     if name == "local":
         if address is not None:
             raise PlannerlabError("--address is for --backend ray")
-        from plannerlab.bench.local import LocalBackend
+        from plannerlab.comparison.local import LocalBackend
 
         return LocalBackend(work_dir, run_trial)
     if name == "ray":
-        from plannerlab.bench.ray_backend import RayBackend
+        from plannerlab.comparison.ray_backend import RayBackend
 
         return RayBackend(run_trial, address=address)
     raise PlannerlabError(f"backend: expected one of {', '.join(BACKENDS)}, got {name!r}")
@@ -572,8 +572,8 @@ def run_comparison(
         trial_timeout_s: wall-clock limit per trial [s], or a function of the trial
             (None: no limit). A trial past it is killed and recorded with status
             ``timeout``; the comparison goes on.
-        backend: where trials run: a backend object (see :mod:`plannerlab.bench.local`,
-            :mod:`plannerlab.bench.ray_backend`), or None for the local fork-server
+        backend: where trials run: a backend object (see :mod:`plannerlab.comparison.local`,
+            :mod:`plannerlab.comparison.ray_backend`), or None for the local fork-server
             backend. A backend made here is closed here.
 
     Returns:
