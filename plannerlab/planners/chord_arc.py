@@ -18,9 +18,12 @@ Build, then solve:
   solve_chord_arc` and turns **every** solution that survives into data, then picks one
   (``choose``) and returns its motion sequence as the joint path.
 
-**Every solution is returned** (``extra["solutions"]``: bend angles, arc lengths,
-curvatures, collision points used, their obstacles and contact types), not only the first.
-Solutions are dropped, with the reason kept (``extra["dropped"]``), when
+The leg's :attr:`~plannerlab.record.leg.PlanResult.contact_plan` (a
+:class:`~plannerlab.record.contact_plan.ContactPlan`) is the typed record of what it found,
+which the executor, the figures and the CLI read. **Every solution is returned**
+(``contact_plan.solutions``: arcs, collision points used, their obstacles and contact
+types), not only the first. Solutions are dropped, with the reason kept
+(``contact_plan.dropped``), when
 
 1. a contact does not behave as its type requires, or the initial push or the re-bend
    sweeps into an obstacle (the search module's motion check), or
@@ -60,7 +63,7 @@ the obstacles' cuts lie in one plane, so a capsule touches an obstacle exactly w
 axis comes closer than r to the cut; it gives the same pairs as python-fcl state by
 state, 30-40 times faster); a touching (link, obstacle) pair is *expected* when the
 link's axis passes within ``contact_tolerance_m`` (= 2·r + ``contact_margin_m``) of one
-of the solution's collision points on that obstacle; ``extra["expected_contacts"]``
+of the solution's collision points on that obstacle; ``contact_plan.expected_contacts``
 lists the chosen solution's expected pairs. Any other touching pair drops the solution
 (3. above). Every state checked counts as one of ``collision_checks``.
 
@@ -110,6 +113,13 @@ from plannerlab.planners.chord_arc_search import (
 )
 from plannerlab.planners.chord_arc_search import prepare as prepare_check
 from plannerlab.problem.scene import Box, Cylinder, Scene, Sphere
+from plannerlab.record.contact_plan import (
+    ContactPlan,
+    ContactSolution,
+    PlanarArc,
+    PlanarShape,
+    PlannedContact,
+)
 from plannerlab.robots.base import Array
 from plannerlab.robots.continuum.model import ContinuumChain
 
@@ -306,19 +316,50 @@ def guide_obstacles(problem: Any) -> frozenset[str]:
     return frozenset(raw)
 
 
-def _shape_dict(sol: ChordArcSolution, real: ChordArcQuery) -> dict[str, Any]:
-    """A solution as data; ``contact_points_m`` are the problem's collision points (the
-    obstacle corners), ``axis_points_m`` where the robot's axis passes them."""
-    return {
-        "contact_indices": list(sol.contact_indices),
-        "contact_points_m": [list(real.collision_points_m[i]) for i in sol.contact_indices],
-        "axis_points_m": [list(p) for p in sol.contact_points_m],
-        "bend_angles_rad": [a.theta_rad for a in sol.arcs],
-        "arc_lengths_m": [a.length_m for a in sol.arcs],
-        "curvatures_per_m": [a.curvature_per_m for a in sol.arcs],
-        "total_length_m": sol.total_length_m,
-        "leftover_m": sol.leftover_m,
-    }
+def _shape(o: PlanarObstacle) -> PlanarShape:
+    """An obstacle's cut as record data."""
+    if isinstance(o, Circle):
+        return PlanarShape(o.name, center_m=o.center_m, radius_m=o.radius_m)
+    return PlanarShape(o.name, vertices_m=o.vertices_m)
+
+
+def _solution(
+    sol: ChordArcSolution,
+    real: ChordArcQuery,
+    *,
+    plan: ChordArcPlan | None = None,
+    path_waypoints: int = 0,
+    expected_contacts: Sequence[PlannedContact] = (),
+    reason: str = "",
+    stage: str = "",
+    unexpected_contacts: Sequence[PlannedContact] = (),
+    cuts_radius_m: float = 0.0,
+) -> ContactSolution:
+    """A solution as record data; ``contact_points_m`` are the problem's collision points
+    (the obstacle corners), ``axis_points_m`` where the robot's axis passes them;
+    ``cuts_radius_m`` > 0 records where a robot of that radius along this zero-thickness
+    curve would cut an obstacle (:func:`thickness_cuts`)."""
+    cuts = thickness_cuts(real, sol, cuts_radius_m) if cuts_radius_m > 0 else np.zeros((0, 2))
+    return ContactSolution(
+        contact_indices=tuple(sol.contact_indices),
+        contact_points_m=tuple(real.collision_points_m[i] for i in sol.contact_indices),
+        axis_points_m=tuple(sol.contact_points_m),
+        arcs=tuple(
+            PlanarArc(a.start_xy_m, a.start_tangent, a.theta_rad, a.length_m) for a in sol.arcs
+        ),
+        total_length_m=sol.total_length_m,
+        leftover_m=sol.leftover_m,
+        contact_obstacles=() if plan is None else tuple(ck.obstacle for ck in plan.contacts),
+        contact_types=() if plan is None else tuple(ck.contact_type for ck in plan.contacts),
+        contact_sides=() if plan is None else tuple(ck.side for ck in plan.contacts),
+        motion=() if plan is None else tuple((m.kind, m.description) for m in plan.motion),
+        path_waypoints=path_waypoints,
+        expected_contacts=tuple(expected_contacts),
+        reason=reason,
+        stage=stage,
+        unexpected_contacts=tuple(unexpected_contacts),
+        cuts_xy_m=tuple((float(x), float(y)) for x, y in cuts),
+    )
 
 
 def _capped(settings: ChordArcSettings, max_iterations: int | None) -> ChordArcSettings:
@@ -341,8 +382,8 @@ class _Candidate:
     path: Array  # (m, dof)
     step_of: Array  # (m,) motion step index of each waypoint (-1: the start)
     reason: str  # why it is dropped; "" if it holds
-    expected: tuple[dict[str, Any], ...]
-    unexpected: tuple[dict[str, Any], ...]
+    expected: tuple[PlannedContact, ...]
+    unexpected: tuple[PlannedContact, ...]
 
 
 def _point_segment_distance(p: Array, a: Array, b: Array) -> Array:
@@ -539,7 +580,7 @@ class ChordArcPlanner:
         query: ChordArcQuery,
         path: Array,
         tol: float,
-    ) -> tuple[list[dict[str, Any]], list[dict[str, Any]], bool]:
+    ) -> tuple[list[PlannedContact], list[PlannedContact], bool]:
         """Contacts of the chain's capsules along a path, split into expected and
         unexpected (link, obstacle) pairs, in one batched planar test
         (:func:`capsule_distances`: every state × link × obstacle at once).
@@ -579,22 +620,22 @@ class ChordArcPlanner:
         near, nearest, away = near[order], nearest[order], away[order]
         starts = np.flatnonzero(np.r_[True, key[1:] != key[:-1]])
         ends = np.r_[starts[1:], len(key)]
-        expected: list[dict[str, Any]] = []
-        unexpected: list[dict[str, Any]] = []
+        expected: list[PlannedContact] = []
+        unexpected: list[PlannedContact] = []
         for a0, a1 in zip(starts, ends, strict=True):
             hits = np.flatnonzero(away[a0:a1])
             k = a0 + (int(hits[0]) if len(hits) else 0)
             ci = int(nearest[k])
-            rec = {
-                "link": robot.link_names[int(li[k])],
-                "obstacle": names[int(ob[k])],
-                "first_state": int(st[k]),
-                "collision_point": None if ci < 0 else ci,
-                "distance_m": None if ci < 0 else float(near[k]),
-            }
+            rec = PlannedContact(
+                link=robot.link_names[int(li[k])],
+                obstacle=names[int(ob[k])],
+                first_state=int(st[k]),
+                collision_point=None if ci < 0 else ci,
+                distance_m=None if ci < 0 else float(near[k]),
+            )
             (unexpected if len(hits) else expected).append(rec)
-        expected.sort(key=lambda r: r["first_state"])
-        unexpected.sort(key=lambda r: r["first_state"])
+        expected.sort(key=lambda r: r.first_state)
+        unexpected.sort(key=lambda r: r.first_state)
         return expected, unexpected, False
 
     # ------------------------------------------------------------------ solve
@@ -633,17 +674,18 @@ class ChordArcPlanner:
         q0 = np.asarray(problem.q_start if q_start is None else q_start, dtype=float)
         q0 = q0.reshape(robot.dof)
         tol = 2.0 * robot.link_radius_m + s.contact_margin_m
-        base_extra: dict[str, Any] = {
-            "collision_points_m": [list(p) for p in real.collision_points_m],
-            "inflated_by_m": robot.link_radius_m if s.inflate_by_radius else 0.0,
-            "contact_tolerance_m": tol,
-            "solutions": [],
-            "dropped": [],
-            "chosen": None,
-            "expected_contacts": [],
-            "allows_contact": True,
-            "guide_obstacles": sorted(guide_obstacles(problem)),
-        }
+        record = ContactPlan(
+            base_xy_m=real.base_xy_m,
+            base_tangent=real.base_tangent,
+            target_xy_m=real.target_xy_m,
+            obstacles=tuple(_shape(o) for o in real.obstacles),
+            planning_obstacles=tuple(_shape(o) for o in query.obstacles),
+            collision_points_m=real.collision_points_m,
+            link_radius_m=robot.link_radius_m,
+            inflated_by_m=robot.link_radius_m if s.inflate_by_radius else 0.0,
+            contact_tolerance_m=tol,
+            guide_obstacles=tuple(sorted(guide_obstacles(problem))),
+        )
 
         # progress: the search starts at the straight robot, at time 0 with no checks
         run.progress.note(float(goal.distance(robot, q0)), time_s=0.0, checks=0)
@@ -654,17 +696,10 @@ class ChordArcPlanner:
             path: Array,
             iterations: int = 0,
             trace: Array | None = None,
-            extra: dict[str, Any] | None = None,
         ) -> PlanResult:
             """The leg's result, with what the search found so far."""
-            return run.result(
-                status,
-                reason,
-                path,
-                iterations=iterations,
-                trace=trace,
-                extra={**base_extra, **(extra or {})},
-            )
+            r = run.result(status, reason, path, iterations=iterations, trace=trace)
+            return r.replace(contact_plan=record)
 
         straight = robot.q_from_arcs([], insertion_m=0.0)
         if not np.allclose(q0, straight, atol=1e-9):
@@ -693,7 +728,7 @@ class ChordArcPlanner:
             return result(Status.INVALID_GOAL, str(exc) + grown, q0[None])
         search_s = time.perf_counter() - t_search
         srch = res.search
-        base_extra["search"] = {
+        search = {
             "time_s": search_s,
             "expansions": srch.expansions,
             "arcs_built": srch.arcs_built,
@@ -705,10 +740,10 @@ class ChordArcPlanner:
             "budget_exhausted": srch.budget_exhausted,
             "geometric_solutions": len(srch.solutions),
         }
-        dropped: list[dict[str, Any]] = [
-            {"reason": d.reason, "stage": "contact_type", **_shape_dict(d.solution, real)}
-            for d in res.dropped
+        dropped: list[ContactSolution] = [
+            _solution(d.solution, real, reason=d.reason, stage="contact_type") for d in res.dropped
         ]
+        record = dataclasses.replace(record, search=search, dropped=tuple(dropped))
         iters = srch.expansions
         if budget.time_limit_s is not None and search_s >= budget.time_limit_s:
             return result(
@@ -735,42 +770,46 @@ class ChordArcPlanner:
                     f"{robot.upper[j]:.3g}]) during step {owner[k]} "
                     f"({plan.motion[owner[k]].kind})"
                 )
-            exp: list[dict[str, Any]] = []
-            unexp: list[dict[str, Any]] = []
+            exp: list[PlannedContact] = []
+            unexp: list[PlannedContact] = []
             if not reason and s.check_contacts and not cut_short:
                 exp, unexp, cut_short = self._classify(robot, tracker, plan, real, path, tol)
                 if unexp:
                     u = unexp[0]
                     reason = (
                         f"the {robot.link_radius_m * 1e3:.3g} mm-radius chain touches "
-                        f"{u['obstacle']!r} with {u['link']} away from the solution's "
-                        f"collision points (waypoint {u['first_state']}; "
+                        f"{u.obstacle!r} with {u.link} away from the solution's "
+                        f"collision points (waypoint {u.first_state}; "
                         f"{len(unexp)} such pair(s))"
                     )
             cands.append(_Candidate(plan, path, owner, reason, tuple(exp), tuple(unexp)))
+        cut_r = 0.0 if s.inflate_by_radius else robot.link_radius_m
         for c in cands:
             if c.reason:
                 dropped.append(
-                    {
-                        "reason": c.reason,
-                        "stage": "chain",
-                        **_shape_dict(c.plan.solution, real),
-                        "unexpected_contacts": list(c.unexpected),
-                    }
+                    _solution(
+                        c.plan.solution,
+                        real,
+                        plan=c.plan,
+                        reason=c.reason,
+                        stage="chain",
+                        unexpected_contacts=c.unexpected,
+                        cuts_radius_m=cut_r,
+                    )
                 )
         kept = [c for c in cands if not c.reason]
-        solutions = []
-        for c in kept:
-            d = _shape_dict(c.plan.solution, real)
-            d["contact_obstacles"] = [ck.obstacle for ck in c.plan.contacts]
-            d["contact_types"] = [ck.contact_type for ck in c.plan.contacts]
-            d["contact_sides"] = [ck.side for ck in c.plan.contacts]
-            d["motion"] = [{"kind": m.kind, "description": m.description} for m in c.plan.motion]
-            d["path_waypoints"] = len(c.path)
-            d["expected_contacts"] = list(c.expected)
-            solutions.append(d)
-        base_extra["solutions"] = solutions
-        base_extra["dropped"] = dropped
+        solutions = tuple(
+            _solution(
+                c.plan.solution,
+                real,
+                plan=c.plan,
+                path_waypoints=len(c.path),
+                expected_contacts=c.expected,
+                cuts_radius_m=cut_r,
+            )
+            for c in kept
+        )
+        record = dataclasses.replace(record, solutions=solutions, dropped=tuple(dropped))
         n_pts = len(query.collision_points_m)
 
         if cut_short:
@@ -782,7 +821,7 @@ class ChordArcPlanner:
                 iters,
             )
         if not kept:
-            why = "; ".join(d["reason"] for d in dropped[:3])
+            why = "; ".join(d.reason for d in dropped[:3])
             if not srch.solutions:
                 status = Status.BUDGET_EXHAUSTED if srch.budget_exhausted else Status.FAILED
                 reason = (
@@ -813,11 +852,9 @@ class ChordArcPlanner:
         c = kept[chosen]
         tips = robot.tip(c.path)[0]
         trace = np.linalg.norm(tips - goal.p_world_m, axis=1)
-        extra = {
-            "chosen": chosen,
-            "expected_contacts": list(c.expected),
-            "motion_step_of_waypoint": c.step_of.tolist(),
-        }
+        record = dataclasses.replace(
+            record, chosen=chosen, motion_step_of_waypoint=tuple(int(k) for k in c.step_of)
+        )
         q_end = c.path[-1]
         summary = (
             f"{len(kept)} solution(s) of {len(srch.solutions)} geometric "
@@ -835,7 +872,6 @@ class ChordArcPlanner:
                 c.path,
                 iters,
                 trace,
-                extra,
             )
         return result(
             Status.SOLVED,
@@ -843,7 +879,6 @@ class ChordArcPlanner:
             c.path,
             iters,
             trace,
-            extra,
         )
 
 

@@ -149,8 +149,8 @@ def execute_results(
 
     Ordinary legs run in one world, each from where the previous one really ended
     (:func:`plannerlab.sim.execute.execute_legs`). Legs of a contact-permitting planner
-    (``extra["allows_contact"]``: ``chord_arc``, whose paths touch the collision points
-    on purpose) run in :func:`plannerlab.sim.continuum.execute_chord_arc`, which sorts
+    (a leg with a ``contact_plan``: ``chord_arc``, whose paths touch the collision
+    points on purpose) run in :func:`plannerlab.sim.continuum.execute_chord_arc`, which sorts
     expected from unexpected contacts; each of them starts from its path's first state.
 
     Raises:
@@ -159,7 +159,7 @@ def execute_results(
     if not results:
         raise PlannerlabError("nothing to execute: the plan has no legs")
     results = [canonical_result(r) for r in results]
-    if any(r.extra.get("allows_contact") for r in results):
+    if any(r.contact_plan is not None for r in results):
         from plannerlab.sim.continuum import execute_chord_arc
 
         return [execute_chord_arc(problem, r, gui=gui) for r in results]

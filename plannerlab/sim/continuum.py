@@ -10,7 +10,7 @@ point after every physics step and classifies it:
 * **expected**: a robot link touching the obstacle that owns one of the *chosen*
   solution's collision points, with the contact point within ``tolerance_m`` of that
   collision point (in the robot's plane). The default is the planner's
-  ``extra["contact_tolerance_m"]`` = 2·link radius + ``contact_margin_m`` (10 mm): the
+  ``contact_plan.contact_tolerance_m`` = 2·link radius + ``contact_margin_m`` (10 mm): the
   capsule's axis passes through the corner, so the capsule overlaps the obstacle there by
   up to one radius, and when the robot meets the corner at a shallow angle ``α`` to one of
   its edges the overlap runs ``r / tan(α)`` along that edge (measured up to 7.6 mm for
@@ -58,7 +58,7 @@ target; the goals of the paper's cases constrain position only), every contact a
 ``collision_point``), and the rest (chosen solution, tolerance, closest approaches) in
 ``extra``. ``path_valid`` is None: an FCL re-check of the path is not made here, it
 reports the collision-point contacts by design; the planner's
-``extra["expected_contacts"]`` holds its classification.
+``contact_plan.expected_contacts`` holds its classification.
 :attr:`~plannerlab.record.execution.Execution.success` = the tip ends inside the goal
 region, no contact is unexpected and the chain followed the path within the problem's
 ``[simulation] max_deviation_m``: the largest deviation of its capsules from the
@@ -211,10 +211,11 @@ def execute_chord_arc(
 
     Args:
         problem: the problem the plan was made for.
-        result: the leg: its ``path``, ``leg``, ``settings`` and ``extra`` (``chosen``,
-            ``solutions`` (their ``contact_indices``, ``contact_points_m``,
-            ``contact_obstacles``), ``contact_tolerance_m``, ``guide_obstacles``).
-        tolerance_m: expected-contact radius [m]; default ``extra["contact_tolerance_m"]``.
+        result: the leg: its ``path``, ``leg``, ``settings`` and ``contact_plan`` (the
+            chosen solution's collision points and their obstacles, the contact
+            tolerance, the guide obstacles).
+        tolerance_m: expected-contact radius [m]; default the contact plan's
+            ``contact_tolerance_m``.
         dt_s: physics time step [s].
         steps_per_waypoint: physics steps per waypoint.
         settle_steps: physics steps holding the last waypoint.
@@ -230,18 +231,19 @@ def execute_chord_arc(
         gui: PyBullet's GUI instead of DIRECT.
 
     Raises:
-        PlannerlabError: no chosen solution in ``extra`` (not a chord_arc plan, or
+        PlannerlabError: no chosen solution in a ``contact_plan`` (not a chord_arc plan, or
             nothing was solved), a path of the wrong shape, or a bad parameter.
     """
     t0 = time.perf_counter()
-    extra = result.extra
-    chosen = extra.get("chosen") if isinstance(extra, Mapping) else None
-    if chosen is None or "solutions" not in extra:
+    contact_plan = result.contact_plan
+    sol = None if contact_plan is None else contact_plan.chosen_solution
+    if contact_plan is None or sol is None:
         raise PlannerlabError(
             f"{problem.name} leg {result.leg}: execute_chord_arc needs a chord_arc plan "
-            "with a chosen solution (extra['chosen'] and extra['solutions']); "
+            "with a chosen solution (its contact_plan); "
             f"this leg is {result.status.value}"
         )
+    chosen = contact_plan.chosen
     if solver not in SOLVERS:
         raise PlannerlabError(f"solver must be one of {', '.join(SOLVERS)}, got {solver!r}")
     if steps_per_waypoint < 1 or settle_steps < 0 or not dt_s > 0:
@@ -257,16 +259,13 @@ def execute_chord_arc(
             f"path must be (m >= 1, {robot.dof}) for {problem.name}, got {path.shape}"
         )
     path = densify_chord_arc_path(path, result.settings)
-    sol = extra["solutions"][int(chosen)]
-    tol = float(extra["contact_tolerance_m"] if tolerance_m is None else tolerance_m)
-    idx = [int(i) for i in sol["contact_indices"]]
-    points = {
-        i: (float(p[0]), float(p[1])) for i, p in zip(idx, sol["contact_points_m"], strict=True)
-    }
-    owners = dict(zip(idx, sol["contact_obstacles"], strict=True))
+    tol = float(contact_plan.contact_tolerance_m if tolerance_m is None else tolerance_m)
+    idx = list(sol.contact_indices)
+    points = dict(zip(idx, sol.contact_points_m, strict=True))
+    owners = dict(zip(idx, sol.contact_obstacles, strict=True))
     goal = problem.goal(leg)
     gravity = problem.simulation.gravity_mps2 if gravity_mps2 is None else gravity_mps2
-    guides = frozenset(str(n) for n in extra.get("guide_obstacles", ()))
+    guides = frozenset(contact_plan.guide_obstacles)
 
     seen: dict[tuple[str, str, bool, bool], list[Any]] = {}
     closest: dict[str, dict[str, Any]] = {}
@@ -453,7 +452,7 @@ def execute_chord_arc(
         solver=solver,
         extra={
             "executor": "chord_arc",
-            "chosen": int(chosen),
+            "chosen": chosen,
             "collision_points_used": idx,
             "contact_tolerance_m": tol,
             "guide_obstacles": sorted(guides),
