@@ -13,17 +13,15 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from plannerlab.planners.chord_arc_search import (
+from plannerlab.planners.chord_arc.geometry import (
     ChordArcInputError,
     ChordArcQuery,
-    ChordArcSettings,
     Circle,
     ConvexPolygon,
-    MotionStep,
-    prepare,
-    search_chord_arc,
-    solve_chord_arc,
 )
+from plannerlab.planners.chord_arc.motion import MotionStep, solve_chord_arc
+from plannerlab.planners.chord_arc.search import prepare, search_chord_arc
+from plannerlab.planners.chord_arc.settings import ChordArcSettings
 from plannerlab.robots.base import Robot, pose_matrix
 from plannerlab.robots.continuum.model import (
     ContinuumChain,
@@ -440,9 +438,9 @@ def test_one_contact_solutions_are_the_two_arc_geometry() -> None:
 
 
 def test_the_planner_has_one_settings_class() -> None:
-    from plannerlab.planners import chord_arc, chord_arc_search
+    from plannerlab.planners import make_planner
 
-    assert chord_arc.ChordArcSettings is chord_arc_search.ChordArcSettings
+    assert type(make_planner("chord_arc").settings) is ChordArcSettings
     with pytest.raises(ChordArcInputError, match="choose must be one of"):
         ChordArcSettings(choose="best")
     assert ChordArcSettings().inflate_by_radius  # the robot's radius by default
@@ -468,7 +466,7 @@ def test_batched_capsule_contacts_equal_fcl(case: int) -> None:
     (link, obstacle) pairs python-fcl reports for the 3-D capsules and boxes."""
     from plannerlab.collision.fcl_checker import CollisionChecker
     from plannerlab.planners import make_planner
-    from plannerlab.planners.chord_arc import capsule_distances
+    from plannerlab.planners.chord_arc.scene import capsule_distances
 
     problem = _problem(case)
     chain = problem.robot

@@ -28,7 +28,7 @@ import pytest
 
 from plannerlab.planners import make_planner
 from plannerlab.planners.base import PlanResult, Status
-from plannerlab.planners.chord_arc import PAPER_TABLE
+from plannerlab.planners.chord_arc.planner import PAPER_TABLE
 from plannerlab.problem.catalog import load_problem
 from plannerlab.problem.load import Budget
 from plannerlab.run.pipeline import leg_rng
@@ -218,7 +218,7 @@ def test_without_the_sleeve_the_chain_is_no_single_section(tmp_path) -> None:
 def test_the_solutions_lost_to_thickness_are_those_that_cut(case: int) -> None:
     """A zero-thickness solution survives the robot's radius exactly when a 2 mm robot
     along its curve would not cut an obstacle away from its collision points."""
-    from plannerlab.planners.chord_arc import thickness_cuts
+    from plannerlab.planners.chord_arc.scene import thickness_cuts
 
     problem = load_problem(f"continuum_case{case}")
     thin_planner = make_planner("chord_arc", {"inflate_by_radius": False})

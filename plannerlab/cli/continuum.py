@@ -181,7 +181,8 @@ def run_case(
 ) -> CaseRun:
     """One row of the table: the plan record, the timed runs, the execution record."""
     from plannerlab.planners import make_planner
-    from plannerlab.planners.chord_arc import PAPER_TABLE, guide_obstacles
+    from plannerlab.planners.chord_arc.planner import PAPER_TABLE
+    from plannerlab.planners.chord_arc.scene import guide_obstacles
     from plannerlab.problem.catalog import load_problem
     from plannerlab.record.files import versions
     from plannerlab.record.plan import ExecutionFile, execution_path

@@ -158,7 +158,7 @@ def _entries() -> dict[str, PlannerEntry]:
     entries.append(
         PlannerEntry(
             "chord_arc",
-            "plannerlab.planners.chord_arc:make",
+            "plannerlab.planners.chord_arc.planner:make",
             "continuum robot's chord-arc tree search with obstacle wrapping (contact at the "
             "problem's collision points)",
             robots=("continuum_chain",),
