@@ -25,7 +25,9 @@ from typing import TYPE_CHECKING, Any
 
 if TYPE_CHECKING:
     from plannerlab.comparison.report import markdown as markdown_report
-    from plannerlab.comparison.trials import ComparisonRun, Trial, compare, summarise
+    from plannerlab.comparison.runner import ComparisonRun, compare
+    from plannerlab.comparison.statistics import summarise
+    from plannerlab.comparison.trial import Trial
     from plannerlab.errors import PlannerlabError
     from plannerlab.planners import make_planner, planner_names
     from plannerlab.plot.animate import animate_plan
@@ -48,10 +50,10 @@ _EXPORTS: dict[str, str] = {
     "make_planner": "plannerlab.planners:make_planner",
     "solve": "plannerlab.run.pipeline:solve_legs",
     "execute": "plannerlab.run.pipeline:execute_plan",
-    "compare": "plannerlab.comparison.trials:compare",
-    "summarise": "plannerlab.comparison.trials:summarise",
-    "Trial": "plannerlab.comparison.trials:Trial",
-    "ComparisonRun": "plannerlab.comparison.trials:ComparisonRun",
+    "compare": "plannerlab.comparison.runner:compare",
+    "summarise": "plannerlab.comparison.statistics:summarise",
+    "Trial": "plannerlab.comparison.trial:Trial",
+    "ComparisonRun": "plannerlab.comparison.runner:ComparisonRun",
     "Status": "plannerlab.record.leg:Status",
     "PlanResult": "plannerlab.record.leg:PlanResult",
     "Plan": "plannerlab.record.plan:Plan",

@@ -21,16 +21,10 @@ from pathlib import Path
 import pytest
 
 from plannerlab.cli.main import main
-from plannerlab.comparison.trials import (
-    ERROR_STATUS,
-    Trial,
-    TrialStore,
-    parse_seeds,
-    run_comparison,
-    run_trial,
-    summarise,
-    wilson_interval,
-)
+from plannerlab.comparison.runner import run_comparison
+from plannerlab.comparison.statistics import summarise, wilson_interval
+from plannerlab.comparison.store import TrialStore
+from plannerlab.comparison.trial import ERROR_STATUS, Trial, parse_seeds, run_trial
 from plannerlab.errors import PlannerlabError
 from plannerlab.problem.catalog import resolve_problem_path
 
@@ -366,7 +360,7 @@ def test_fork_server_children_match_spawned_interpreters(comparison: dict, tmp_p
 def test_a_trial_past_its_time_limit_is_killed_and_recorded(tmp_path: Path) -> None:
     """A planner that overruns the per-trial limit is killed, recorded as timeout, and the
     comparison goes on with the next trial."""
-    from plannerlab.comparison.trials import TIMEOUT_STATUS
+    from plannerlab.comparison.trial import TIMEOUT_STATUS
 
     path = resolve_problem_path(PROBLEM).resolve()
     slow = Trial.make(PROBLEM, path, "gradient", 0)  # default budget: seconds
@@ -644,3 +638,21 @@ def test_store_is_locked_while_written(tmp_path: Path) -> None:
         with pytest.raises(PlannerlabError, match="in use"), store.writer():
             pass
     assert TrialStore(tmp_path / "s.jsonl").load() == {"k": {"key": "k", "x": 1}}
+
+
+def test_the_api_checks_a_comparison_as_the_cli_does(tmp_path: Path) -> None:
+    """``plannerlab.compare`` builds the same ComparisonSpec as ``plannerlab compare``: a
+    planner on the wrong robot kind, an unknown leg or a bad budget fail before any trial
+    runs (no store is written)."""
+    import plannerlab as pl
+
+    store = tmp_path / "s.jsonl"
+    with pytest.raises(PlannerlabError, match="works on continuum_chain robots"):
+        pl.compare(["armz_pocket"], ["chord_arc"], [0], store)
+    with pytest.raises(PlannerlabError, match="unknown leg 'nowhere'"):
+        pl.compare(["armz_pocket"], ["gradient"], [0], store, legs="nowhere")
+    with pytest.raises(PlannerlabError, match="max_collision_checks: expected a number > 0"):
+        pl.compare(["armz_pocket"], ["gradient"], [0], store, budget={"max_collision_checks": 0})
+    with pytest.raises(PlannerlabError, match="backend: expected one of local, ray"):
+        pl.compare(["armz_pocket"], ["gradient"], [0], store, backend="slurm")
+    assert not store.exists()

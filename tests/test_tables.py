@@ -29,7 +29,7 @@ from plannerlab.cli.tables import (
     pick_columns,
     print_summary_tables,
 )
-from plannerlab.comparison.trials import SUMMARY_COLUMNS as ROW_KEYS
+from plannerlab.comparison.statistics import SUMMARY_COLUMNS as ROW_KEYS
 from plannerlab.errors import PlannerlabError
 from plannerlab.planners.base import PlanResult
 

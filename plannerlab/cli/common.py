@@ -122,25 +122,6 @@ def budget_from_args(problem: Any, args: argparse.Namespace) -> Any:
     )
 
 
-def legs_from_spec(problem: Any, spec: str | None) -> list[int] | None:
-    if spec is None or spec.strip() == "all":
-        return None
-    legs = []
-    for x in spec.split(","):
-        x = x.strip()
-        try:
-            legs.append(problem.resolve_leg(x))
-        except (IndexError, KeyError) as exc:
-            names = ", ".join(f"{i} {g.name}" for i, g in enumerate(problem.goals))
-            raise PlannerlabError(
-                f"--legs: unknown leg {x!r} of {problem.name} ({problem.source}); "
-                f"its legs are: {names}"
-            ) from exc
-    if len(set(legs)) != len(legs):
-        raise PlannerlabError(f"--legs: {spec!r} names a leg twice")
-    return legs
-
-
 def require_display(gui: bool) -> None:
     """``--gui`` opens PyBullet's window: on Linux that needs an X display."""
     if gui and sys.platform.startswith("linux") and not os.environ.get("DISPLAY"):

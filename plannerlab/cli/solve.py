@@ -15,7 +15,6 @@ from plannerlab.cli.common import (
     add_budget_args,
     budget_from_args,
     leg_spec,
-    legs_from_spec,
     parse_overrides,
     require_display,
     seed_int,
@@ -68,7 +67,7 @@ def solve_and_save(args: argparse.Namespace, console: Console, out: Path | None 
     """Solve as the flags say and write the plan file (``out``, default beside the
     results); return the plan and where it went."""
     from plannerlab.problem.catalog import load_problem
-    from plannerlab.run.pipeline import solve_legs
+    from plannerlab.run.pipeline import legs_from_spec, solve_legs
 
     problem = load_problem(args.problem)
     if not getattr(args, "json", False):

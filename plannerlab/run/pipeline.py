@@ -70,6 +70,31 @@ def _check_problem_start(problem: Problem) -> None:
         raise ProblemError(problem.source, "start", f"a collision-free start state; {reason}")
 
 
+def legs_from_spec(problem: Problem, spec: str | None) -> list[int] | None:
+    """The legs a ``--legs`` text names (indices or goal names, comma-separated; ``all`` or
+    None: every leg).
+
+    Raises:
+        PlannerlabError: an unknown leg (the problem's legs listed) or one named twice.
+    """
+    if spec is None or spec.strip() == "all":
+        return None
+    legs = []
+    for x in spec.split(","):
+        x = x.strip()
+        try:
+            legs.append(problem.resolve_leg(x))
+        except (IndexError, KeyError) as exc:
+            names = ", ".join(f"{i} {g.name}" for i, g in enumerate(problem.goals))
+            raise PlannerlabError(
+                f"--legs: unknown leg {x!r} of {problem.name} ({problem.source}); "
+                f"its legs are: {names}"
+            ) from exc
+    if len(set(legs)) != len(legs):
+        raise PlannerlabError(f"--legs: {spec!r} names a leg twice")
+    return legs
+
+
 def solve_legs(
     problem: Problem,
     planner_name: str,
