@@ -194,6 +194,81 @@ def _solution(
     )
 
 
+def _candidate_solution(c: _Candidate, real: ChordArcQuery, cut_r: float) -> ContactSolution:
+    """A chain-checked solution as record data: kept (its path and expected contacts) or
+    dropped by the chain's check (its reason and unexpected contacts)."""
+    if c.reason:
+        return _solution(
+            c.plan.solution,
+            real,
+            plan=c.plan,
+            reason=c.reason,
+            stage="chain",
+            unexpected_contacts=c.unexpected,
+            cuts_radius_m=cut_r,
+        )
+    return _solution(
+        c.plan.solution,
+        real,
+        plan=c.plan,
+        path_waypoints=len(c.path),
+        expected_contacts=c.expected,
+        cuts_radius_m=cut_r,
+    )
+
+
+def _empty_record(
+    problem: Any, real: ChordArcQuery, query: ChordArcQuery, tol: float, inflated: bool
+) -> ContactPlan:
+    """The leg's contact plan before the search: the plane, the points, the tolerances."""
+    robot = problem.robot
+    return ContactPlan(
+        base_xy_m=real.base_xy_m,
+        base_tangent=real.base_tangent,
+        target_xy_m=real.target_xy_m,
+        obstacles=tuple(_shape(o) for o in real.obstacles),
+        planning_obstacles=tuple(_shape(o) for o in query.obstacles),
+        collision_points_m=real.collision_points_m,
+        link_radius_m=robot.link_radius_m,
+        inflated_by_m=robot.link_radius_m if inflated else 0.0,
+        contact_tolerance_m=tol,
+        guide_obstacles=tuple(sorted(guide_obstacles(problem))),
+    )
+
+
+def _search_counts(srch: Any, search_s: float) -> dict[str, Any]:
+    """The search's counters as record data."""
+    return {
+        "time_s": search_s,
+        "expansions": srch.expansions,
+        "arcs_built": srch.arcs_built,
+        "arcs_checked": srch.arcs_checked,
+        "rejected_bend": srch.arcs_rejected_bend,
+        "rejected_length": srch.arcs_rejected_length,
+        "rejected_obstacle": srch.arcs_rejected_obstacle,
+        "depth_reached": srch.depth_reached,
+        "budget_exhausted": srch.budget_exhausted,
+        "geometric_solutions": len(srch.solutions),
+    }
+
+
+def _nothing_kept(srch: Any, dropped: Sequence[ContactSolution], n_pts: int) -> tuple[Status, str]:
+    """Status and reason of a leg without a solution to execute."""
+    if not srch.solutions:
+        status = Status.BUDGET_EXHAUSTED if srch.budget_exhausted else Status.FAILED
+        return status, (
+            f"no chord-arc shape reaches the target through the {n_pts} "
+            f"collision points ({srch.expansions} expansions, depth "
+            f"{srch.depth_reached}"
+            + (", expansion budget used up)" if srch.budget_exhausted else ")")
+        )
+    why = "; ".join(d.reason for d in dropped[:3])
+    return Status.FAILED, (
+        f"all {len(srch.solutions)} geometric solution(s) dropped: {why}"
+        + (" …" if len(dropped) > 3 else "")
+    )
+
+
 def _capped(settings: ChordArcSettings, max_iterations: int | None) -> ChordArcSettings:
     """``settings`` with ``max_expansions`` capped by a budget's ``max_iterations``."""
     if max_iterations is None:
@@ -384,6 +459,62 @@ class ChordArcPlanner:
         unexpected.sort(key=lambda r: r.first_state)
         return expected, unexpected, False
 
+    def _chain_check(
+        self,
+        robot: ContinuumChain,
+        tracker: BudgetTracker,
+        plans: Sequence[ChordArcPlan],
+        real: ChordArcQuery,
+        tol: float,
+    ) -> tuple[list[_Candidate], bool]:
+        """Each searched solution as the chain moves it: its joint path, whether a joint
+        leaves its bounds, and its contacts (:meth:`_classify`); a candidate with a
+        ``reason`` is dropped. Returns the candidates and whether the check budget cut the
+        contact classification short."""
+        cands: list[_Candidate] = []
+        cut_short = False
+        for plan in plans:
+            path, owner = self.motion_path(robot, plan.motion)
+            reason = ""
+            lo_ok = path >= robot.lower - 1e-12
+            hi_ok = path <= robot.upper + 1e-12
+            if not (lo_ok.all() and hi_ok.all()):
+                k, j = np.argwhere(~(lo_ok & hi_ok))[0]
+                reason = (
+                    f"the chain cannot follow it: {robot.joint_names[j]} would reach "
+                    f"{path[k, j]:.3g} (bounds [{robot.lower[j]:.3g}, "
+                    f"{robot.upper[j]:.3g}]) during step {owner[k]} "
+                    f"({plan.motion[owner[k]].kind})"
+                )
+            exp: list[PlannedContact] = []
+            unexp: list[PlannedContact] = []
+            if not reason and self.settings.check_contacts and not cut_short:
+                exp, unexp, cut_short = self._classify(robot, tracker, plan, real, path, tol)
+                if unexp:
+                    u = unexp[0]
+                    reason = (
+                        f"the {robot.link_radius_m * 1e3:.3g} mm-radius chain touches "
+                        f"{u.obstacle!r} with {u.link} away from the solution's "
+                        f"collision points (waypoint {u.first_state}; "
+                        f"{len(unexp)} such pair(s))"
+                    )
+            cands.append(_Candidate(plan, path, owner, reason, tuple(exp), tuple(unexp)))
+        return cands, cut_short
+
+    def _choose(self, kept: Sequence[_Candidate]) -> int:
+        """The index of the solution to execute (``settings.choose``)."""
+        if self.settings.choose == "shortest":
+            return min(range(len(kept)), key=lambda i: kept[i].plan.solution.total_length_m)
+        if self.settings.choose == "fewest_contacts":
+            return min(
+                range(len(kept)),
+                key=lambda i: (
+                    len(kept[i].plan.solution.contact_indices),
+                    kept[i].plan.solution.total_length_m,
+                ),
+            )
+        return 0
+
     # ------------------------------------------------------------------ solve
     def solve(
         self,
@@ -420,18 +551,7 @@ class ChordArcPlanner:
         q0 = np.asarray(problem.q_start if q_start is None else q_start, dtype=float)
         q0 = q0.reshape(robot.dof)
         tol = 2.0 * robot.link_radius_m + s.contact_margin_m
-        record = ContactPlan(
-            base_xy_m=real.base_xy_m,
-            base_tangent=real.base_tangent,
-            target_xy_m=real.target_xy_m,
-            obstacles=tuple(_shape(o) for o in real.obstacles),
-            planning_obstacles=tuple(_shape(o) for o in query.obstacles),
-            collision_points_m=real.collision_points_m,
-            link_radius_m=robot.link_radius_m,
-            inflated_by_m=robot.link_radius_m if s.inflate_by_radius else 0.0,
-            contact_tolerance_m=tol,
-            guide_obstacles=tuple(sorted(guide_obstacles(problem))),
-        )
+        record = _empty_record(problem, real, query, tol, s.inflate_by_radius)
 
         # progress: the search starts at the straight robot, at time 0 with no checks
         run.progress.note(float(goal.distance(robot, q0)), time_s=0.0, checks=0)
@@ -474,18 +594,7 @@ class ChordArcPlanner:
             return result(Status.INVALID_GOAL, str(exc) + grown, q0[None])
         search_s = time.perf_counter() - t_search
         srch = res.search
-        search = {
-            "time_s": search_s,
-            "expansions": srch.expansions,
-            "arcs_built": srch.arcs_built,
-            "arcs_checked": srch.arcs_checked,
-            "rejected_bend": srch.arcs_rejected_bend,
-            "rejected_length": srch.arcs_rejected_length,
-            "rejected_obstacle": srch.arcs_rejected_obstacle,
-            "depth_reached": srch.depth_reached,
-            "budget_exhausted": srch.budget_exhausted,
-            "geometric_solutions": len(srch.solutions),
-        }
+        search = _search_counts(srch, search_s)
         dropped: list[ContactSolution] = [
             _solution(d.solution, real, reason=d.reason, stage="contact_type") for d in res.dropped
         ]
@@ -500,61 +609,12 @@ class ChordArcPlanner:
                 iters,
             )
 
-        # the chain's view of each surviving solution: joint bounds, then FCL contacts
-        cands: list[_Candidate] = []
-        cut_short = False
-        for plan in res.plans:
-            path, owner = self.motion_path(robot, plan.motion)
-            reason = ""
-            lo_ok = path >= robot.lower - 1e-12
-            hi_ok = path <= robot.upper + 1e-12
-            if not (lo_ok.all() and hi_ok.all()):
-                k, j = np.argwhere(~(lo_ok & hi_ok))[0]
-                reason = (
-                    f"the chain cannot follow it: {robot.joint_names[j]} would reach "
-                    f"{path[k, j]:.3g} (bounds [{robot.lower[j]:.3g}, "
-                    f"{robot.upper[j]:.3g}]) during step {owner[k]} "
-                    f"({plan.motion[owner[k]].kind})"
-                )
-            exp: list[PlannedContact] = []
-            unexp: list[PlannedContact] = []
-            if not reason and s.check_contacts and not cut_short:
-                exp, unexp, cut_short = self._classify(robot, tracker, plan, real, path, tol)
-                if unexp:
-                    u = unexp[0]
-                    reason = (
-                        f"the {robot.link_radius_m * 1e3:.3g} mm-radius chain touches "
-                        f"{u.obstacle!r} with {u.link} away from the solution's "
-                        f"collision points (waypoint {u.first_state}; "
-                        f"{len(unexp)} such pair(s))"
-                    )
-            cands.append(_Candidate(plan, path, owner, reason, tuple(exp), tuple(unexp)))
+        # the chain's view of each surviving solution: joint bounds, then its contacts
+        cands, cut_short = self._chain_check(robot, tracker, res.plans, real, tol)
         cut_r = 0.0 if s.inflate_by_radius else robot.link_radius_m
-        for c in cands:
-            if c.reason:
-                dropped.append(
-                    _solution(
-                        c.plan.solution,
-                        real,
-                        plan=c.plan,
-                        reason=c.reason,
-                        stage="chain",
-                        unexpected_contacts=c.unexpected,
-                        cuts_radius_m=cut_r,
-                    )
-                )
         kept = [c for c in cands if not c.reason]
-        solutions = tuple(
-            _solution(
-                c.plan.solution,
-                real,
-                plan=c.plan,
-                path_waypoints=len(c.path),
-                expected_contacts=c.expected,
-                cuts_radius_m=cut_r,
-            )
-            for c in kept
-        )
+        solutions = tuple(_candidate_solution(c, real, cut_r) for c in kept)
+        dropped += [_candidate_solution(c, real, cut_r) for c in cands if c.reason]
         record = dataclasses.replace(record, solutions=solutions, dropped=tuple(dropped))
         n_pts = len(query.collision_points_m)
 
@@ -567,34 +627,10 @@ class ChordArcPlanner:
                 iters,
             )
         if not kept:
-            why = "; ".join(d.reason for d in dropped[:3])
-            if not srch.solutions:
-                status = Status.BUDGET_EXHAUSTED if srch.budget_exhausted else Status.FAILED
-                reason = (
-                    f"no chord-arc shape reaches the target through the {n_pts} "
-                    f"collision points ({srch.expansions} expansions, depth "
-                    f"{srch.depth_reached}"
-                    + (", expansion budget used up)" if srch.budget_exhausted else ")")
-                )
-            else:
-                status = Status.FAILED
-                reason = f"all {len(srch.solutions)} geometric solution(s) dropped: {why}" + (
-                    " …" if len(dropped) > 3 else ""
-                )
+            status, reason = _nothing_kept(srch, dropped, n_pts)
             return result(status, reason, q0[None], iters)
 
-        if s.choose == "shortest":
-            chosen = min(range(len(kept)), key=lambda i: kept[i].plan.solution.total_length_m)
-        elif s.choose == "fewest_contacts":
-            chosen = min(
-                range(len(kept)),
-                key=lambda i: (
-                    len(kept[i].plan.solution.contact_indices),
-                    kept[i].plan.solution.total_length_m,
-                ),
-            )
-        else:
-            chosen = 0
+        chosen = self._choose(kept)
         c = kept[chosen]
         tips = robot.tip(c.path)[0]
         trace = np.linalg.norm(tips - goal.p_world_m, axis=1)
