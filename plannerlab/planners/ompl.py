@@ -84,12 +84,14 @@ Design (measured on ``armz_inspection``, 23 continuous joints):
   temporary file; afterwards each message is re-emitted on the ``plannerlab.ompl``
   logger at its level, and the previous handler and log level are restored. OMPL's log
   level follows that logger's effective level.
-* **Seeding.** ``solve`` derives an OMPL seed from ``rng`` and calls
-  ``ompl.util.RNG.setSeed`` first thing. OMPL's seed is process-global and only takes
-  effect before OMPL's first random generator exists, so only the first solve in a
-  process is reproducible; seeded trials run each in a fresh process (bench), and
-  :func:`seed_ompl` is for such a process to call before any OMPL object exists. A
-  later, ineffective setSeed makes OMPL log an error, re-emitted here at DEBUG level.
+* **Seeding.** OMPL's seed is process-global and only takes effect before OMPL's first
+  random generator exists. ``solve`` asks for a seed derived from ``rng``
+  (``ompl.util.RNG.setSeed``): in a fresh process the first solve's request takes
+  effect (before it, no OMPL generator exists, whatever :func:`seed_ompl` set), so a
+  seeded trial, which runs in its own process, is reproducible; every later request in
+  that process has no effect (OMPL logs an error, re-emitted here at DEBUG level). OMPL
+  is thus seeded once per process, and every leg records the seed **in effect**
+  (``extra["ompl_seed"]``, ``ompl.util.RNG.getSeed()``), not the one it asked for.
 """
 
 from __future__ import annotations
@@ -737,9 +739,12 @@ class OMPLPlanner:
                 f"{self.name}: goal_selection must be 'ik' or 'near', got "
                 f"{self.settings.goal_selection!r}"
             )
-        ompl_seed = int(rng.integers(1, _SEED_MAX))
+        requested = int(rng.integers(1, _SEED_MAX))
         with _ompl_logging(LOGGER):
-            ou.RNG.setSeed(ompl_seed)  # effective only before OMPL's first generator
+            # effective only before OMPL's first generator exists (the first solve of a
+            # process); every leg records the seed in effect, whether or not this took
+            ou.RNG.setSeed(requested)
+            ompl_seed = int(ou.RNG.getSeed())
             result = self._solve(problem, leg, budget, rng, q_start, ompl_seed)
         return result
 
