@@ -283,7 +283,6 @@ STILL_TOO_LONG = {
     "planners/gradient_clearance.py": "the descent's compiled kernels are being moved out",
     "planners/ompl.py": "space, goal pool, driver and roadmap planners in one module",
     "planners/ompl.py:_plan": "the OMPL driver in one function",
-    "problem/load.py": "the loader per table",
     "robots/irb6/ik.py": "the analytic IK's cases",
     "sim/execute.py:_run": "retiming, tracking and measuring in one function",
 }

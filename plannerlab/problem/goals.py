@@ -14,6 +14,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from plannerlab.robots.base import Array, Robot
+from plannerlab.robots.registry import reach_function
 
 
 @dataclass(frozen=True, eq=False)
@@ -89,16 +90,9 @@ def unreachable_reason(robot: Robot, goal: GoalRegion) -> str | None:
     """
     p = np.asarray(goal.p_world_m, dtype=float)
     T = np.asarray(robot.T_world_base, dtype=float)
-    if robot.kind == "irb6":
-        lo, hi = robot.track_range_m  # type: ignore[attr-defined]
-        p_s = T[:3, :3].T @ (p - T[:3, 3])
-        h = robot.shoulder_height_m  # type: ignore[attr-defined]
-        closest = np.array([0.0, h, min(max(p_s[2], lo), hi)])
-        dist = float(np.linalg.norm(p_s - closest))
-        reach = float(
-            robot.lower_arm_m + robot.upper_arm_m + robot.wrist_to_flange_m  # type: ignore[attr-defined]
-        )
-        where = f"the shoulder's line along the track (λ0 in [{lo:g}, {hi:g}] m)"
+    reach_from = reach_function(robot.kind)
+    if reach_from is not None:
+        dist, reach, where = reach_from(robot, p)
     else:
         q = np.zeros(robot.dof)
         seg = np.asarray(robot.link_segments(q), dtype=float)

@@ -29,7 +29,6 @@ File layout (every key is documented in ``docs/problem-format.md``)::
 
 from __future__ import annotations
 
-import importlib
 import math
 import tomllib
 from collections.abc import Mapping
@@ -43,6 +42,7 @@ from plannerlab.errors import ProblemError, UnknownNameError, did_you_mean
 from plannerlab.problem.goals import GoalRegion
 from plannerlab.problem.scene import OBSTACLE_TYPES, Box, Cylinder, Obstacle, Scene, Sphere
 from plannerlab.robots.base import Array, Robot, pose_matrix
+from plannerlab.robots.registry import FAMILIES, gravity_off_reason, robot_table
 from plannerlab.robots.schema import COMMON_KEYS, Key, RobotTable, TableValueError
 
 KNOWN_TABLES = (
@@ -454,15 +454,12 @@ def _continuum(reader: TableReader, obstacle_names: list[str]) -> None:
 
 def _simulation(top: TableReader, robot: Robot) -> SimSettings:
     if not top.has("simulation"):
-        if robot.kind == "armz":
-            # Under gravity a 16-m Arm-Z bent sideways needs far more torque than its
-            # joints have and collapses in PyBullet; every bundled Arm-Z problem turns
-            # gravity off (see the comment in problems/armz_pocket.toml).
-            return SimSettings(
-                (0.0, 0.0, 0.0),
-                origin="gravity off: the Arm-Z default when [simulation] is absent "
-                "(as in every bundled Arm-Z problem); set gravity_mps2 to change it",
-            )
+        # a family may default to no gravity: under gravity a 16-m Arm-Z bent sideways
+        # needs far more torque than its joints have and collapses in PyBullet, and every
+        # bundled Arm-Z problem turns gravity off (see problems/armz_pocket.toml)
+        off = gravity_off_reason(robot.kind)
+        if off is not None:
+            return SimSettings((0.0, 0.0, 0.0), origin=off)
         return SimSettings(origin="gravity -9.81 m/s² along -z: the default")
     sim = TableReader(top.source, "simulation", top.raw("simulation"))
     sim.unknown_keys(("gravity_mps2", "max_track_err_rad", "max_deviation_m", "note"))
@@ -479,29 +476,6 @@ def _simulation(top: TableReader, robot: Robot) -> SimSettings:
         max_deviation_m=sim.number("max_deviation_m", 0.01, positive=True),
         origin=origin,
     )
-
-
-#: robot type in a problem file -> "module:attribute" of its table declaration
-#: (:class:`~plannerlab.robots.schema.RobotTable`, beside the robot's model); a family is
-#: imported only when a problem asks for it
-ROBOT_TYPES: dict[str, str] = {
-    "armz": "plannerlab.robots.armz.schema:TABLE",
-    "irb6": "plannerlab.robots.irb6.schema:TABLE",
-    "continuum_chain": "plannerlab.robots.continuum.schema:TABLE",
-}
-
-
-def robot_table(kind: str) -> RobotTable:
-    """The ``[robot]`` table declaration of robot type ``kind`` (imports its family).
-
-    Raises:
-        UnknownNameError: for a type that is not in :data:`ROBOT_TYPES`.
-    """
-    if kind not in ROBOT_TYPES:
-        raise UnknownNameError("robot type", kind, ROBOT_TYPES)
-    module_name, attribute = ROBOT_TYPES[kind].split(":")
-    table: RobotTable = getattr(importlib.import_module(module_name), attribute)
-    return table
 
 
 def _table_value(reader: TableReader, key: Key) -> Any:
@@ -555,12 +529,12 @@ def build_robot(reader: TableReader) -> Robot:
     """Build the robot described by a problem file's ``[robot]`` table: its type's declared
     keys are parsed here, then its family's constructor builds it."""
     kind = reader.string("type")
-    if kind not in ROBOT_TYPES:
+    if kind not in FAMILIES:
         import difflib
 
-        close = difflib.get_close_matches(kind, ROBOT_TYPES, n=1)
+        close = difflib.get_close_matches(kind, FAMILIES, n=1)
         hint = f" (did you mean {close[0]!r}?)" if close else ""
-        raise reader.fail("type", f"one of {', '.join(ROBOT_TYPES)}, got {kind!r}{hint}")
+        raise reader.fail("type", f"one of {', '.join(FAMILIES)}, got {kind!r}{hint}")
     table = robot_table(kind)
     values = parse_robot_table(reader, table)
     try:
