@@ -623,7 +623,7 @@ class ClearanceDescent:
         q0 = np.array(problem.q_start if q_start is None else q_start, dtype=float)
         # the field (and for the compiled backend, loading or compiling its core) is built
         # before the tracker starts, like the checker: a one-off cost outside the limits
-        self.model(problem).point(goal, q0)
+        self.model(problem).warm_up(goal, q0)
         tracker = BudgetTracker(budget, checker)
         run = LegRun(self.name, s, problem, leg, tracker)
         path: list[Array] = [q0]
@@ -785,6 +785,9 @@ class _NumpyModel:
     def hold(self, q: Array, direction: Array) -> Array:
         return self._descent._hold_clearance(self._field, q, direction)
 
+    def warm_up(self, goal, q: Array) -> None:
+        """Nothing to load."""
+
 
 class _CompiledModel:
     """The field and the step compiled (:mod:`plannerlab.planners._descent_core`): one
@@ -815,6 +818,10 @@ class _CompiledModel:
 
     def hold(self, q: Array, direction: Array) -> Array:
         return self._core.hold_clearance(q, direction, self._settings.min_clearance_m + 0.01)
+
+    def warm_up(self, goal, q: Array) -> None:
+        """Load (or compile) both kernels: one call each."""
+        self.hold(q, self.point(goal, q).direction)
 
 
 _Model = _NumpyModel | _CompiledModel
