@@ -30,7 +30,8 @@ with ``extra["q_stall"]`` and ``extra["descent_rad"]`` (joint-space distance tra
 Escapes from a stall (``escape`` setting): ``detour`` (sub-goals near the stall: the tip
 drawn back along its own body, ``retract_step``, ``2 retract_step``, … modules, each
 followed by the leg's descent; deterministic), ``rrtconnect`` (RRT-Connect from the stall
-to a goal state found near it) and ``random_detour``, the detour with its sub-goals drawn
+to a goal state found near it, or, when the descent near the stall finds none, to goal
+states drawn by IK) and ``random_detour``, the detour with its sub-goals drawn
 from the planner's generator: each retract goes back a random ``1 … 2 retract_step``
 modules further than the last and aims at a point drawn uniformly in a ball of
 ``retract_jitter_m`` round the body's face there; a detour that finds no way is drawn
@@ -94,6 +95,8 @@ class ClearanceSettings:
             its mean step is ``retract_step + 0.5``).
         retract_jitter_m: radius of the ball round the body's face in which
             ``random_detour`` draws each retract sub-goal's point [m].
+        escape_goal_samples: goal states the ``rrtconnect`` escape draws by IK (seeded
+            from the stall) when the descent near the stall finds no collision-free goal.
         hold_clearance: when a step would take a pair below ``min_clearance_m``, try
             once the same step with the part that closes such pairs taken out
             (:meth:`ClearanceDescent._hold_clearance`) before shrinking the step; without
@@ -127,6 +130,7 @@ class ClearanceSettings:
     subgoal_pos_tol_m: float = 0.5
     subgoal_angle_tol_deg: float = 30.0
     retract_jitter_m: float = 0.5
+    escape_goal_samples: int = 4
     hold_clearance: bool = True
     backend: str = "compiled"
 
@@ -147,6 +151,10 @@ class ClearanceSettings:
             )
         if not self.retract_jitter_m >= 0:
             raise PlannerlabError(f"retract_jitter_m must be >= 0, got {self.retract_jitter_m}")
+        if self.escape_goal_samples < 1:
+            raise PlannerlabError(
+                f"escape_goal_samples must be >= 1, got {self.escape_goal_samples}"
+            )
         if self.retract_step < 1:
             raise PlannerlabError(f"retract_step must be >= 1, got {self.retract_step}")
         if self.stall_window < 2:
@@ -586,9 +594,11 @@ class ClearanceDescent:
         tracker: BudgetTracker,
         rng: np.random.Generator,
     ) -> tuple[list[Array], int, str]:
-        """RRT-Connect from the stall to a goal state found near it (see near_goal_state),
-        with the checks and time left, at most ``escape_checks`` checks; its iterations
-        count in the leg's afterwards (the caller adds them)."""
+        """RRT-Connect from the stall to a goal state found near it (see near_goal_state)
+        or, when the descent from the stall ends in no collision-free goal state, to
+        ``escape_goal_samples`` goal states drawn by IK (OMPL's ``near_or_ik`` goal
+        selection), with the checks and time left, at most ``escape_checks`` checks; its
+        iterations count in the leg's afterwards (the caller adds them)."""
         if self.escape_planner is None:
             raise PlannerlabError(
                 f"{self.name}: no escape planner given (make it by name, make_planner)"
@@ -596,7 +606,9 @@ class ClearanceDescent:
         sub = tracker.remaining(self.settings.escape_checks, limit_iterations=False)
         if sub is None:
             return [np.array(q_stall)], 0, f"not started: {tracker.exhausted() or 'no budget'}"
-        rrt = self.escape_planner({"goal_selection": "near", "goal_samples": 1})
+        rrt = self.escape_planner(
+            {"goal_selection": "near_or_ik", "goal_samples": self.settings.escape_goal_samples}
+        )
         r = rrt.solve(problem, leg, sub, rng, q_start=q_stall)
         tracker.charge_checks(r.collision_checks)  # the sub-planner's checks count here
         if r.solved:

@@ -128,6 +128,8 @@ LOGGER = logging.getLogger("plannerlab.ompl")
 
 #: OMPL seeds must be in [1, 2**31 - 1] (0 means "random" to OMPL)
 _SEED_MAX = 2**31 - 1
+#: how the goal pool is filled (``goal_selection`` setting)
+GOAL_SELECTIONS = ("ik", "near", "near_or_ik")
 
 
 # ---------------------------------------------------------------------------- settings
@@ -146,7 +148,10 @@ class OMPLSettings:
         goal_selection: ``"ik"`` (numeric IK restarts seeded from the leg start, see
             :func:`~plannerlab.problem.ik.sample_goal_state`) or ``"near"`` (the goal state
             ``gradient.clearance`` selects: its descent from the leg start with the path
-            unchecked, so the goal stays near the start; one state, one check).
+            unchecked, so the goal stays near the start; one state, one check) or
+            ``"near_or_ik"`` (that near state; when its descent ends in no collision-free
+            goal state, ``goal_samples`` IK states as with ``"ik"``: the escape of
+            ``gradient.clearance+rrtconnect``, which gave up with ``invalid_goal`` before).
     """
 
     simplify: bool = True
@@ -732,9 +737,10 @@ class OMPLPlanner:
                 f"{', '.join(_MOTION_CHECKS)}, got "
                 f"{self.settings.motion_check!r}"
             )
-        if self.settings.goal_selection not in ("ik", "near"):
+        if self.settings.goal_selection not in GOAL_SELECTIONS:
             raise PlannerlabError(
-                f"{self.name}: goal_selection must be 'ik' or 'near', got "
+                f"{self.name}: goal_selection must be one of "
+                f"{', '.join(map(repr, GOAL_SELECTIONS))}, got "
                 f"{self.settings.goal_selection!r}"
             )
         ompl_seed = int(rng.integers(1, _SEED_MAX))
@@ -812,11 +818,23 @@ class OMPLPlanner:
         c_pool = checker.checks
         per_slot = max(1, s.max_goal_attempts // max(s.goal_samples, 1))
         pool_cut_short = ""
-        for _ in range(s.goal_samples):
+        selection = s.goal_selection
+        if selection == "near_or_ik":
+            # the near goal first; when its descent finds none, the IK pool
+            q_near = (
+                None
+                if guard.exhausted() is not None
+                else _near_goal(problem, leg, q0, checker, tracker)
+            )
+            extra["goal_near_found"] = q_near is not None
+            if q_near is not None:
+                pool.append(wrap_to_pi(q_near, robot.continuous))
+            selection = "near" if pool else "ik"
+        for _ in range(s.goal_samples if not pool else 0):
             if guard.exhausted() is not None:
                 pool_cut_short = guard.exhausted() or ""
                 break
-            if s.goal_selection == "near":
+            if selection == "near":
                 q_goal = _near_goal(problem, leg, q0, checker, tracker)
             else:
                 q_goal = sample_goal_state(
