@@ -19,6 +19,7 @@ other processes than the wall-clock planning time.
 from __future__ import annotations
 
 import argparse
+import os
 import time
 
 import numpy as np
@@ -57,7 +58,11 @@ def main() -> None:
     assert best is not None
     rows["compiled"] = list(best)
 
-    print(f"{args.problem} / {args.planner} / seed {args.seed}: {len(plan_np.legs)} legs")
+    load = ", ".join(f"{v:.1f}" for v in os.getloadavg())
+    print(
+        f"{args.problem} / {args.planner} / seed {args.seed}: {len(plan_np.legs)} legs; "
+        f"{os.cpu_count()} CPUs, load average {load} (1, 5, 15 min) at the end"
+    )
     print(
         f"{'backend':<9} {'solved':>6} {'iterations':>10} {'planning s':>10} {'CPU s':>7} "
         f"{'ms/iter':>8} {'CPU ms/iter':>11}"

@@ -58,47 +58,54 @@ def _frames(q, F1, T0, M):
 
 
 @njit(cache=True, nogil=True)
-def _centres_and_jacobians(F, link, t):
-    """Sphere centres (s, 3) and their Jacobians (s, 3, dof): joint j (0-based) turns about
-    frame j + 1's z axis and moves the spheres of links j + 1 and beyond."""
-    dof = F.shape[0] - 2
+def _centres(F, link, t):
+    """Sphere centres (s, 3): on link i, ``a + t (b − a)`` between frames i and i + 1."""
     S = link.shape[0]
     P = np.empty((S, 3))
-    J = np.zeros((S, 3, dof))
     for s in range(S):
         li = link[s]
         for k in range(3):
             a = F[li, k, 3]
             b = F[li + 1, k, 3]
             P[s, k] = a + t[s] * (b - a)
-        for j in range(dof):
-            if j + 1 > li:
-                break
-            zx, zy, zz = F[j + 1, 0, 2], F[j + 1, 1, 2], F[j + 1, 2, 2]
-            dx = P[s, 0] - F[j + 1, 0, 3]
-            dy = P[s, 1] - F[j + 1, 1, 3]
-            dz = P[s, 2] - F[j + 1, 2, 3]
-            J[s, 0, j] = zy * dz - zz * dy
-            J[s, 1, j] = zz * dx - zx * dz
-            J[s, 2, j] = zx * dy - zy * dx
-    return P, J
+    return P
 
 
 # ---------------------------------------------------------------------- pairs
 @njit(cache=True, nogil=True)
-def _pairs(P, r, scene_idx, self_a, self_b, kinds, Rs, cs, pars, bound, far_m):
+def _pairs(
+    P,
+    r,
+    scene_idx,
+    self_a,
+    self_b,
+    kinds,
+    Rs,
+    cs,
+    pars,
+    bound,
+    far_m,
+    A,
+    B,
+    lp_of_row,
+    lp_links,
+    link_ends,
+):
     """Every sphere pair, in ``ClearanceField._pairs``' order: distance d (m,), direction
     n (m, 3), spheres a and b (b = −1: an obstacle). A pair at least ``far_m`` apart gets
     d = ``far_m`` and no direction (the descent asks nothing of it: only pairs closer than
     the margin cost, and only pairs closer than the clearance floor are held); an obstacle's
-    pairs are skipped by its bounding sphere (radius ``bound``) when they are that far."""
+    pairs are skipped by its bounding sphere (radius ``bound``) when they are that far.
+    ``A`` and ``B`` (m,) are the pairs' spheres, fixed (:func:`pair_spheres`); the self
+    pairs of two links whose sphere chains are that far apart (their midpoints farther than
+    both half-lengths, radii and ``far_m``) are skipped together (``lp_of_row``: each self
+    pair's link pair, ``lp_links`` (k, 2) its links, ``link_ends`` (L, 2) each link's first
+    and last sphere)."""
     n_scene = scene_idx.shape[0]
     n_obs = kinds.shape[0]
     m = n_obs * n_scene + self_a.shape[0]
     d = np.empty(m)
     nrm = np.empty((m, 3))
-    A = np.empty(m, dtype=np.int64)
-    B = np.empty(m, dtype=np.int64)
     loc = np.empty(3)
     g = np.empty(3)
     row = 0
@@ -108,8 +115,6 @@ def _pairs(P, r, scene_idx, self_a, self_b, kinds, Rs, cs, pars, bound, far_m):
         kind = kinds[o]
         for ii in range(n_scene):
             s = scene_idx[ii]
-            A[row] = s
-            B[row] = -1
             dx = P[s, 0] - c[0]
             dy = P[s, 1] - c[1]
             dz = P[s, 2] - c[2]
@@ -174,11 +179,34 @@ def _pairs(P, r, scene_idx, self_a, self_b, kinds, Rs, cs, pars, bound, far_m):
                 d[row] = dist
                 nrm[row, 0], nrm[row, 1], nrm[row, 2] = g[0], g[1], g[2]
             row += 1
+    n_links = link_ends.shape[0]
+    mid = np.empty((n_links, 3))
+    reach_l = np.empty(n_links)
+    for li in range(n_links):
+        s0, s1 = link_ends[li, 0], link_ends[li, 1]
+        if s0 < 0:
+            continue
+        hx = 0.5 * (P[s1, 0] - P[s0, 0])
+        hy = 0.5 * (P[s1, 1] - P[s0, 1])
+        hz = 0.5 * (P[s1, 2] - P[s0, 2])
+        mid[li, 0], mid[li, 1], mid[li, 2] = P[s0, 0] + hx, P[s0, 1] + hy, P[s0, 2] + hz
+        reach_l[li] = math.sqrt(hx * hx + hy * hy + hz * hz) + r[s0]
+    n_lp = lp_links.shape[0]
+    lp_far = np.empty(n_lp, dtype=np.bool_)
+    for k in range(n_lp):
+        i, j = lp_links[k, 0], lp_links[k, 1]
+        dx = mid[i, 0] - mid[j, 0]
+        dy = mid[i, 1] - mid[j, 1]
+        dz = mid[i, 2] - mid[j, 2]
+        reach = reach_l[i] + reach_l[j] + far_m
+        lp_far[k] = dx * dx + dy * dy + dz * dz >= reach * reach * (1.0 + 1e-12)
     for ii in range(self_a.shape[0]):
+        if lp_far[lp_of_row[ii]]:
+            d[row] = far_m
+            row += 1
+            continue
         a = self_a[ii]
         b = self_b[ii]
-        A[row] = a
-        B[row] = b
         dx = P[a, 0] - P[b, 0]
         dy = P[a, 1] - P[b, 1]
         dz = P[a, 2] - P[b, 2]
@@ -192,18 +220,57 @@ def _pairs(P, r, scene_idx, self_a, self_b, kinds, Rs, cs, pars, bound, far_m):
             den = nd if nd > 1e-12 else 1.0
             nrm[row, 0], nrm[row, 1], nrm[row, 2] = dx / den, dy / den, dz / den
         row += 1
-    return d, nrm, A, B
+    return d, nrm
+
+
+def pair_spheres(
+    scene_idx: np.ndarray, n_obstacles: int, self_a: np.ndarray, self_b: np.ndarray, link
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """The fixed bookkeeping of :func:`_pairs`: the spheres of every pair in its order,
+    a (m,) and b (m,) (−1: an obstacle); each self pair's link pair, the link pairs' links
+    (k, 2) and each link's first and last sphere (L, 2; −1 for a link without spheres)."""
+    a = np.concatenate([np.tile(scene_idx, n_obstacles), self_a]).astype(np.int64)
+    b = np.concatenate([np.full(len(scene_idx) * n_obstacles, -1), self_b]).astype(np.int64)
+    link = np.asarray(link, dtype=np.int64)
+    n_links = int(link.max()) + 1 if len(link) else 0
+    ends = np.full((n_links, 2), -1, dtype=np.int64)
+    for li in range(n_links):
+        on = np.flatnonzero(link == li)
+        if len(on):
+            ends[li] = on[0], on[-1]
+    pairs = np.stack([link[self_a], link[self_b]], axis=1) if len(self_a) else np.zeros((0, 2))
+    lp_links, lp_of_row = np.unique(pairs.astype(np.int64), axis=0, return_inverse=True)
+    return (
+        a,
+        b,
+        np.asarray(lp_of_row, dtype=np.int64).reshape(-1),
+        np.ascontiguousarray(lp_links, dtype=np.int64).reshape(-1, 2),
+        ends,
+    )
 
 
 @njit(cache=True, nogil=True)
-def _pair_gradient(J, nrm, a, b, row, out):
-    """∇d (dof,) of one pair into ``out``: n · J_a (− n · J_b for a self pair)."""
-    dof = J.shape[2]
+def _pair_gradient(F, P, link, nrm, a, b, row, out):
+    """∇d (dof,) of one pair into ``out``: n · J_a (− n · J_b for a self pair), with the
+    centre's Jacobian column ``J_s[:, j] = z_j × (p_s − o_j)`` for the joints j (0-based,
+    about frame j + 1's z axis) below its link, 0 beyond."""
+    dof = F.shape[0] - 2
+    n0, n1, n2 = nrm[row, 0], nrm[row, 1], nrm[row, 2]
     for j in range(dof):
-        out[j] = nrm[row, 0] * J[a, 0, j] + nrm[row, 1] * J[a, 1, j] + nrm[row, 2] * J[a, 2, j]
-    if b >= 0:
-        for j in range(dof):
-            out[j] -= nrm[row, 0] * J[b, 0, j] + nrm[row, 1] * J[b, 1, j] + nrm[row, 2] * J[b, 2, j]
+        out[j] = 0.0
+    for side in range(2):
+        s = a if side == 0 else b
+        if s < 0:
+            break
+        sign = 1.0 if side == 0 else -1.0
+        li = link[s]
+        for j in range(min(dof, li)):
+            zx, zy, zz = F[j + 1, 0, 2], F[j + 1, 1, 2], F[j + 1, 2, 2]
+            dx = P[s, 0] - F[j + 1, 0, 3]
+            dy = P[s, 1] - F[j + 1, 1, 3]
+            dz = P[s, 2] - F[j + 1, 2, 3]
+            g = n0 * (zy * dz - zz * dy) + n1 * (zz * dx - zx * dz) + n2 * (zx * dy - zy * dx)
+            out[j] += sign * g
 
 
 # ---------------------------------------------------------------------- the descent
@@ -224,6 +291,11 @@ def evaluate(
     cs,
     pars,
     bound,
+    A_idx,
+    B_idx,
+    lp_of_row,
+    lp_links,
+    link_ends,
     margin,
     far_m,
     p_goal,
@@ -237,9 +309,13 @@ def evaluate(
     damping,
     goal_depth,
     want_direction,
+    d_ref,
+    floor_m,
 ):
     """The descent's view of state q: (F, f, pos_err_m, ang_err_deg, cost, gradient (dof,),
-    distances (m,), direction (dof,); zeros unless ``want_direction``)."""
+    distances (m,), direction (dof,); zeros unless ``want_direction``, spacious). Spacious:
+    every pair is at least ``floor_m`` apart or no closer than in ``d_ref`` (the distances
+    at the state the step starts from; empty: True)."""
     dof = q.shape[0]
     Fr = _frames(q, F1, T0, M)
     tip = dof + 1
@@ -252,9 +328,24 @@ def evaluate(
     f = r1 * dist + r2 * cn**2
     ang_err_deg = math.degrees(math.acos(min(max(dot, -1.0), 1.0)))
 
-    P, J = _centres_and_jacobians(Fr, link, t)
-    d, nrm, A_idx, B_idx = _pairs(
-        P, r, scene_idx, self_a, self_b, kinds, Rs, cs, pars, bound, far_m
+    P = _centres(Fr, link, t)
+    d, nrm = _pairs(
+        P,
+        r,
+        scene_idx,
+        self_a,
+        self_b,
+        kinds,
+        Rs,
+        cs,
+        pars,
+        bound,
+        far_m,
+        A_idx,
+        B_idx,
+        lp_of_row,
+        lp_links,
+        link_ends,
     )
     cost = 0.0
     grad = np.zeros(dof)
@@ -273,13 +364,19 @@ def evaluate(
             close[k] = i
             k += 1
             wgt = -2.0 * (margin - d[i]) / margin
-            _pair_gradient(J, nrm, A_idx[i], B_idx[i], i, gi)
+            _pair_gradient(Fr, P, link, nrm, A_idx[i], B_idx[i], i, gi)
             for j in range(dof):
                 grad[j] += wgt * gi[j]
     F = r1 * dist + r2 * cn**2 + weight * cost
+    spacious = True
+    if d_ref.shape[0] == d.shape[0]:
+        for i in range(d.shape[0]):
+            if d[i] < floor_m and d[i] < d_ref[i] - 1e-9:
+                spacious = False
+                break
     direction = np.zeros(dof)
     if not want_direction:
-        return F, f, dist, ang_err_deg, cost, grad, d, direction
+        return F, f, dist, ang_err_deg, cost, grad, d, direction, spacious
 
     # tip Jacobians: dp/dθ_j = z_j × (p − o_j), dn/dθ_j = z_j × n
     Jp = np.empty((3, dof))
@@ -302,7 +399,7 @@ def evaluate(
                 g = (diff[0] * Jp[0, j] + diff[1] * Jp[1, j] + diff[2] * Jp[2, j]) / dist
             gn = n_goal[0] * Jn[0, j] + n_goal[1] * Jn[1, j] + n_goal[2] * Jn[2, j]
             direction[j] = -(r1 * g - 2.0 * r2 * cn * gn + weight * grad[j])
-        return F, f, dist, ang_err_deg, cost, grad, d, direction
+        return F, f, dist, ang_err_deg, cost, grad, d, direction, spacious
 
     pos_scale = 1.0 / pos_tol
     ang_scale = 1.0 / math.radians(angle_tol_deg)
@@ -325,7 +422,7 @@ def evaluate(
         dd = np.empty((n_close, dof))
         for c in range(n_close):
             i = close[c]
-            _pair_gradient(J, nrm, A_idx[i], B_idx[i], i, gi)
+            _pair_gradient(Fr, P, link, nrm, A_idx[i], B_idx[i], i, gi)
             dd[c] = gi
         k2 = weight / margin
         A = A + k2 * (dd.T @ dd)
@@ -334,7 +431,7 @@ def evaluate(
     for j in range(dof):
         A[j, j] += damping**2
     direction = np.linalg.solve(A, b)
-    return F, f, dist, ang_err_deg, cost, grad, d, direction
+    return F, f, dist, ang_err_deg, cost, grad, d, direction, spacious
 
 
 @njit(cache=True, nogil=True)
@@ -355,6 +452,11 @@ def hold_clearance(
     cs,
     pars,
     bound,
+    A_idx,
+    B_idx,
+    lp_of_row,
+    lp_links,
+    link_ends,
     floor_m,
 ):
     """``ClearanceDescent._hold_clearance``: ``direction`` changed as little as possible so
@@ -362,9 +464,24 @@ def hold_clearance(
     0.1 of its gradient's rate); active-set projection, at most 10 rounds."""
     dof = q.shape[0]
     Fr = _frames(q, F1, T0, M)
-    P, J = _centres_and_jacobians(Fr, link, t)
-    d, nrm, A_idx, B_idx = _pairs(
-        P, r, scene_idx, self_a, self_b, kinds, Rs, cs, pars, bound, floor_m
+    P = _centres(Fr, link, t)
+    d, nrm = _pairs(
+        P,
+        r,
+        scene_idx,
+        self_a,
+        self_b,
+        kinds,
+        Rs,
+        cs,
+        pars,
+        bound,
+        floor_m,
+        A_idx,
+        B_idx,
+        lp_of_row,
+        lp_links,
+        link_ends,
     )
     n_act = 0
     for i in range(d.shape[0]):
@@ -377,7 +494,7 @@ def hold_clearance(
     k = 0
     for i in range(d.shape[0]):
         if d[i] < floor_m:
-            _pair_gradient(J, nrm, A_idx[i], B_idx[i], i, gi)
+            _pair_gradient(Fr, P, link, nrm, A_idx[i], B_idx[i], i, gi)
             G[k] = gi
             k += 1
     dnorm = math.sqrt(np.sum(direction * direction))
@@ -420,6 +537,8 @@ class Evaluation:
     #: every sphere pair's distance, those at least ``far_m`` apart reported as ``far_m``
     distances_m: Array
     direction: Array
+    #: no pair below the clearance floor that came closer than in ``d_ref``
+    spacious: bool
 
 
 class CompiledField:
@@ -469,9 +588,15 @@ class CompiledField:
             else:  # pragma: no cover - scene types are closed
                 raise TypeError(f"unknown obstacle {o!r}")
         self._scene = (kinds, Rs, cs, pars, bound)
+        self._pair_spheres = pair_spheres(
+            self._spheres[3], k, self._spheres[4], self._spheres[5], self._spheres[0]
+        )
         self.margin_m = float(field.margin_m)
         #: pairs at least this far apart are reported at this distance (see _pairs)
         self.far_m = max(float(far_m), self.margin_m)
+        self._no_ref = np.zeros(0)
+        #: the last goal asked about and its arrays (fresh, writeable: one numba version)
+        self._goal: tuple[object, Array, Array] = (None, self._no_ref, self._no_ref)
 
     def evaluate(
         self,
@@ -484,18 +609,24 @@ class CompiledField:
         damping: float,
         goal_depth: float,
         want_direction: bool,
+        d_ref: Array | None = None,
+        floor_m: float = 0.0,
     ) -> Evaluation:
         """F, f, tip errors, clearance cost and gradient, distances and (when asked) the
-        step direction at q (dof,) towards ``goal`` (a GoalRegion)."""
+        step direction at q (dof,) towards ``goal`` (a GoalRegion); ``spacious`` against
+        the distances ``d_ref`` (see :func:`evaluate`)."""
+        if goal is not self._goal[0]:
+            self._goal = (goal, np.array(goal.p_world_m, dtype=float), np.array(goal.n_world))
         out = evaluate(
             np.array(q, dtype=float),
             *self._chain,
             *self._spheres,
             *self._scene,
+            *self._pair_spheres,
             self.margin_m,
             self.far_m,
-            np.array(goal.p_world_m, dtype=float),
-            np.array(goal.n_world, dtype=float),
+            self._goal[1],
+            self._goal[2],
             float(goal.pos_tol_m),
             float(goal.angle_tol_deg),
             float(r1),
@@ -505,10 +636,20 @@ class CompiledField:
             float(damping),
             float(goal_depth),
             bool(want_direction),
+            self._no_ref if d_ref is None else d_ref,
+            float(floor_m),
         )
-        F, f, pos_err, ang_err, cost, grad, d, direction = out
+        F, f, pos_err, ang_err, cost, grad, d, direction, spacious = out
         return Evaluation(
-            float(F), float(f), float(pos_err), float(ang_err), float(cost), grad, d, direction
+            float(F),
+            float(f),
+            float(pos_err),
+            float(ang_err),
+            float(cost),
+            grad,
+            d,
+            direction,
+            bool(spacious),
         )
 
     def hold_clearance(self, q: Array, direction: Array, floor_m: float) -> Array:
@@ -519,5 +660,6 @@ class CompiledField:
             *self._chain,
             *self._spheres,
             *self._scene,
+            *self._pair_spheres,
             float(floor_m),
         )

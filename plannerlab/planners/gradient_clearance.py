@@ -408,11 +408,11 @@ class ClearanceDescent:
                 continue
             step = direction * min(1.0, radius / big)
             q_new = wrap_to_pi(q + step, robot.continuous)
-            there = model.point(goal, q_new)
+            there = model.point(goal, q_new, d_now)
             F_new = there.F
             # keep min_clearance_m (a tracking arm overshoots a little), unless already closer
             d_new = there.distances_m
-            spacious = bool(np.all((d_new >= s.min_clearance_m) | (d_new >= d_now - 1e-9)))
+            spacious = there.spacious
             if F_new < F_now and spacious and (checker is None or checker.is_valid(q_new)):
                 d_now = d_new
                 q = q_new
@@ -740,8 +740,24 @@ class _NumpyPoint:
     """The numpy descent's view of one state; each piece is computed when first asked
     (the direction only at accepted states), as the numpy descent always did."""
 
-    def __init__(self, descent: ClearanceDescent, field: ClearanceField, goal, q: Array):
+    def __init__(
+        self,
+        descent: ClearanceDescent,
+        field: ClearanceField,
+        goal,
+        q: Array,
+        d_ref: Array | None = None,
+    ):
         self._descent, self._field, self._goal, self._q = descent, field, goal, q
+        self._d_ref = d_ref
+
+    @cached_property
+    def spacious(self) -> bool:
+        """No pair below ``min_clearance_m`` that came closer than in ``d_ref``."""
+        if self._d_ref is None:
+            return True
+        d_new, floor = self.distances_m, self._descent.settings.min_clearance_m
+        return bool(np.all((d_new >= floor) | (d_new >= self._d_ref - 1e-9)))
 
     @cached_property
     def _clearance(self):
@@ -791,8 +807,8 @@ class _NumpyModel:
     def __init__(self, descent: ClearanceDescent, field: ClearanceField) -> None:
         self._descent, self._field = descent, field
 
-    def point(self, goal, q: Array) -> _NumpyPoint:
-        return _NumpyPoint(self._descent, self._field, goal, q)
+    def point(self, goal, q: Array, d_ref: Array | None = None) -> _NumpyPoint:
+        return _NumpyPoint(self._descent, self._field, goal, q, d_ref)
 
     def hold(self, q: Array, direction: Array) -> Array:
         return self._descent._hold_clearance(self._field, q, direction)
@@ -814,7 +830,7 @@ class _CompiledModel:
         # descent (the spacious test looks only below min_clearance_m)
         self._core = CompiledField(field, far_m=max(s.margin_m, s.min_clearance_m + 0.01))
 
-    def point(self, goal, q: Array):
+    def point(self, goal, q: Array, d_ref: Array | None = None):
         s = self._settings
         return self._core.evaluate(
             q,
@@ -826,6 +842,8 @@ class _CompiledModel:
             s.damping,
             s.goal_depth,
             True,
+            d_ref,
+            s.min_clearance_m,
         )
 
     def hold(self, q: Array, direction: Array) -> Array:
