@@ -663,3 +663,23 @@ class CompiledField:
             *self._pair_spheres,
             float(floor_m),
         )
+
+
+def warm_up() -> None:
+    """Load (or compile) both kernels once in this process, on a small arm beside a box:
+    callers that time a solve from outside (tests, benches) do this before their clock,
+    as they build a collision checker to load the collision core. The planners do not
+    need it: they load the kernels before their tracker starts."""
+    from plannerlab.problem.goals import GoalRegion
+    from plannerlab.problem.scene import Scene
+    from plannerlab.robots.armz.model import ArmZ
+    from plannerlab.robots.base import trans
+
+    robot = ArmZ(n_modules=8)
+    scene = Scene((Box("box", trans(2.0, 0.0, 2.0), np.array([0.5, 0.5, 0.5])),))
+    core = CompiledField(ClearanceField(robot, scene, 0.3), far_m=0.3)  # type: ignore[arg-type]
+    goal = GoalRegion("warm_up", np.array([1.0, 0.0, 3.0]), np.array([0.0, 0.0, 1.0]), 0.1, 10.0)
+    q = np.zeros(robot.dof)
+    e = core.evaluate(q, goal, 1.0, 1.0, 0.2, True, 0.1, 0.3, True)
+    core.evaluate(q, goal, 1.0, 1.0, 0.2, True, 0.1, 0.3, True, e.distances_m, 0.03)
+    core.hold_clearance(q, e.direction, 0.04)
