@@ -104,7 +104,8 @@ class ClearanceSettings:
             variants: the leave leg stalled at iteration 7 and no retract got out).
         backend: "compiled" (the field and the step in numba,
             :mod:`plannerlab.planners._descent_core`; Arm-Z only, other robots use numpy)
-            or "numpy" (the reference: the same iterates to rounding, ~20 times slower).
+            or "numpy" (the reference: the same iterates to rounding, 30-50 times slower;
+            `bench/descent_bench.py`).
     """
 
     r1: float = 1.0
