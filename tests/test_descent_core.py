@@ -83,3 +83,16 @@ def test_compiled_descent_takes_the_numpy_descents_path(problem_name, leg, statu
 def test_backend_setting_is_checked():
     with pytest.raises(PlannerlabError, match="backend setting"):
         make_planner("gradient.clearance", {"backend": "cuda"})
+
+
+def test_robots_other_than_armz_descend_in_numpy_and_say_so():
+    problem = load_problem("irb6_case1")
+    r = make_planner("gradient.clearance").solve(
+        problem, 0, Budget(max_iterations=5), np.random.default_rng(0)
+    )
+    assert r.extra["descent_backend"] == "numpy"
+    arm = load_problem("armz_pocket")
+    r = make_planner("gradient.clearance").solve(
+        arm, 0, Budget(max_iterations=5), np.random.default_rng(0)
+    )
+    assert r.extra["descent_backend"] == "compiled"

@@ -660,6 +660,8 @@ class ClearanceDescent:
                 "descent_rad": descent_rad,
                 "escapes": escapes_log,
                 "path_rad": path_length(np.array(path), robot.continuous),
+                # what ran: "compiled" falls back to numpy for robots other than Arm-Z
+                "descent_backend": self.model(problem).backend,
             }
             if status is Status.LOCAL_MINIMUM:
                 extra["q_stall"] = np.asarray(path[-1], dtype=float).tolist()
@@ -805,6 +807,8 @@ class _NumpyPoint:
 class _NumpyModel:
     """The field and the step in numpy (``backend = "numpy"``: the reference)."""
 
+    backend = "numpy"
+
     def __init__(self, descent: ClearanceDescent, field: ClearanceField) -> None:
         self._descent, self._field = descent, field
 
@@ -821,6 +825,8 @@ class _NumpyModel:
 class _CompiledModel:
     """The field and the step compiled (:mod:`plannerlab.planners._descent_core`): one
     call per state gives F, f, the tip errors, the distances and the step direction."""
+
+    backend = "compiled"
 
     def __init__(self, descent: ClearanceDescent, field: ClearanceField) -> None:
         from plannerlab.planners._descent_core import CompiledField
