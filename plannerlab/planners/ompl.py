@@ -759,6 +759,12 @@ class OMPLPlanner:
         ompl_seed: int,
     ) -> PlanResult:
         checker = problem_checker(problem)
+        if self.settings.goal_selection != "ik":
+            # the near goal's descent is compiled: its kernels are loaded (or compiled)
+            # before the tracker starts, as the checker's core is
+            from plannerlab.planners._descent_core import warm_up
+
+            warm_up()
         guard = _Guard(checker, BudgetTracker(budget, checker))
         try:
             return self._plan(problem, leg, rng, q_start, ompl_seed, guard)
