@@ -286,6 +286,10 @@ CLI_CASES = {
         ["--planner", "ompl.rrtconnect", "--set", "goal_selection=far"],
         "goal_selection",
     ),
+    "descent_backend_unknown": (
+        ["--planner", "gradient.clearance", "--set", "backend=cuda"],
+        "backend",
+    ),
 }
 
 

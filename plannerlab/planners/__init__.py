@@ -142,7 +142,7 @@ def _entries() -> dict[str, PlannerEntry]:
         (
             "gradient.clearance+rrtconnect",
             "gradient.clearance; at a stall, RRT-Connect from the stall to a goal state "
-            "found by the clearance descent from the stall",
+            "found by the clearance descent from the stall, or drawn by IK when it finds none",
             True,
         ),
     ):

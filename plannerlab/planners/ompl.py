@@ -130,6 +130,8 @@ LOGGER = logging.getLogger("plannerlab.ompl")
 
 #: OMPL seeds must be in [1, 2**31 - 1] (0 means "random" to OMPL)
 _SEED_MAX = 2**31 - 1
+#: how the goal pool is filled (``goal_selection`` setting)
+GOAL_SELECTIONS = ("ik", "near", "near_or_ik")
 
 
 # ---------------------------------------------------------------------------- settings
@@ -148,7 +150,10 @@ class OMPLSettings:
         goal_selection: ``"ik"`` (numeric IK restarts seeded from the leg start, see
             :func:`~plannerlab.problem.ik.sample_goal_state`) or ``"near"`` (the goal state
             ``gradient.clearance`` selects: its descent from the leg start with the path
-            unchecked, so the goal stays near the start; one state, one check).
+            unchecked, so the goal stays near the start; one state, one check) or
+            ``"near_or_ik"`` (that near state; when its descent ends in no collision-free
+            goal state, ``goal_samples`` IK states as with ``"ik"``: the escape of
+            ``gradient.clearance+rrtconnect``, which gave up with ``invalid_goal`` before).
     """
 
     simplify: bool = True
@@ -734,9 +739,10 @@ class OMPLPlanner:
                 f"{', '.join(_MOTION_CHECKS)}, got "
                 f"{self.settings.motion_check!r}"
             )
-        if self.settings.goal_selection not in ("ik", "near"):
+        if self.settings.goal_selection not in GOAL_SELECTIONS:
             raise PlannerlabError(
-                f"{self.name}: goal_selection must be 'ik' or 'near', got "
+                f"{self.name}: goal_selection must be one of "
+                f"{', '.join(map(repr, GOAL_SELECTIONS))}, got "
                 f"{self.settings.goal_selection!r}"
             )
         requested = int(rng.integers(1, _SEED_MAX))
@@ -758,6 +764,12 @@ class OMPLPlanner:
         ompl_seed: int,
     ) -> PlanResult:
         checker = problem_checker(problem)
+        if self.settings.goal_selection != "ik":
+            # the near goal's descent is compiled: its kernels are loaded (or compiled)
+            # before the tracker starts, as the checker's core is
+            from plannerlab.planners._descent_core import warm_up
+
+            warm_up()
         guard = _Guard(checker, BudgetTracker(budget, checker))
         try:
             return self._plan(problem, leg, rng, q_start, ompl_seed, guard)
@@ -817,11 +829,23 @@ class OMPLPlanner:
         c_pool = checker.checks
         per_slot = max(1, s.max_goal_attempts // max(s.goal_samples, 1))
         pool_cut_short = ""
-        for _ in range(s.goal_samples):
+        selection = s.goal_selection
+        if selection == "near_or_ik":
+            # the near goal first; when its descent finds none, the IK pool
+            q_near = (
+                None
+                if guard.exhausted() is not None
+                else _near_goal(problem, leg, q0, checker, tracker)
+            )
+            extra["goal_near_found"] = q_near is not None
+            if q_near is not None:
+                pool.append(wrap_to_pi(q_near, robot.continuous))
+            selection = "near" if pool else "ik"
+        for _ in range(s.goal_samples if not pool else 0):
             if guard.exhausted() is not None:
                 pool_cut_short = guard.exhausted() or ""
                 break
-            if s.goal_selection == "near":
+            if selection == "near":
                 q_goal = _near_goal(problem, leg, q0, checker, tracker)
             else:
                 q_goal = sample_goal_state(
