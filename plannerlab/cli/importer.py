@@ -68,10 +68,17 @@ def cmd_import_mbm(args: argparse.Namespace, console: Console) -> int:
             tip_link=args.tip_link,
             name=name,
             safety_margin_m=args.margin_m,
+            joint_step_rad=args.joint_step,
         )
         target.write_text(text, encoding="utf-8")
     console.print(f"{len(pairs)} problem files written to {escape(str(out))}", highlight=False)
     return 0
+
+
+def mbm_default_joint_step() -> float:
+    from plannerlab.problem.mbm import DEFAULT_JOINT_STEP_RAD
+
+    return DEFAULT_JOINT_STEP_RAD
 
 
 def add_parser(sub: Any) -> None:
@@ -104,6 +111,12 @@ def add_parser(sub: Any) -> None:
         default=0.0,
         help="[planning] safety_margin_m of the files (MotionBenchMaker's states are valid "
         "with no margin)",
+    )
+    m.add_argument(
+        "--joint-step",
+        type=float,
+        default=mbm_default_joint_step(),
+        help="[checking] joint_step of the files [rad]",
     )
     m.add_argument(
         "--fetch",

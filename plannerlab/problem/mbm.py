@@ -52,6 +52,10 @@ MBM_SCENARIOS = (
     "table_pick",
     "table_under_pick",
 )
+#: ``[checking] joint_step`` of imported problems [rad]: with no margin the edges are
+#: checked at it and re-checked at a quarter of it; at 0.05 (plannerlab's default) RRT-Connect
+#: paths on table_under_pick failed the re-check (a sphere 1 m out moves 5 cm per step)
+DEFAULT_JOINT_STEP_RAD = 0.02
 #: the goal tolerance when the request gives none [rad]
 DEFAULT_JOINT_TOL_RAD = 1e-3
 
@@ -348,6 +352,7 @@ def problem_toml(
     srdf: Path | None = None,
     name: str | None = None,
     safety_margin_m: float = 0.0,
+    joint_step_rad: float = DEFAULT_JOINT_STEP_RAD,
 ) -> str:
     """The text of a plannerlab problem file (to be written at ``out_path``) for one
     MotionBenchMaker problem. The robot is read from ``urdf`` (for its joint order and
@@ -355,6 +360,8 @@ def problem_toml(
 
     ``safety_margin_m`` is the file's ``[planning] safety_margin_m``: 0 by default, as
     MotionBenchMaker's states are valid with no margin (a margin can make them collide).
+    With no margin, edges are checked every ``joint_step_rad`` (``[checking] joint_step``)
+    and re-checked at a quarter of it.
     """
     from plannerlab.robots.urdf.model import UrdfChain, UrdfError
 
@@ -390,6 +397,7 @@ def problem_toml(
         lines.append(f"allowed_collisions = [{pairs}]")
     lines += ["", "[start]", f"q = {_vec(q_start)}", ""]
     lines += ["[planning]", f"safety_margin_m = {_f(safety_margin_m)}", ""]
+    lines += ["[checking]", f"joint_step = {_f(joint_step_rad)}", ""]
     for o in obstacles:
         rpy_deg = np.degrees(matrix_to_rpy(o.T_world[:3, :3]))
         lines += [

@@ -149,6 +149,10 @@ class UrdfChain:
         object.__setattr__(self, "urdf_path", path)
         if not path.is_file():
             raise UrdfError("urdf", f"an existing URDF file; {path} does not exist")
+        try:  # yourdfpy would recover from broken XML and read part of it
+            ET.parse(path)
+        except ET.ParseError as exc:
+            raise UrdfError("urdf", f"a well-formed URDF (XML); {path}: {exc}") from None
         try:
             model = yourdfpy.URDF.load(
                 str(path),
@@ -170,7 +174,7 @@ class UrdfChain:
         if self.tip_link not in links:
             raise UrdfError(
                 "tip_link",
-                f"a link of {path.name}{_hint(self.tip_link, list(links))}; "
+                f"a link of {path.name}, got {self.tip_link!r}{_hint(self.tip_link, list(links))}; "
                 f"its links: {', '.join(links)}",
             )
         # the chain: root -> tip
