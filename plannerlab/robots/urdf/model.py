@@ -127,6 +127,8 @@ class UrdfChain:
     excluded_pairs: frozenset[tuple[int, int]] = field(init=False, repr=False)
     #: movable joints off the chain, frozen at the value given (URDF joint name -> value)
     frozen_joints: dict[str, float] = field(init=False, repr=False)
+    #: the URDF link of each capsule (the simulator's link of each plannerlab link)
+    link_urdf_names: tuple[str, ...] = field(init=False, repr=False)
     #: an upper bound of the tip's distance from the root link's origin [m]
     max_reach_m: float = field(init=False, repr=False)
     # the chain's fixed data (see __post_init__)
@@ -343,6 +345,7 @@ class UrdfChain:
         s(self, "dof", dof)
         s(self, "joint_names", tuple(j.name for j in movable))
         s(self, "link_names", tuple(cap_names))
+        s(self, "link_urdf_names", tuple(cap_link))
         s(self, "lower", frozen_array(np.where(cont, -np.pi, lower)))
         s(self, "upper", frozen_array(np.where(cont, np.pi, upper)))
         s(self, "continuous", frozen_array(cont, bool))
