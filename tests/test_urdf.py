@@ -238,3 +238,19 @@ def test_an_imported_problem_is_solved_by_rrtconnect_on_a_fixed_seed(tmp_path):
     # re-checked here, densified, with FCL
     fcl = CollisionChecker(problem.robot, problem.scene, backend="fcl")
     assert fcl.check_path(path_q, problem.joint_step / 4).valid
+
+
+# ---------------------------------------------------------------- the compiled core
+def test_the_core_checks_a_urdf_chain_as_fcl_does(tmp_path):
+    """Compiled chain kinematics + capsule tests against FCL on random Panda states in an
+    imported shelf scene (spheres against a box, a cylinder and a sphere)."""
+    problem = parse_problem(_import(tmp_path, "shelf"))
+    core = CollisionChecker(problem.robot, problem.scene, backend="core", margin_m=0.01)
+    fcl = CollisionChecker(problem.robot, problem.scene, backend="fcl", margin_m=0.01)
+    Q = np.random.default_rng(5).uniform(problem.robot.lower, problem.robot.upper, (3000, 7))
+    assert core._core is not None
+    assert np.allclose(core._core.segments(Q), problem.robot.link_segments(Q), atol=1e-12)
+    v_core, v_fcl = core.valid_batch(Q), fcl.valid_batch(Q)
+    assert 0.2 < v_core.mean() < 0.95  # both kinds of state are there
+    assert np.array_equal(v_core, v_fcl)
+    assert [core.is_valid(q) for q in Q[:300]] == v_fcl[:300].tolist()

@@ -457,6 +457,22 @@ class UrdfChain:
             b = int(parent[b - 1])
         return out
 
+    def chain_data(self) -> tuple[Any, ...]:
+        """The chain as plain arrays, for compiled kinematics
+        (:mod:`plannerlab.collision.chain`): per movable joint its parent body (dof,), the
+        fixed transform body -> joint frame (dof, 4, 4), the unit axis (dof, 3) and whether
+        it slides (dof,); per capsule its body (L,) and its end points in that body's frame
+        (L, 3) twice."""
+        return (
+            self._parent_body,
+            self._pre,
+            self._axes,
+            np.array(self._prismatic, dtype=bool),
+            self._cap_body,
+            self._cap_a,
+            self._cap_b,
+        )
+
     def link_segments(self, q: Array) -> Array:
         """Capsule axes in the world: (L, 2, 3) for one q, (k, L, 2, 3) for a batch."""
         B = self._bodies(q)
