@@ -730,7 +730,7 @@ class Core:
         self._continuous = np.ascontiguousarray(robot.continuous, dtype=np.bool_)
         self._armz = getattr(robot, "kind", "") == "armz"
         #: a URDF chain: its capsules from compiled kinematics (collision/chain.py)
-        self._chain: tuple[np.ndarray, ...] | None = None
+        self._chain: Any = None
         if callable(getattr(robot, "chain_data", None)):
             self._chain = chain_arrays(robot)
         if self._armz:
