@@ -789,7 +789,8 @@ class Core:
             return armz_segments(Qc, self._T0, self._T1, self._M, out)
         if self._chain is not None:
             out = np.empty((len(Qc), self.n_links, 2, 3))
-            return chain_segments(Qc, *self._chain, out)
+            kinematics: Any = chain_segments  # a numba dispatcher
+            return kinematics(Qc, *self._chain, out)
         return np.ascontiguousarray(self.robot.link_segments(Qc), dtype=float)
 
     # ------------------------------------------------------------------ queries
@@ -807,7 +808,8 @@ class Core:
         if self._armz:
             return armz_first_invalid(Qc, self._T0, self._T1, self._M, *self._geo) < 0
         if self._chain is not None:
-            return chain_first_invalid(Qc, *self._chain, *self._geo) < 0
+            kernel: Any = chain_first_invalid  # a numba dispatcher
+            return bool(kernel(Qc, *self._chain, *self._geo) < 0)
         return bool(self.valid(Qc)[0])
 
     def first_invalid(self, Q: Array) -> int:
@@ -816,7 +818,8 @@ class Core:
         if self._armz:
             return int(armz_first_invalid(Qc, self._T0, self._T1, self._M, *self._geo))
         if self._chain is not None:
-            return int(chain_first_invalid(Qc, *self._chain, *self._geo))
+            kernel: Any = chain_first_invalid  # a numba dispatcher
+            return int(kernel(Qc, *self._chain, *self._geo))
         return int(first_invalid(self.segments(Qc), *self._geo))
 
     def edge_first_invalid(
