@@ -254,3 +254,38 @@ def test_the_core_checks_a_urdf_chain_as_fcl_does(tmp_path):
     assert 0.2 < v_core.mean() < 0.95  # both kinds of state are there
     assert np.array_equal(v_core, v_fcl)
     assert [core.is_valid(q) for q in Q[:300]] == v_fcl[:300].tolist()
+
+
+def test_the_gradient_method_descends_on_joint_distance_to_a_goal_state(tmp_path):
+    """In free space the paper's descent (analytic gradient) walks straight to a goal
+    state: the joint distance shrinks to the tolerance."""
+    from plannerlab.planners import make_planner
+    from plannerlab.problem.load import Budget
+
+    text = f"""
+[problem]
+name = "free"
+[robot]
+type = "urdf"
+urdf = "{URDF.as_posix()}"
+srdf = "{SRDF.as_posix()}"
+tip_link = "panda_hand"
+[start]
+q = [0, -0.785, 0, -2.356, 0, 1.571, 0.785]
+[[goals]]
+name = "g"
+q = [0.5, -0.5, 0.3, -2.0, 0.2, 1.8, 0.6]
+joint_tol_rad = 0.01
+"""
+    path = tmp_path / "free.toml"
+    path.write_text(text, encoding="utf-8")
+    problem = parse_problem(path)
+    r = make_planner("gradient.analytic").solve(
+        problem, 0, Budget(max_iterations=2000), np.random.default_rng(0)
+    )
+    assert r.status.value == "solved", r.reason
+    goal = problem.goals[0]
+    assert float(goal.joint_error(r.path[-1])) <= 0.01
+    # straight in joint space: every state on the way is closer than the start
+    d = goal.joint_error(r.path)
+    assert np.all(np.diff(d) <= 1e-12)
