@@ -289,3 +289,11 @@ joint_tol_rad = 0.01
     # straight in joint space: every state on the way is closer than the start
     d = goal.joint_error(r.path)
     assert np.all(np.diff(d) <= 1e-12)
+
+
+def test_the_reach_bound_holds_for_random_panda_states(panda):
+    Q = np.random.default_rng(2).uniform(panda.lower, panda.upper, (2000, 7))
+    p, _ = panda.tip(Q)
+    dist = np.linalg.norm(p - panda.T_world_base[:3, 3], axis=1)
+    assert np.max(dist) <= panda.max_reach_m
+    assert np.max(dist) >= 0.7 * panda.max_reach_m  # and it is not loose
