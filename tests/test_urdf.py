@@ -297,3 +297,28 @@ def test_the_reach_bound_holds_for_random_panda_states(panda):
     dist = np.linalg.norm(p - panda.T_world_base[:3, 3], axis=1)
     assert np.max(dist) <= panda.max_reach_m
     assert np.max(dist) >= 0.7 * panda.max_reach_m  # and it is not loose
+
+
+def test_import_mbm_on_the_command_line_writes_a_problem_that_loads(tmp_path, capsys):
+    from plannerlab.cli.main import main
+
+    code = main(
+        [
+            "import",
+            "mbm",
+            str(MBM / "scene_table.yaml"),
+            str(MBM / "request_table.yaml"),
+            "--urdf",
+            str(URDF),
+            "--srdf",
+            str(SRDF),
+            "--name",
+            "table_test",
+            "--out",
+            str(tmp_path / "out"),
+        ]
+    )
+    assert code == 0, capsys.readouterr().err
+    problem = parse_problem(tmp_path / "out" / "table_test.toml")
+    assert problem.name == "table_test" and len(problem.scene.obstacles) == 2
+    assert problem.safety_margin_m == 0.0 and problem.joint_step == pytest.approx(0.02)
