@@ -196,7 +196,11 @@ def _room_table() -> list[tuple[tuple[str, ...], tuple[str, ...]]]:
         paths = tuple(
             p for p in re.findall(r"`([^`]+)`", cells[0]) if "/" in p or p.endswith(".py")
         )
-        tokens = tuple(t.strip() for t in cells[-1].split(",") if t.strip() not in ("", "—"))
+        tokens = tuple(
+            re.sub(r"\s*\(.*?\)", "", t).strip()
+            for t in cells[-1].split(",")
+            if t.strip() not in ("", "—")
+        )
         rows.append((tuple(p.replace("<family>/", "") for p in paths), tokens))
     return rows
 
@@ -284,6 +288,8 @@ STILL_TOO_LONG = {
     "planners/_descent_core.py:evaluate": "one fused numba kernel: spheres, pairs, cost, gradient",
     "planners/ompl.py": "space, goal pool, driver and roadmap planners in one module",
     "planners/ompl.py:_plan": "the OMPL driver in one function",
+    "problem/load.py": "the loader per table",
+    "robots/urdf/model.py:__post_init__": "URDF reading, chain folding and capsules in one method",
     "robots/irb6/ik.py": "the analytic IK's cases",
     "sim/execute.py:_run": "retiming, tracking and measuring in one function",
 }

@@ -23,7 +23,7 @@ from typing import Any, Protocol
 
 import numpy as np
 
-from plannerlab.problem.goals import GoalRegion
+from plannerlab.problem.goals import GoalRegion, JointGoal
 from plannerlab.robots.base import Array, Robot, wrap_to_pi
 from plannerlab.robots.registry import goal_sampler
 
@@ -165,6 +165,8 @@ def sample_goal_state(
 ) -> Array | None:
     """A collision-free state inside both tolerances of ``goal``, or None.
 
+    A :class:`~plannerlab.problem.goals.JointGoal` is its goal state (if it is valid).
+
     Restart schedule, attempt ``k = 0, 1, …``: with probability ``uniform_fraction`` (never
     on the first attempt of each seed round when seeds are given) a uniformly random state;
     otherwise seed ``k mod len(seeds)`` plus Gaussian noise of standard deviation
@@ -208,6 +210,11 @@ def sample_goal_state(
         (dof,) state inside the region and collision-free, or None after ``attempts``
         (or once ``stop`` says so).
     """
+    if isinstance(goal, JointGoal):
+        # a goal state is its own (only) sample: one check
+        if stop is not None and stop():
+            return None
+        return np.array(goal.q_rad) if checker.is_valid(goal.q_rad) else None
     seed_list = [np.asarray(s, dtype=float).reshape(robot.dof) for s in seeds]
     analytic = _analytic_goal_sampler(robot)
     if analytic is not None:

@@ -9,11 +9,13 @@ Checks that need the collision checker (a start in collision) are made by
 File layout (every key is documented in ``docs/problem-format.md``)::
 
     [problem]   name, description
-    [robot]     type = "armz" | "irb6" | "continuum_chain", then the type's parameters
+    [robot]     type = "armz" | "irb6" | "continuum_chain" | "urdf", then the type's
+                parameters
     [start]     q | q_deg | fill | fill_deg
     [[obstacles]] name, type = "box" | "cylinder" | "sphere", center_m, rpy_deg,
                   size_m | radius_m, length_m
-    [[goals]]   name, p_m, n, pos_tol_m, angle_tol_deg     (one per leg, in order)
+    [[goals]]   name, p_m, n, pos_tol_m, angle_tol_deg     (one per leg, in order), or
+                name, q | q_deg, joint_tol_rad              (a goal state)
     [budget]    max_iterations, max_collision_checks, time_limit_s
     [checking]  joint_step       (largest joint step between checked states on an edge)
     [planning]  safety_margin_m  (clearance every plan keeps; edge resolution in metres)
@@ -39,7 +41,7 @@ from typing import Any
 import numpy as np
 
 from plannerlab.errors import ProblemError, UnknownNameError, did_you_mean
-from plannerlab.problem.goals import GoalRegion
+from plannerlab.problem.goals import GoalRegion, JointGoal
 from plannerlab.problem.scene import OBSTACLE_TYPES, Box, Cylinder, Obstacle, Scene, Sphere
 from plannerlab.robots.base import Array, Robot, pose_matrix
 from plannerlab.robots.registry import FAMILIES, gravity_off_reason, robot_table
@@ -318,7 +320,13 @@ def _obstacle(reader: TableReader) -> Obstacle:
     return Sphere(name, T, reader.number("radius_m", positive=True))
 
 
-def _goal(reader: TableReader) -> GoalRegion:
+#: default ``[[goals]] joint_tol_rad`` of a goal state [rad, m for prismatic joints]
+DEFAULT_JOINT_TOL_RAD = 1e-3
+
+
+def _goal(reader: TableReader, robot: Robot) -> GoalRegion:
+    if reader.has("q") or reader.has("q_deg"):
+        return _joint_goal(reader, robot)
     reader.unknown_keys(("name", "p_m", "n", "pos_tol_m", "angle_tol_deg", "note"))
     p = reader.vector("p_m", 3)
     n = reader.vector("n", 3)
@@ -341,6 +349,36 @@ def _goal(reader: TableReader) -> GoalRegion:
         pos_tol_m=reader.number("pos_tol_m", positive=True),
         angle_tol_deg=angle_tol_deg,
     )
+
+
+def _joint_goal(reader: TableReader, robot: Robot) -> JointGoal:
+    """A goal state: ``q`` (rad, m for prismatic joints) or ``q_deg``, ``joint_tol_rad``."""
+    reader.unknown_keys(("name", "q", "q_deg", "joint_tol_rad", "note"))
+    if reader.has("q") and reader.has("q_deg"):
+        raise reader.fail("q", "one of q, q_deg (a goal state), not both")
+    name = reader.string("name")
+    if not name.strip():
+        raise reader.fail("name", "a non-empty name (legs are chosen by it: --legs NAME)")
+    q = _joint_values(reader, robot, "q" if reader.has("q") else "q_deg")
+    tol = reader.number("joint_tol_rad", DEFAULT_JOINT_TOL_RAD, positive=True)
+    return JointGoal.at(robot, name, q, tol)
+
+
+def _joint_values(reader: TableReader, robot: Robot, k: str) -> Array:
+    """One value per joint under key ``k`` (``*_deg``: degrees), within the joint limits."""
+    q = reader.vector(k)
+    if q.shape != (robot.dof,):
+        raise reader.fail(k, f"{robot.dof} joint values for this {robot.kind} robot, got {q.size}")
+    if k.endswith("_deg"):
+        q = np.deg2rad(q)
+    lo, hi = robot.lower, robot.upper
+    bad = np.flatnonzero(~robot.continuous & ((q < lo - 1e-12) | (q > hi + 1e-12)))
+    if bad.size:
+        i = int(bad[0])
+        raise reader.fail(
+            k, f"joint {robot.joint_names[i]} within [{lo[i]:.6g}, {hi[i]:.6g}], got {q[i]:.6g}"
+        )
+    return q
 
 
 def _start(reader: TableReader, robot: Robot) -> Array:
@@ -504,7 +542,25 @@ def _table_value(reader: TableReader, key: Key) -> Any:
                 name, f"[lower, upper] with lower <= upper{unit}, got {[float(x) for x in v]}"
             )
         return v
+    if key.kind == "pairs":
+        raw = reader.raw(name, list(key.default))  # type: ignore[arg-type]
+        ok = isinstance(raw, list) and all(
+            isinstance(p, list) and len(p) == 2 and all(isinstance(x, str) for x in p) for p in raw
+        )
+        if not ok:
+            raise reader.fail(name, f"a list of [name, name] pairs of strings, got {raw!r:.80}")
+        return tuple((a, b) for a, b in raw)
     s = reader.string(name, key.default)
+    if key.kind == "path":
+        if not s:
+            return ""
+        folder = Path(reader.source).parent if reader.source != "<memory>" else Path.cwd()
+        resolved = (folder / s).resolve()
+        if not resolved.is_file():
+            raise reader.fail(
+                name, f"an existing file, relative to the problem file; {resolved} does not exist"
+            )
+        return str(resolved)
     if key.choices and s not in key.choices:
         choices = " or ".join(
             f'"{c}"' + (" (the default)" if c == key.default else "") for c in key.choices
@@ -522,6 +578,9 @@ def parse_robot_table(reader: TableReader, table: RobotTable) -> dict[str, Any]:
             among its choices.
     """
     reader.unknown_keys((COMMON_KEYS[0], *table.names, *COMMON_KEYS[1:]))
+    for key in table.keys:
+        if key.required and not reader.has(key.name):
+            raise reader.fail(key.name, f"is missing ({key.meaning})")
     return {key.name: _table_value(reader, key) for key in table.keys}
 
 
@@ -570,7 +629,9 @@ def problem_from_dict(data: Mapping[str, Any], source: str) -> Problem:
     raw_goals = top.raw("goals")
     if not isinstance(raw_goals, list) or not raw_goals:
         raise top.fail("goals", "a non-empty array of tables [[goals]] (one per leg)")
-    goals = tuple(_goal(TableReader(source, f"goals[{i}]", g)) for i, g in enumerate(raw_goals))
+    goals = tuple(
+        _goal(TableReader(source, f"goals[{i}]", g), robot) for i, g in enumerate(raw_goals)
+    )
     goal_names = [g.name for g in goals]
     for i, n in enumerate(goal_names):
         if goal_names.index(n) != i:

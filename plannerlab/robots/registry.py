@@ -73,6 +73,11 @@ FAMILIES: dict[str, RobotFamily] = {
         "plannerlab.robots.continuum.schema:TABLE",
         summary="a planar continuum robot as a chain of rigid links behind a port",
     ),
+    "urdf": RobotFamily(
+        "urdf",
+        "plannerlab.robots.urdf.schema:TABLE",
+        summary="any serial chain read from a URDF (yourdfpy), with its collision spheres",
+    ),
 }
 
 
