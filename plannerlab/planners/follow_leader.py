@@ -1,0 +1,547 @@
+"""Follow-the-leader: a path for the tip through free workspace, tracked by the clearance
+descent, so the body follows the tip through a window.
+
+The clearance descent (:mod:`plannerlab.planners.gradient_clearance`) pulls the tip
+straight at the goal; in a room entered through a window it tips the arm over the room's
+roof and stalls there (a local minimum no retract of its detour gets out of). A
+hyper-redundant arm's classic answer is follow-the-leader:
+
+1. **The leader's path** (:func:`tip_path`): a shortest path for the tip on a voxel grid
+   of the scene's signed distance, from the tip of the start state to the goal's approach
+   point ``p_d − approach_m · n_d`` (then along the goal's normal into the goal). Only
+   voxels whose centre is at least ``tip_clearance_m`` (the tip module's radius plus the
+   problem's safety margin plus ``extra_clearance_m``) from every obstacle are free, and
+   a step costs its length times ``1 + centre_weight · max(0, 1 − d / centre_m)``, so the
+   path keeps to the middle of a window rather than grazing its frame. The search is
+   :func:`scipy.sparse.csgraph.dijkstra` on the 26-connected graph of free voxels, in a
+   box round the start tip, the goal and the obstacles (the arm's reach at most).
+2. **The body follows** (:class:`FollowLeader`): the clearance descent
+   (:meth:`~plannerlab.planners.gradient_clearance.ClearanceDescent.descend`, its public
+   entry point) tracks a sub-goal that moves along the path: ``lookahead_m`` ahead of the
+   path point nearest the tip, its normal the path's direction there, within
+   ``subgoal_pos_tol_m`` and ``subgoal_angle_tol_deg``. The descent's clearance term keeps
+   the body off the window's frame while the tip leads it in. At the path's end the leg's
+   own descent (approach point, then the goal, with its settling) finishes the leg.
+
+If the tracking stalls (the descent cannot bring the tip to the next sub-goal), the
+``+detour`` variant hands the stall to the clearance descent's detour escape; the
+randomised variant (``random_grid``) shifts the voxel grid by a random fraction of a
+voxel and scales the centring weight, and plans a new leader path from the stall
+(``max_replans`` times), so its seeds are different runs.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass, replace
+from typing import Any
+
+import numpy as np
+from scipy.sparse import coo_matrix
+from scipy.sparse.csgraph import dijkstra
+
+from plannerlab.collision.fcl_checker import problem_checker
+from plannerlab.errors import PlannerlabError
+from plannerlab.planners.base import (
+    BudgetTracker,
+    LegRun,
+    Planner,
+    PlanResult,
+    Status,
+    start_collision,
+    with_overrides,
+)
+from plannerlab.planners.gradient_clearance import ClearanceDescent, ClearanceSettings
+from plannerlab.problem.scene import Box, Cylinder, Scene, Sphere
+from plannerlab.robots.base import Array, joint_difference
+from plannerlab.robots.paths import path_length
+
+
+@dataclass(frozen=True)
+class FollowLeaderSettings:
+    """Settings of follow-the-leader.
+
+    Attributes:
+        voxel_m: edge of the search grid's voxels [m].
+        extra_clearance_m: clearance the tip path keeps beyond the tip module's radius and
+            the problem's safety margin [m].
+        centre_m: distance from the obstacles below which a path step costs more [m].
+        centre_weight: how much more: a step at distance d costs its length times
+            ``1 + centre_weight · max(0, 1 − d / centre_m)``.
+        pad_m: the search box reaches this far beyond the start tip, the goal, its
+            approach point and the arm's base [m] (and never beyond the arm's reach from
+            its base); doubled while no path is found, up to the reach.
+        approach_m: the path ends at ``p_d − approach_m · n_d``, the goal's approach point.
+        lookahead_m: the sub-goal runs this far ahead of the path point nearest the tip.
+        subgoal_pos_tol_m, subgoal_angle_tol_deg: tolerances of the moving sub-goal.
+        stride_m: the sub-goal advances at most this far along the path per descent.
+        escape: "none" or "detour" (the clearance descent's detour from a stall).
+        random_grid: shift the grid by a random fraction of a voxel and scale
+            ``centre_weight`` by a random factor in [0.5, 1.5] (the seed's draw).
+        max_replans: (``random_grid``) new leader paths drawn from a tracking stall.
+        descent: overrides of the clearance descent's settings (a mapping).
+    """
+
+    voxel_m: float = 0.3
+    extra_clearance_m: float = 0.05
+    centre_m: float = 1.5
+    centre_weight: float = 4.0
+    pad_m: float = 3.0
+    approach_m: float = 2.5
+    lookahead_m: float = 1.5
+    subgoal_pos_tol_m: float = 0.5
+    subgoal_angle_tol_deg: float = 45.0
+    stride_m: float = 1.0
+    escape: str = "none"
+    random_grid: bool = False
+    max_replans: int = 3
+
+    def __post_init__(self) -> None:
+        if not self.voxel_m > 0:
+            raise PlannerlabError(f"voxel_m must be > 0, got {self.voxel_m}")
+        if self.escape not in ("none", "detour"):
+            raise PlannerlabError(f"escape setting: 'none' or 'detour', got {self.escape!r}")
+        for key in ("lookahead_m", "stride_m", "subgoal_pos_tol_m", "centre_m"):
+            if not getattr(self, key) > 0:
+                raise PlannerlabError(f"{key} must be > 0, got {getattr(self, key)}")
+        if self.max_replans < 0:
+            raise PlannerlabError(f"max_replans must be >= 0, got {self.max_replans}")
+
+
+# ---------------------------------------------------------------------- workspace search
+def scene_distance_m(scene: Scene, points_m: Array) -> Array:
+    """Signed distance [m] of points (k, 3) to the nearest obstacle (inf without any)."""
+    p = np.asarray(points_m, dtype=float).reshape(-1, 3)
+    d = np.full(len(p), np.inf)
+    for o in scene.obstacles:
+        T = o.T_world_obstacle
+        local = (p - T[:3, 3]) @ T[:3, :3]
+        if isinstance(o, Box):
+            q = np.abs(local) - o.size_m / 2.0
+            di = np.linalg.norm(np.maximum(q, 0.0), axis=1) + np.minimum(q.max(axis=1), 0.0)
+        elif isinstance(o, Cylinder):
+            q = np.stack(
+                [np.hypot(local[:, 0], local[:, 1]) - o.radius_m, np.abs(local[:, 2]) - o.length_m / 2],
+                axis=1,
+            )
+            di = np.linalg.norm(np.maximum(q, 0.0), axis=1) + np.minimum(q.max(axis=1), 0.0)
+        elif isinstance(o, Sphere):
+            di = np.linalg.norm(local, axis=1) - o.radius_m
+        else:  # pragma: no cover - the scene's types are closed
+            raise PlannerlabError(f"obstacle {o.name}: unknown kind {o.kind!r}")
+        d = np.minimum(d, di)
+    return d
+
+
+#: the 13 grid offsets of a 26-neighbourhood, one of each opposite pair
+_OFFSETS = np.array(
+    [
+        (i, j, k)
+        for i in (-1, 0, 1)
+        for j in (-1, 0, 1)
+        for k in (-1, 0, 1)
+        if (i, j, k) > (0, 0, 0)
+    ]
+)
+
+
+@dataclass(frozen=True)
+class TipPath:
+    """The leader's path.
+
+    Attributes:
+        points_m: (m, 3) from the start tip to the goal, the last two the approach point
+            and the goal point [m].
+        arc_m: (m,) arc length at each point [m].
+        min_distance_m: the smallest obstacle distance of the grid part [m].
+        free_voxels: how many voxels of the search box were free.
+    """
+
+    points_m: Array
+    arc_m: Array
+    min_distance_m: float
+    free_voxels: int
+
+    def at(self, s_m: float) -> tuple[Array, Array]:
+        """Point and unit direction of the path at arc length ``s_m``."""
+        s = float(np.clip(s_m, 0.0, self.arc_m[-1]))
+        i = int(np.clip(np.searchsorted(self.arc_m, s, side="right") - 1, 0, len(self.arc_m) - 2))
+        a, b = self.points_m[i], self.points_m[i + 1]
+        seg = float(self.arc_m[i + 1] - self.arc_m[i])
+        t = 0.0 if seg <= 0 else (s - self.arc_m[i]) / seg
+        p = a + t * (b - a)
+        # direction: the chord over about one metre round s (a smooth tangent on a grid path)
+        lo = self._point(max(s - 0.5, 0.0))
+        hi = self._point(min(s + 0.5, float(self.arc_m[-1])))
+        d = hi - lo
+        n = float(np.linalg.norm(d))
+        return p, (d / n if n > 1e-9 else np.array([0.0, 0.0, 1.0]))
+
+    def _point(self, s: float) -> Array:
+        return np.array([np.interp(s, self.arc_m, self.points_m[:, k]) for k in range(3)])
+
+    def nearest_arc_m(self, p_m: Array, s_from_m: float, window_m: float) -> float:
+        """Arc length of the path point nearest ``p_m`` within ``[s_from, s_from + window]``."""
+        s = np.linspace(s_from_m, min(s_from_m + window_m, float(self.arc_m[-1])), 41)
+        pts = np.stack([np.interp(s, self.arc_m, self.points_m[:, k]) for k in range(3)], axis=1)
+        return float(s[int(np.argmin(np.linalg.norm(pts - p_m, axis=1)))])
+
+
+def tip_path(
+    scene: Scene,
+    start_m: Array,
+    goal_m: Array,
+    goal_n: Array,
+    *,
+    clearance_m: float,
+    approach_m: float,
+    voxel_m: float,
+    centre_m: float,
+    centre_weight: float,
+    pad_m: float,
+    reach_centre_m: Array,
+    reach_m: float,
+    offset_m: Array | None = None,
+) -> TipPath | None:
+    """The leader's path from ``start_m`` to the approach point ``goal_m − approach_m ·
+    goal_n`` on the free voxels (obstacle distance >= ``clearance_m``), then to ``goal_m``;
+    None when the two are not connected. The start and the approach point are joined to
+    their nearest free voxel (a tip that starts close to a wall). See the module docstring.
+    """
+    start = np.asarray(start_m, dtype=float)
+    goal = np.asarray(goal_m, dtype=float)
+    approach = goal - approach_m * np.asarray(goal_n, dtype=float)
+    pts = np.vstack([start, approach, goal, reach_centre_m])
+    lo = np.min(pts, axis=0) - pad_m
+    hi = np.max(pts, axis=0) + pad_m
+    lo = np.maximum(lo, np.asarray(reach_centre_m) - reach_m)
+    hi = np.minimum(hi, np.asarray(reach_centre_m) + reach_m)
+    lo = lo + (np.zeros(3) if offset_m is None else np.asarray(offset_m) - voxel_m)
+    shape = np.maximum(np.ceil((hi - lo) / voxel_m).astype(int) + 1, 2)
+    axes = [lo[k] + voxel_m * np.arange(shape[k]) for k in range(3)]
+    grid = np.stack(np.meshgrid(*axes, indexing="ij"), axis=-1).reshape(-1, 3)
+    dist = scene_distance_m(scene, grid).reshape(tuple(shape))
+    free = dist >= clearance_m
+    n_free = int(free.sum())
+    if n_free == 0:
+        return None
+    index = np.full(tuple(shape), -1, dtype=np.int64)
+    index[free] = np.arange(n_free)
+    ijk = np.argwhere(free)
+    w_node = 1.0 + centre_weight * np.maximum(0.0, 1.0 - dist[free] / centre_m)
+    rows, cols, vals = [], [], []
+    for off in _OFFSETS:
+        nb = ijk + off
+        ok = np.all((nb >= 0) & (nb < shape), axis=1)
+        a = np.flatnonzero(ok)
+        b = index[nb[ok, 0], nb[ok, 1], nb[ok, 2]]
+        keep = b >= 0
+        a, b = a[keep], b[keep]
+        length = voxel_m * float(np.linalg.norm(off))
+        rows.append(a)
+        cols.append(b)
+        vals.append(length * 0.5 * (w_node[a] + w_node[b]))
+    graph = coo_matrix(
+        (np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))),
+        shape=(n_free, n_free),
+    ).tocsr()
+    centres = grid.reshape(tuple(shape) + (3,))[free]
+
+    def nearest(p: Array) -> int:
+        return int(np.argmin(np.linalg.norm(centres - p, axis=1)))
+
+    i0, i1 = nearest(start), nearest(approach)
+    cost, pred = dijkstra(graph, directed=False, indices=i0, return_predecessors=True)
+    if not np.isfinite(cost[i1]):
+        return None
+    chain = [i1]
+    while chain[-1] != i0:
+        chain.append(int(pred[chain[-1]]))
+    grid_pts = centres[chain[::-1]]
+    points = np.vstack([start, grid_pts, approach, goal])
+    # drop repeated points (start or approach on a voxel centre)
+    seg = np.linalg.norm(np.diff(points, axis=0), axis=1)
+    points = points[np.concatenate([[True], seg > 1e-9])]
+    points = _shortcut(points, scene, clearance_m, voxel_m / 3)
+    arc = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(points, axis=0), axis=1))])
+    return TipPath(points, arc, float(dist[free][chain].min()), n_free)
+
+
+def _shortcut(points: Array, scene: Scene, clearance_m: float, step_m: float) -> Array:
+    """The path with every point skipped whose neighbours see each other with the same
+    clearance (greedy, from the start; the first and last two points kept)."""
+    if len(points) <= 3:
+        return points
+    keep = [0]
+    i = 0
+    last = len(points) - 2  # the approach point
+    while i < last:
+        j = last
+        while j > i + 1:
+            a, b = points[i], points[j]
+            n = max(2, int(np.ceil(np.linalg.norm(b - a) / step_m)) + 1)
+            line = a + np.linspace(0.0, 1.0, n)[:, None] * (b - a)
+            # the start may be closer to a wall than clearance_m: do not ask more than it has
+            need = min(clearance_m, float(scene_distance_m(scene, a[None])[0]))
+            if float(scene_distance_m(scene, line).min()) >= need - 1e-9:
+                break
+            j -= 1
+        keep.append(j)
+        i = j
+    keep.append(len(points) - 1)
+    return points[keep]
+
+
+# ---------------------------------------------------------------------- the planner
+class FollowLeader:
+    """Follow-the-leader with the clearance descent (see the module docstring)."""
+
+    def __init__(
+        self,
+        name: str,
+        settings: FollowLeaderSettings,
+        descent: ClearanceSettings,
+        escape_planner: Callable[[Mapping[str, Any]], Planner] | None = None,
+    ) -> None:
+        self.name = name
+        self.settings = settings
+        self.descent_settings = descent
+        # the tracking descent: no approach of its own, done as soon as inside the sub-goal
+        self._track = ClearanceDescent(
+            name, replace(descent, approach_m=0.0, goal_depth=1.0, settle_iterations=0)
+        )
+        self._finish = ClearanceDescent(name, replace(descent, escape="none"), escape_planner)
+
+    def leader_path(
+        self, problem, leg: int, q: Array, rng: np.random.Generator | None
+    ) -> TipPath | None:
+        """The leader's path from the tip of ``q`` into leg's goal (randomised with rng)."""
+        s = self.settings
+        robot = problem.robot
+        goal = problem.goal(leg)
+        p_tip, _ = robot.tip(q)
+        F0 = robot.fk(q)
+        base = F0[0, :3, 3]
+        reach = float(np.sum(np.linalg.norm(np.diff(F0[:, :3, 3], axis=0), axis=1)))
+        offset = None
+        weight = s.centre_weight
+        if rng is not None:
+            offset = rng.uniform(0.0, s.voxel_m, size=3)
+            weight = s.centre_weight * float(rng.uniform(0.5, 1.5))
+        r_tip = float(np.asarray(robot.link_radii_m)[-1])
+        pad = s.pad_m
+        while True:
+            leader = tip_path(
+                problem.scene,
+                p_tip,
+                goal.p_world_m,
+                goal.n_world,
+                clearance_m=r_tip + problem.safety_margin_m + s.extra_clearance_m,
+                approach_m=s.approach_m,
+                voxel_m=s.voxel_m,
+                centre_m=s.centre_m,
+                centre_weight=weight,
+                pad_m=pad,
+                reach_centre_m=base,
+                reach_m=reach,
+                offset_m=offset,
+            )
+            if leader is not None or pad >= reach:
+                return leader
+            pad = min(2.0 * pad, reach)
+
+    def subgoals(self, leader: TipPath) -> list[tuple[Array, Array]]:
+        """The sub-goals along the leader's path, up to its approach point: each corner of
+        the path, looking along the segment after it, and points every ``stride_m`` along
+        every segment after the first, looking along it (the tip goes to the first corner
+        as the descent takes it, then advances along its own normal). The approach
+        point looks along the goal's normal."""
+        s = self.settings
+        pts = leader.points_m
+        out: list[tuple[Array, Array]] = []
+        last = len(pts) - 2  # the approach point
+        for i in range(1, last + 1):
+            a, b = pts[i - 1], pts[i]
+            d = b - a
+            length = float(np.linalg.norm(d))
+            if length < 1e-9:
+                continue
+            u = d / length
+            if i > 1:
+                n_mid = int(np.floor(length / s.stride_m))
+                for k in range(1, n_mid + 1):
+                    t = k * s.stride_m
+                    if t < length - 0.5 * s.stride_m:
+                        out.append((a + t * u, u))
+            nxt = pts[i + 1] - b
+            nn = float(np.linalg.norm(nxt))
+            out.append((b, nxt / nn if nn > 1e-9 else u))
+        return out
+
+    def _follow(
+        self,
+        problem,
+        leg: int,
+        q0: Array,
+        leader: TipPath,
+        checker,
+        tracker: BudgetTracker,
+        used: int,
+    ) -> tuple[Status, str, list[Array], int]:
+        """Descend to each sub-goal along the leader's path in turn (:meth:`subgoals`); a
+        sub-goal the descent stalls before is passed over, two in a row end the tracking."""
+        from plannerlab.problem.goals import GoalRegion
+
+        s = self.settings
+        path = [np.array(q0)]
+        iterations = 0
+        goals = self.subgoals(leader)
+        stalls = 0
+        for k, (p_sub, n_sub) in enumerate(goals):
+            sub = GoalRegion(
+                f"leader{k}", p_sub, n_sub, s.subgoal_pos_tol_m, s.subgoal_angle_tol_deg
+            )
+            st, reason, seg, _, it = self._track.descend(
+                problem, leg, path[-1], checker, tracker, sub, used + iterations
+            )
+            iterations += it
+            path.extend(seg[1:])
+            if st is Status.LOCAL_MINIMUM:
+                stalls += 1
+                if stalls >= 2:
+                    return (
+                        st,
+                        f"tracking stalled at sub-goal {k + 1} of {len(goals)}: {reason}",
+                        path,
+                        iterations,
+                    )
+                continue
+            if st is not Status.SOLVED:
+                return st, reason, path, iterations
+            stalls = 0
+        return Status.SOLVED, f"followed {len(goals)} sub-goals", path, iterations
+
+    def solve(
+        self,
+        problem,
+        leg: int,
+        budget,
+        rng: np.random.Generator,
+        q_start: Array | None = None,
+        stepper=None,
+    ) -> PlanResult:
+        """Plan the leader's path, follow it, finish with the leg's descent."""
+        del stepper  # kinematic
+        s = self.settings
+        robot = problem.robot
+        goal = problem.goal(leg)
+        checker = problem_checker(problem)
+        q0 = np.array(problem.q_start if q_start is None else q_start, dtype=float)
+        tracker = BudgetTracker(budget, checker)
+        run = LegRun(self.name, s, problem, leg, tracker)
+        path: list[Array] = [q0]
+        iterations = 0
+        minima = escapes = 0
+        log: list[dict] = []
+
+        def note(states: list[Array]) -> None:
+            if states:
+                run.progress.note(float(np.min(goal.distance(robot, np.asarray(states)))))
+
+        def done(status: Status, reason: str) -> PlanResult:
+            extra: dict = {
+                "leader": log,
+                "path_rad": path_length(np.array(path), robot.continuous),
+            }
+            if status is Status.LOCAL_MINIMUM:
+                extra["q_stall"] = np.asarray(path[-1], dtype=float).tolist()
+            return run.result(
+                status,
+                reason,
+                path,
+                iterations=iterations,
+                local_minima=minima,
+                escapes=escapes,
+                extra=extra,
+            )
+
+        why_not = start_collision(checker, q0)
+        if why_not is not None:
+            return done(Status.INVALID_START, why_not)
+        note([q0])
+        draw_rng = rng if s.random_grid else None
+        attempts = 1 + (s.max_replans if s.random_grid else 0)
+        reason = ""
+        for attempt in range(attempts):
+            q = np.array(path[-1])
+            if goal.contains(robot, q):
+                return done(Status.SOLVED, "in the goal region")
+            leader = self.leader_path(problem, leg, q, draw_rng)
+            entry: dict = {"attempt": attempt, "from_leg_start_rad": float(
+                np.linalg.norm(joint_difference(q, q0, robot.continuous))
+            )}
+            log.append(entry)
+            if leader is None:
+                entry["leader"] = "none"
+                reason = "no path for the tip through free workspace"
+                continue
+            entry["leader_m"] = float(leader.arc_m[-1])
+            entry["leader_clearance_m"] = leader.min_distance_m
+            st, reason, seg, it = self._follow(problem, leg, q, leader, checker, tracker, iterations)
+            iterations += it
+            note(seg)
+            path.extend(seg[1:])
+            entry["follow"] = st.value
+            if st is Status.BUDGET_EXHAUSTED:
+                return done(st, reason)
+            # finish: the leg's descent (approach point, goal), with its escape if any
+            st2, reason2, seg2, _, it2 = self._finish.leg_descent(
+                problem, leg, np.array(path[-1]), checker, tracker, iterations
+            )
+            iterations += it2
+            note(seg2)
+            path.extend(seg2[1:])
+            entry["finish"] = st2.value
+            if st2 is Status.SOLVED:
+                return done(st2, f"followed the leader ({reason}); {reason2}")
+            if st2 is Status.BUDGET_EXHAUSTED:
+                return done(st2, reason2)
+            minima += 1
+            reason = f"{reason}; finish: {reason2}"
+            if s.escape == "detour":
+                esc, it3, how = self._finish._detour(
+                    problem, leg, np.array(path[-1]), checker, tracker, iterations
+                )
+                iterations += it3
+                entry["detour"] = how
+                if len(esc) > 1:
+                    escapes += 1
+                    note(esc)
+                    path.extend(esc[1:])
+                    if goal.contains(robot, path[-1]):
+                        return done(Status.SOLVED, f"followed the leader; detour {how}")
+        return done(Status.LOCAL_MINIMUM, reason)
+
+
+VARIANTS: dict[str, dict[str, object]] = {
+    "gradient.follow_leader": {},
+    "gradient.follow_leader+detour": {"escape": "detour"},
+    "gradient.follow_leader+random": {"random_grid": True},
+}
+
+
+def make(
+    name: str,
+    overrides: dict,
+    *,
+    escape_planner: Callable[[Mapping[str, Any]], Planner] | None = None,
+) -> FollowLeader:
+    """Registry factory for the ``gradient.follow_leader`` family. Overrides of the
+    clearance descent's settings are given as ``descent.<key>``."""
+    if name not in VARIANTS:
+        raise PlannerlabError(f"{name} is not a follow-the-leader planner ({', '.join(VARIANTS)})")
+    own = {k: v for k, v in overrides.items() if not k.startswith("descent.")}
+    sub = {k[len("descent.") :]: v for k, v in overrides.items() if k.startswith("descent.")}
+    base = FollowLeaderSettings(**VARIANTS[name])  # type: ignore[arg-type]
+    descent = with_overrides(ClearanceSettings(), sub, f"{name} (descent)")
+    return FollowLeader(name, with_overrides(base, own, name), descent, escape_planner)
