@@ -62,7 +62,7 @@ class FollowLeaderSettings:
     """Settings of follow-the-leader.
 
     Attributes:
-        voxel_m: edge of the search grid's voxels [m].
+        voxel_m: edge of the search grid's voxels [m]; 0: half the tip module's radius.
         extra_clearance_m: clearance the tip path keeps beyond the tip module's radius and
             the problem's safety margin [m].
         centre_m: distance from the obstacles below which a path step costs more [m].
@@ -82,7 +82,7 @@ class FollowLeaderSettings:
         descent: overrides of the clearance descent's settings (a mapping).
     """
 
-    voxel_m: float = 0.3
+    voxel_m: float = 0.0
     extra_clearance_m: float = 0.05
     centre_m: float = 1.5
     centre_weight: float = 4.0
@@ -97,8 +97,8 @@ class FollowLeaderSettings:
     max_replans: int = 3
 
     def __post_init__(self) -> None:
-        if not self.voxel_m > 0:
-            raise PlannerlabError(f"voxel_m must be > 0, got {self.voxel_m}")
+        if not self.voxel_m >= 0:
+            raise PlannerlabError(f"voxel_m must be >= 0, got {self.voxel_m}")
         if self.escape not in ("none", "detour"):
             raise PlannerlabError(f"escape setting: 'none' or 'detour', got {self.escape!r}")
         for key in ("lookahead_m", "stride_m", "subgoal_pos_tol_m", "centre_m"):
@@ -130,6 +130,42 @@ def scene_distance_m(scene: Scene, points_m: Array) -> Array:
         else:  # pragma: no cover - the scene's types are closed
             raise PlannerlabError(f"obstacle {o.name}: unknown kind {o.kind!r}")
         d = np.minimum(d, di)
+    return d
+
+
+def grid_distance_m(scene: Scene, axes: list[Array], cap_m: float) -> Array:
+    """Obstacle distances [m] at the points of the grid ``axes`` (three 1-D arrays of
+    coordinates), exact up to ``cap_m`` and ``inf`` beyond it: each obstacle is measured
+    only in the block of the grid within ``cap_m`` of its bounding box."""
+    shape = tuple(len(a) for a in axes)
+    d = np.full(shape, np.inf)
+    for o in scene.obstacles:
+        T = o.T_world_obstacle
+        half = o.half_extents_world()
+        block = []
+        for k in range(3):
+            lo = np.searchsorted(axes[k], T[k, 3] - half[k] - cap_m, side="left")
+            hi = np.searchsorted(axes[k], T[k, 3] + half[k] + cap_m, side="right")
+            block.append(slice(int(lo), int(hi)))
+        if any(b.start >= b.stop for b in block):
+            continue
+        sub = [axes[k][block[k]] for k in range(3)]
+        if isinstance(o, Box) and np.allclose(np.abs(T[:3, :3]), np.eye(3)):
+            # an axis-aligned box: separable, no point array needed
+            qx, qy, qz = (
+                (np.abs(sub[k] - T[k, 3]) - o.size_m[k] / 2.0)
+                for k in range(3)
+            )
+            qx, qy, qz = qx[:, None, None], qy[None, :, None], qz[None, None, :]
+            di = np.sqrt(
+                np.maximum(qx, 0.0) ** 2 + np.maximum(qy, 0.0) ** 2 + np.maximum(qz, 0.0) ** 2
+            ) + np.minimum(np.maximum(np.maximum(qx, qy), qz), 0.0)
+        else:
+            pts = np.stack(np.meshgrid(*sub, indexing="ij"), axis=-1).reshape(-1, 3)
+            di = scene_distance_m(Scene((o,)), pts).reshape(tuple(len(a) for a in sub))
+        view = d[block[0], block[1], block[2]]
+        np.minimum(view, di, out=view)
+    d[d > cap_m] = np.inf
     return d
 
 
@@ -202,11 +238,13 @@ def tip_path(
     reach_centre_m: Array,
     reach_m: float,
     offset_m: Array | None = None,
+    stop: Callable[[], bool] | None = None,
 ) -> TipPath | None:
     """The leader's path from ``start_m`` to the approach point ``goal_m − approach_m ·
     goal_n`` on the free voxels (obstacle distance >= ``clearance_m``), then to ``goal_m``;
     None when the two are not connected. The start and the approach point are joined to
     their nearest free voxel (a tip that starts close to a wall). See the module docstring.
+    ``stop()`` is asked between the stages (distances, graph, search): True gives None.
     """
     start = np.asarray(start_m, dtype=float)
     goal = np.asarray(goal_m, dtype=float)
@@ -219,11 +257,10 @@ def tip_path(
     lo = lo + (np.zeros(3) if offset_m is None else np.asarray(offset_m) - voxel_m)
     shape = np.maximum(np.ceil((hi - lo) / voxel_m).astype(int) + 1, 2)
     axes = [lo[k] + voxel_m * np.arange(shape[k]) for k in range(3)]
-    grid = np.stack(np.meshgrid(*axes, indexing="ij"), axis=-1).reshape(-1, 3)
-    dist = scene_distance_m(scene, grid).reshape(tuple(shape))
+    dist = grid_distance_m(scene, axes, max(centre_m, clearance_m) + voxel_m)
     free = dist >= clearance_m
     n_free = int(free.sum())
-    if n_free == 0:
+    if n_free == 0 or (stop is not None and stop()):
         return None
     index = np.full(tuple(shape), -1, dtype=np.int64)
     index[free] = np.arange(n_free)
@@ -245,14 +282,16 @@ def tip_path(
         (np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))),
         shape=(n_free, n_free),
     ).tocsr()
-    centres = grid.reshape(tuple(shape) + (3,))[free]
+    centres = lo + voxel_m * ijk
+    if stop is not None and stop():
+        return None
 
     def nearest(p: Array) -> int:
         return int(np.argmin(np.linalg.norm(centres - p, axis=1)))
 
     i0, i1 = nearest(start), nearest(approach)
     cost, pred = dijkstra(graph, directed=False, indices=i0, return_predecessors=True)
-    if not np.isfinite(cost[i1]):
+    if not np.isfinite(cost[i1]) or (stop is not None and stop()):
         return None
     chain = [i1]
     while chain[-1] != i0:
@@ -313,9 +352,15 @@ class FollowLeader:
         self._finish = ClearanceDescent(name, replace(descent, escape="none"), escape_planner)
 
     def leader_path(
-        self, problem, leg: int, q: Array, rng: np.random.Generator | None
+        self,
+        problem,
+        leg: int,
+        q: Array,
+        rng: np.random.Generator | None,
+        stop: Callable[[], bool] | None = None,
     ) -> TipPath | None:
-        """The leader's path from the tip of ``q`` into leg's goal (randomised with rng)."""
+        """The leader's path from the tip of ``q`` into leg's goal (randomised with rng;
+        None when there is none, or ``stop()`` said so)."""
         s = self.settings
         robot = problem.robot
         goal = problem.goal(leg)
@@ -323,12 +368,13 @@ class FollowLeader:
         F0 = robot.fk(q)
         base = F0[0, :3, 3]
         reach = float(np.sum(np.linalg.norm(np.diff(F0[:, :3, 3], axis=0), axis=1)))
+        r_tip = float(np.asarray(robot.link_radii_m)[-1])
+        voxel = s.voxel_m if s.voxel_m > 0 else 0.5 * r_tip
         offset = None
         weight = s.centre_weight
         if rng is not None:
-            offset = rng.uniform(0.0, s.voxel_m, size=3)
+            offset = rng.uniform(0.0, voxel, size=3)
             weight = s.centre_weight * float(rng.uniform(0.5, 1.5))
-        r_tip = float(np.asarray(robot.link_radii_m)[-1])
         pad = s.pad_m
         while True:
             leader = tip_path(
@@ -338,15 +384,16 @@ class FollowLeader:
                 goal.n_world,
                 clearance_m=r_tip + problem.safety_margin_m + s.extra_clearance_m,
                 approach_m=s.approach_m,
-                voxel_m=s.voxel_m,
+                voxel_m=voxel,
                 centre_m=s.centre_m,
                 centre_weight=weight,
                 pad_m=pad,
                 reach_centre_m=base,
                 reach_m=reach,
                 offset_m=offset,
+                stop=stop,
             )
-            if leader is not None or pad >= reach:
+            if leader is not None or pad >= reach or (stop is not None and stop()):
                 return leader
             pad = min(2.0 * pad, reach)
 
@@ -476,7 +523,11 @@ class FollowLeader:
             q = np.array(path[-1])
             if goal.contains(robot, q):
                 return done(Status.SOLVED, "in the goal region")
-            leader = self.leader_path(problem, leg, q, draw_rng)
+            leader = self.leader_path(
+                problem, leg, q, draw_rng, lambda: tracker.exhausted(iterations) is not None
+            )
+            if tracker.exhausted(iterations) is not None:
+                return done(Status.BUDGET_EXHAUSTED, str(tracker.exhausted(iterations)))
             entry: dict = {"attempt": attempt, "from_leg_start_rad": float(
                 np.linalg.norm(joint_difference(q, q0, robot.continuous))
             )}
