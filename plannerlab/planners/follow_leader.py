@@ -17,17 +17,22 @@ hyper-redundant arm's classic answer is follow-the-leader:
    box round the start tip, the goal and the obstacles (the arm's reach at most).
 2. **The body follows** (:class:`FollowLeader`): the clearance descent
    (:meth:`~plannerlab.planners.gradient_clearance.ClearanceDescent.descend`, its public
-   entry point) tracks a sub-goal that moves along the path: ``lookahead_m`` ahead of the
-   path point nearest the tip, its normal the path's direction there, within
-   ``subgoal_pos_tol_m`` and ``subgoal_angle_tol_deg``. The descent's clearance term keeps
-   the body off the window's frame while the tip leads it in. At the path's end the leg's
-   own descent (approach point, then the goal, with its settling) finishes the leg.
+   entry point) tracks a sub-goal that moves along the path (:meth:`FollowLeader.subgoals`):
+   to the path's first corner (the tip turns there as the descent takes it), then along
+   every later segment every ``stride_m``, looking along it, each within
+   ``subgoal_pos_tol_m`` and ``subgoal_angle_tol_deg``: the tip advances along its own
+   normal and the descent's clearance term keeps the body off the window's frame while
+   the tip leads it in. A sub-goal the descent stalls before is passed over; two in a row
+   end the tracking.
+3. **The finish** is the clearance descent's own solve of the leg from the state the
+   tracking reached (its approach point, then the goal, with its settling); in the
+   ``+detour`` variant with the descent's detour from a stall.
 
-If the tracking stalls (the descent cannot bring the tip to the next sub-goal), the
-``+detour`` variant hands the stall to the clearance descent's detour escape; the
-randomised variant (``random_grid``) shifts the voxel grid by a random fraction of a
-voxel and scales the centring weight, and plans a new leader path from the stall
-(``max_replans`` times), so its seeds are different runs.
+The search and the tracking are deterministic (``gradient.follow_leader``: its seeds are
+one run). The randomised variant (``+random``, ``random_grid``) shifts the voxel grid by
+a random fraction of a voxel and scales the centring weight by the seed's draw, and draws
+a new leader path from where a try ended (``max_replans`` times), so its seeds are
+different runs and a success rate over them says how often the method works.
 """
 
 from __future__ import annotations
@@ -72,14 +77,15 @@ class FollowLeaderSettings:
             approach point and the arm's base [m] (and never beyond the arm's reach from
             its base); doubled while no path is found, up to the reach.
         approach_m: the path ends at ``p_d − approach_m · n_d``, the goal's approach point.
-        lookahead_m: the sub-goal runs this far ahead of the path point nearest the tip.
         subgoal_pos_tol_m, subgoal_angle_tol_deg: tolerances of the moving sub-goal.
-        stride_m: the sub-goal advances at most this far along the path per descent.
+        stride_m: spacing of the sub-goals along the path's segments after its first [m].
         escape: "none" or "detour" (the clearance descent's detour from a stall).
         random_grid: shift the grid by a random fraction of a voxel and scale
             ``centre_weight`` by a random factor in [0.5, 1.5] (the seed's draw).
-        max_replans: (``random_grid``) new leader paths drawn from a tracking stall.
-        descent: overrides of the clearance descent's settings (a mapping).
+        max_replans: (``random_grid``) new leader paths drawn from where a try ended.
+
+    The clearance descent's settings are its own (:class:`ClearanceSettings`), overridden
+    as ``descent.<key>``.
     """
 
     voxel_m: float = 0.0
@@ -88,7 +94,6 @@ class FollowLeaderSettings:
     centre_weight: float = 4.0
     pad_m: float = 3.0
     approach_m: float = 2.5
-    lookahead_m: float = 1.5
     subgoal_pos_tol_m: float = 0.5
     subgoal_angle_tol_deg: float = 45.0
     stride_m: float = 1.0
@@ -101,7 +106,7 @@ class FollowLeaderSettings:
             raise PlannerlabError(f"voxel_m must be >= 0, got {self.voxel_m}")
         if self.escape not in ("none", "detour"):
             raise PlannerlabError(f"escape setting: 'none' or 'detour', got {self.escape!r}")
-        for key in ("lookahead_m", "stride_m", "subgoal_pos_tol_m", "centre_m"):
+        for key in ("stride_m", "subgoal_pos_tol_m", "centre_m"):
             if not getattr(self, key) > 0:
                 raise PlannerlabError(f"{key} must be > 0, got {getattr(self, key)}")
         if self.max_replans < 0:
@@ -121,7 +126,10 @@ def scene_distance_m(scene: Scene, points_m: Array) -> Array:
             di = np.linalg.norm(np.maximum(q, 0.0), axis=1) + np.minimum(q.max(axis=1), 0.0)
         elif isinstance(o, Cylinder):
             q = np.stack(
-                [np.hypot(local[:, 0], local[:, 1]) - o.radius_m, np.abs(local[:, 2]) - o.length_m / 2],
+                [
+                    np.hypot(local[:, 0], local[:, 1]) - o.radius_m,
+                    np.abs(local[:, 2]) - o.length_m / 2,
+                ],
                 axis=1,
             )
             di = np.linalg.norm(np.maximum(q, 0.0), axis=1) + np.minimum(q.max(axis=1), 0.0)
@@ -152,10 +160,7 @@ def grid_distance_m(scene: Scene, axes: list[Array], cap_m: float) -> Array:
         sub = [axes[k][block[k]] for k in range(3)]
         if isinstance(o, Box) and np.allclose(np.abs(T[:3, :3]), np.eye(3)):
             # an axis-aligned box: separable, no point array needed
-            qx, qy, qz = (
-                (np.abs(sub[k] - T[k, 3]) - o.size_m[k] / 2.0)
-                for k in range(3)
-            )
+            qx, qy, qz = ((np.abs(sub[k] - T[k, 3]) - o.size_m[k] / 2.0) for k in range(3))
             qx, qy, qz = qx[:, None, None], qy[None, :, None], qz[None, None, :]
             di = np.sqrt(
                 np.maximum(qx, 0.0) ** 2 + np.maximum(qy, 0.0) ** 2 + np.maximum(qz, 0.0) ** 2
@@ -171,13 +176,7 @@ def grid_distance_m(scene: Scene, axes: list[Array], cap_m: float) -> Array:
 
 #: the 13 grid offsets of a 26-neighbourhood, one of each opposite pair
 _OFFSETS = np.array(
-    [
-        (i, j, k)
-        for i in (-1, 0, 1)
-        for j in (-1, 0, 1)
-        for k in (-1, 0, 1)
-        if (i, j, k) > (0, 0, 0)
-    ]
+    [(i, j, k) for i in (-1, 0, 1) for j in (-1, 0, 1) for k in (-1, 0, 1) if (i, j, k) > (0, 0, 0)]
 )
 
 
@@ -197,30 +196,6 @@ class TipPath:
     arc_m: Array
     min_distance_m: float
     free_voxels: int
-
-    def at(self, s_m: float) -> tuple[Array, Array]:
-        """Point and unit direction of the path at arc length ``s_m``."""
-        s = float(np.clip(s_m, 0.0, self.arc_m[-1]))
-        i = int(np.clip(np.searchsorted(self.arc_m, s, side="right") - 1, 0, len(self.arc_m) - 2))
-        a, b = self.points_m[i], self.points_m[i + 1]
-        seg = float(self.arc_m[i + 1] - self.arc_m[i])
-        t = 0.0 if seg <= 0 else (s - self.arc_m[i]) / seg
-        p = a + t * (b - a)
-        # direction: the chord over about one metre round s (a smooth tangent on a grid path)
-        lo = self._point(max(s - 0.5, 0.0))
-        hi = self._point(min(s + 0.5, float(self.arc_m[-1])))
-        d = hi - lo
-        n = float(np.linalg.norm(d))
-        return p, (d / n if n > 1e-9 else np.array([0.0, 0.0, 1.0]))
-
-    def _point(self, s: float) -> Array:
-        return np.array([np.interp(s, self.arc_m, self.points_m[:, k]) for k in range(3)])
-
-    def nearest_arc_m(self, p_m: Array, s_from_m: float, window_m: float) -> float:
-        """Arc length of the path point nearest ``p_m`` within ``[s_from, s_from + window]``."""
-        s = np.linspace(s_from_m, min(s_from_m + window_m, float(self.arc_m[-1])), 41)
-        pts = np.stack([np.interp(s, self.arc_m, self.points_m[:, k]) for k in range(3)], axis=1)
-        return float(s[int(np.argmin(np.linalg.norm(pts - p_m, axis=1)))])
 
 
 def tip_path(
@@ -349,7 +324,9 @@ class FollowLeader:
         self._track = ClearanceDescent(
             name, replace(descent, approach_m=0.0, goal_depth=1.0, settle_iterations=0)
         )
-        self._finish = ClearanceDescent(name, replace(descent, escape="none"), escape_planner)
+        self._finish = ClearanceDescent(
+            name, replace(descent, escape=settings.escape), escape_planner
+        )
 
     def leader_path(
         self,
@@ -523,14 +500,20 @@ class FollowLeader:
             q = np.array(path[-1])
             if goal.contains(robot, q):
                 return done(Status.SOLVED, "in the goal region")
-            leader = self.leader_path(
-                problem, leg, q, draw_rng, lambda: tracker.exhausted(iterations) is not None
-            )
+            used = iterations
+
+            def stop(used: int = used) -> bool:
+                return tracker.exhausted(used) is not None
+
+            leader = self.leader_path(problem, leg, q, draw_rng, stop)
             if tracker.exhausted(iterations) is not None:
                 return done(Status.BUDGET_EXHAUSTED, str(tracker.exhausted(iterations)))
-            entry: dict = {"attempt": attempt, "from_leg_start_rad": float(
-                np.linalg.norm(joint_difference(q, q0, robot.continuous))
-            )}
+            entry: dict = {
+                "attempt": attempt,
+                "from_leg_start_rad": float(
+                    np.linalg.norm(joint_difference(q, q0, robot.continuous))
+                ),
+            }
             log.append(entry)
             if leader is None:
                 entry["leader"] = "none"
@@ -538,39 +521,38 @@ class FollowLeader:
                 continue
             entry["leader_m"] = float(leader.arc_m[-1])
             entry["leader_clearance_m"] = leader.min_distance_m
-            st, reason, seg, it = self._follow(problem, leg, q, leader, checker, tracker, iterations)
+            st, reason, seg, it = self._follow(
+                problem, leg, q, leader, checker, tracker, iterations
+            )
             iterations += it
             note(seg)
             path.extend(seg[1:])
             entry["follow"] = st.value
             if st is Status.BUDGET_EXHAUSTED:
                 return done(st, reason)
-            # finish: the leg's descent (approach point, goal), with its escape if any
-            st2, reason2, seg2, _, it2 = self._finish.leg_descent(
-                problem, leg, np.array(path[-1]), checker, tracker, iterations
-            )
-            iterations += it2
-            note(seg2)
-            path.extend(seg2[1:])
-            entry["finish"] = st2.value
-            if st2 is Status.SOLVED:
-                return done(st2, f"followed the leader ({reason}); {reason2}")
-            if st2 is Status.BUDGET_EXHAUSTED:
-                return done(st2, reason2)
-            minima += 1
-            reason = f"{reason}; finish: {reason2}"
-            if s.escape == "detour":
-                esc, it3, how = self._finish._detour(
-                    problem, leg, np.array(path[-1]), checker, tracker, iterations
-                )
-                iterations += it3
-                entry["detour"] = how
-                if len(esc) > 1:
-                    escapes += 1
-                    note(esc)
-                    path.extend(esc[1:])
-                    if goal.contains(robot, path[-1]):
-                        return done(Status.SOLVED, f"followed the leader; detour {how}")
+            # finish: the clearance descent's own solve of the leg from here (approach
+            # point, goal), with its detour from a stall in the +detour variant
+            sub = tracker.remaining(limit_iterations=False)
+            if sub is None:
+                return done(Status.BUDGET_EXHAUSTED, str(tracker.exhausted(iterations)))
+            b = tracker.budget
+            if b.max_iterations is not None:
+                sub = sub.replace(max_iterations=max(b.max_iterations - iterations, 1))
+            r = self._finish.solve(problem, leg, sub, rng, q_start=np.array(path[-1]))
+            tracker.charge_checks(r.collision_checks)
+            iterations += r.iterations
+            minima += r.local_minima
+            escapes += r.escapes
+            note(list(r.path))
+            path.extend(list(r.path[1:]))
+            entry["finish"] = r.status.value
+            if r.escapes:
+                entry["finish_escapes"] = r.extra.get("escapes", [])
+            if r.status is Status.SOLVED:
+                return done(r.status, f"followed the leader ({reason}); {r.reason}")
+            if r.status is not Status.LOCAL_MINIMUM:
+                return done(r.status, r.reason)
+            reason = f"{reason}; finish: {r.reason}"
         return done(Status.LOCAL_MINIMUM, reason)
 
 
