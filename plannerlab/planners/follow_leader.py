@@ -24,9 +24,13 @@ hyper-redundant arm's classic answer is follow-the-leader:
    normal and the descent's clearance term keeps the body off the window's frame while
    the tip leads it in. A sub-goal the descent stalls before is passed over; two in a row
    end the tracking.
-3. **The finish** is the clearance descent's own solve of the leg from the state the
-   tracking reached (its approach point, then the goal, with its settling); in the
-   ``+detour`` variant with the descent's detour from a stall.
+3. **The finish** is the clearance descent of the leg
+   (:meth:`~plannerlab.planners.gradient_clearance.ClearanceDescent.leg_descent`) from the
+   state the tracking reached (its approach point, then the goal, with its settling); if
+   it stalls, the ``+detour`` variant hands the stall to the descent's own ``solve`` with
+   its detour escape. Where no leader's path
+   exists (no way for the tip at that clearance), the finish alone runs: the planner is
+   then the clearance descent.
 
 The search and the tracking are deterministic (``gradient.follow_leader``: its seeds are
 one run). The randomised variant (``+random``, ``random_grid``) shifts the voxel grid by
@@ -53,6 +57,7 @@ from plannerlab.planners.base import (
     Planner,
     PlanResult,
     Status,
+    settings_dict,
     start_collision,
     with_overrides,
 )
@@ -324,9 +329,8 @@ class FollowLeader:
         self._track = ClearanceDescent(
             name, replace(descent, approach_m=0.0, goal_depth=1.0, settle_iterations=0)
         )
-        self._finish = ClearanceDescent(
-            name, replace(descent, escape=settings.escape), escape_planner
-        )
+        self._finish = ClearanceDescent(name, replace(descent, escape="none"))
+        self._detour = ClearanceDescent(name, replace(descent, escape="detour"), escape_planner)
 
     def leader_path(
         self,
@@ -475,6 +479,7 @@ class FollowLeader:
         def done(status: Status, reason: str) -> PlanResult:
             extra: dict = {
                 "leader": log,
+                "descent_settings": settings_dict(self.descent_settings),
                 "path_rad": path_length(np.array(path), robot.continuous),
             }
             if status is Status.LOCAL_MINIMUM:
@@ -516,43 +521,57 @@ class FollowLeader:
             }
             log.append(entry)
             if leader is None:
+                # no way for the tip at that clearance: the descent alone, as
+                # gradient.clearance would go
                 entry["leader"] = "none"
                 reason = "no path for the tip through free workspace"
-                continue
-            entry["leader_m"] = float(leader.arc_m[-1])
-            entry["leader_clearance_m"] = leader.min_distance_m
-            st, reason, seg, it = self._follow(
-                problem, leg, q, leader, checker, tracker, iterations
+            else:
+                entry["leader_m"] = float(leader.arc_m[-1])
+                entry["leader_clearance_m"] = leader.min_distance_m
+                st, reason, seg, it = self._follow(
+                    problem, leg, q, leader, checker, tracker, iterations
+                )
+                iterations += it
+                note(seg)
+                path.extend(seg[1:])
+                entry["follow"] = st.value
+                if st is Status.BUDGET_EXHAUSTED:
+                    return done(st, reason)
+            # finish: the clearance descent of the leg from here (approach point, goal)
+            st2, reason2, seg2, _, it2 = self._finish.leg_descent(
+                problem, leg, np.array(path[-1]), checker, tracker, iterations
             )
-            iterations += it
-            note(seg)
-            path.extend(seg[1:])
-            entry["follow"] = st.value
-            if st is Status.BUDGET_EXHAUSTED:
-                return done(st, reason)
-            # finish: the clearance descent's own solve of the leg from here (approach
-            # point, goal), with its detour from a stall in the +detour variant
-            sub = tracker.remaining(limit_iterations=False)
-            if sub is None:
-                return done(Status.BUDGET_EXHAUSTED, str(tracker.exhausted(iterations)))
-            b = tracker.budget
-            if b.max_iterations is not None:
-                sub = sub.replace(max_iterations=max(b.max_iterations - iterations, 1))
-            r = self._finish.solve(problem, leg, sub, rng, q_start=np.array(path[-1]))
-            tracker.charge_checks(r.collision_checks)
-            iterations += r.iterations
-            minima += r.local_minima
-            escapes += r.escapes
-            note(list(r.path))
-            path.extend(list(r.path[1:]))
-            entry["finish"] = r.status.value
-            if r.escapes:
-                entry["finish_escapes"] = r.extra.get("escapes", [])
-            if r.status is Status.SOLVED:
-                return done(r.status, f"followed the leader ({reason}); {r.reason}")
-            if r.status is not Status.LOCAL_MINIMUM:
-                return done(r.status, r.reason)
-            reason = f"{reason}; finish: {r.reason}"
+            iterations += it2
+            note(seg2)
+            path.extend(seg2[1:])
+            entry["finish"] = st2.value
+            if st2 is Status.SOLVED:
+                return done(st2, f"followed the leader ({reason}); {reason2}")
+            if st2 is not Status.LOCAL_MINIMUM:
+                return done(st2, reason2)
+            minima += 1
+            reason = f"{reason}; finish: {reason2}"
+            if s.escape == "detour":
+                # the clearance descent's own solve from the stall, with its detour
+                sub = tracker.remaining(limit_iterations=False)
+                if sub is None:
+                    return done(Status.BUDGET_EXHAUSTED, str(tracker.exhausted(iterations)))
+                b = tracker.budget
+                if b.max_iterations is not None:
+                    sub = sub.replace(max_iterations=max(b.max_iterations - iterations, 1))
+                r = self._detour.solve(problem, leg, sub, rng, q_start=np.array(path[-1]))
+                tracker.charge_checks(r.collision_checks)
+                iterations += r.iterations
+                minima += r.local_minima
+                escapes += r.escapes
+                note(list(r.path))
+                path.extend(list(r.path[1:]))
+                entry["detour"] = r.extra.get("escapes", [])
+                if r.status is Status.SOLVED:
+                    return done(r.status, f"followed the leader; {r.reason}")
+                if r.status is not Status.LOCAL_MINIMUM:
+                    return done(r.status, r.reason)
+                reason = f"{reason}; detour: {r.reason}"
         return done(Status.LOCAL_MINIMUM, reason)
 
 
