@@ -84,6 +84,8 @@ class FollowLeaderSettings:
         approach_m: the path ends at ``p_d − approach_m · n_d``, the goal's approach point.
         subgoal_pos_tol_m, subgoal_angle_tol_deg: tolerances of the moving sub-goal.
         stride_m: spacing of the sub-goals along the path's segments after its first [m].
+        track_approach: also sub-goals every ``stride_m`` from the approach point towards
+            the goal, looking along the goal's normal (the finish then starts closer).
         escape: "none" or "detour" (the clearance descent's detour from a stall).
         random_grid: shift the grid by a random fraction of a voxel and scale
             ``centre_weight`` by a random factor in [0.5, 1.5] (the seed's draw).
@@ -102,6 +104,7 @@ class FollowLeaderSettings:
     subgoal_pos_tol_m: float = 0.5
     subgoal_angle_tol_deg: float = 45.0
     stride_m: float = 1.0
+    track_approach: bool = False
     escape: str = "none"
     random_grid: bool = False
     max_replans: int = 3
@@ -404,6 +407,15 @@ class FollowLeader:
             nxt = pts[i + 1] - b
             nn = float(np.linalg.norm(nxt))
             out.append((b, nxt / nn if nn > 1e-9 else u))
+        if s.track_approach:
+            a, b = pts[-2], pts[-1]
+            length = float(np.linalg.norm(b - a))
+            if length > 1e-9:
+                u = (b - a) / length
+                k = 1
+                while k * s.stride_m < length - 0.5 * s.stride_m:
+                    out.append((a + k * s.stride_m * u, u))
+                    k += 1
         return out
 
     def _follow(
