@@ -155,6 +155,36 @@ def _entries() -> dict[str, PlannerEntry]:
                 options=_ESCAPE_RRTCONNECT,
             )
         )
+    for name, summary, uses_rng in (
+        (
+            "gradient.follow_leader",
+            "follow-the-leader: a shortest path for the tip through free workspace (voxel "
+            "grid of the scene's distance, into the goal along its normal), tracked by the "
+            "clearance descent so the body follows the tip",
+            False,
+        ),
+        (
+            "gradient.follow_leader+detour",
+            "gradient.follow_leader; if the descent stalls after the leader's path, the "
+            "clearance descent's detour",
+            False,
+        ),
+        (
+            "gradient.follow_leader+random",
+            "gradient.follow_leader with the grid shifted and the centring weight scaled by "
+            "the seed, a new leader path drawn from a stall",
+            True,
+        ),
+    ):
+        entries.append(
+            PlannerEntry(
+                name,
+                "plannerlab.planners.follow_leader:make",
+                summary,
+                uses_rng=uses_rng,
+                options=_ESCAPE_RRTCONNECT,
+            )
+        )
     entries.append(
         PlannerEntry(
             "chord_arc",
