@@ -37,6 +37,7 @@ from plannerlab.collision.geometry import (
     capsule_obstacle_hit,
     seg_seg,
 )
+from plannerlab.collision.reach import pair_rates
 from plannerlab.problem.scene import Box, Cylinder, Scene, Sphere
 from plannerlab.robots.base import Array, Robot, joint_difference
 from plannerlab.robots.paths import (
@@ -484,6 +485,196 @@ def armz_edge_first_invalid(
 
 
 @njit(cache=True, nogil=True)
+def _box_gap(lo, hi, i, olo, ohi, j):
+    """A lower bound of the distance between the shapes in boxes i and j: the boxes' gap."""
+    g2 = 0.0
+    for c in range(3):
+        x = max(olo[j, c] - hi[i, c], lo[i, c] - ohi[j, c], 0.0)
+        g2 += x * x
+    return math.sqrt(g2)
+
+
+@njit(cache=True, nogil=True)
+def advance_dt(
+    seg, radii, radii_self, moving, allowed, kinds, Rs, cs, hs, olo, ohi, v_link, v_pair,
+    margin, dt_max, buf,
+):
+    """Conservative advancement from one valid state: the largest ``dt <= dt_max`` with
+    ``v_p · dt <= d_p + margin`` for every checked pair ``p``.
+
+    ``d_p``: the pair's distance with the capsules inflated (by the margin against the
+    scene, by half of it each against each other; clamped at 0), ``v_p``: an upper bound
+    of how fast the pair's distance changes per unit of the edge parameter (``v_link``
+    (L,) for a link against the scene, ``v_pair`` (L, L) for a link pair). Pairs whose
+    boxes are so far apart that they cannot limit the step are not measured.
+    """
+    lo, hi, w, lo2, hi2, _ = buf
+    L = seg.shape[0]
+    n_obs = kinds.shape[0]
+    _link_boxes(seg, radii, lo, hi)
+    nv = np.empty(3)
+    best = dt_max
+    for li in range(L):
+        v = v_link[li]
+        if not moving[li] or v <= 0.0:
+            continue
+        for oi in range(n_obs):
+            if _box_gap(lo, hi, li, olo, ohi, oi) + margin >= best * v:
+                continue
+            dist, _ = capsule_obstacle(
+                kinds[oi], Rs[oi], cs[oi], hs[oi], seg[li, 0], seg[li, 1], radii[li], False,
+                nv, w,
+            )
+            dt = (max(dist, 0.0) + margin) / v
+            if dt < best:
+                best = dt
+    _link_boxes(seg, radii_self, lo2[:L], hi2[:L])
+    for i in range(L):
+        for j in range(i + 1, L):
+            v = v_pair[i, j]
+            if v <= 0.0 or not allowed[i, j]:
+                continue
+            if _box_gap(lo2, hi2, i, lo2, hi2, j) + margin >= best * v:
+                continue
+            d2, _, _ = seg_seg(seg[i, 0], seg[i, 1], seg[j, 0], seg[j, 1])
+            dist = math.sqrt(d2) - radii_self[i] - radii_self[j]
+            dt = (max(dist, 0.0) + margin) / v
+            if dt < best:
+                best = dt
+    return best
+
+
+@njit(cache=True, nogil=True)
+def edge_rates(d, W, Pr, v_link, v_pair):
+    """Per unit of the edge parameter, bounds of how fast each link (against the scene)
+    and each link pair moves along an edge of joint change ``d``: ``|d| @ W``, ``|d| @ Pr``."""
+    dof, L = W.shape
+    for li in range(L):
+        v_link[li] = 0.0
+        for j in range(L):
+            v_pair[li, j] = 0.0
+    for k in range(dof):
+        a = abs(d[k])
+        if a == 0.0:
+            continue
+        for li in range(L):
+            v_link[li] += a * W[k, li]
+            for j in range(li + 1, L):
+                v_pair[li, j] += a * Pr[k, li, j]
+
+
+@njit(cache=True, nogil=True)
+def armz_path_advance(
+    P,
+    first,
+    joint_step,
+    continuous,
+    limit,
+    weights,
+    W,
+    Pr,
+    margin,
+    T0,
+    T1,
+    M,
+    radii,
+    radii_self,
+    moving,
+    allowed,
+    tree,
+    kinds,
+    Rs,
+    cs,
+    hs,
+    olo,
+    ohi,
+):
+    """An Arm-Z path (m, dof) checked edge by edge with conservative advancement (see
+    :meth:`Core.path_advance`): returns (queries, status, edge, t), status 0 all valid,
+    1 the state ``P[edge] + t · d_edge`` is invalid, 2 ``limit`` queries were spent first.
+    """
+    m, dof = P.shape
+    L = dof + 1
+    seg = np.empty((1, L, 2, 3))
+    buf = _scratch(L)
+    pairs = np.empty((1, 3), dtype=np.int64)
+    d = np.empty(dof)
+    q = np.empty((1, dof))
+    v_link = np.empty(L)
+    v_pair = np.empty((L, L))
+    queries = 0
+    have_seg = False  # seg holds the current vertex, validity known
+    if first == 2:  # queried already by the caller: measured again, not counted
+        armz_segments(P[0:1], T0, T1, M, seg)
+        have_seg = True
+    if first == 1:
+        if limit < 1:
+            return queries, 2, 0, 0.0
+        armz_segments(P[0:1], T0, T1, M, seg)
+        queries += 1
+        have_seg = True
+        if _state_hits(
+            seg[0], radii, radii_self, moving, allowed, tree, kinds, Rs, cs, hs, olo, ohi,
+            buf, True, pairs,
+        ):
+            return queries, 1, 0, 0.0
+    for e in range(m - 1):
+        span = 0.0
+        metric = 0.0
+        for i in range(dof):
+            x = P[e + 1, i] - P[e, i]
+            if continuous[i]:
+                x = (x + np.pi) % (2.0 * np.pi) - np.pi
+            d[i] = x
+            span = max(span, abs(x))
+            metric += weights[i] * abs(x)
+        n = max(1.0, math.ceil(span / joint_step - 1e-12), math.ceil(metric - 1e-12))
+        dt_min = 1.0 / n
+        dt_cap = joint_step / span if span > 0.0 else 1.0
+        adaptive = dt_cap > dt_min * (1.0 + 1e-12)
+        if adaptive:
+            edge_rates(d, W, Pr, v_link, v_pair)
+        t = 0.0
+        dt = dt_min
+        if adaptive:
+            if not have_seg:  # the edge's start: measured, not checked (the caller's)
+                if queries >= limit:
+                    return queries, 2, e, 0.0
+                armz_segments(P[e : e + 1], T0, T1, M, seg)
+                queries += 1
+            dt = advance_dt(
+                seg[0], radii, radii_self, moving, allowed, kinds, Rs, cs, hs, olo, ohi,
+                v_link, v_pair, margin, 1.0, buf,
+            )
+        while True:
+            step = max(dt_min, min(dt, dt_cap))
+            tn = t + step
+            if tn >= 1.0 - 1e-9:
+                tn = 1.0
+            if queries >= limit:
+                return queries, 2, e, t
+            for i in range(dof):
+                q[0, i] = P[e, i] + tn * d[i]
+            armz_segments(q, T0, T1, M, seg)
+            queries += 1
+            if _state_hits(
+                seg[0], radii, radii_self, moving, allowed, tree, kinds, Rs, cs, hs, olo,
+                ohi, buf, True, pairs,
+            ):
+                return queries, 1, e, tn
+            if tn == 1.0:
+                break
+            if adaptive:
+                dt = advance_dt(
+                    seg[0], radii, radii_self, moving, allowed, kinds, Rs, cs, hs, olo,
+                    ohi, v_link, v_pair, margin, 1.0 - tn, buf,
+                )
+            t = tn
+        have_seg = True
+    return queries, 0, m - 1, 1.0
+
+
+@njit(cache=True, nogil=True)
 def all_hits(seg, radii, radii_self, moving, allowed, tree, kinds, Rs, cs, hs, olo, ohi):
     """Every colliding pair of one state (L, 2, 3): (m, 3) rows (link, other, other_is_link)."""
     L = seg.shape[0]
@@ -634,6 +825,7 @@ class Core:
         scene: Scene,
         margin_m: float = 0.0,
         edge_weights: Array | None = None,
+        link_rates: tuple[Array, Array] | None = None,
     ) -> None:
         if not supports(scene):
             raise ValueError("the core tests boxes, cylinders and spheres only")
@@ -681,6 +873,15 @@ class Core:
         self.olo = np.ascontiguousarray(lo, dtype=float).reshape(n, 3)
         self.ohi = np.ascontiguousarray(hi, dtype=float).reshape(n, 3)
         self.tree = chain_tree(allowed)
+        #: conservative advancement (:meth:`path_advance`): per joint and link, and per
+        #: joint and link pair, bounds of how fast they move (see reach.py); None: off
+        self._rates: tuple[np.ndarray, np.ndarray] | None = None
+        if link_rates is not None:
+            W, rigid = link_rates
+            self._rates = (
+                np.ascontiguousarray(W, dtype=float),
+                np.ascontiguousarray(pair_rates(np.asarray(W), np.asarray(rigid), allowed)),
+            )
         self._geo = (
             self.radii,
             self.radii_self,
@@ -710,8 +911,10 @@ class Core:
         here, when the checker is built, and not inside a planner's time limit."""
         kernels: tuple[Any, ...] = (
             (armz_frames, armz_segments, armz_first_invalid, armz_edge_first_invalid)
+            + ((armz_path_advance,) if self._rates is not None else ())
             if self._armz
             else (first_invalid, edge_states)
+            + ((advance_dt, edge_rates) if self._rates is not None else ())
         ) + (valid_batch, all_hits, pair_distances_kernel)
         if all(k.signatures for k in kernels):
             return  # compiled or loaded already in this process
@@ -724,6 +927,10 @@ class Core:
         self.edge_first_invalid(q, q, 1.0)
         self.hits(q)
         self.pair_distances(q, 0.0)
+        if self._rates is not None:
+            q1 = q.copy()
+            q1[0] += 0.5 if q[0] + 0.5 <= self.robot.upper[0] else -0.5
+            self.path_advance(np.vstack([q, q1]), 1, 0.05, None)
 
     # ------------------------------------------------------------------ kinematics
     def _Q(self, Q: Array) -> np.ndarray:
@@ -817,6 +1024,109 @@ class Core:
             span = float(np.max(np.abs(joint_difference(qb, qa, self._continuous))))
             raise edge_too_long(span, step, max(n, edge_steps(qa, qb, step, self._continuous)))
         return int(n), int(bad)
+
+    def path_advance(
+        self, path: Array, first: int, joint_step: float, limit: int | None
+    ) -> tuple[int, int, int, float]:
+        """Check a path (m, dof) edge by edge with conservative advancement.
+
+        Along each edge ``q(t) = P[e] + t · d_e`` (the short way round for continuous
+        joints), from a valid state at ``t`` the next checked state is at
+        ``t + max(1/n, min(dt_ca, joint_step / span))``: ``n`` the edge's uniform count
+        (:func:`edge_states`, radian and metric steps), ``dt_ca`` the conservative
+        advancement step (:func:`advance_dt`). Each state visited is one query (its
+        validity, plus its pair distances when the step needs them). The first state:
+        ``first`` 1 checks it (one query), 0 only measures it when a step needs it (one
+        query then), 2 measures it without counting (the caller queried it already: a
+        path checked in pieces). At most ``limit`` queries (None: no limit).
+
+        Returns (queries, status, edge, t): status 0 every checked state valid, 1 the
+        state at ``t`` on edge ``edge`` invalid, 2 the limit was reached first.
+        """
+        if self._rates is None:
+            raise ValueError("path_advance needs link rates (a checker with a margin)")
+        P = np.ascontiguousarray(np.atleast_2d(np.asarray(path, dtype=float)))
+        lim = _NO_LIMIT if limit is None else max(int(limit), 0)
+        step = float(joint_step)
+        W, Pr = self._rates
+        if self._armz:
+            qn, status, e, t = armz_path_advance(
+                P,
+                int(first),
+                step,
+                self._continuous,
+                lim,
+                self.edge_weights,
+                W,
+                Pr,
+                self.margin_m,
+                self._T0,
+                self._T1,
+                self._M,
+                *self._geo,
+            )
+            return int(qn), int(status), int(e), float(t)
+        return self._path_advance_py(P, int(first), step, lim)
+
+    def _path_advance_py(
+        self, P: np.ndarray, first: int, joint_step: float, limit: int
+    ) -> tuple[int, int, int, float]:
+        """:meth:`path_advance` for robots whose kinematics are not compiled: the same
+        steps, one compiled call per state."""
+        W, Pr = self._rates  # type: ignore[misc]
+        r, rs, moving, allowed, tree, kinds, Rs, cs, hs, olo, ohi = self._geo
+        L = self.n_links
+        buf = _scratch(L)
+        v_link = np.empty(L)
+        v_pair = np.empty((L, L))
+        queries = 0
+        seg: np.ndarray | None = self.segments(P[0]) if first == 2 else None
+        if first == 1:
+            if limit < 1:
+                return queries, 2, 0, 0.0
+            seg = self.segments(P[0])
+            queries += 1
+            if first_invalid(seg, *self._geo) >= 0:
+                return queries, 1, 0, 0.0
+        for e in range(len(P) - 1):
+            d = joint_difference(P[e + 1], P[e], self._continuous)
+            span = float(np.max(np.abs(d), initial=0.0))
+            metric = float(np.abs(d) @ self.edge_weights)
+            n = max(1.0, math.ceil(span / joint_step - 1e-12), math.ceil(metric - 1e-12))
+            dt_min = 1.0 / n
+            dt_cap = joint_step / span if span > 0.0 else 1.0
+            adaptive = dt_cap > dt_min * (1.0 + 1e-12)
+            t, dt = 0.0, dt_min
+            if adaptive:
+                edge_rates(d, W, Pr, v_link, v_pair)
+                if seg is None:
+                    if queries >= limit:
+                        return queries, 2, e, 0.0
+                    seg = self.segments(P[e])
+                    queries += 1
+                dt = advance_dt(
+                    seg[0], r, rs, moving, allowed, kinds, Rs, cs, hs, olo, ohi, v_link,
+                    v_pair, self.margin_m, 1.0, buf,
+                )
+            while True:
+                tn = t + max(dt_min, min(dt, dt_cap))
+                if tn >= 1.0 - 1e-9:
+                    tn = 1.0
+                if queries >= limit:
+                    return queries, 2, e, t
+                seg = self.segments(P[e] + tn * d)
+                queries += 1
+                if first_invalid(seg, *self._geo) >= 0:
+                    return queries, 1, e, tn
+                if tn == 1.0:
+                    break
+                if adaptive:
+                    dt = advance_dt(
+                        seg[0], r, rs, moving, allowed, kinds, Rs, cs, hs, olo, ohi,
+                        v_link, v_pair, self.margin_m, 1.0 - tn, buf,
+                    )
+                t = tn
+        return queries, 0, len(P) - 1, 1.0
 
     def hits(self, q: Array) -> np.ndarray:
         """Every colliding pair at q: (m, 3) rows (link, other, other_is_link)."""

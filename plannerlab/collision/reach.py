@@ -93,3 +93,89 @@ def joint_reach_m(robot: Robot) -> Array:
                 bound = w * chain + along
             reach[i] = max(reach[i], bound)
     return reach
+
+
+def link_reach_m(robot: Robot) -> tuple[Array, Array]:
+    """Per joint and link, an upper bound [m per rad, or m per m] of how fast any point of
+    that link's capsule moves when the joint moves alone, and per joint whether it moves
+    the links it moves rigidly (one rotation or translation for all of them).
+
+    Returns ``(W (dof, L), rigid (dof,) bool)``. ``W[i, l]`` is zero when joint ``i`` never
+    moves link ``l``; ``W[i].max() <= joint_reach_m(robot)[i]``: for a revolute joint the
+    chain sum of :func:`joint_reach_m` is stopped at link ``l`` (the first moved link's
+    start from the axis, plus the moved links up to ``l`` and the gaps between them, plus
+    ``l``'s radius). This is what lets a link near the base, or a link pair joined by few
+    joints, take larger steps than the whole chain's bound allows (conservative
+    advancement, :mod:`plannerlab.collision.core`). ``rigid``: the moved links keep their
+    shapes and relative poses, so the distance between two links that both move with
+    joint ``i`` does not change with it.
+    """
+    dof = robot.dof
+    cont = np.asarray(robot.continuous, dtype=bool)
+    lo = np.where(cont, -np.pi, robot.lower)
+    hi = np.where(cont, np.pi, robot.upper)
+    rng = np.random.default_rng(0)
+    states = np.vstack(
+        [np.clip(np.zeros(dof), robot.lower, robot.upper), rng.uniform(lo, hi, (_SAMPLES, dof))]
+    )
+    radii = np.asarray(robot.link_radii_m, dtype=float)
+    L = len(radii)
+    W = np.zeros((dof, L))
+    rigid = np.ones(dof, dtype=bool)
+    for q in states:
+        S = np.asarray(robot.link_segments(q), dtype=float)  # (L, 2, 3)
+        lengths = np.linalg.norm(S[:, 1] - S[:, 0], axis=-1)
+        for i in range(dof):
+            h = _H if q[i] + _H <= hi[i] else -_H
+            qp = q.copy()
+            qp[i] += h
+            V = (np.asarray(robot.link_segments(qp), dtype=float) - S) / h  # (L, 2, 3)
+            speed = np.linalg.norm(V, axis=-1)  # (L, 2)
+            moved = np.flatnonzero(speed.max(axis=1) > _MOVES)
+            if len(moved) == 0:
+                continue
+            f = int(moved[0])
+            P = S[moved].reshape(-1, 3) - S[f, 0]
+            Vr = V[moved].reshape(-1, 3) - V[f, 0]
+            A = -_skew(P).reshape(-1, 3)
+            omega = np.linalg.lstsq(A, Vr.reshape(-1), rcond=None)[0]
+            w = float(np.linalg.norm(omega))
+            # the finite difference is exact to ~h·speed²: a rigid motion fits to that
+            tol = 1e-4 * max(1.0, float(speed.max()))
+            if float(np.abs(A @ omega - Vr.reshape(-1)).max(initial=0.0)) > tol:
+                rigid[i] = False
+            if w < 1e-6:  # a translation: each moved link at its own endpoints' speed
+                bound = speed[moved].max(axis=1)
+            else:
+                gaps = np.concatenate(
+                    [[0.0], np.linalg.norm(S[moved[1:], 0] - S[moved[:-1], 1], axis=-1)]
+                )
+                chain = (
+                    float(np.linalg.norm(V[f, 0])) / w
+                    + np.cumsum(lengths[moved])
+                    + np.cumsum(gaps)
+                    + radii[moved]
+                )
+                along = abs(float(np.dot(V[f, 0], omega))) / w
+                bound = w * chain + along
+            W[i, moved] = np.maximum(W[i, moved], bound)
+    return W, rigid
+
+
+def pair_rates(W: Array, rigid: Array, allowed: Array) -> Array:
+    """Per joint and link pair, an upper bound of how fast the pair's distance changes
+    when the joint moves alone: (dof, L, L), zero outside ``allowed`` (upper triangle).
+
+    A joint that moves neither link, or moves both rigidly, does not change it; one that
+    moves one link changes it at most by that link's speed; one that moves both
+    non-rigidly, at most by the sum of their speeds."""
+    moves = W > 0.0
+    a = W[:, :, None]
+    b = W[:, None, :]
+    one = np.where(moves[:, :, None] & ~moves[:, None, :], a, 0.0) + np.where(
+        ~moves[:, :, None] & moves[:, None, :], b, 0.0
+    )
+    both = np.where(
+        moves[:, :, None] & moves[:, None, :] & ~rigid[:, None, None], a + b, 0.0
+    )
+    return np.where(np.triu(allowed, 1)[None], one + both, 0.0)
