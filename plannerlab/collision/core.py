@@ -570,6 +570,7 @@ def armz_path_advance(
     joint_step,
     continuous,
     limit,
+    cap,
     weights,
     W,
     Pr,
@@ -591,7 +592,8 @@ def armz_path_advance(
 ):
     """An Arm-Z path (m, dof) checked edge by edge with conservative advancement (see
     :meth:`Core.path_advance`): returns (queries, status, edge, t), status 0 all valid,
-    1 the state ``P[edge] + t · d_edge`` is invalid, 2 ``limit`` queries were spent first.
+    1 the state ``P[edge] + t · d_edge`` is invalid, 2 ``limit`` queries were spent first,
+    3 edge ``edge``'s grid would have more than ``cap`` states (nothing checked on it).
     """
     m, dof = P.shape
     L = dof + 1
@@ -629,6 +631,8 @@ def armz_path_advance(
             span = max(span, abs(x))
             metric += weights[i] * abs(x)
         n = max(1.0, math.ceil(span / joint_step - 1e-12), math.ceil(metric - 1e-12))
+        if n > cap:
+            return queries, 3, e, 0.0
         dt_min = 1.0 / n
         dt_cap = joint_step / span if span > 0.0 else 1.0
         adaptive = dt_cap > dt_min * (1.0 + 1e-12)
@@ -1042,12 +1046,17 @@ class Core:
 
         Returns (queries, status, edge, t): status 0 every checked state valid, 1 the
         state at ``t`` on edge ``edge`` invalid, 2 the limit was reached first.
+
+        Raises:
+            PlannerlabError: as ``interpolate_edge``, an edge whose grid would have more
+                than ``MAX_EDGE_STATES`` states (the edges before it are checked).
         """
         if self._rates is None:
             raise ValueError("path_advance needs link rates (a checker with a margin)")
         P = np.ascontiguousarray(np.atleast_2d(np.asarray(path, dtype=float)))
         lim = _NO_LIMIT if limit is None else max(int(limit), 0)
         step = float(joint_step)
+        require_joint_step(step)
         W, Pr = self._rates
         if self._armz:
             qn, status, e, t = armz_path_advance(
@@ -1056,6 +1065,7 @@ class Core:
                 step,
                 self._continuous,
                 lim,
+                MAX_EDGE_STATES,
                 self.edge_weights,
                 W,
                 Pr,
@@ -1065,8 +1075,13 @@ class Core:
                 self._M,
                 *self._geo,
             )
-            return int(qn), int(status), int(e), float(t)
-        return self._path_advance_py(P, int(first), step, lim)
+        else:
+            qn, status, e, t = self._path_advance_py(P, int(first), step, lim)
+        if status == 3:
+            qa, qb = P[e], P[e + 1]
+            span = float(np.max(np.abs(joint_difference(qb, qa, self._continuous))))
+            raise edge_too_long(span, step, max(MAX_EDGE_STATES + 1, edge_steps(qa, qb, step, self._continuous)))
+        return int(qn), int(status), int(e), float(t)
 
     def _path_advance_py(
         self, P: np.ndarray, first: int, joint_step: float, limit: int
@@ -1093,6 +1108,8 @@ class Core:
             span = float(np.max(np.abs(d), initial=0.0))
             metric = float(np.abs(d) @ self.edge_weights)
             n = max(1.0, math.ceil(span / joint_step - 1e-12), math.ceil(metric - 1e-12))
+            if n > MAX_EDGE_STATES:
+                return queries, 3, e, 0.0
             dt_min = 1.0 / n
             dt_cap = joint_step / span if span > 0.0 else 1.0
             adaptive = dt_cap > dt_min * (1.0 + 1e-12)

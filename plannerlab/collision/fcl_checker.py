@@ -326,7 +326,6 @@ class CollisionChecker:
         ``max_states`` did not suffice (the edge is then unfinished)."""
         assert self._core is not None
         path = np.array([q_a, q_b], dtype=float)
-        self._edge_counts(path, joint_step)  # raises on a too long edge
         q, status, _, _ = self._core.path_advance(path, 0, joint_step, max_states)
         self.checks += q
         if status == 2:

@@ -46,9 +46,10 @@ def _skew(p: Array) -> Array:
     )
 
 
-def joint_reach_m(robot: Robot) -> Array:
-    """Per joint, an upper bound [m per rad, or m per m] of how fast any point of the
-    robot's collision geometry moves when that joint moves alone (see the module)."""
+def _motions(robot: Robot) -> tuple[Array, Array, Array, Array]:
+    """The states the bounds are taken at, their capsule axes S (k, L, 2, 3), the axes'
+    velocities per joint V (k, dof, L, 2, 3) by a one-sided finite difference, and the
+    upper joint limits used (all in two batched ``link_segments`` calls)."""
     dof = robot.dof
     cont = np.asarray(robot.continuous, dtype=bool)
     lo = np.where(cont, -np.pi, robot.lower)
@@ -57,16 +58,29 @@ def joint_reach_m(robot: Robot) -> Array:
     states = np.vstack(
         [np.clip(np.zeros(dof), robot.lower, robot.upper), rng.uniform(lo, hi, (_SAMPLES, dof))]
     )
+    k = len(states)
+    S = np.asarray(robot.link_segments(states), dtype=float)
+    h = np.where(states + _H <= hi, _H, -_H)  # (k, dof)
+    Qp = np.repeat(states[:, None, :], dof, axis=1)
+    idx = np.arange(dof)
+    Qp[:, idx, idx] += h
+    Sp = np.asarray(robot.link_segments(Qp.reshape(k * dof, dof)), dtype=float)
+    V = (Sp.reshape((k, dof) + S.shape[1:]) - S[:, None]) / h[:, :, None, None, None]
+    return states, S, V, hi
+
+
+def joint_reach_m(robot: Robot) -> Array:
+    """Per joint, an upper bound [m per rad, or m per m] of how fast any point of the
+    robot's collision geometry moves when that joint moves alone (see the module)."""
+    dof = robot.dof
+    states, SS, VV, _ = _motions(robot)
     radii = np.asarray(robot.link_radii_m, dtype=float)
     reach = np.zeros(dof)
-    for q in states:
-        S = np.asarray(robot.link_segments(q), dtype=float)  # (L, 2, 3)
+    for s_i in range(len(states)):
+        S = SS[s_i]
         lengths = np.linalg.norm(S[:, 1] - S[:, 0], axis=-1)
         for i in range(dof):
-            h = _H if q[i] + _H <= hi[i] else -_H
-            qp = q.copy()
-            qp[i] += h
-            V = (np.asarray(robot.link_segments(qp), dtype=float) - S) / h  # (L, 2, 3)
+            V = VV[s_i, i]  # (L, 2, 3)
             speed = np.linalg.norm(V, axis=-1)  # (L, 2)
             moved = np.flatnonzero(speed.max(axis=1) > _MOVES)
             if len(moved) == 0:
@@ -111,25 +125,16 @@ def link_reach_m(robot: Robot) -> tuple[Array, Array]:
     joint ``i`` does not change with it.
     """
     dof = robot.dof
-    cont = np.asarray(robot.continuous, dtype=bool)
-    lo = np.where(cont, -np.pi, robot.lower)
-    hi = np.where(cont, np.pi, robot.upper)
-    rng = np.random.default_rng(0)
-    states = np.vstack(
-        [np.clip(np.zeros(dof), robot.lower, robot.upper), rng.uniform(lo, hi, (_SAMPLES, dof))]
-    )
+    states, SS, VV, _ = _motions(robot)
     radii = np.asarray(robot.link_radii_m, dtype=float)
     L = len(radii)
     W = np.zeros((dof, L))
     rigid = np.ones(dof, dtype=bool)
-    for q in states:
-        S = np.asarray(robot.link_segments(q), dtype=float)  # (L, 2, 3)
+    for s_i in range(len(states)):
+        S = SS[s_i]
         lengths = np.linalg.norm(S[:, 1] - S[:, 0], axis=-1)
         for i in range(dof):
-            h = _H if q[i] + _H <= hi[i] else -_H
-            qp = q.copy()
-            qp[i] += h
-            V = (np.asarray(robot.link_segments(qp), dtype=float) - S) / h  # (L, 2, 3)
+            V = VV[s_i, i]  # (L, 2, 3)
             speed = np.linalg.norm(V, axis=-1)  # (L, 2)
             moved = np.flatnonzero(speed.max(axis=1) > _MOVES)
             if len(moved) == 0:
