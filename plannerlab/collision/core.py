@@ -564,6 +564,112 @@ def edge_rates(d, W, Pr, v_link, v_pair):
 
 
 @njit(cache=True, nogil=True)
+def _quad_step(u, c2, c):
+    """Largest s with ``u s + c2 s² / 2 <= c`` (u, c2 >= 0; inf when both are 0)."""
+    if c2 <= 0.0:
+        return c / u if u > 0.0 else np.inf
+    return 2.0 * c / (u + math.sqrt(u * u + 2.0 * c2 * c))
+
+
+@njit(cache=True, nogil=True)
+def armz_advance_dt(
+    q, seg, d, T1, M, radii, radii_self, moving, allowed, kinds, Rs, cs, hs, olo, ohi,
+    v_link, v_pair, margin, dt_max, buf, rho,
+):
+    """:func:`advance_dt` for Arm-Z with bounds taken at this configuration.
+
+    Joint ``f`` turns links ``f+1 ..`` about its axis, so a point of link ``l`` moves at
+    ``|d_f| · ρ_fl`` per unit of the edge parameter from it, ``ρ_fl`` the largest distance
+    of link ``l``'s axis points from joint ``f``'s axis (at an end point: the distance to
+    a line is convex). Along the step ``ρ_fl`` grows at most as fast as link ``l`` moves
+    relative to joint ``f``, at most ``v_link[l]``; so over a step ``s`` link ``l`` moves
+    at most ``u s + a v s² / 2`` (``u = Σ_f |d_f| ρ_fl``, ``a = Σ_f |d_f|``), and at most
+    ``v_link[l] · s`` (the configuration-free bound): the step is the larger of the two
+    that keeps ``d + margin``. A link pair ``(i, j)`` is the same with the joints between
+    them (``i <= f < j``) moving ``j`` relative to ``i``.
+    """
+    lo, hi, w, lo2, hi2, _ = buf
+    L = seg.shape[0]
+    dof = L - 1
+    n_obs = kinds.shape[0]
+    # joint axes at q (the loop of armz_segments)
+    R = np.empty((3, 3))
+    p = np.empty(3)
+    for i in range(3):
+        p[i] = T1[i, 3]
+        for j in range(3):
+            R[i, j] = T1[i, j]
+    for f in range(dof):
+        ox, oy, oz = p[0], p[1], p[2]
+        zx, zy, zz = R[0, 2], R[1, 2], R[2, 2]
+        for li in range(f + 1, L):
+            best_r = 0.0
+            for e in range(2):
+                x = seg[li, e, 0] - ox
+                y = seg[li, e, 1] - oy
+                z = seg[li, e, 2] - oz
+                t = x * zx + y * zy + z * zz
+                r2 = x * x + y * y + z * z - t * t
+                if r2 > best_r:
+                    best_r = r2
+            rho[f, li] = math.sqrt(best_r)
+        c = math.cos(q[f])
+        sn = math.sin(q[f])
+        for i in range(3):
+            g0 = c * R[i, 0] + sn * R[i, 1]
+            g1 = -sn * R[i, 0] + c * R[i, 1]
+            g2 = R[i, 2]
+            p[i] += g0 * M[0, 3] + g1 * M[1, 3] + g2 * M[2, 3]
+            R[i, 0] = g0 * M[0, 0] + g1 * M[1, 0] + g2 * M[2, 0]
+            R[i, 1] = g0 * M[0, 1] + g1 * M[1, 1] + g2 * M[2, 1]
+            R[i, 2] = g0 * M[0, 2] + g1 * M[1, 2] + g2 * M[2, 2]
+    _link_boxes(seg, radii, lo, hi)
+    nv = np.empty(3)
+    best = dt_max
+    for li in range(L):
+        v = v_link[li]
+        if not moving[li] or v <= 0.0:
+            continue
+        u = 0.0
+        a = 0.0
+        for f in range(li):
+            u += abs(d[f]) * rho[f, li]
+            a += abs(d[f])
+        for oi in range(n_obs):
+            cc = _box_gap(lo, hi, li, olo, ohi, oi) + margin
+            if max(cc / v, _quad_step(u, a * v, cc)) >= best:
+                continue
+            dist, _ = capsule_obstacle(
+                kinds[oi], Rs[oi], cs[oi], hs[oi], seg[li, 0], seg[li, 1], radii[li], False,
+                nv, w,
+            )
+            cc = max(dist, 0.0) + margin
+            dt = max(cc / v, _quad_step(u, a * v, cc))
+            if dt < best:
+                best = dt
+    _link_boxes(seg, radii_self, lo2[:L], hi2[:L])
+    for j in range(L):
+        u = 0.0
+        a = 0.0
+        for i in range(j - 1, -1, -1):
+            u += abs(d[i]) * rho[i, j]
+            a += abs(d[i])
+            v = v_pair[i, j]
+            if v <= 0.0 or not allowed[i, j]:
+                continue
+            cc = _box_gap(lo2, hi2, i, lo2, hi2, j) + margin
+            c2 = a * v_link[j]
+            if max(cc / v, _quad_step(u, c2, cc)) >= best:
+                continue
+            d2, _, _ = seg_seg(seg[i, 0], seg[i, 1], seg[j, 0], seg[j, 1])
+            cc = max(math.sqrt(d2) - radii_self[i] - radii_self[j], 0.0) + margin
+            dt = max(cc / v, _quad_step(u, c2, cc))
+            if dt < best:
+                best = dt
+    return best
+
+
+@njit(cache=True, nogil=True)
 def armz_path_advance(
     P,
     first,
@@ -604,8 +710,12 @@ def armz_path_advance(
     q = np.empty((1, dof))
     v_link = np.empty(L)
     v_pair = np.empty((L, L))
+    rho = np.zeros((dof, L))
+    qv = np.empty(dof)  # the state seg holds
     queries = 0
     have_seg = False  # seg holds the current vertex, validity known
+    for i in range(dof):
+        qv[i] = P[0, i]
     if first == 2:  # queried already by the caller: measured again, not counted
         armz_segments(P[0:1], T0, T1, M, seg)
         have_seg = True
@@ -645,10 +755,12 @@ def armz_path_advance(
                 if queries >= limit:
                     return queries, 2, e, 0.0
                 armz_segments(P[e : e + 1], T0, T1, M, seg)
+                for i in range(dof):
+                    qv[i] = P[e, i]
                 queries += 1
-            dt = advance_dt(
-                seg[0], radii, radii_self, moving, allowed, kinds, Rs, cs, hs, olo, ohi,
-                v_link, v_pair, margin, 1.0, buf,
+            dt = armz_advance_dt(
+                qv, seg[0], d, T1, M, radii, radii_self, moving, allowed, kinds, Rs, cs, hs,
+                olo, ohi, v_link, v_pair, margin, 1.0, buf, rho,
             )
         while True:
             step = max(dt_min, min(dt, dt_cap))
@@ -669,11 +781,13 @@ def armz_path_advance(
             if tn == 1.0:
                 break
             if adaptive:
-                dt = advance_dt(
-                    seg[0], radii, radii_self, moving, allowed, kinds, Rs, cs, hs, olo,
-                    ohi, v_link, v_pair, margin, 1.0 - tn, buf,
+                dt = armz_advance_dt(
+                    q[0], seg[0], d, T1, M, radii, radii_self, moving, allowed, kinds, Rs,
+                    cs, hs, olo, ohi, v_link, v_pair, margin, 1.0 - tn, buf, rho,
                 )
             t = tn
+        for i in range(dof):
+            qv[i] = q[0, i]
         have_seg = True
     return queries, 0, m - 1, 1.0
 
