@@ -28,7 +28,7 @@ import numpy as np
 
 from plannerlab.collision.core import Core, PairDistances
 from plannerlab.collision.core import supports as core_supports
-from plannerlab.collision.reach import joint_reach_m, link_reach_m
+from plannerlab.collision.reach import joint_reach_m, reach_bounds
 from plannerlab.problem.scene import Box, Cylinder, Scene, Sphere
 from plannerlab.robots.base import Array, Robot
 from plannerlab.robots.paths import densify, edge_counts
@@ -102,12 +102,18 @@ class CollisionChecker:
         #: per joint, how fast the geometry moves [m per rad or m] (see reach.py); with a
         #: margin, edges are checked so that no point moves more than the margin between
         #: two checked states (on top of the radian step asked for)
-        self.reach_m: np.ndarray | None = joint_reach_m(robot) if margin_m > 0 else None
+        use_core = backend == "core" or (backend == "auto" and core_supports(scene))
+        advance = margin_m > 0 and use_core and edge_check in ("auto", "advance")
+        rates: tuple[np.ndarray, np.ndarray] | None = None
+        self.reach_m: np.ndarray | None = None
+        if advance:
+            self.reach_m, W, rigid = reach_bounds(robot)
+            rates = (W, rigid)
+        elif margin_m > 0:
+            self.reach_m = joint_reach_m(robot)
         self.edge_weights: np.ndarray | None = (
             None if self.reach_m is None else self.reach_m / self.margin_m
         )
-        use_core = backend == "core" or (backend == "auto" and core_supports(scene))
-        advance = margin_m > 0 and use_core and edge_check in ("auto", "advance")
         if edge_check == "advance" and not advance:
             raise ValueError("edge_check 'advance' needs a margin > 0 and the core backend")
         #: how edges and paths are checked: "grid" (every state of :meth:`densify`) or
@@ -121,7 +127,7 @@ class CollisionChecker:
                 scene,
                 self.margin_m,
                 self.edge_weights,
-                link_reach_m(robot) if advance else None,
+                rates,
             )
         #: which backend answers the queries: "core" or "fcl"
         self.backend = "core" if self._core is not None else "fcl"

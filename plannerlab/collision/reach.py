@@ -109,12 +109,13 @@ def joint_reach_m(robot: Robot) -> Array:
     return reach
 
 
-def link_reach_m(robot: Robot) -> tuple[Array, Array]:
+def reach_bounds(robot: Robot) -> tuple[Array, Array, Array]:
     """Per joint and link, an upper bound [m per rad, or m per m] of how fast any point of
     that link's capsule moves when the joint moves alone, and per joint whether it moves
     the links it moves rigidly (one rotation or translation for all of them).
 
-    Returns ``(W (dof, L), rigid (dof,) bool)``. ``W[i, l]`` is zero when joint ``i`` never
+    Returns ``(reach (dof,), W (dof, L), rigid (dof,) bool)``: ``reach`` is
+    :func:`joint_reach_m`'s bound (the same numbers, from the same pass). ``W[i, l]`` is zero when joint ``i`` never
     moves link ``l``; ``W[i].max() <= joint_reach_m(robot)[i]``: for a revolute joint the
     chain sum of :func:`joint_reach_m` is stopped at link ``l`` (the first moved link's
     start from the axis, plus the moved links up to ``l`` and the gaps between them, plus
@@ -129,6 +130,7 @@ def link_reach_m(robot: Robot) -> tuple[Array, Array]:
     radii = np.asarray(robot.link_radii_m, dtype=float)
     L = len(radii)
     W = np.zeros((dof, L))
+    reach = np.zeros(dof)
     rigid = np.ones(dof, dtype=bool)
     for s_i in range(len(states)):
         S = SS[s_i]
@@ -151,6 +153,7 @@ def link_reach_m(robot: Robot) -> tuple[Array, Array]:
                 rigid[i] = False
             if w < 1e-6:  # a translation: each moved link at its own endpoints' speed
                 bound = speed[moved].max(axis=1)
+                reach[i] = max(reach[i], float(speed[moved].max()))
             else:
                 gaps = np.concatenate(
                     [[0.0], np.linalg.norm(S[moved[1:], 0] - S[moved[:-1], 1], axis=-1)]
@@ -163,8 +166,24 @@ def link_reach_m(robot: Robot) -> tuple[Array, Array]:
                 )
                 along = abs(float(np.dot(V[f, 0], omega))) / w
                 bound = w * chain + along
+                whole = (  # joint_reach_m's sum, in its order (the same floats)
+                    float(np.linalg.norm(V[f, 0])) / w
+                    + float(lengths[moved].sum())
+                    + float(gaps[1:].sum())
+                    + float(radii[moved].max())
+                )
+                reach[i] = max(reach[i], w * whole + along)
             W[i, moved] = np.maximum(W[i, moved], bound)
+    return reach, W, rigid
+
+
+def link_reach_m(robot: Robot) -> tuple[Array, Array]:
+    """``(W, rigid)`` of :func:`reach_bounds`."""
+    _, W, rigid = reach_bounds(robot)
     return W, rigid
+
+
+
 
 
 def pair_rates(W: Array, rigid: Array, allowed: Array) -> Array:
