@@ -89,9 +89,7 @@ class CollisionChecker:
         if backend not in ("auto", "core", "fcl"):
             raise ValueError(f"backend must be 'auto', 'core' or 'fcl', got {backend!r}")
         if edge_check not in ("auto", "grid", "advance"):
-            raise ValueError(
-                f"edge_check must be 'auto', 'grid' or 'advance', got {edge_check!r}"
-            )
+            raise ValueError(f"edge_check must be 'auto', 'grid' or 'advance', got {edge_check!r}")
         if backend == "core" and not core_supports(scene):
             raise ValueError("backend 'core' covers boxes, cylinders and spheres only")
         if not (margin_m >= 0.0 and np.isfinite(margin_m)):

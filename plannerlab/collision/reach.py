@@ -115,15 +115,15 @@ def reach_bounds(robot: Robot) -> tuple[Array, Array, Array]:
     the links it moves rigidly (one rotation or translation for all of them).
 
     Returns ``(reach (dof,), W (dof, L), rigid (dof,) bool)``: ``reach`` is
-    :func:`joint_reach_m`'s bound (the same numbers, from the same pass). ``W[i, l]`` is zero when joint ``i`` never
-    moves link ``l``; ``W[i].max() <= joint_reach_m(robot)[i]``: for a revolute joint the
-    chain sum of :func:`joint_reach_m` is stopped at link ``l`` (the first moved link's
-    start from the axis, plus the moved links up to ``l`` and the gaps between them, plus
-    ``l``'s radius). This is what lets a link near the base, or a link pair joined by few
-    joints, take larger steps than the whole chain's bound allows (conservative
+    :func:`joint_reach_m`'s bound (the same numbers, from the same pass). ``W[i, l]`` is
+    zero when joint ``i`` never moves link ``l``; ``W[i].max() <= reach[i]``: for a revolute
+    joint the chain sum of :func:`joint_reach_m` is stopped at link ``l`` (the first moved
+    link's start from the axis, plus the moved links up to ``l`` and the gaps between them,
+    plus ``l``'s radius). This is what lets a link near the base, or a link pair joined by
+    few joints, take larger steps than the whole chain's bound allows (conservative
     advancement, :mod:`plannerlab.collision.core`). ``rigid``: the moved links keep their
-    shapes and relative poses, so the distance between two links that both move with
-    joint ``i`` does not change with it.
+    shapes and relative poses, so the distance between two links that both move with joint
+    ``i`` does not change with it.
     """
     dof = robot.dof
     states, SS, VV, _ = _motions(robot)
@@ -183,9 +183,6 @@ def link_reach_m(robot: Robot) -> tuple[Array, Array]:
     return W, rigid
 
 
-
-
-
 def pair_rates(W: Array, rigid: Array, allowed: Array) -> Array:
     """Per joint and link pair, an upper bound of how fast the pair's distance changes
     when the joint moves alone: (dof, L, L), zero outside ``allowed`` (upper triangle).
@@ -199,7 +196,5 @@ def pair_rates(W: Array, rigid: Array, allowed: Array) -> Array:
     one = np.where(moves[:, :, None] & ~moves[:, None, :], a, 0.0) + np.where(
         ~moves[:, :, None] & moves[:, None, :], b, 0.0
     )
-    both = np.where(
-        moves[:, :, None] & moves[:, None, :] & ~rigid[:, None, None], a + b, 0.0
-    )
+    both = np.where(moves[:, :, None] & moves[:, None, :] & ~rigid[:, None, None], a + b, 0.0)
     return np.where(np.triu(allowed, 1)[None], one + both, 0.0)
