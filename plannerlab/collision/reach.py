@@ -196,5 +196,6 @@ def pair_rates(W: Array, rigid: Array, allowed: Array) -> Array:
     one = np.where(moves[:, :, None] & ~moves[:, None, :], a, 0.0) + np.where(
         ~moves[:, :, None] & moves[:, None, :], b, 0.0
     )
-    both = np.where(moves[:, :, None] & moves[:, None, :] & ~rigid[:, None, None], a + b, 0.0)
+    loose = np.logical_not(np.asarray(rigid, dtype=bool))
+    both = np.where(moves[:, :, None] & moves[:, None, :] & loose[:, None, None], a + b, 0.0)
     return np.where(np.triu(allowed, 1)[None], one + both, 0.0)
