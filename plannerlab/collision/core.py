@@ -48,8 +48,10 @@ grown along the step by how far the link can move relative to that axis (a quadr
 term, sound), instead of the length of the chain behind the joint.
 
 Counting: each state visited is one check (its validity, plus its pair distances when
-the step needs them; a distance pass with box pruning costs about as much as the check,
-see the table), and an edge measured at its start costs one more. A path's states never
+the step needs them), and an edge measured at its start costs one more. A visited state
+costs more than a plain check (a distance pass, with box pruning, after it); its cost
+ratio has not been measured in isolation: the wall times in the table are the honest
+account. A path's states never
 outnumber its grid's (each step is at least the grid's), so a planner's re-check reserve
 computed from the grid (``_recheck_cost`` in planners/ompl.py) stays an upper bound.
 
