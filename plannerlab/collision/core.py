@@ -1057,6 +1057,24 @@ def pair_distances_kernel(
     return idx[:m].copy(), d[:m].copy(), tl[:m].copy(), to[:m].copy(), n[:m].copy()
 
 
+@njit(cache=True, nogil=True)
+def min_clearance_kernel(
+    segs, radii, radii_self, moving, allowed, tree, kinds, Rs, cs, hs, olo, ohi, include_self
+):
+    """Smallest signed distance [m] over every checked pair of every state (k, L, 2, 3)
+    (link pairs only with ``include_self``; inf when none): :func:`pair_distances_kernel`
+    state by state."""
+    best = np.inf
+    for s in range(segs.shape[0]):
+        idx, d, _, _, _ = pair_distances_kernel(
+            segs[s], radii, radii_self, moving, allowed, tree, kinds, Rs, cs, hs, olo, ohi, np.inf
+        )
+        for m in range(d.shape[0]):
+            if (include_self or idx[m, 2] == 0) and d[m] < best:
+                best = d[m]
+    return best
+
+
 # ---------------------------------------------------------------------- Python front
 
 
@@ -1191,7 +1209,7 @@ class Core:
             if self._armz
             else (first_invalid, edge_states)
             + ((advance_dt, edge_rates) if self._rates is not None else ())
-        ) + (valid_batch, all_hits, pair_distances_kernel)
+        ) + (valid_batch, all_hits, pair_distances_kernel, min_clearance_kernel)
         if all(k.signatures for k in kernels):
             return  # compiled or loaded already in this process
         q = np.clip(np.zeros(self.robot.dof), self.robot.lower, self.robot.upper)
@@ -1203,6 +1221,7 @@ class Core:
         self.edge_first_invalid(q, q, 1.0)
         self.hits(q)
         self.pair_distances(q, 0.0)
+        self.min_clearance(q2)
         if self._rates is not None:
             q1 = q.copy()
             q1[0] += 0.5 if q[0] + 0.5 <= self.robot.upper[0] else -0.5
@@ -1224,6 +1243,14 @@ class Core:
         out = np.empty((len(Qc), self.robot.dof + 2, 4, 4))
         armz_frames(Qc, self._T0, self._T1, self._M, out)
         return out[0] if single else out
+
+    def tip(self, q: Array) -> tuple[Array, Array]:
+        """The robot's ``tip(q)`` (position [m], face normal) for one q (dof,): compiled for
+        Arm-Z (its last frame, as ``ArmZ.tip``), else the robot's own."""
+        if not self._armz:
+            return self.robot.tip(q)
+        F = self.fk(q)[-1]
+        return F[:3, 3].copy(), F[:3, 2].copy()
 
     def segments(self, Q: Array) -> np.ndarray:
         """Capsule axes (k, L, 2, 3) for Q (k, dof)."""
@@ -1466,6 +1493,11 @@ class Core:
             t_other=to,
             n_world=n,
         )
+
+    def min_clearance(self, Q: Array, include_self: bool = True) -> float:
+        """:meth:`clearance`'s smallest over the states Q (k, dof), in one compiled call
+        (inf when there is no state or no pair)."""
+        return float(min_clearance_kernel(self.segments(Q), *self._geo, bool(include_self)))
 
     def clearance(self, q: Array, include_self: bool = True) -> float:
         """Smallest signed distance [m] over every checked pair (inf when none)."""

@@ -351,6 +351,14 @@ class CollisionChecker:
             for a, b, is_link in hits
         )
 
+    def tip(self, q: Array) -> tuple[Array, Array]:
+        """The robot's ``tip(q)`` (position [m], face normal) for one q (dof,), from the
+        core's compiled kinematics when it has them (Arm-Z), else the robot's. Not a
+        collision check (not counted)."""
+        if self._core is not None:
+            return self._core.tip(q)
+        return self.robot.tip(q)
+
     def clearance(self, q: Array, include_self: bool = True) -> float:
         """Smallest signed distance [m] over every checked pair; negative = penetration.
 
@@ -374,6 +382,15 @@ class CollisionChecker:
                 best = min(best, self._signed_distance(self._links_self[i], self._links_self[j]))
         self.checks += 1
         return float(best)
+
+    def min_clearance(self, Q: Array, include_self: bool = True) -> float:
+        """The smallest :meth:`clearance` over the states Q (k, dof) (inf when k = 0),
+        counting one check per state; on the core in one compiled call."""
+        Q = np.atleast_2d(np.asarray(Q, dtype=float))
+        if self._core is None:
+            return min((self.clearance(q, include_self) for q in Q), default=float("inf"))
+        self.checks += len(Q)
+        return self._core.min_clearance(Q, include_self)
 
     def pair_distances(self, q: Array, margin_m: float) -> PairDistances:
         """Every checked pair at q (dof,) whose signed distance is below ``margin_m`` [m].
@@ -411,6 +428,16 @@ class CollisionChecker:
         point of the robot moves more than the margin between two states (the bound
         ``Σ |Δq_i| · reach_i``). Returns (states, owning edge of each)."""
         return densify(path, joint_step, self.robot.continuous, self.edge_weights)
+
+    def grid_states(self, path: Array, joint_step: float) -> int:
+        """``len(self.densify(path, joint_step)[0])``, without making the states: the most
+        checks :meth:`check_path` makes on the path (the grid's; conservative advancement
+        makes at most as many)."""
+        path = np.atleast_2d(np.asarray(path, dtype=float))
+        if len(path) < 2:
+            return len(path)
+        _, n = edge_counts(path, joint_step, self.robot.continuous, self.edge_weights)
+        return 1 + int(n.sum())
 
     def _edge_counts(self, path: Array, joint_step: float) -> tuple[Array, np.ndarray]:
         """Per edge of a path (m ≥ 2 states): the joint change and the grid's number of

@@ -393,13 +393,10 @@ def _ompl_logging(logger: logging.Logger) -> Iterator[None]:
 
 # ---------------------------------------------------------------------------- helpers
 def _recheck_cost(path: Array, joint_step: float, checker: CollisionChecker) -> int:
-    """Collision checks ``checker.check_path(path, joint_step)`` will make (all states of
-    the path as the checker densifies it, metric edge resolution included), computed
-    without checking anything."""
-    path = np.atleast_2d(np.asarray(path, dtype=float))
-    if len(path) < 2:
-        return len(path)
-    return len(checker.densify(path, joint_step)[0])
+    """Collision checks ``checker.check_path(path, joint_step)`` will make at most (all
+    states of the path as the checker densifies it, metric edge resolution included;
+    conservative advancement makes no more), computed without checking anything."""
+    return checker.grid_states(path, joint_step)
 
 
 def _goal_chain(data: Any, space: _Space) -> Array | None:
@@ -856,9 +853,11 @@ class OMPLPlanner:
 
         best = [math.inf]
 
+        tip = checker.tip  # compiled kinematics where the checker has them
+
         def distance(state: Any) -> float:
             fk[0] += 1
-            d = float(goal.distance(robot, space.to_q(state)))
+            d = float(goal.distance_from_tip(*tip(space.to_q(state))))
             if d < best[0]:
                 best[0] = d
                 trace.append(d)

@@ -73,7 +73,12 @@ class GoalRegion:
 
         Zero exactly inside the region; grows with the larger of the two scaled errors.
         """
-        pos_err, ang_err = self.errors(robot, q)
+        p, n = robot.tip(q)
+        return self.distance_from_tip(p, n)
+
+    def distance_from_tip(self, p_world_m: Array, n_world: Array) -> Array:
+        """:meth:`distance` of a tip pose (3,) or (k, 3)."""
+        pos_err, ang_err = self.errors_from_tip(p_world_m, n_world)
         scaled = np.maximum(pos_err / self.pos_tol_m, ang_err / self.angle_tol_deg)
         return np.maximum(scaled - 1.0, 0.0)
 
