@@ -94,6 +94,7 @@ Design (measured on ``armz_inspection``, 23 continuous joints):
 
 from __future__ import annotations
 
+import ctypes
 import dataclasses
 import logging
 import math
@@ -423,6 +424,10 @@ def _reach_m(robot: Robot, q: Array) -> float:
     return float(np.sum(np.linalg.norm(seg[:, 1] - seg[:, 0], axis=-1)))
 
 
+#: the capsule name nanobind reads a ``void *`` argument from (see ``_Space._fast_reader``)
+_NB_HANDLE = b"nb_handle"
+
+
 class _Space:
     """Conversion between joint vectors and OMPL states for one robot (one solve).
 
@@ -449,6 +454,7 @@ class _Space:
             hi = np.where(cont, self.center + 2.0 * np.pi, robot.upper)
             self.space = self._real_vector(lo, hi)
             self.compound = False
+            self._use_fast_reader()
             return
         self.cont_idx = [int(i) for i in np.flatnonzero(cont)]
         self.bound_idx = [int(i) for i in np.flatnonzero(~cont)]
@@ -464,6 +470,53 @@ class _Space:
         else:
             space = self._real_vector(robot.lower, robot.upper)
         self.space = space
+        self._use_fast_reader()
+
+    def _use_fast_reader(self) -> None:
+        reader = self._fast_reader()
+        if reader is not None:
+            self.to_q = reader  # type: ignore[method-assign]
+
+    def _fast_reader(self) -> Callable[[Any], Array] | None:
+        """One-call reading of a state, or None: OMPL's ``StateSpace::serialize`` writes
+        the state's reals (SO2 values, then the RealVector block: :meth:`to_q`'s order)
+        into a buffer this space owns, passed as the ``void *`` capsule nanobind accepts;
+        one binding call instead of two per joint. Used only if the layout is confirmed on
+        a test state (else None, and :meth:`to_q` reads joint by joint)."""
+        buf = np.zeros(self.dof)
+        try:
+            if int(self.space.getSerializationLength()) != buf.nbytes:
+                return None
+            new = ctypes.pythonapi.PyCapsule_New
+            new.restype = ctypes.py_object
+            new.argtypes = (ctypes.c_void_p, ctypes.c_char_p, ctypes.c_void_p)
+            capsule = new(buf.ctypes.data, _NB_HANDLE, None)
+            serialize = self.space.serialize
+            probe = self.space.allocState()  # freed with its Python object
+            q = wrap_to_pi(self.center + 0.1 + 0.01 * np.arange(self.dof), self.robot.continuous)
+            self.set_state(probe, q)
+            serialize(capsule, probe)
+            order = self.cont_idx + self.bound_idx  # the joint of each serialized real
+            ok = np.array_equal(buf[np.argsort(order)], self._read(probe))
+        except (TypeError, AttributeError, ValueError):
+            return None
+        if not ok:
+            return None
+        self._buf = buf  # the capsule points into it: kept alive with this space
+        if order == list(range(self.dof)):
+
+            def read(state: Any) -> Array:
+                serialize(capsule, state)
+                return buf.copy()
+
+            return read
+        joint_of = np.argsort(order)  # q = buf[joint_of] (a new array)
+
+        def read_permuted(state: Any) -> Array:
+            serialize(capsule, state)
+            return buf[joint_of]
+
+        return read_permuted
 
     @staticmethod
     def _real_vector(lower: Array, upper: Array) -> Any:
@@ -477,6 +530,11 @@ class _Space:
         return rv
 
     def to_q(self, state: Any) -> Array:
+        """The joint vector (dof,) of an OMPL state (a new array)."""
+        return self._read(state)
+
+    def _read(self, state: Any) -> Array:
+        """:meth:`to_q` joint by joint (two binding calls per joint)."""
         q = np.empty(self.dof)
         if self.compound:
             for k, i in enumerate(self.cont_idx):
