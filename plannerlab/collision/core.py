@@ -158,6 +158,38 @@ def armz_segments(Q, T0, T1, M, out):
     return out
 
 
+@njit(cache=True, nogil=True)
+def armz_segments_axes(q, T0, T1, M, seg, z):
+    """:func:`armz_segments` of one state q (dof,) → seg (dof + 1, 2, 3), and the joints'
+    axis directions z (dof, 3) (joint ``f`` turns about ``z[f]`` through ``seg[f, 1]``);
+    the same floats as :func:`armz_segments`."""
+    dof = q.shape[0]
+    R = np.empty((3, 3))
+    p = np.empty(3)
+    for i in range(3):
+        seg[0, 0, i] = T0[i, 3]
+        p[i] = T1[i, 3]
+        for j in range(3):
+            R[i, j] = T1[i, j]
+    for f in range(dof):
+        c = math.cos(q[f])
+        sn = math.sin(q[f])
+        for i in range(3):
+            seg[f, 1, i] = p[i]
+            seg[f + 1, 0, i] = p[i]
+            z[f, i] = R[i, 2]
+        for i in range(3):
+            g0 = c * R[i, 0] + sn * R[i, 1]
+            g1 = -sn * R[i, 0] + c * R[i, 1]
+            g2 = R[i, 2]
+            p[i] += g0 * M[0, 3] + g1 * M[1, 3] + g2 * M[2, 3]
+            R[i, 0] = g0 * M[0, 0] + g1 * M[1, 0] + g2 * M[2, 0]
+            R[i, 1] = g0 * M[0, 1] + g1 * M[1, 1] + g2 * M[2, 1]
+            R[i, 2] = g0 * M[0, 2] + g1 * M[1, 2] + g2 * M[2, 2]
+    for i in range(3):
+        seg[dof, 1, i] = p[i]
+
+
 # ---------------------------------------------------------------------- broad + narrow phase
 
 
@@ -640,11 +672,9 @@ def _quad_step(u, c2, c):
 
 @njit(cache=True, nogil=True)
 def armz_advance_dt(
-    q,
     seg,
     d,
-    T1,
-    M,
+    z_axes,
     radii,
     radii_self,
     moving,
@@ -678,16 +708,10 @@ def armz_advance_dt(
     L = seg.shape[0]
     dof = L - 1
     n_obs = kinds.shape[0]
-    # joint axes at q (the loop of armz_segments)
-    R = np.empty((3, 3))
-    p = np.empty(3)
-    for i in range(3):
-        p[i] = T1[i, 3]
-        for j in range(3):
-            R[i, j] = T1[i, j]
+    # joint f's axis: direction z_axes[f] through seg[f, 1] (armz_segments_axes)
     for f in range(dof):
-        ox, oy, oz = p[0], p[1], p[2]
-        zx, zy, zz = R[0, 2], R[1, 2], R[2, 2]
+        ox, oy, oz = seg[f, 1, 0], seg[f, 1, 1], seg[f, 1, 2]
+        zx, zy, zz = z_axes[f, 0], z_axes[f, 1], z_axes[f, 2]
         for li in range(f + 1, L):
             best_r = 0.0
             for e in range(2):
@@ -699,16 +723,6 @@ def armz_advance_dt(
                 if r2 > best_r:
                     best_r = r2
             rho[f, li] = math.sqrt(best_r)
-        c = math.cos(q[f])
-        sn = math.sin(q[f])
-        for i in range(3):
-            g0 = c * R[i, 0] + sn * R[i, 1]
-            g1 = -sn * R[i, 0] + c * R[i, 1]
-            g2 = R[i, 2]
-            p[i] += g0 * M[0, 3] + g1 * M[1, 3] + g2 * M[2, 3]
-            R[i, 0] = g0 * M[0, 0] + g1 * M[1, 0] + g2 * M[2, 0]
-            R[i, 1] = g0 * M[0, 1] + g1 * M[1, 1] + g2 * M[2, 1]
-            R[i, 2] = g0 * M[0, 2] + g1 * M[1, 2] + g2 * M[2, 2]
     _link_boxes(seg, radii, lo, hi)
     nv = np.empty(3)
     best = dt_max
@@ -723,7 +737,7 @@ def armz_advance_dt(
             a += abs(d[f])
         for oi in range(n_obs):
             cc = _box_gap(lo, hi, li, olo, ohi, oi) + margin
-            if max(cc / v, _quad_step(u, a * v, cc)) >= best:
+            if cc / v >= best or _quad_step(u, a * v, cc) >= best:  # max(..) >= best
                 continue
             dist, _ = capsule_obstacle(
                 kinds[oi],
@@ -753,7 +767,7 @@ def armz_advance_dt(
                 continue
             cc = _box_gap(lo2, hi2, i, lo2, hi2, j) + margin
             c2 = a * v_link[j]
-            if max(cc / v, _quad_step(u, c2, cc)) >= best:
+            if cc / v >= best or _quad_step(u, c2, cc) >= best:  # max(..) >= best
                 continue
             d2, _, _ = seg_seg(seg[i, 0], seg[i, 1], seg[j, 0], seg[j, 1])
             cc = max(math.sqrt(d2) - radii_self[i] - radii_self[j], 0.0) + margin
@@ -768,8 +782,8 @@ def armz_path_advance(
     P,
     first,
     joint_step,
-    continuous,
     limit,
+    continuous,
     cap,
     weights,
     W,
@@ -805,18 +819,16 @@ def armz_path_advance(
     v_link = np.empty(L)
     v_pair = np.empty((L, L))
     rho = np.zeros((dof, L))
-    qv = np.empty(dof)  # the state seg holds
+    z_axes = np.empty((dof, 3))  # the joints' axes at the state seg holds
     queries = 0
     have_seg = False  # seg holds the current vertex, validity known
-    for i in range(dof):
-        qv[i] = P[0, i]
     if first == 2:  # queried already by the caller: measured again, not counted
-        armz_segments(P[0:1], T0, T1, M, seg)
+        armz_segments_axes(P[0], T0, T1, M, seg[0], z_axes)
         have_seg = True
     if first == 1:
         if limit < 1:
             return queries, 2, 0, 0.0
-        armz_segments(P[0:1], T0, T1, M, seg)
+        armz_segments_axes(P[0], T0, T1, M, seg[0], z_axes)
         queries += 1
         have_seg = True
         if _state_hits(
@@ -861,16 +873,12 @@ def armz_path_advance(
             if not have_seg:  # the edge's start: measured, not checked (the caller's)
                 if queries >= limit:
                     return queries, 2, e, 0.0
-                armz_segments(P[e : e + 1], T0, T1, M, seg)
-                for i in range(dof):
-                    qv[i] = P[e, i]
+                armz_segments_axes(P[e], T0, T1, M, seg[0], z_axes)
                 queries += 1
             dt = armz_advance_dt(
-                qv,
                 seg[0],
                 d,
-                T1,
-                M,
+                z_axes,
                 radii,
                 radii_self,
                 moving,
@@ -897,7 +905,7 @@ def armz_path_advance(
                 return queries, 2, e, t
             for i in range(dof):
                 q[0, i] = P[e, i] + tn * d[i]
-            armz_segments(q, T0, T1, M, seg)
+            armz_segments_axes(q[0], T0, T1, M, seg[0], z_axes)
             queries += 1
             if _state_hits(
                 seg[0],
@@ -921,11 +929,9 @@ def armz_path_advance(
                 break
             if adaptive:
                 dt = armz_advance_dt(
-                    q[0],
                     seg[0],
                     d,
-                    T1,
-                    M,
+                    z_axes,
                     radii,
                     radii_self,
                     moving,
@@ -944,8 +950,6 @@ def armz_path_advance(
                     rho,
                 )
             t = tn
-        for i in range(dof):
-            qv[i] = q[0, i]
         have_seg = True
     return queries, 0, m - 1, 1.0
 
@@ -1197,6 +1201,20 @@ class Core:
             self._T0 = T0
             self._T1 = T0 @ armz._T_base_j1
             self._M = np.ascontiguousarray(armz._M, dtype=np.float64)
+        #: armz_path_advance's arguments after (P, first, joint_step, limit)
+        self._advance_args: tuple[Any, ...] = ()
+        if self._armz and self._rates is not None:
+            self._advance_args = (
+                self._continuous,
+                MAX_EDGE_STATES,
+                self.edge_weights,
+                *self._rates,
+                self.margin_m,
+                self._T0,
+                self._T1,
+                self._M,
+                *self._geo,
+            )
         self._warm_up()
 
     def _warm_up(self) -> None:
@@ -1352,28 +1370,16 @@ class Core:
         """
         if self._rates is None:
             raise ValueError("path_advance needs link rates (a checker with a margin)")
-        P = np.ascontiguousarray(np.atleast_2d(np.asarray(path, dtype=float)))
+        P = path
+        if not (
+            type(P) is np.ndarray and P.ndim == 2 and P.dtype == np.float64 and P.flags.c_contiguous
+        ):
+            P = np.ascontiguousarray(np.atleast_2d(np.asarray(path, dtype=float)))
         lim = _NO_LIMIT if limit is None else max(int(limit), 0)
         step = float(joint_step)
         require_joint_step(step)
-        W, Pr = self._rates
         if self._armz:
-            qn, status, e, t = armz_path_advance(
-                P,
-                int(first),
-                step,
-                self._continuous,
-                lim,
-                MAX_EDGE_STATES,
-                self.edge_weights,
-                W,
-                Pr,
-                self.margin_m,
-                self._T0,
-                self._T1,
-                self._M,
-                *self._geo,
-            )
+            qn, status, e, t = armz_path_advance(P, int(first), step, lim, *self._advance_args)
         else:
             qn, status, e, t = self._path_advance_py(P, int(first), step, lim)
         if status == 3:

@@ -329,7 +329,9 @@ class CollisionChecker:
         (q_a's measurement included when a step needs it), or ``max_states + 1`` when
         ``max_states`` did not suffice (the edge is then unfinished)."""
         assert self._core is not None
-        path = np.array([q_a, q_b], dtype=float)
+        path = np.empty((2, self.robot.dof))
+        path[0] = q_a
+        path[1] = q_b
         q, status, _, _ = self._core.path_advance(path, 0, joint_step, max_states)
         self.checks += q
         if status == 2:
