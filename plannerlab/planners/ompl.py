@@ -424,6 +424,10 @@ def _reach_m(robot: Robot, q: Array) -> float:
     return float(np.sum(np.linalg.norm(seg[:, 1] - seg[:, 0], axis=-1)))
 
 
+#: most states of a path handed to OMPL's PathSimplifier.simplify (its collapseCloseVertices
+#: takes time cubic in them, with no termination condition polled)
+_SIMPLIFY_MAX_STATES = 100
+
 #: the capsule name nanobind reads a ``void *`` argument from (see ``_Space._fast_reader``)
 _NB_HANDLE = b"nb_handle"
 
@@ -475,7 +479,7 @@ class _Space:
     def _use_fast_reader(self) -> None:
         reader = self._fast_reader()
         if reader is not None:
-            self.to_q = reader  # type: ignore[method-assign]
+            self.to_q = reader  # type: ignore[method-assign, assignment]
 
     def _fast_reader(self) -> Callable[[Any], Array] | None:
         """One-call reading of a state, or None: OMPL's ``StateSpace::serialize`` writes
@@ -1152,7 +1156,24 @@ class OMPLPlanner:
         if s.simplify and guard.exhausted() is None:
             simplifier = og.PathSimplifier(si, goal_obj)
             c0 = checker.checks
-            simplifier.simplify(simplified, ob.PlannerTerminationCondition(simplify_done))
+            # OMPL's simplify runs one whole pass whatever the termination condition says,
+            # and its collapseCloseVertices compares every vertex pair at each of up to n
+            # steps without polling it: on the chain of hundreds of tiny edges an
+            # optimizing planner's dense tree gives (cheap edge checks make dense trees),
+            # that pass takes minutes. Such a path is thinned first by reduceVertices
+            # (random shortcuts, each a checked motion), and left as it is if it stays long.
+            thinning = 0
+            while (
+                simplified.getStateCount() > _SIMPLIFY_MAX_STATES
+                and thinning < 20
+                and not simplify_done()
+            ):
+                simplifier.reduceVertices(simplified)
+                thinning += 1
+            if thinning:
+                extra["thinning_passes"] = thinning
+            if simplified.getStateCount() <= _SIMPLIFY_MAX_STATES:
+                simplifier.simplify(simplified, ob.PlannerTerminationCondition(simplify_done))
             extra["simplify_checks"] = checker.checks - c0
         left = tracker.checks_left()
         if left is None or recheck_cost(simplified) <= left:
