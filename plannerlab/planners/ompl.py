@@ -426,7 +426,7 @@ def _reach_m(robot: Robot, q: Array) -> float:
 
 #: most states of a path handed to OMPL's PathSimplifier.simplify (its collapseCloseVertices
 #: takes time cubic in them, with no termination condition polled)
-_SIMPLIFY_MAX_STATES = 100
+_SIMPLIFY_MAX_STATES = 400
 
 #: the capsule name nanobind reads a ``void *`` argument from (see ``_Space._fast_reader``)
 _NB_HANDLE = b"nb_handle"
