@@ -1287,7 +1287,15 @@ class Core:
 
     def is_valid(self, q: Array) -> bool:
         """Validity of one state q (dof,): one compiled call for Arm-Z."""
-        Qc = self._Q(q)
+        if (
+            type(q) is np.ndarray
+            and q.shape == (self.robot.dof,)
+            and q.dtype == np.float64
+            and q.flags.c_contiguous
+        ):
+            Qc = q.reshape(1, -1)  # a view: what _Q would make, without its checks
+        else:
+            Qc = self._Q(q)
         if len(Qc) != 1:
             raise ValueError(f"q must be one state ({self.robot.dof},), got shape {np.shape(q)}")
         if self._armz:
