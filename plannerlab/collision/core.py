@@ -63,6 +63,25 @@ margin 0.01 m; median per solve, this 2-core machine under other jobs, ``nice -n
     advance, per-link chain bounds                         44 803   0.302        -    10/10
     advance, + bounds at the configuration (Arm-Z)         14 888   0.181     1.13x   10/10
     ... + joint and link bounds in one pass                14 888   0.157     1.31x   10/10
+
+Then, on main f729c34 (the same checks per solve; ``MPlib/pl`` is now given for wall and
+CPU time, both from the bench's own lines; the machine shared by about five jobs, load
+4-10, so wall times vary by about ±30 % from run to run)::
+
+    option                                          checks/solve  CPU s   MPlib/pl wall, CPU
+    rebased, as above                                     14 888   0.173     1.57x, 1.35x
+    + reach bounds vectorised, goal distance from the
+      compiled tip, path clearance in one call            14 888   ~0.141         -
+    + OMPL states read in one binding call                14 888   0.113     1.95x, 1.89x
+    + joint axes with the capsule axes, leaner calls,
+      scalar goal distance                                14 888   0.096     2.14x, 2.34x
+
+Where a solve's time went before these (cProfile with CPU time, and timers around the
+callbacks): edge checks about a third (their compiled part ~2.5 µs per visited state, of
+which the distance pass 1.5 µs), reading OMPL states joint by joint ~20 %, the goal
+heuristic's NumPy kinematics ~15 %, building the checker's reach bounds ~10 %, the
+planned clearance ~5 %; OMPL itself (nearest neighbours on the SO(2) compound metric)
+about a fifth.
 """
 
 from __future__ import annotations
