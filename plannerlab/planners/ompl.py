@@ -916,10 +916,14 @@ class OMPLPlanner:
         best = [math.inf]
 
         tip = checker.tip  # compiled kinematics where the checker has them
+        # a goal whose distance is GoalRegion's (the tip's) takes the compiled tip; a goal
+        # with a distance of its own (a joint goal, say) is asked as it is
+        by_tip = type(goal).distance is GoalRegion.distance
 
         def distance(state: Any) -> float:
             fk[0] += 1
-            d = float(goal.distance_from_tip(*tip(space.to_q(state))))
+            q = space.to_q(state)
+            d = float(goal.distance_from_tip(*tip(q)) if by_tip else goal.distance(robot, q))
             if d < best[0]:
                 best[0] = d
                 trace.append(d)
