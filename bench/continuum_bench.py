@@ -42,15 +42,15 @@ from rich.markup import escape
 from rich.table import Table
 
 from plannerlab.planners import make_planner
-from plannerlab.planners.chord_arc import PAPER_TABLE, capsule_distances
-from plannerlab.planners.chord_arc_search import (
+from plannerlab.planners.chord_arc.geometry import (
     ChordArcInputError,
     ChordArcQuery,
-    ChordArcResult,
-    ChordArcSettings,
     ConvexPolygon,
-    solve_chord_arc,
 )
+from plannerlab.planners.chord_arc.motion import ChordArcResult, solve_chord_arc
+from plannerlab.planners.chord_arc.planner import PAPER_TABLE
+from plannerlab.planners.chord_arc.scene import capsule_distances
+from plannerlab.planners.chord_arc.settings import ChordArcSettings
 from plannerlab.problem.catalog import load_problem
 
 ROOT = Path(__file__).resolve().parents[1]

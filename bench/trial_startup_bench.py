@@ -5,7 +5,7 @@ Usage:
     PYTHONPATH=. python bench/trial_startup_bench.py [N]   # N trials per start method (6)
 
 Runs the same N small trials (``armz_pocket``, ``ompl.rrtconnect``, 300 collision checks,
-seeds 0..N-1, one at a time) through :func:`plannerlab.bench.trials.run_comparison` with
+seeds 0..N-1, one at a time) through :func:`plannerlab.comparison.runner.run_comparison` with
 the local backend's two start methods, in this one process. Start-up is what each child
 records as ``startup_s``: from the parent's launch of the trial to the child being ready
 to load the problem, plannerlab's trial modules (numpy, FCL, PyBullet, OMPL, toppra, the
@@ -22,8 +22,9 @@ from pathlib import Path
 
 
 def main(argv: list[str]) -> int:
-    from plannerlab.bench.local import LocalBackend
-    from plannerlab.bench.trials import Trial, run_comparison, run_trial
+    from plannerlab.comparison.local import LocalBackend
+    from plannerlab.comparison.runner import run_comparison
+    from plannerlab.comparison.trial import Trial, run_trial
     from plannerlab.problem.catalog import resolve_problem_path
     from plannerlab.record.files import versions
 

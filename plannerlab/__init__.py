@@ -24,10 +24,10 @@ import importlib
 from typing import TYPE_CHECKING, Any
 
 if TYPE_CHECKING:
-    from plannerlab.bench.report import markdown as markdown_report
-    from plannerlab.bench.task import execute_plan as execute
-    from plannerlab.bench.task import solve_legs as solve
-    from plannerlab.bench.trials import ComparisonRun, Trial, compare, summarise
+    from plannerlab.comparison.report import markdown as markdown_report
+    from plannerlab.comparison.runner import ComparisonRun, compare
+    from plannerlab.comparison.statistics import summarise
+    from plannerlab.comparison.trial import Trial
     from plannerlab.errors import PlannerlabError
     from plannerlab.planners import make_planner, planner_names
     from plannerlab.plot.animate import animate_plan
@@ -37,6 +37,8 @@ if TYPE_CHECKING:
     from plannerlab.record.execution import Execution
     from plannerlab.record.leg import PlanResult, Status
     from plannerlab.record.plan import ExecutionFile, Plan
+    from plannerlab.run.pipeline import execute_plan as execute
+    from plannerlab.run.pipeline import solve_legs as solve
 
 #: public name -> "module:attribute", imported on first access
 _EXPORTS: dict[str, str] = {
@@ -46,19 +48,19 @@ _EXPORTS: dict[str, str] = {
     "Budget": "plannerlab.problem.load:Budget",
     "planner_names": "plannerlab.planners:planner_names",
     "make_planner": "plannerlab.planners:make_planner",
-    "solve": "plannerlab.bench.task:solve_legs",
-    "execute": "plannerlab.bench.task:execute_plan",
-    "compare": "plannerlab.bench.trials:compare",
-    "summarise": "plannerlab.bench.trials:summarise",
-    "Trial": "plannerlab.bench.trials:Trial",
-    "ComparisonRun": "plannerlab.bench.trials:ComparisonRun",
+    "solve": "plannerlab.run.pipeline:solve_legs",
+    "execute": "plannerlab.run.pipeline:execute_plan",
+    "compare": "plannerlab.comparison.runner:compare",
+    "summarise": "plannerlab.comparison.statistics:summarise",
+    "Trial": "plannerlab.comparison.trial:Trial",
+    "ComparisonRun": "plannerlab.comparison.runner:ComparisonRun",
     "Status": "plannerlab.record.leg:Status",
     "PlanResult": "plannerlab.record.leg:PlanResult",
     "Plan": "plannerlab.record.plan:Plan",
     "Execution": "plannerlab.record.execution:Execution",
     "ExecutionFile": "plannerlab.record.plan:ExecutionFile",
     "PlannerlabError": "plannerlab.errors:PlannerlabError",
-    "markdown_report": "plannerlab.bench.report:markdown",
+    "markdown_report": "plannerlab.comparison.report:markdown",
     "snapshot_figure": "plannerlab.plot.plans:snapshot_figure",
     "trace_figure": "plannerlab.plot.plans:trace_figure",
     "animate_plan": "plannerlab.plot.animate:animate_plan",

@@ -286,6 +286,10 @@ CLI_CASES = {
         ["--planner", "ompl.rrtconnect", "--set", "goal_selection=far"],
         "goal_selection",
     ),
+    "descent_backend_unknown": (
+        ["--planner", "gradient.clearance", "--set", "backend=cuda"],
+        "backend",
+    ),
 }
 
 
@@ -596,3 +600,107 @@ def test_too_small_a_budget_is_reported_as_the_budget():
     )
     assert r.status is Status.BUDGET_EXHAUSTED, r.reason
     assert "collision-check budget of 2" in r.reason and r.collision_checks <= 2
+
+
+# --------------------------------------------------------------- URDF robots
+_PANDA = ROOT / "problems" / "urdf" / "panda"
+URDF_PROBLEM_TOML = f"""\
+[problem]
+name = "panda"
+[robot]
+type = "urdf"
+urdf = "{(_PANDA / "panda_spherized.urdf").as_posix()}"
+srdf = "{(_PANDA / "panda.srdf").as_posix()}"
+tip_link = "panda_hand"
+[start]
+q = [0, -0.785, 0, -2.356, 0, 1.571, 0.785]
+[[goals]]
+name = "g"
+q = [1.2, -0.3, 0.2, -2.0, 0.1, 1.9, 0.9]
+"""
+
+URDF_CASES = {
+    # name: (replace this, with that, what the error must name)
+    "missing_urdf_file": ("panda_spherized.urdf", "no_such.urdf", ("robot.urdf", "no_such.urdf")),
+    "unknown_tip_link": (
+        'tip_link = "panda_hand"',
+        'tip_link = "panda_hnd"',
+        ("robot.tip_link", "panda_hnd", "did you mean 'panda_hand'"),
+    ),
+    "missing_tip_link": ('tip_link = "panda_hand"', "", ("robot.tip_link", "is missing")),
+    "missing_srdf_file": ("panda.srdf", "nope.srdf", ("robot.srdf", "nope.srdf")),
+    "unknown_allowed_link": (
+        'tip_link = "panda_hand"',
+        'tip_link = "panda_hand"\nallowed_collisions = [["panda_link1", "panda_lnk3"]]',
+        ("robot.allowed_collisions", "panda_lnk3"),
+    ),
+    "allowed_not_pairs": (
+        'tip_link = "panda_hand"',
+        'tip_link = "panda_hand"\nallowed_collisions = ["panda_link1"]',
+        ("robot.allowed_collisions", "pairs"),
+    ),
+    "goal_state_too_short": (
+        "q = [1.2, -0.3, 0.2, -2.0, 0.1, 1.9, 0.9]",
+        "q = [1.2, -0.3]",
+        ("goals[0].q", "7 joint values"),
+    ),
+    "goal_state_off_limits": (
+        "q = [1.2, -0.3, 0.2, -2.0, 0.1, 1.9, 0.9]",
+        "q = [1.2, -0.3, 0.2, 2.0, 0.1, 1.9, 0.9]",
+        ("goals[0].q", "panda_joint4"),
+    ),
+    "goal_state_and_position": (
+        "q = [1.2, -0.3, 0.2, -2.0, 0.1, 1.9, 0.9]",
+        "q = [1.2, -0.3, 0.2, -2.0, 0.1, 1.9, 0.9]\np_m = [0, 0, 1]",
+        ("goals[0].p_m",),
+    ),
+}
+
+
+@pytest.mark.parametrize("case", sorted(URDF_CASES))
+def test_bad_urdf_problem_file(capsys, tmp_path, case):
+    old, new, names = URDF_CASES[case]
+    assert old in URDF_PROBLEM_TOML
+    path = write_problem(tmp_path, URDF_PROBLEM_TOML.replace(old, new))
+    code, _, err = run(capsys, "solve", str(path), "--planner", "ompl.rrtconnect")
+    assert_clean_error(code, err.replace("\n", ""), str(path), *names)
+
+
+def test_the_valid_urdf_problem_is_valid(tmp_path):
+    problem = parse_problem(write_problem(tmp_path, URDF_PROBLEM_TOML))
+    assert problem.robot.kind == "urdf" and problem.robot.dof == 7
+
+
+def test_a_malformed_urdf_names_the_file_and_the_key(capsys, tmp_path):
+    broken = tmp_path / "broken.urdf"
+    broken.write_text("<robot name='x'><link name='a'>", encoding="utf-8")
+    text = URDF_PROBLEM_TOML.replace((_PANDA / "panda_spherized.urdf").as_posix(), "broken.urdf")
+    path = write_problem(tmp_path, text)
+    code, _, err = run(capsys, "solve", str(path), "--planner", "ompl.rrtconnect")
+    assert_clean_error(code, err.replace("\n", ""), str(path), "robot.urdf", "broken.urdf")
+
+
+def test_bad_mbm_yaml_names_the_file_and_the_key(capsys, tmp_path):
+    scene = tmp_path / "scene0001.yaml"
+    request = tmp_path / "request0001.yaml"
+    scene.write_text(
+        "world:\n  collision_objects:\n    - id: a\n      primitives:\n"
+        "        - type: cone\n          dimensions: [1, 2]\n      primitive_poses:\n"
+        "        - position: [0, 0, 0]\n          orientation: [0, 0, 0, 1]\n",
+        encoding="utf-8",
+    )
+    request.write_text("start_state: {}\n", encoding="utf-8")
+    code, _, err = run(
+        capsys,
+        "import",
+        "mbm",
+        str(scene),
+        str(request),
+        "--urdf",
+        str(_PANDA / "panda_spherized.urdf"),
+        "--out",
+        str(tmp_path / "out"),
+    )
+    assert_clean_error(
+        code, err.replace("\n", ""), str(scene), "world.collision_objects[0].primitives[0]"
+    )

@@ -20,17 +20,11 @@ from pathlib import Path
 
 import pytest
 
-from plannerlab.bench.trials import (
-    ERROR_STATUS,
-    Trial,
-    TrialStore,
-    parse_seeds,
-    run_comparison,
-    run_trial,
-    summarise,
-    wilson_interval,
-)
 from plannerlab.cli.main import main
+from plannerlab.comparison.runner import run_comparison
+from plannerlab.comparison.statistics import summarise, wilson_interval
+from plannerlab.comparison.store import TrialStore
+from plannerlab.comparison.trial import ERROR_STATUS, Trial, parse_seeds, run_trial
 from plannerlab.errors import PlannerlabError
 from plannerlab.problem.catalog import resolve_problem_path
 
@@ -349,7 +343,7 @@ def test_a_planner_whose_seeds_are_one_trial_is_marked_and_gets_no_interval(
 
 def test_fork_server_children_match_spawned_interpreters(comparison: dict, tmp_path: Path) -> None:
     """A child forked from the warm fork server gives what a fresh interpreter gives."""
-    from plannerlab.bench.local import LocalBackend
+    from plannerlab.comparison.local import LocalBackend
 
     first = {r["key"]: r for r in _lines(comparison["store"])}
     pick = [t for t in _trials() if t.seed == 2]
@@ -366,7 +360,7 @@ def test_fork_server_children_match_spawned_interpreters(comparison: dict, tmp_p
 def test_a_trial_past_its_time_limit_is_killed_and_recorded(tmp_path: Path) -> None:
     """A planner that overruns the per-trial limit is killed, recorded as timeout, and the
     comparison goes on with the next trial."""
-    from plannerlab.bench.trials import TIMEOUT_STATUS
+    from plannerlab.comparison.trial import TIMEOUT_STATUS
 
     path = resolve_problem_path(PROBLEM).resolve()
     slow = Trial.make(PROBLEM, path, "gradient", 0)  # default budget: seconds
@@ -400,9 +394,11 @@ def test_cli_trial_timeout_records_timeouts(tmp_path: Path) -> None:
         code = main(
             [
                 "compare",
-                SLOW_PROBLEM,  # the clearance descent plans for many seconds here
+                SLOW_PROBLEM,  # the numpy clearance descent plans for many seconds here
                 "--planners",
                 "gradient.clearance",
+                "--set",
+                "gradient.clearance:backend=numpy",
                 "--seeds",
                 "0",
                 "--trial-timeout",
@@ -512,8 +508,11 @@ def test_a_trial_whose_process_dies_is_recorded(tmp_path: Path) -> None:
 
     path = resolve_problem_path(PROBLEM).resolve()
     slow_path = resolve_problem_path(SLOW_PROBLEM).resolve()
-    # the clearance descent over the paper's seven legs: many seconds, whatever the machine
-    victim = Trial.make(SLOW_PROBLEM, slow_path, "gradient.clearance", 0)
+    # the numpy clearance descent over the paper's seven legs: many seconds, whatever the
+    # machine (the compiled one plans them in well under a second)
+    victim = Trial.make(
+        SLOW_PROBLEM, slow_path, "gradient.clearance", 0, settings={"backend": "numpy"}
+    )
     other = Trial.make(PROBLEM, path, "gradient.analytic", 0, budget={"max_collision_checks": 100})
     killed: list[int] = []
 
@@ -644,3 +643,21 @@ def test_store_is_locked_while_written(tmp_path: Path) -> None:
         with pytest.raises(PlannerlabError, match="in use"), store.writer():
             pass
     assert TrialStore(tmp_path / "s.jsonl").load() == {"k": {"key": "k", "x": 1}}
+
+
+def test_the_api_checks_a_comparison_as_the_cli_does(tmp_path: Path) -> None:
+    """``plannerlab.compare`` builds the same ComparisonSpec as ``plannerlab compare``: a
+    planner on the wrong robot kind, an unknown leg or a bad budget fail before any trial
+    runs (no store is written)."""
+    import plannerlab as pl
+
+    store = tmp_path / "s.jsonl"
+    with pytest.raises(PlannerlabError, match="works on continuum_chain robots"):
+        pl.compare(["armz_pocket"], ["chord_arc"], [0], store)
+    with pytest.raises(PlannerlabError, match="unknown leg 'nowhere'"):
+        pl.compare(["armz_pocket"], ["gradient"], [0], store, legs="nowhere")
+    with pytest.raises(PlannerlabError, match="max_collision_checks: expected a number > 0"):
+        pl.compare(["armz_pocket"], ["gradient"], [0], store, budget={"max_collision_checks": 0})
+    with pytest.raises(PlannerlabError, match="backend: expected one of local, ray"):
+        pl.compare(["armz_pocket"], ["gradient"], [0], store, backend="slurm")
+    assert not store.exists()

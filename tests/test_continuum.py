@@ -13,17 +13,15 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from plannerlab.planners.chord_arc_search import (
+from plannerlab.planners.chord_arc.geometry import (
     ChordArcInputError,
     ChordArcQuery,
-    ChordArcSettings,
     Circle,
     ConvexPolygon,
-    MotionStep,
-    prepare,
-    search_chord_arc,
-    solve_chord_arc,
 )
+from plannerlab.planners.chord_arc.motion import MotionStep, solve_chord_arc
+from plannerlab.planners.chord_arc.search import prepare, search_chord_arc
+from plannerlab.planners.chord_arc.settings import ChordArcSettings
 from plannerlab.robots.base import Robot, pose_matrix
 from plannerlab.robots.continuum.model import (
     ContinuumChain,
@@ -440,9 +438,9 @@ def test_one_contact_solutions_are_the_two_arc_geometry() -> None:
 
 
 def test_the_planner_has_one_settings_class() -> None:
-    from plannerlab.planners import chord_arc, chord_arc_search
+    from plannerlab.planners import make_planner
 
-    assert chord_arc.ChordArcSettings is chord_arc_search.ChordArcSettings
+    assert type(make_planner("chord_arc").settings) is ChordArcSettings
     with pytest.raises(ChordArcInputError, match="choose must be one of"):
         ChordArcSettings(choose="best")
     assert ChordArcSettings().inflate_by_radius  # the robot's radius by default
@@ -468,7 +466,7 @@ def test_batched_capsule_contacts_equal_fcl(case: int) -> None:
     (link, obstacle) pairs python-fcl reports for the 3-D capsules and boxes."""
     from plannerlab.collision.fcl_checker import CollisionChecker
     from plannerlab.planners import make_planner
-    from plannerlab.planners.chord_arc import capsule_distances
+    from plannerlab.planners.chord_arc.scene import capsule_distances
 
     problem = _problem(case)
     chain = problem.robot
@@ -555,26 +553,41 @@ def test_problem_files_load_as_continuum_chains(case: int) -> None:
     np.testing.assert_allclose(robot.T_world_base[:3, 0], [0.0, 1.0, 0.0], atol=1e-15)
 
 
-def test_case_figure_draws_the_query_and_the_solutions(tmp_path: Path) -> None:
+def test_case_figure_draws_the_contact_plan(tmp_path: Path) -> None:
+    """The figure is drawn from the leg's record (no search), and the record's arcs are
+    the search's curves."""
     from matplotlib.patches import Polygon
 
+    from plannerlab.planners import make_planner
     from plannerlab.plot.continuum import case_figure, draw_case, solution_xy
+    from plannerlab.problem.catalog import load_problem
+    from plannerlab.run.pipeline import leg_rng
 
-    q = _wall_query()
-    res = solve_chord_arc(q)
-    fig = case_figure(q, res)
+    problem = load_problem("continuum_case1")
+    planner = make_planner("chord_arc")
+    r = planner.solve(problem, 0, problem.budget, leg_rng(0, 0))
+    plan = r.contact_plan
+    assert plan is not None and plan.solutions
+    _, res = planner.search(problem, 0)
+    by_points = {p.solution.contact_indices: p.solution for p in res.plans}
+    for sol in plan.solutions:
+        a = np.linspace(0.0, 1.0, 100)
+        curve = np.vstack([arc.points(a) for arc in by_points[sol.contact_indices].arcs])
+        np.testing.assert_allclose(solution_xy(sol), curve, atol=1e-12)
+    fig = case_figure(plan)
     (ax,) = fig.axes
     polys = [p for p in ax.patches if isinstance(p, Polygon)]
-    assert len(polys) == len(q.obstacles)
-    np.testing.assert_allclose(polys[0].get_xy()[:4], np.array(q.obstacles[0].vertices_m))
+    assert len(polys) == sum(1 for o in plan.obstacles if not o.is_disc)
     lines = {ln.get_label(): ln for ln in ax.get_lines()}
-    np.testing.assert_allclose(lines["collision points"].get_xydata(), q.collision_points_m)
-    np.testing.assert_allclose(lines["target"].get_xydata(), [q.target_xy_m])
+    np.testing.assert_allclose(lines["collision points"].get_xydata(), plan.collision_points_m)
+    np.testing.assert_allclose(lines["target"].get_xydata(), [plan.target_xy_m])
     red = [ln for ln in ax.get_lines() if ln.get_color() == "tab:red"]
-    assert len(red) == len(res.plans)
-    for ln, p in zip(red, res.plans, strict=True):
-        np.testing.assert_allclose(ln.get_xydata(), solution_xy(p.solution))
-    out = draw_case(q, res, tmp_path / "fig" / "wall.png")
+    assert len(red) == len(plan.solutions)
+    for ln, sol in zip(red, plan.solutions, strict=True):
+        np.testing.assert_allclose(ln.get_xydata(), solution_xy(sol))
+    grey = [ln for ln in ax.get_lines() if ln.get_color() == "0.6"]
+    assert len(grey) == len(plan.dropped)
+    out = draw_case(plan, tmp_path / "fig" / "case1.png")
     assert out.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
 
 
@@ -589,3 +602,29 @@ def test_plot_module_leaves_the_backend_alone() -> None:
         "assert 'matplotlib.pyplot' not in __import__('sys').modules"
     )
     subprocess.run([sys.executable, "-c", code], check=True, env={"MPLBACKEND": "svg"})
+
+
+def test_the_zero_thickness_plan_records_where_the_robot_would_cut() -> None:
+    """Case 2 (the paper's two solutions, one lost for a 2 mm robot): the thickness figure
+    needs no search of its own, the zero-thickness leg's record says where a robot of the
+    link's radius along the lost curve would cut the obstacles."""
+    from plannerlab.planners import make_planner
+    from plannerlab.plot.continuum import searched
+    from plannerlab.problem.catalog import load_problem
+    from plannerlab.run.pipeline import leg_rng
+
+    problem = load_problem("continuum_case2")
+    plans = {
+        thick: make_planner("chord_arc", {"inflate_by_radius": thick})
+        .solve(problem, 0, problem.budget, leg_rng(0, 0))
+        .contact_plan
+        for thick in (False, True)
+    }
+    thin = {s.contact_indices: s for s in searched(plans[False])}
+    thick = {s.contact_indices for s in searched(plans[True])}
+    lost = set(thin) - thick
+    assert len(thin) == 2 and len(thick) == 1 and len(lost) == 1
+    assert thin[lost.pop()].cuts_xy_m  # the lost one cuts a corner
+    assert all(not s.cuts_xy_m for s in searched(plans[True]))  # the axis plan records none
+    assert plans[True].inflated_by_m == problem.robot.link_radius_m > 0
+    assert plans[False].inflated_by_m == 0.0

@@ -26,12 +26,12 @@ from concurrent.futures import ProcessPoolExecutor
 import numpy as np
 import pytest
 
-from plannerlab.bench.task import leg_rng
 from plannerlab.planners import make_planner
 from plannerlab.planners.base import PlanResult, Status
-from plannerlab.planners.chord_arc import PAPER_TABLE
+from plannerlab.planners.chord_arc.planner import PAPER_TABLE
 from plannerlab.problem.catalog import load_problem
 from plannerlab.problem.load import Budget
+from plannerlab.run.pipeline import leg_rng
 
 CASES = (1, 2, 3)
 #: zero-thickness solution counts: the paper's Table I
@@ -70,7 +70,7 @@ _RRT = """
 import json, sys
 from plannerlab.problem.catalog import load_problem
 from plannerlab.planners import make_planner
-from plannerlab.bench.task import leg_rng
+from plannerlab.run.pipeline import leg_rng
 p = load_problem(sys.argv[1])
 r = make_planner("ompl.rrtconnect").solve(
     p, 0, p.budget.replace(max_collision_checks=int(sys.argv[2])), leg_rng(0, 0))
@@ -120,29 +120,33 @@ def _rrt(rrt_runs, case: int) -> dict:
 def test_chord_arc_solution_counts(case: int, thick: bool) -> None:
     r = _solve(case, {"inflate_by_radius": thick})
     assert r.status is Status.SOLVED, r.reason
-    sols = r.extra["solutions"]
+    cp = r.contact_plan
+    assert cp is not None
+    sols = cp.solutions
     assert len(sols) == (THICK_SOLUTIONS if thick else PAPER_SOLUTIONS)[case]
     if thick:
-        assert sols[r.extra["chosen"]]["contact_indices"] == list(CHOSEN_POINTS[case])
-        assert not any(d.get("unexpected_contacts") for d in r.extra["dropped"])
+        assert cp.chosen_solution.contact_indices == CHOSEN_POINTS[case]
+        assert not any(d.unexpected_contacts for d in cp.dropped)
     for s in sols:
-        n = len(s["contact_indices"])
+        n = len(s.contact_indices)
         assert n >= 1  # unsolvable without contact
-        assert len(s["bend_angles_rad"]) == len(s["arc_lengths_m"]) == n + 1
-        assert len(s["contact_points_m"]) == len(s["contact_types"]) == n
-        assert set(s["contact_types"]) <= {"forward", "backward"}
-        assert s["total_length_m"] <= load_problem(f"continuum_case{case}").robot.length_m
-    assert r.extra["dropped"] and all(d["reason"] for d in r.extra["dropped"])
-    assert 0 <= r.extra["chosen"] < len(sols)
+        assert len(s.bend_angles_rad) == len(s.arc_lengths_m) == len(s.arcs) == n + 1
+        assert len(s.contact_points_m) == len(s.contact_types) == n
+        assert set(s.contact_types) <= {"forward", "backward"}
+        assert s.total_length_m <= load_problem(f"continuum_case{case}").robot.length_m
+        assert s.path_waypoints > 0 and not s.reason
+    assert cp.dropped and all(d.reason and d.stage for d in cp.dropped)
+    assert cp.chosen is not None and 0 <= cp.chosen < len(sols)
     # the path: retracted start, tip at the target, contact only at collision points
     assert np.all(r.path[0] == 0.0)
     assert r.pos_err_m < 1e-3
-    chosen = sols[r.extra["chosen"]]
-    assert r.extra["expected_contacts"]
-    assert {e["collision_point"] for e in r.extra["expected_contacts"]} <= set(
-        chosen["contact_indices"]
+    assert cp.expected_contacts
+    assert {e.collision_point for e in cp.expected_contacts} <= set(
+        cp.chosen_solution.contact_indices
     )
+    # the record goes through the codec and back unchanged
     assert json.loads(json.dumps(r.to_dict())) == r.to_dict()
+    assert PlanResult.from_dict(json.loads(json.dumps(r.to_dict()))).contact_plan == cp
 
 
 @pytest.mark.parametrize("case", CASES)
@@ -151,7 +155,7 @@ def test_chord_arc_is_the_same_every_run(case: int) -> None:
     np.testing.assert_array_equal(a.path, b.path)
     da, db = a.to_dict(), b.to_dict()
     for d in (da, db):
-        d["extra"].pop("search")  # holds the search's wall time
+        d["contact_plan"]["search"].pop("time_s")  # the search's wall time
         d.pop("time_s")
         d.pop("seed")
         d["progress"] = [row[1:] for row in d["progress"]]  # without the clock
@@ -173,7 +177,7 @@ def test_a_single_section_without_contact_reaches_no_target(case: int) -> None:
     """The paper: "all three cases are unsolvable for a single section without contact"."""
     r = _solve(case, {"max_depth": 1})
     assert r.status is Status.FAILED
-    assert r.extra["search"]["geometric_solutions"] == 0
+    assert r.contact_plan.search["geometric_solutions"] == 0
 
 
 # --------------------------------------------------------------------------- RRT-Connect
@@ -214,7 +218,7 @@ def test_without_the_sleeve_the_chain_is_no_single_section(tmp_path) -> None:
 def test_the_solutions_lost_to_thickness_are_those_that_cut(case: int) -> None:
     """A zero-thickness solution survives the robot's radius exactly when a 2 mm robot
     along its curve would not cut an obstacle away from its collision points."""
-    from plannerlab.planners.chord_arc import thickness_cuts
+    from plannerlab.planners.chord_arc.scene import thickness_cuts
 
     problem = load_problem(f"continuum_case{case}")
     thin_planner = make_planner("chord_arc", {"inflate_by_radius": False})
@@ -248,17 +252,17 @@ def test_execution_reaches_the_target_touching_only_the_planned_points(
     data = executions[case].result(timeout=900)
     plan = PlanResult.from_dict(data["plan"])
     e = Execution.from_dict(data["execution"])
-    sol = plan.extra["solutions"][e.extra["chosen"]]
-    assert tuple(sol["contact_indices"]) == CHOSEN_POINTS[case]
+    sol = plan.contact_plan.solutions[e.extra["chosen"]]
+    assert sol.contact_indices == CHOSEN_POINTS[case]
     assert tuple(e.extra["collision_points_used"]) == CHOSEN_POINTS[case]
-    assert [m["kind"] for m in sol["motion"]] == ["follow", "push", "rebend", "follow"]
+    assert [kind for kind, _ in sol.motion] == ["follow", "push", "rebend", "follow"]
     assert e.final_pos_err_m < problem.goal(0).pos_tol_m, e.reason
     assert e.goal_reached and e.leg == 0 and e.goal == problem.goal(0).name
     assert not e.unexpected_contacts, e.reason
     assert e.success, e.reason
     assert e.path_valid is None  # no FCL re-check: the path touches by design
-    guides = set(plan.extra["guide_obstacles"])
-    owners = set(sol["contact_obstacles"])
+    guides = set(plan.contact_plan.guide_obstacles)
+    owners = set(sol.contact_obstacles)
     touched = {c.other_name for c in e.contacts}
     assert touched <= owners | guides, touched
     # the log: one row per commanded waypoint, the chain on the path to 1 cm

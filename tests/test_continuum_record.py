@@ -52,8 +52,8 @@ def test_json_embeds_the_plan_and_execution_records(continuum_run) -> None:
     plan = Plan.load(plan_file)
     (leg,) = plan.legs
     assert plan.planner == "chord_arc" and plan.seed == 0 and plan.problem == CASE
-    assert leg.solved and leg.extra["chosen"] == 0
-    assert leg.extra["solutions"][0]["contact_indices"] == [1]
+    assert leg.solved and leg.contact_plan.chosen == 0
+    assert leg.contact_plan.solutions[0].contact_indices == (1,)
     # the execution entry is the execution file's record
     ex = ExecutionFile.load(out / f"{CASE}.plan.exec.json")
     assert ex.plan_file == str(plan_file) and ex.planner == "chord_arc"
@@ -96,10 +96,10 @@ def test_plannerlab_plot_reads_a_continuum_plan(continuum_run, tmp_path) -> None
 
 
 def test_densify_restores_the_planner_steps_and_keeps_a_sampled_path() -> None:
-    from plannerlab.bench.task import leg_rng, solve_legs
     from plannerlab.planners import make_planner
     from plannerlab.problem.catalog import load_problem
     from plannerlab.robots.paths import waypoints
+    from plannerlab.run.pipeline import leg_rng, solve_legs
     from plannerlab.sim.continuum import densify_chord_arc_path
 
     problem = load_problem("continuum_case2")

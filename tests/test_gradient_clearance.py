@@ -6,13 +6,13 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from plannerlab.bench.task import leg_rng, solve_legs
 from plannerlab.collision.fcl_checker import CollisionChecker
 from plannerlab.errors import PlannerlabError
 from plannerlab.planners import make_planner
 from plannerlab.planners.base import Status
 from plannerlab.planners.clearance import ClearanceField
 from plannerlab.problem.catalog import load_problem
+from plannerlab.run.pipeline import leg_rng, solve_legs
 
 
 def test_clearance_gradient_is_the_derivative_of_the_cost():

@@ -20,10 +20,10 @@ import pytest
 from conftest import plannerlab
 
 import plannerlab as pl
-from plannerlab.bench.task import canonical_result, execute_results, leg_rng
 from plannerlab.record.codec import dumps, loads
 from plannerlab.record.plan import ExecutionFile, Plan, execution_path
 from plannerlab.robots.paths import waypoints
+from plannerlab.run.pipeline import canonical_result, execute_results, leg_rng
 
 PROBLEM = "armz_pocket"
 PLANNER = "gradient.clearance+detour"

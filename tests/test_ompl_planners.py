@@ -195,6 +195,30 @@ def test_a_held_path_is_always_rechecked_within_the_budget(suffix: str) -> None:
     assert outcomes.count(Status.SOLVED) == len(outcomes), outcomes
 
 
+def _seeds_in_effect(seed: int) -> list[int]:
+    """Spawned worker: three solves in one process, each from its own generator."""
+    del seed
+    planner = make_planner("ompl.rrtconnect")
+    return [
+        int(
+            planner.solve(
+                toy_problem(), 0, Budget(max_collision_checks=2_000), np.random.default_rng(s)
+            ).extra["ompl_seed"]
+        )
+        for s in (1, 2, 3)
+    ]
+
+
+def test_every_leg_records_the_ompl_seed_in_effect() -> None:
+    """OMPL is seeded once per process, by the first solve: every later solve records
+    that seed (the one in effect), not the one it asked for (which OMPL ignores)."""
+    ctx = mp.get_context("spawn")
+    with ctx.Pool(1, maxtasksperchild=1) as pool:
+        (seeds,) = pool.map(_seeds_in_effect, [0])
+    first_request = int(np.random.default_rng(1).integers(1, 2**31 - 1))
+    assert seeds == [first_request] * 3
+
+
 def test_rrtconnect_regression_fresh_processes() -> None:
     """Fixed seed, check budget: the same path in two fresh processes, and solved."""
     ctx = mp.get_context("spawn")

@@ -19,7 +19,6 @@ from matplotlib import animation
 from PIL import Image
 from scipy.spatial import ConvexHull
 
-from plannerlab.bench.task import solve_legs
 from plannerlab.cli.main import main
 from plannerlab.errors import PlannerlabError
 from plannerlab.plot.animate import animation_figure, motion_frames, write_animation
@@ -33,6 +32,7 @@ from plannerlab.plot.plans import (
     trace_figure,
 )
 from plannerlab.problem.catalog import load_problem
+from plannerlab.run.pipeline import solve_legs
 
 #: gradient+rrtconnect solves armz_pocket in ~65 000 checks with the 1-cm margin (edges in metres)
 CHECKS = 200_000

@@ -90,7 +90,7 @@ def test_bad_file_names_file_key_and_expectation(tmp_path, case):
 
 def test_a_start_in_collision_is_refused_where_planning_starts(tmp_path):
     """Loading needs no collision checker; planning checks the start once, naming the pairs."""
-    from plannerlab.bench.task import solve_legs
+    from plannerlab.run.pipeline import solve_legs
 
     problem = load_problem(write_problem(tmp_path, START_IN_COLLISION))
     with pytest.raises(ProblemError) as err:

@@ -13,13 +13,8 @@ import numpy as np
 import pytest
 
 from plannerlab.errors import ProblemError, UnknownNameError
-from plannerlab.problem.load import (
-    ROBOT_TYPES,
-    TableReader,
-    build_robot,
-    parse_robot_table,
-    robot_table,
-)
+from plannerlab.problem.load import TableReader, build_robot, parse_robot_table
+from plannerlab.robots.registry import FAMILIES, robot_table
 from plannerlab.robots.schema import Key, RobotTable, TableValueError
 
 DOC = Path(__file__).resolve().parents[1] / "docs" / "problem-format.md"
@@ -48,7 +43,7 @@ def _doc_value(cell: str) -> object:
     return tomllib.loads("v = " + cell.replace("−", "-"))["v"]
 
 
-@pytest.mark.parametrize("kind", sorted(ROBOT_TYPES))
+@pytest.mark.parametrize("kind", sorted(FAMILIES))
 def test_the_doc_lists_every_declared_key_with_its_unit_and_default(kind):
     table = robot_table(kind)
     rows = _doc_rows(kind)
@@ -56,11 +51,16 @@ def test_the_doc_lists_every_declared_key_with_its_unit_and_default(kind):
     for key in table.keys:
         unit, default, meaning = rows[key.name]
         assert unit == key.unit, (kind, key.name)
+        if key.required:
+            assert default == "required", (kind, key.name, default)
+            continue
         value = _doc_value(default)
-        if key.kind == "vector":
+        if key.kind == "pairs":
+            assert value == [list(p) for p in key.default], (kind, key.name)  # type: ignore[union-attr]
+        elif key.kind == "vector":
             assert isinstance(value, list), (kind, key.name, default)
             assert np.allclose(value, key.default, rtol=0, atol=1e-12), (kind, key.name)
-        elif key.kind == "string":
+        elif key.kind in ("string", "path"):
             assert value == key.default, (kind, key.name)
         else:
             assert isinstance(value, int | float) and abs(value - key.default) < 1e-12, (
@@ -80,11 +80,16 @@ def test_the_doc_check_reads_a_table_as_written():
     assert _doc_value(rows["dead_wedge_side"][1]) == "-z"
 
 
-@pytest.mark.parametrize("kind", sorted(ROBOT_TYPES))
+@pytest.mark.parametrize("kind", sorted(FAMILIES))
 def test_a_table_with_only_the_type_builds_the_models_defaults(kind):
     """The declared defaults are the model's own: nothing drifts between the two."""
     table = robot_table(kind)
     assert table.type == kind
+    required = [k.name for k in table.keys if k.required]
+    if required:  # a URDF robot has no defaults to build: the table names what is missing
+        with pytest.raises(ProblemError, match=rf"mem\.toml.*robot\.{required[0]}\] is missing"):
+            build_robot(TableReader("mem.toml", "robot", {"type": kind}))
+        return
     robot = build_robot(TableReader("mem.toml", "robot", {"type": kind}))
     default = type(robot)()
     for f in dataclasses.fields(robot):
@@ -158,9 +163,9 @@ def test_a_bad_value_names_the_file_the_key_and_the_expectation(case):
 
 
 def test_a_combination_the_constructor_refuses_names_its_key(monkeypatch):
-    import plannerlab.problem.load as load
+    from plannerlab.robots import registry
 
-    monkeypatch.setitem(load.ROBOT_TYPES, "toy", f"{__name__}:TOY")
+    monkeypatch.setitem(registry.FAMILIES, "toy", registry.RobotFamily("toy", f"{__name__}:TOY"))
     reader = TableReader("toy.toml", "robot", {"type": "toy", "count": 7})
     with pytest.raises(ProblemError) as err:
         build_robot(reader)
@@ -201,3 +206,60 @@ def test_a_malformed_declaration_is_refused_when_declared(kwargs):
 def test_type_and_note_are_not_declared_by_a_family():
     with pytest.raises(ValueError, match="common to every robot table"):
         Key("note", "string", "")
+
+
+def test_a_family_plugs_in_with_one_registry_entry(monkeypatch, tmp_path):
+    """A new robot family needs its entry in robots/registry.py and nothing in problem/:
+    a problem file naming it loads through the registered table, and its own reach bound
+    and goal sampler are the ones used."""
+    from plannerlab.problem.goals import GoalRegion, unreachable_reason
+    from plannerlab.problem.load import parse_problem
+    from plannerlab.robots import registry
+    from plannerlab.robots.registry import goal_sampler
+
+    entry = registry.RobotFamily(
+        "armz_alias",
+        f"{__name__}:ALIAS_TABLE",
+        reach=f"{__name__}:_tiny_reach",
+        goal_sampler=f"{__name__}:_no_goal",
+    )
+    monkeypatch.setitem(registry.FAMILIES, "armz_alias", entry)
+    path = tmp_path / "p.toml"
+    path.write_text(
+        '[problem]\nname = "alias"\n[robot]\ntype = "armz_alias"\nn_modules = 6\n'
+        '[start]\nfill_deg = 180.0\n[[goals]]\nname = "g"\n'
+        "p_m = [1.0, 0.0, 1.0]\nn = [0.0, 0.0, 1.0]\npos_tol_m = 0.1\nangle_tol_deg = 10.0\n",
+        encoding="utf-8",
+    )
+    problem = parse_problem(path)
+    assert problem.robot.dof == 5  # the Arm-Z table built it
+    goal = GoalRegion("g", np.array([1.0, 0.0, 1.0]), np.array([0.0, 0.0, 1.0]), 0.1, 10.0)
+    assert "tiny reach" in unreachable_reason(problem.robot, goal)
+    assert goal_sampler("armz_alias") is _no_goal
+
+
+def _alias_build(values):
+    from plannerlab.robots.armz.schema import TABLE
+
+    robot = TABLE.build(values)
+    object.__setattr__(robot, "kind", "armz_alias")  # a family's robots carry its kind
+    return robot
+
+
+def _alias_table():
+    import dataclasses
+
+    from plannerlab.robots.armz.schema import TABLE
+
+    return dataclasses.replace(TABLE, type="armz_alias", build=_alias_build)
+
+
+ALIAS_TABLE = _alias_table()
+
+
+def _tiny_reach(robot, p_world_m):
+    return float(np.linalg.norm(p_world_m)), 0.01, "tiny reach"
+
+
+def _no_goal(robot, goal, rng, seeds=()):
+    return None

@@ -18,7 +18,6 @@ import numpy as np
 import pytest
 from rich.console import Console
 
-from plannerlab.bench.trials import SUMMARY_COLUMNS as ROW_KEYS
 from plannerlab.cli.main import main
 from plannerlab.cli.solve import leg_table
 from plannerlab.cli.tables import (
@@ -30,6 +29,7 @@ from plannerlab.cli.tables import (
     pick_columns,
     print_summary_tables,
 )
+from plannerlab.comparison.statistics import SUMMARY_COLUMNS as ROW_KEYS
 from plannerlab.errors import PlannerlabError
 from plannerlab.planners.base import PlanResult
 

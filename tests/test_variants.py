@@ -96,8 +96,8 @@ def test_a_committed_variant_is_solved_and_executed_end_to_end():
     the best gradient-based planner with default settings does all seven legs within
     20 000 checks per leg, every path valid at a quarter of joint_step, and PyBullet
     executes every leg without contact with the tip in every goal region."""
-    from plannerlab.bench.task import execute_plan, solve_legs
     from plannerlab.record.leg import Status
+    from plannerlab.run.pipeline import execute_plan, solve_legs
 
     problem = load_problem(PROBLEMS / "variants" / "armz_inspection_v00.toml")
     budget = problem.budget.replace(max_collision_checks=20_000, time_limit_s=None)

@@ -14,8 +14,8 @@ from plannerlab.errors import PlannerlabError
 
 
 def cmd_animate(args: argparse.Namespace, console: Console) -> int:
-    from plannerlab.bench.plan_check import check_plan, read_plan
     from plannerlab.plot.animate import animate_plan
+    from plannerlab.run.plan_check import check_plan, read_plan
 
     if args.frames < 2:
         raise PlannerlabError(f"--frames: expected >= 2, got {args.frames}")
@@ -28,7 +28,7 @@ def cmd_animate(args: argparse.Namespace, console: Console) -> int:
     executions = plan_executions(args.plan)
     note = "with its execution record (PLAN.exec.json)"
     if not executions and not args.no_execute:
-        from plannerlab.bench.task import execute_results
+        from plannerlab.run.pipeline import execute_results
 
         with console.status(f"executing {len(plan.legs)} legs in PyBullet (none recorded)"):
             executions = execute_results(problem, plan.legs)

@@ -1,5 +1,5 @@
 """What the subcommands share: budget and leg flags, setting overrides; numbers are
-formatted by :func:`plannerlab.bench.report.fmt`, as in the tables."""
+formatted by :func:`plannerlab.comparison.report.fmt`, as in the tables."""
 
 from __future__ import annotations
 
@@ -120,25 +120,6 @@ def budget_from_args(problem: Any, args: argparse.Namespace) -> Any:
         max_collision_checks=args.max_checks,
         time_limit_s=args.time_limit,
     )
-
-
-def legs_from_spec(problem: Any, spec: str | None) -> list[int] | None:
-    if spec is None or spec.strip() == "all":
-        return None
-    legs = []
-    for x in spec.split(","):
-        x = x.strip()
-        try:
-            legs.append(problem.resolve_leg(x))
-        except (IndexError, KeyError) as exc:
-            names = ", ".join(f"{i} {g.name}" for i, g in enumerate(problem.goals))
-            raise PlannerlabError(
-                f"--legs: unknown leg {x!r} of {problem.name} ({problem.source}); "
-                f"its legs are: {names}"
-            ) from exc
-    if len(set(legs)) != len(legs):
-        raise PlannerlabError(f"--legs: {spec!r} names a leg twice")
-    return legs
 
 
 def require_display(gui: bool) -> None:

@@ -21,7 +21,9 @@ CSV, Markdown and OMPL benchmark logs in ``DIR/NAME/`` (load a log with
 
 Budgets are per leg; use ``--max-checks`` or ``--max-iterations`` for reproducible
 numbers, ``--time-limit`` for benchmarks. Argument parsing and printing only: the work
-is :mod:`plannerlab.bench.trials` and :mod:`plannerlab.bench.report`.
+is :class:`plannerlab.comparison.spec.ComparisonSpec` (the checks, shared with
+:func:`plannerlab.compare`), :func:`plannerlab.comparison.runner.run_spec` and
+:mod:`plannerlab.comparison.report`.
 """
 
 from __future__ import annotations
@@ -51,7 +53,6 @@ from rich.progress import (
 from plannerlab.cli.common import (
     add_budget_args,
     leg_spec,
-    legs_from_spec,
     parse_scoped_overrides,
     positive_int,
     positive_seconds,
@@ -199,34 +200,16 @@ def _json_safe(x: Any) -> Any:
 
 # ---------------------------------------------------------------------- command
 def cmd_compare(args: argparse.Namespace, console: Console) -> int:
-    from plannerlab.bench.report import machine_info, write_reports
-    from plannerlab.bench.trials import (
-        ERROR_STATUS,
-        TIMEOUT_STATUS,
-        Trial,
-        TrialStore,
-        default_name,
-        default_trial_timeout_s,
-        make_backend,
-        parse_seeds,
-        run_comparison,
-        store_path,
-        summarise,
-    )
-    from plannerlab.planners import get_entry, make_planner
-    from plannerlab.problem.catalog import load_problem, resolve_problem_path
+    from plannerlab.comparison.report import machine_info, write_reports
+    from plannerlab.comparison.runner import run_spec
+    from plannerlab.comparison.spec import ComparisonSpec
+    from plannerlab.comparison.statistics import summarise
+    from plannerlab.comparison.store import TrialStore, default_name, store_path
+    from plannerlab.comparison.trial import ERROR_STATUS, TIMEOUT_STATUS, parse_seeds
     from plannerlab.record.files import versions
 
     # -- validate everything before the first process starts
     columns = pick_columns(args.columns, args.wide, args.execute)
-    if args.jobs < 1:
-        raise PlannerlabError(f"--jobs: expected >= 1, got {args.jobs}")
-    if args.trial_timeout is not None and not (
-        math.isfinite(args.trial_timeout) and args.trial_timeout > 0
-    ):
-        raise PlannerlabError(f"--trial-timeout: expected a number > 0, got {args.trial_timeout}")
-    if args.address is not None and args.backend != "ray":
-        raise PlannerlabError("--address is for --backend ray")
     for flag, v in (
         ("--max-checks", args.max_checks),
         ("--max-iterations", args.max_iterations),
@@ -234,59 +217,32 @@ def cmd_compare(args: argparse.Namespace, console: Console) -> int:
     ):
         if v is not None and v <= 0:
             raise PlannerlabError(f"{flag}: expected > 0, got {v}")
-    seeds = parse_seeds(args.seeds)
     planners = list(dict.fromkeys(_split(args.planners)))
-    if not planners:
-        raise PlannerlabError("--planners: give at least one planner name")
-    entries = {name: get_entry(name) for name in planners}  # unknown: "did you mean"
-    settings = parse_scoped_overrides(args.set, planners)
-    for name in planners:
-        make_planner(name, settings.get(name))  # unknown setting or bad value: raises now
-    problems = []
-    for spec in dict.fromkeys(args.problems):
-        problems.append((load_problem(spec), resolve_problem_path(spec).resolve()))
-    names = [p.name for p, _ in problems]
-    if len(set(names)) != len(names):
-        raise PlannerlabError(f"two problem files have the same problem name: {names}")
-    for problem, _ in problems:
-        for name, entry in entries.items():
-            if entry.robots is not None and problem.robot.kind not in entry.robots:
-                raise PlannerlabError(
-                    f"planner {name} works on {', '.join(entry.robots)} robots; "
-                    f"{problem.name} has a {problem.robot.kind}"
-                )
-    legs_by_problem: dict[str, list[int] | None] = {}
-    for problem, _ in problems:
-        legs_by_problem[problem.name] = legs_from_spec(problem, args.legs)
-    budget = {
-        "max_iterations": args.max_iterations,
-        "max_collision_checks": args.max_checks,
-        "time_limit_s": args.time_limit,
-    }
-    budget = {k: v for k, v in budget.items() if v is not None}
-    name = args.name or default_name(names, planners)
+    spec = ComparisonSpec.build(
+        args.problems,
+        planners,
+        parse_seeds(args.seeds),
+        budget={
+            "max_iterations": args.max_iterations,
+            "max_collision_checks": args.max_checks,
+            "time_limit_s": args.time_limit,
+        },
+        settings=parse_scoped_overrides(args.set, planners),
+        legs=args.legs,
+        execute=args.execute,
+        jobs=args.jobs,
+        backend=args.backend,
+        address=args.address,
+        trial_timeout_s=args.trial_timeout,
+        retry_errors=args.retry_errors,
+    )
+    name = args.name or default_name(spec.problem_names, list(spec.planners))
     if not re.fullmatch(r"[A-Za-z0-9._+-]+", name) or name in (".", ".."):
         raise PlannerlabError(f"--name: letters, digits and . _ + - only, got {name!r}")
     folder = Path(args.out) / name
     store = TrialStore(store_path(args.out, name))
     command = _command(args)
-
-    # seeds outermost within a problem: an interrupted run stays balanced over planners
-    trials = [
-        Trial.make(
-            problem.name,
-            path,
-            planner,
-            seed,
-            budget=budget,
-            settings=settings.get(planner),
-            legs=legs_by_problem[problem.name],
-            execute=args.execute,
-        )
-        for problem, path in problems
-        for seed in seeds
-        for planner in planners
-    ]
+    trials = spec.trials
 
     # -- run, with a progress bar
     started = datetime.now(UTC)
@@ -320,28 +276,9 @@ def cmd_compare(args: argparse.Namespace, console: Console) -> int:
         )
         progress.update(task, advance=1, detail=detail() + last)
 
-    budgets_used = {p.name: p.budget.replace(**budget) for p, _ in problems}
-    n_legs = {p.name: len(legs_by_problem[p.name] or range(p.legs)) for p, _ in problems}
-
-    def trial_timeout(trial: Trial) -> float:
-        if args.trial_timeout is not None:
-            return float(args.trial_timeout)
-        return default_trial_timeout_s(
-            budgets_used[trial.problem].time_limit_s, n_legs[trial.problem], trial.execute
-        )
-
-    backend = make_backend(args.backend, store.path.parent / ".running", address=args.address)
     try:
         with progress:
-            run = run_comparison(
-                trials,
-                store,
-                jobs=args.jobs,
-                on_done=on_done,
-                retry_errors=args.retry_errors,
-                trial_timeout_s=trial_timeout,
-                backend=backend,
-            )
+            run = run_spec(spec, store, on_done)
     except KeyboardInterrupt:
         done = counts["ran"] + counts["skipped"]
         console.print(
@@ -351,38 +288,15 @@ def cmd_compare(args: argparse.Namespace, console: Console) -> int:
             highlight=False,
         )
         return 130
-    finally:
-        backend.close()
     wall_s = time.perf_counter() - t0
 
     # -- report
-    order_p = {n: i for i, n in enumerate(names)}
-    order_pl = {n: i for i, n in enumerate(planners)}
-    records = sorted(
-        run.records,
-        key=lambda r: (
-            order_p.get(r["problem"], 1 << 30),
-            order_pl.get(r["planner"], 1 << 30),
-            int(r["seed"]),
-        ),
-    )
+    records = sorted(run.records, key=spec.sort_key)
     rows = summarise(records)
     meta = {
         "command": command,
-        "problems": names,
-        "problem_files": [str(path) for _, path in problems],
-        "planners": planners,
-        "seeds": seeds,
+        **spec.to_dict(),
         "seeds_spec": args.seeds,
-        "budget": budget,
-        "budgets_used": {p.name: p.budget.replace(**budget).to_dict() for p, _ in problems},
-        "settings": settings,
-        "legs": args.legs,
-        "execute": bool(args.execute),
-        "jobs": args.jobs,
-        "backend": args.backend,
-        "trial_timeout_s": args.trial_timeout,
-        "trials": len(trials),
         "ran": run.ran,
         "skipped": run.skipped,
         "errors": sum(1 for r in records if r.get("status") in (ERROR_STATUS, TIMEOUT_STATUS)),
@@ -443,6 +357,6 @@ def _print_tables(console: Console, rows: list[dict[str, Any]], columns: list[st
         "checks summed over legs. All columns: --wide, report.md, summary.csv.[/dim]",
         highlight=False,
     )
-    from plannerlab.bench.report import BUDGET_NOTE
+    from plannerlab.comparison.report import BUDGET_NOTE
 
     console.print(f"[dim]{escape(BUDGET_NOTE)}[/dim]", highlight=False)

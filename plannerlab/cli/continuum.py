@@ -15,11 +15,13 @@ runs the chosen solution in PyBullet (:func:`plannerlab.sim.continuum.execute_ch
 and shows the tip error and the expected / unexpected contacts.
 
 The data behind each row are the house's records: the first run is planned by
-:func:`plannerlab.bench.task.solve_legs` (seed 0) into a :class:`~plannerlab.record.plan.Plan`
+:func:`plannerlab.run.pipeline.solve_legs` (seed 0) into a :class:`~plannerlab.record.plan.Plan`
 whose one :class:`~plannerlab.record.leg.PlanResult` gives the row, and the execution is
 an :class:`~plannerlab.record.execution.Execution`. ``--out DIR`` writes them as any
 ``solve`` / ``execute`` would: ``DIR/<case>.plan.json`` and ``DIR/<case>.plan.exec.json``
-(so ``plannerlab plot`` and ``plannerlab execute`` read them). ``--json`` prints one
+(so ``plannerlab plot`` and ``plannerlab execute`` read them). The figures are drawn from
+the legs' contact plans (:class:`~plannerlab.record.contact_plan.ContactPlan`): the first
+run's and the zero-thickness run's, so a case costs ``--runs`` + 2 searches. ``--json`` prints one
 document (``planner``, ``runs``, ``overrides``, ``cases``: per case the timing summary,
 the files written, and the ``plan`` and ``execution`` records through the one codec).
 
@@ -38,7 +40,6 @@ from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
 
-import numpy as np
 from rich.console import Console
 from rich.markup import escape
 from rich.table import Table
@@ -106,58 +107,34 @@ def _case_name(case: str) -> str:
     return f"continuum_case{case}" if case.isdigit() else case
 
 
-def _thickness_figure(planner: Any, problem: Any, out: Path) -> Path:
-    """Where the paper's zero-thickness curves and the robot of the problem's radius part."""
-    from plannerlab.planners.chord_arc import thickness_cuts
-    from plannerlab.plot.continuum import save, thickness_figure
+def _thickness_figure(thin: Any, thick: Any, problem: Any, out: Path) -> Path:
+    """Where the paper's zero-thickness curves and the robot of the problem's radius part,
+    from the two legs' contact plans."""
+    from plannerlab.plot.continuum import save, searched, thickness_figure
 
-    thin_planner = planner.with_settings(inflate_by_radius=False)
-    thick_planner = planner.with_settings(inflate_by_radius=True)
-    query, thin = thin_planner.search(problem, 0)
-    grown = thick_planner.planning_query(problem, query)
-    _, thick = thick_planner.search(problem, 0)
+    thin_plan, thick_plan = thin.contact_plan, thick.contact_plan
     r = problem.robot.link_radius_m
-    cuts = [thickness_cuts(query, p.solution, r) for p in thin.plans]
-    kept = {p.solution.contact_indices for p in thick.plans}
-    lost = [
-        p.solution.contact_indices for p in thin.plans if p.solution.contact_indices not in kept
-    ]
+    kept = {s.contact_indices for s in searched(thick_plan)}
+    lost = [s.contact_indices for s in searched(thin_plan) if s.contact_indices not in kept]
     title = (
-        f"{problem.name}: {len(thin.plans)} zero-thickness solution(s) (paper), "
-        f"{len(thick.plans)} for r = {r * 1e3:g} mm"
+        f"{problem.name}: {len(searched(thin_plan))} zero-thickness solution(s) (paper), "
+        f"{len(searched(thick_plan))} for r = {r * 1e3:g} mm"
         + (f"; lost: {', '.join(str(list(c)) for c in lost)}" if lost else "")
     )
-    fig = thickness_figure(
-        query,
-        grown,
-        [p.solution for p in thin.plans],
-        [p.solution for p in thick.plans],
-        r,
-        np.vstack(cuts) if cuts else np.zeros((0, 2)),
-        title=title,
-    )
+    fig = thickness_figure(thin_plan, thick_plan, title=title)
     return save(fig, out / f"{problem.name}_thickness.png")
 
 
-def _figure(planner: Any, problem: Any, result: Any, out: Path) -> Path:
-    """Fig. 4: the search's curves, split into the planner's kept and dropped ones."""
-    from plannerlab.planners.chord_arc_search import ChordArcResult, DroppedSolution
+def _figure(problem: Any, result: Any, out: Path) -> Path:
+    """Fig. 4: the search's curves, the planner's kept and dropped ones."""
     from plannerlab.plot.continuum import draw_case
 
-    query, res = planner.search(problem, result.leg)
-    kept = {tuple(s["contact_indices"]) for s in result.extra["solutions"]}
-    plans = tuple(p for p in res.plans if p.solution.contact_indices in kept)
-    chain_dropped = tuple(
-        DroppedSolution(p.solution, p.contacts, "dropped by the chain check")
-        for p in res.plans
-        if p.solution.contact_indices not in kept
-    )
-    shown = ChordArcResult(res.search, plans, res.dropped + chain_dropped)
+    plan = result.contact_plan
     title = (
-        f"{problem.name}: {len(plans)} solution(s), "
-        f"{len(query.collision_points_m)} collision points"
+        f"{problem.name}: {len(plan.solutions)} solution(s), "
+        f"{len(plan.collision_points_m)} collision points"
     )
-    return draw_case(query, shown, out / f"{problem.name}.png", title=title)
+    return draw_case(plan, out / f"{problem.name}.png", title=title)
 
 
 @dataclasses.dataclass(frozen=True)
@@ -165,7 +142,7 @@ class CaseRun:
     """One case of the table: the records behind its row and the timing summary.
 
     Attributes:
-        plan: the first (warm-up) run as a plan (:func:`plannerlab.bench.task.solve_legs`,
+        plan: the first (warm-up) run as a plan (:func:`plannerlab.run.pipeline.solve_legs`,
             seed 0): its one leg's :class:`~plannerlab.record.leg.PlanResult` is the row.
         execution: the chosen solution executed in PyBullet (``--execute``), or None.
         timing: ``runs``, ``search_median_s``, ``solve_median_s``, ``same_every_run``,
@@ -203,12 +180,13 @@ def run_case(
     out: Path | None = None,
 ) -> CaseRun:
     """One row of the table: the plan record, the timed runs, the execution record."""
-    from plannerlab.bench.task import execute_results, leg_rng, solve_legs
     from plannerlab.planners import make_planner
-    from plannerlab.planners.chord_arc import PAPER_TABLE, guide_obstacles
+    from plannerlab.planners.chord_arc.planner import PAPER_TABLE
+    from plannerlab.planners.chord_arc.scene import guide_obstacles
     from plannerlab.problem.catalog import load_problem
     from plannerlab.record.files import versions
     from plannerlab.record.plan import ExecutionFile, execution_path
+    from plannerlab.run.pipeline import execute_results, leg_rng, solve_legs
 
     problem = load_problem(_case_name(case))
     planner = make_planner("chord_arc", overrides)
@@ -219,8 +197,9 @@ def run_case(
     for i in range(runs):
         r = planner.solve(problem, 0, budget, leg_rng(i, 0))
         solve_s.append(r.time_s)
-        search_s.append(r.extra.get("search", {}).get("time_s", float("nan")))
-        counts.add((r.status.value, len(r.extra["solutions"]), len(r.extra["dropped"])))
+        cp = r.contact_plan
+        search_s.append(float(cp.search.get("time_s", float("nan"))) if cp else float("nan"))
+        counts.add((r.status.value, *((len(cp.solutions), len(cp.dropped)) if cp else ())))
     paper = PAPER_TABLE.get(problem.name)
     thin = make_planner("chord_arc", {**overrides, "inflate_by_radius": False})
     thin_r = thin.solve(problem, 0, budget, leg_rng(0, 0))
@@ -229,15 +208,23 @@ def run_case(
         "search_median_s": statistics.median(search_s),
         "solve_median_s": statistics.median(solve_s),
         "same_every_run": len(counts) <= 1,
-        "solutions_zero_thickness": len(thin_r.extra["solutions"]),
+        "solutions_zero_thickness": (
+            len(thin_r.contact_plan.solutions) if thin_r.contact_plan else 0
+        ),
         "paper": None if paper is None else dataclasses.asdict(paper),
     }
     files: dict[str, str] = {}
-    if figures is not None and first.extra["solutions"]:
-        files["figure"] = str(_figure(planner, problem, first, figures))
-        files["thickness_figure"] = str(_thickness_figure(planner, problem, figures))
+    first_plan = first.contact_plan
+    if figures is not None and first_plan is not None and first_plan.solutions:
+        files["figure"] = str(_figure(problem, first, figures))
+        thick = first
+        if not first.settings.get("inflate_by_radius", True):
+            thick_planner = make_planner("chord_arc", {**overrides, "inflate_by_radius": True})
+            thick = thick_planner.solve(problem, 0, budget, leg_rng(0, 0))
+        if thin_r.contact_plan is not None and thick.contact_plan is not None:
+            files["thickness_figure"] = str(_thickness_figure(thin_r, thick, problem, figures))
     execution = None
-    if do_execute and first.extra.get("chosen") is not None:
+    if do_execute and first_plan is not None and first_plan.chosen is not None:
         guide_obstacles(problem)  # validated (the plan's extra carries the names)
         (execution,) = execute_results(problem, plan.legs)
     if out is not None:
@@ -306,8 +293,9 @@ def cmd_continuum(args: argparse.Namespace, console: Console) -> int:
     for row in rows:
         r, timing = row.result, row.timing
         paper = timing["paper"]
-        sol = r.extra["solutions"]
-        chosen = r.extra.get("chosen")
+        cp = r.contact_plan
+        sol = cp.solutions if cp else ()
+        chosen = cp.chosen if cp else None
         p_ms = f"{paper['time_s'] * 1e3:.0f}" if paper else "-"
         p_pts = f" ({paper['collision_points']})" if paper else ""
         p_sol = f" ({paper['solutions']})" if paper else ""
@@ -318,11 +306,11 @@ def cmd_continuum(args: argparse.Namespace, console: Console) -> int:
             f"{timing['search_median_s'] * 1e3:.2f}",
             f"{timing['solve_median_s'] * 1e3:.0f}",
             p_ms,
-            f"{len(r.extra['collision_points_m'])}{p_pts}",
+            f"{len(cp.collision_points_m) if cp else 0}{p_pts}",
             f"{len(sol)}{p_sol}",
             str(timing["solutions_zero_thickness"]),
-            str(len(r.extra["dropped"])),
-            "-" if chosen is None else f"#{chosen}: {sol[chosen]['contact_indices']}",
+            str(len(cp.dropped) if cp else 0),
+            "-" if chosen is None else f"#{chosen}: {list(sol[chosen].contact_indices)}",
             "yes" if timing["same_every_run"] else "[red]no[/red]",
         ]
         if args.execute:
@@ -338,8 +326,8 @@ def cmd_continuum(args: argparse.Namespace, console: Console) -> int:
                 ]
                 notes.append(f"{r.problem} execution: {e.reason}")
         t.add_row(*cells)
-        for d in r.extra["dropped"]:
-            notes.append(f"{r.problem} dropped: {d['reason']}")
+        for d in cp.dropped if cp else ():
+            notes.append(f"{r.problem} dropped: {d.reason}")
         if "figure" in row.files:
             notes.append(
                 f"{r.problem} figures: {row.files['figure']}, {row.files['thickness_figure']}"

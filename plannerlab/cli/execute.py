@@ -11,10 +11,10 @@ from rich.console import Console
 from rich.markup import escape
 from rich.table import Table
 
-from plannerlab.bench.report import fmt
 from plannerlab.cli.common import require_display
 from plannerlab.cli.solve import add_plan_arguments, leg_table, solve_and_save
 from plannerlab.cli.tables import table
+from plannerlab.comparison.report import fmt
 from plannerlab.errors import PlanFileError, PlannerlabError
 from plannerlab.record.codec import dumps
 
@@ -73,10 +73,10 @@ def execution_table(legs: Any, executions: Any) -> Table:
 
 
 def cmd_execute(args: argparse.Namespace, console: Console) -> int:
-    from plannerlab.bench.plan_check import check_plan, read_plan
-    from plannerlab.bench.task import execute_plan
     from plannerlab.record.files import versions
     from plannerlab.record.plan import ExecutionFile, execution_path
+    from plannerlab.run.pipeline import execute_plan
+    from plannerlab.run.plan_check import check_plan, read_plan
 
     require_display(args.gui)
     if args.problem.endswith(".json"):

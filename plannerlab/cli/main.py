@@ -122,6 +122,9 @@ def build_parser() -> argparse.ArgumentParser:
     from plannerlab.cli.continuum import add_continuum_parser
 
     add_continuum_parser(sub)
+    from plannerlab.cli.importer import add_parser as add_import_parser
+
+    add_import_parser(sub)
     for name, p in sub.choices.items():
         p.formatter_class = HelpFormatter
         if not p.description:

@@ -20,8 +20,8 @@ def plan_executions(plan_file: str | Path) -> list[Any]:
 
 
 def cmd_plot(args: argparse.Namespace, console: Console) -> int:
-    from plannerlab.bench.plan_check import check_plan, read_plan
     from plannerlab.plot.plans import plot_plan
+    from plannerlab.run.plan_check import check_plan, read_plan
 
     plan = read_plan(args.plan)
     problem = plan.load_problem()

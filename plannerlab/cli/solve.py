@@ -10,18 +10,17 @@ from typing import Any
 from rich.console import Console
 from rich.table import Table
 
-from plannerlab.bench.report import fmt
 from plannerlab.cli.common import (
     RESULTS_DIR,
     add_budget_args,
     budget_from_args,
     leg_spec,
-    legs_from_spec,
     parse_overrides,
     require_display,
     seed_int,
 )
 from plannerlab.cli.tables import table
+from plannerlab.comparison.report import fmt
 from plannerlab.record.codec import dumps
 
 
@@ -67,8 +66,8 @@ def _default_plan_path(problem: str, planner: str, seed: int) -> Path:
 def solve_and_save(args: argparse.Namespace, console: Console, out: Path | None = None) -> Any:
     """Solve as the flags say and write the plan file (``out``, default beside the
     results); return the plan and where it went."""
-    from plannerlab.bench.task import solve_legs
     from plannerlab.problem.catalog import load_problem
+    from plannerlab.run.pipeline import legs_from_spec, solve_legs
 
     problem = load_problem(args.problem)
     if not getattr(args, "json", False):

@@ -24,7 +24,7 @@ from rich.console import Console
 from rich.markup import escape
 from rich.table import Table
 
-from plannerlab.bench.report import fmt, mm
+from plannerlab.comparison.report import fmt, mm
 from plannerlab.errors import UnknownNameError
 
 #: width of piped output when neither COLUMNS nor a terminal says otherwise

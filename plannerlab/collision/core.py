@@ -93,6 +93,7 @@ from typing import Any
 import numpy as np
 from numba import njit
 
+from plannerlab.collision.chain import chain_arrays, chain_segments
 from plannerlab.collision.geometry import (
     BOX,
     CYLINDER,
@@ -509,6 +510,38 @@ def armz_first_invalid(
         ):
             return s
     return -1
+
+
+@njit(cache=True, nogil=True)
+def chain_first_invalid(
+    Q,
+    T0,
+    parent,
+    pre,
+    axes,
+    prismatic,
+    cap_body,
+    cap_a,
+    cap_b,
+    radii,
+    radii_self,
+    moving,
+    allowed,
+    tree,
+    kinds,
+    Rs,
+    cs,
+    hs,
+    olo,
+    ohi,
+):
+    """:func:`first_invalid` of a URDF chain's states Q (k, dof), kinematics included
+    (:func:`~plannerlab.collision.chain.chain_segments`): one compiled call per query."""
+    segs = np.empty((Q.shape[0], cap_body.shape[0], 2, 3))
+    chain_segments(Q, T0, parent, pre, axes, prismatic, cap_body, cap_a, cap_b, segs)
+    return first_invalid(
+        segs, radii, radii_self, moving, allowed, tree, kinds, Rs, cs, hs, olo, ohi
+    )
 
 
 @njit(cache=True, nogil=True)
@@ -1214,6 +1247,10 @@ class Core:
         )
         self._continuous = np.ascontiguousarray(robot.continuous, dtype=np.bool_)
         self._armz = getattr(robot, "kind", "") == "armz"
+        #: a URDF chain: its capsules from compiled kinematics (collision/chain.py)
+        self._chain: Any = None
+        if callable(getattr(robot, "chain_data", None)):
+            self._chain = chain_arrays(robot)
         if self._armz:
             armz: Any = robot  # an ArmZ: its fixed transforms feed the compiled kinematics
             T0 = np.ascontiguousarray(armz.T_world_base, dtype=np.float64)
@@ -1244,6 +1281,8 @@ class Core:
             (armz_frames, armz_segments, armz_first_invalid, armz_edge_first_invalid)
             + ((armz_path_advance,) if self._rates is not None else ())
             if self._armz
+            else (first_invalid, edge_states, chain_segments, chain_first_invalid)
+            if self._chain is not None
             else (first_invalid, edge_states)
             + ((advance_dt, edge_rates) if self._rates is not None else ())
         ) + (valid_batch, all_hits, pair_distances_kernel, min_clearance_kernel)
@@ -1295,6 +1334,10 @@ class Core:
         if self._armz:
             out = np.empty((len(Qc), self.n_links, 2, 3))
             return armz_segments(Qc, self._T0, self._T1, self._M, out)
+        if self._chain is not None:
+            out = np.empty((len(Qc), self.n_links, 2, 3))
+            kinematics: Any = chain_segments  # a numba dispatcher
+            return kinematics(Qc, *self._chain, out)
         return np.ascontiguousarray(self.robot.link_segments(Qc), dtype=float)
 
     # ------------------------------------------------------------------ queries
@@ -1319,6 +1362,9 @@ class Core:
             raise ValueError(f"q must be one state ({self.robot.dof},), got shape {np.shape(q)}")
         if self._armz:
             return armz_first_invalid(Qc, self._T0, self._T1, self._M, *self._geo) < 0
+        if self._chain is not None:
+            kernel: Any = chain_first_invalid  # a numba dispatcher
+            return bool(kernel(Qc, *self._chain, *self._geo) < 0)
         return bool(self.valid(Qc)[0])
 
     def first_invalid(self, Q: Array) -> int:
@@ -1326,6 +1372,9 @@ class Core:
         Qc = self._Q(Q)
         if self._armz:
             return int(armz_first_invalid(Qc, self._T0, self._T1, self._M, *self._geo))
+        if self._chain is not None:
+            kernel: Any = chain_first_invalid  # a numba dispatcher
+            return int(kernel(Qc, *self._chain, *self._geo))
         return int(first_invalid(self.segments(Qc), *self._geo))
 
     def edge_first_invalid(

@@ -142,7 +142,7 @@ def _entries() -> dict[str, PlannerEntry]:
         (
             "gradient.clearance+rrtconnect",
             "gradient.clearance; at a stall, RRT-Connect from the stall to a goal state "
-            "found by the clearance descent from the stall",
+            "found by the clearance descent from the stall, or drawn by IK when it finds none",
             True,
         ),
     ):
@@ -158,7 +158,7 @@ def _entries() -> dict[str, PlannerEntry]:
     entries.append(
         PlannerEntry(
             "chord_arc",
-            "plannerlab.planners.chord_arc:make",
+            "plannerlab.planners.chord_arc.planner:make",
             "continuum robot's chord-arc tree search with obstacle wrapping (contact at the "
             "problem's collision points)",
             robots=("continuum_chain",),

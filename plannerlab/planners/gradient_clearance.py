@@ -30,7 +30,8 @@ with ``extra["q_stall"]`` and ``extra["descent_rad"]`` (joint-space distance tra
 Escapes from a stall (``escape`` setting): ``detour`` (sub-goals near the stall: the tip
 drawn back along its own body, ``retract_step``, ``2 retract_step``, … modules, each
 followed by the leg's descent; deterministic), ``rrtconnect`` (RRT-Connect from the stall
-to a goal state found near it) and ``random_detour``, the detour with its sub-goals drawn
+to a goal state found near it, or, when the descent near the stall finds none, to goal
+states drawn by IK) and ``random_detour``, the detour with its sub-goals drawn
 from the planner's generator: each retract goes back a random ``1 … 2 retract_step``
 modules further than the last and aims at a point drawn uniformly in a ball of
 ``retract_jitter_m`` round the body's face there; a detour that finds no way is drawn
@@ -43,6 +44,7 @@ from __future__ import annotations
 
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass
+from functools import cached_property
 from typing import Any
 
 import numpy as np
@@ -64,6 +66,8 @@ from plannerlab.robots.paths import path_length
 
 #: the escapes from a stall (``escape`` setting)
 ESCAPES = ("none", "detour", "random_detour", "rrtconnect")
+#: how the field and the step are computed (``backend`` setting)
+BACKENDS = ("compiled", "numpy")
 
 
 @dataclass(frozen=True)
@@ -91,11 +95,17 @@ class ClearanceSettings:
             its mean step is ``retract_step + 0.5``).
         retract_jitter_m: radius of the ball round the body's face in which
             ``random_detour`` draws each retract sub-goal's point [m].
+        escape_goal_samples: goal states the ``rrtconnect`` escape draws by IK (seeded
+            from the stall) when the descent near the stall finds no collision-free goal.
         hold_clearance: when a step would take a pair below ``min_clearance_m``, try
             once the same step with the part that closes such pairs taken out
             (:meth:`ClearanceDescent._hold_clearance`) before shrinking the step; without
             it the descent stalls against the clearance floor (measured on room
             variants: the leave leg stalled at iteration 7 and no retract got out).
+        backend: "compiled" (the field and the step in numba,
+            :mod:`plannerlab.planners._descent_core`; Arm-Z only, other robots use numpy)
+            or "numpy" (the reference: the same iterates to rounding, 30-50 times slower;
+            `bench/descent_bench.py`).
     """
 
     r1: float = 1.0
@@ -121,7 +131,9 @@ class ClearanceSettings:
     subgoal_pos_tol_m: float = 0.5
     subgoal_angle_tol_deg: float = 30.0
     retract_jitter_m: float = 0.5
+    escape_goal_samples: int = 4
     hold_clearance: bool = True
+    backend: str = "compiled"
 
     def __post_init__(self) -> None:
         if self.direction not in ("gradient", "gauss_newton"):
@@ -130,12 +142,20 @@ class ClearanceSettings:
             )
         if not self.margin_m > 0:
             raise PlannerlabError(f"margin_m must be > 0, got {self.margin_m}")
+        if self.backend not in BACKENDS:
+            raise PlannerlabError(
+                f"backend setting: one of {', '.join(map(repr, BACKENDS))}, got {self.backend!r}"
+            )
         if self.escape not in ESCAPES:
             raise PlannerlabError(
                 f"escape setting: one of {', '.join(map(repr, ESCAPES))}, got {self.escape!r}"
             )
         if not self.retract_jitter_m >= 0:
             raise PlannerlabError(f"retract_jitter_m must be >= 0, got {self.retract_jitter_m}")
+        if self.escape_goal_samples < 1:
+            raise PlannerlabError(
+                f"escape_goal_samples must be >= 1, got {self.escape_goal_samples}"
+            )
         if self.retract_step < 1:
             raise PlannerlabError(f"retract_step must be >= 1, got {self.retract_step}")
         if self.stall_window < 2:
@@ -154,6 +174,8 @@ class ClearanceDescent:
         self.name = name
         self.settings = settings
         self.escape_planner = escape_planner
+        #: (problem, its model): the field of the last problem solved (see :meth:`model`)
+        self._model_cache: tuple[Any, _Model] | None = None
 
     # ------------------------------------------------------------------ pieces
     def _f(self, robot, goal, q: Array) -> float:
@@ -250,7 +272,7 @@ class ClearanceDescent:
         self,
         robot,
         goal,
-        field: ClearanceField,
+        model: _Model,
         q: Array,
         checker: CollisionChecker,
         max_step: float,
@@ -261,7 +283,7 @@ class ClearanceDescent:
         from a wall when the region leaves room (a tracking arm overshoots a little).
         Appends the accepted states to ``path``; returns the iterations used."""
         s = self.settings
-        c = field(q)
+        c = model.point(goal, q)
         radius = max_step
         used = 0
         for used in range(1, s.settle_iterations + 1):  # noqa: B007
@@ -270,12 +292,11 @@ class ClearanceDescent:
             if c.cost <= 0.0 or big < 1e-12 or radius < s.min_step_rad:
                 break
             q_new = wrap_to_pi(q - g * (radius / big), robot.continuous)
-            pos_err, ang_err = goal.errors(robot, q_new)
-            c_new = field(q_new)
+            c_new = model.point(goal, q_new)
             if (
                 c_new.cost < c.cost
-                and pos_err <= s.settle_fraction * goal.pos_tol_m
-                and ang_err <= s.settle_fraction * goal.angle_tol_deg
+                and c_new.pos_err_m <= s.settle_fraction * goal.pos_tol_m
+                and c_new.ang_err_deg <= s.settle_fraction * goal.angle_tol_deg
                 and checker.is_valid(q_new)
             ):
                 q, c = q_new, c_new
@@ -287,6 +308,21 @@ class ClearanceDescent:
 
     def _F(self, robot, goal, field: ClearanceField, q: Array) -> float:
         return self._f(robot, goal, q) + self.settings.clearance_weight * field(q).cost
+
+    def model(self, problem) -> _Model:
+        """The field and step of ``problem`` on the ``backend`` setting's engine (built
+        once per problem and kept: building the field's pair lists takes milliseconds)."""
+        cached = self._model_cache
+        if cached is not None and cached[0] is problem:
+            return cached[1]
+        field = ClearanceField(problem.robot, problem.scene, self.settings.margin_m)
+        model: _Model
+        if self.settings.backend == "compiled" and getattr(problem.robot, "kind", "") == "armz":
+            model = _CompiledModel(self, field)
+        else:
+            model = _NumpyModel(self, field)
+        self._model_cache = (problem, model)
+        return model
 
     # ------------------------------------------------------------------ solve
     def descend(
@@ -308,21 +344,22 @@ class ClearanceDescent:
         s = self.settings
         robot = problem.robot
         goal = goal if goal is not None else problem.goal(leg)
-        field = ClearanceField(robot, problem.scene, s.margin_m)
+        model = self.model(problem)
         max_step = s.max_step_rad if s.max_step_rad > 0 else problem.joint_step / 2
         q = np.array(q_start, dtype=float)
         path = [q.copy()]
-        f_now = self._f(robot, goal, q)
+        here = model.point(goal, q)
+        f_now = here.f
         trace = [f_now]
         best, best_iter = f_now, 0
         radius = max_step
         iteration = 0
         inside_since = 0
-        d_now = field(q).distances_m
-        direction, F_now = self._direction(robot, goal, field, q)
+        d_now = here.distances_m
+        direction, F_now = here.direction, here.F
         held = False
         while True:
-            pos_err, ang_err = goal.errors(robot, q)
+            pos_err, ang_err = here.pos_err_m, here.ang_err_deg
             inside = pos_err <= goal.pos_tol_m and ang_err <= goal.angle_tol_deg
             deep = (
                 pos_err <= s.goal_depth * goal.pos_tol_m
@@ -333,7 +370,7 @@ class ClearanceDescent:
             # (an executed path then ends inside too), as long as it makes progress
             if deep or (inside and (stalled or iteration - inside_since >= s.deepen_iterations)):
                 if checker is not None and s.settle_iterations > 0:
-                    iteration += self._settle(robot, goal, field, q, checker, max_step, path)
+                    iteration += self._settle(robot, goal, model, q, checker, max_step, path)
                 return (
                     Status.SOLVED,
                     f"in the goal region after {iteration} iterations",
@@ -372,22 +409,23 @@ class ClearanceDescent:
                 continue
             step = direction * min(1.0, radius / big)
             q_new = wrap_to_pi(q + step, robot.continuous)
-            c_new = field(q_new)
-            F_new = self._f(robot, goal, q_new) + s.clearance_weight * c_new.cost
+            there = model.point(goal, q_new, d_now)
+            F_new = there.F
             # keep min_clearance_m (a tracking arm overshoots a little), unless already closer
-            d_new = c_new.distances_m
-            spacious = bool(np.all((d_new >= s.min_clearance_m) | (d_new >= d_now - 1e-9)))
+            d_new = there.distances_m
+            spacious = there.spacious
             if F_new < F_now and spacious and (checker is None or checker.is_valid(q_new)):
                 d_now = d_new
                 q = q_new
+                here = there
                 path.append(q.copy())
                 radius = min(radius * 1.5, max_step)
-                direction, F_now = self._direction(robot, goal, field, q)
-                f_now = self._f(robot, goal, q)
+                direction, F_now = here.direction, here.F
+                f_now = here.f
                 held = False
             elif not spacious and not held and s.hold_clearance:
                 # the step takes a pair below min_clearance_m: slide along it instead
-                direction = self._hold_clearance(field, q, direction)
+                direction = model.hold(q, direction)
                 held = True
             else:
                 radius *= 0.5
@@ -557,9 +595,11 @@ class ClearanceDescent:
         tracker: BudgetTracker,
         rng: np.random.Generator,
     ) -> tuple[list[Array], int, str]:
-        """RRT-Connect from the stall to a goal state found near it (see near_goal_state),
-        with the checks and time left, at most ``escape_checks`` checks; its iterations
-        count in the leg's afterwards (the caller adds them)."""
+        """RRT-Connect from the stall to a goal state found near it (see near_goal_state)
+        or, when the descent from the stall ends in no collision-free goal state, to
+        ``escape_goal_samples`` goal states drawn by IK (OMPL's ``near_or_ik`` goal
+        selection), with the checks and time left, at most ``escape_checks`` checks; its
+        iterations count in the leg's afterwards (the caller adds them)."""
         if self.escape_planner is None:
             raise PlannerlabError(
                 f"{self.name}: no escape planner given (make it by name, make_planner)"
@@ -567,7 +607,9 @@ class ClearanceDescent:
         sub = tracker.remaining(self.settings.escape_checks, limit_iterations=False)
         if sub is None:
             return [np.array(q_stall)], 0, f"not started: {tracker.exhausted() or 'no budget'}"
-        rrt = self.escape_planner({"goal_selection": "near", "goal_samples": 1})
+        rrt = self.escape_planner(
+            {"goal_selection": "near_or_ik", "goal_samples": self.settings.escape_goal_samples}
+        )
         r = rrt.solve(problem, leg, sub, rng, q_start=q_stall)
         tracker.charge_checks(r.collision_checks)  # the sub-planner's checks count here
         if r.solved:
@@ -592,6 +634,9 @@ class ClearanceDescent:
         goal = problem.goal(leg)
         checker = problem_checker(problem)
         q0 = np.array(problem.q_start if q_start is None else q_start, dtype=float)
+        # the field (and for the compiled backend, loading or compiling its core) is built
+        # before the tracker starts, like the checker: a one-off cost outside the limits
+        self.model(problem).warm_up(goal, q0)
         tracker = BudgetTracker(budget, checker)
         run = LegRun(self.name, s, problem, leg, tracker)
         path: list[Array] = [q0]
@@ -615,6 +660,8 @@ class ClearanceDescent:
                 "descent_rad": descent_rad,
                 "escapes": escapes_log,
                 "path_rad": path_length(np.array(path), robot.continuous),
+                # what ran: "compiled" falls back to numpy for robots other than Arm-Z
+                "descent_backend": self.model(problem).backend,
             }
             if status is Status.LOCAL_MINIMUM:
                 extra["q_stall"] = np.asarray(path[-1], dtype=float).tolist()
@@ -690,6 +737,131 @@ class ClearanceDescent:
                     Status.SOLVED,
                     f"descent stalled {minima} times; escaped from the stall by {how}",
                 )
+
+
+class _NumpyPoint:
+    """The numpy descent's view of one state; each piece is computed when first asked
+    (the direction only at accepted states), as the numpy descent always did."""
+
+    def __init__(
+        self,
+        descent: ClearanceDescent,
+        field: ClearanceField,
+        goal,
+        q: Array,
+        d_ref: Array | None = None,
+    ):
+        self._descent, self._field, self._goal, self._q = descent, field, goal, q
+        self._d_ref = d_ref
+
+    @cached_property
+    def spacious(self) -> bool:
+        """No pair below ``min_clearance_m`` that came closer than in ``d_ref``."""
+        if self._d_ref is None:
+            return True
+        d_new, floor = self.distances_m, self._descent.settings.min_clearance_m
+        return bool(np.all((d_new >= floor) | (d_new >= self._d_ref - 1e-9)))
+
+    @cached_property
+    def _clearance(self):
+        return self._field(self._q)
+
+    @cached_property
+    def f(self) -> float:
+        return self._descent._f(self._field.robot, self._goal, self._q)
+
+    @property
+    def F(self) -> float:  # noqa: N802 - the module docstring's F
+        return self.f + self._descent.settings.clearance_weight * self._clearance.cost
+
+    @property
+    def cost(self) -> float:
+        return self._clearance.cost
+
+    @property
+    def gradient(self) -> Array:
+        return self._clearance.gradient
+
+    @property
+    def distances_m(self) -> Array:
+        return self._clearance.distances_m
+
+    @cached_property
+    def _errors(self) -> tuple[float, float]:
+        pos_err, ang_err = self._goal.errors(self._field.robot, self._q)
+        return float(pos_err), float(ang_err)
+
+    @property
+    def pos_err_m(self) -> float:
+        return self._errors[0]
+
+    @property
+    def ang_err_deg(self) -> float:
+        return self._errors[1]
+
+    @cached_property
+    def direction(self) -> Array:
+        return self._descent._direction(self._field.robot, self._goal, self._field, self._q)[0]
+
+
+class _NumpyModel:
+    """The field and the step in numpy (``backend = "numpy"``: the reference)."""
+
+    backend = "numpy"
+
+    def __init__(self, descent: ClearanceDescent, field: ClearanceField) -> None:
+        self._descent, self._field = descent, field
+
+    def point(self, goal, q: Array, d_ref: Array | None = None) -> _NumpyPoint:
+        return _NumpyPoint(self._descent, self._field, goal, q, d_ref)
+
+    def hold(self, q: Array, direction: Array) -> Array:
+        return self._descent._hold_clearance(self._field, q, direction)
+
+    def warm_up(self, goal, q: Array) -> None:
+        """Nothing to load."""
+
+
+class _CompiledModel:
+    """The field and the step compiled (:mod:`plannerlab.planners._descent_core`): one
+    call per state gives F, f, the tip errors, the distances and the step direction."""
+
+    backend = "compiled"
+
+    def __init__(self, descent: ClearanceDescent, field: ClearanceField) -> None:
+        from plannerlab.planners._descent_core import CompiledField
+
+        s = descent.settings
+        self._settings = s
+        # distances beyond both the margin and the hold's floor matter to no test of the
+        # descent (the spacious test looks only below min_clearance_m)
+        self._core = CompiledField(field, far_m=max(s.margin_m, s.min_clearance_m + 0.01))
+
+    def point(self, goal, q: Array, d_ref: Array | None = None):
+        s = self._settings
+        return self._core.evaluate(
+            q,
+            goal,
+            s.r1,
+            s.r2,
+            s.clearance_weight,
+            s.direction == "gauss_newton",
+            s.damping,
+            s.goal_depth,
+            True,
+            d_ref,
+            s.min_clearance_m,
+        )
+
+    def hold(self, q: Array, direction: Array) -> Array:
+        return self._core.hold_clearance(q, direction, self._settings.min_clearance_m + 0.01)
+
+    def warm_up(self, goal, q: Array) -> None:
+        """Load (or compile) both kernels: one call each."""
+        self.hold(q, self.point(goal, q).direction)
+
+
+_Model = _NumpyModel | _CompiledModel
 
 
 def _in_ball(rng: np.random.Generator, radius_m: float) -> Array:

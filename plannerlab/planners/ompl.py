@@ -84,12 +84,14 @@ Design (measured on ``armz_inspection``, 23 continuous joints):
   temporary file; afterwards each message is re-emitted on the ``plannerlab.ompl``
   logger at its level, and the previous handler and log level are restored. OMPL's log
   level follows that logger's effective level.
-* **Seeding.** ``solve`` derives an OMPL seed from ``rng`` and calls
-  ``ompl.util.RNG.setSeed`` first thing. OMPL's seed is process-global and only takes
-  effect before OMPL's first random generator exists, so only the first solve in a
-  process is reproducible; seeded trials run each in a fresh process (bench), and
-  :func:`seed_ompl` is for such a process to call before any OMPL object exists. A
-  later, ineffective setSeed makes OMPL log an error, re-emitted here at DEBUG level.
+* **Seeding.** OMPL's seed is process-global and only takes effect before OMPL's first
+  random generator exists. ``solve`` asks for a seed derived from ``rng``
+  (``ompl.util.RNG.setSeed``): in a fresh process the first solve's request takes
+  effect (before it, no OMPL generator exists, whatever :func:`seed_ompl` set), so a
+  seeded trial, which runs in its own process, is reproducible; every later request in
+  that process has no effect (OMPL logs an error, re-emitted here at DEBUG level). OMPL
+  is thus seeded once per process, and every leg records the seed **in effect**
+  (``extra["ompl_seed"]``, ``ompl.util.RNG.getSeed()``), not the one it asked for.
 """
 
 from __future__ import annotations
@@ -129,6 +131,8 @@ LOGGER = logging.getLogger("plannerlab.ompl")
 
 #: OMPL seeds must be in [1, 2**31 - 1] (0 means "random" to OMPL)
 _SEED_MAX = 2**31 - 1
+#: how the goal pool is filled (``goal_selection`` setting)
+GOAL_SELECTIONS = ("ik", "near", "near_or_ik")
 
 
 # ---------------------------------------------------------------------------- settings
@@ -147,7 +151,10 @@ class OMPLSettings:
         goal_selection: ``"ik"`` (numeric IK restarts seeded from the leg start, see
             :func:`~plannerlab.problem.ik.sample_goal_state`) or ``"near"`` (the goal state
             ``gradient.clearance`` selects: its descent from the leg start with the path
-            unchecked, so the goal stays near the start; one state, one check).
+            unchecked, so the goal stays near the start; one state, one check) or
+            ``"near_or_ik"`` (that near state; when its descent ends in no collision-free
+            goal state, ``goal_samples`` IK states as with ``"ik"``: the escape of
+            ``gradient.clearance+rrtconnect``, which gave up with ``invalid_goal`` before).
     """
 
     simplify: bool = True
@@ -791,14 +798,18 @@ class OMPLPlanner:
                 f"{', '.join(_MOTION_CHECKS)}, got "
                 f"{self.settings.motion_check!r}"
             )
-        if self.settings.goal_selection not in ("ik", "near"):
+        if self.settings.goal_selection not in GOAL_SELECTIONS:
             raise PlannerlabError(
-                f"{self.name}: goal_selection must be 'ik' or 'near', got "
+                f"{self.name}: goal_selection must be one of "
+                f"{', '.join(map(repr, GOAL_SELECTIONS))}, got "
                 f"{self.settings.goal_selection!r}"
             )
-        ompl_seed = int(rng.integers(1, _SEED_MAX))
+        requested = int(rng.integers(1, _SEED_MAX))
         with _ompl_logging(LOGGER):
-            ou.RNG.setSeed(ompl_seed)  # effective only before OMPL's first generator
+            # effective only before OMPL's first generator exists (the first solve of a
+            # process); every leg records the seed in effect, whether or not this took
+            ou.RNG.setSeed(requested)
+            ompl_seed = int(ou.RNG.getSeed())
             result = self._solve(problem, leg, budget, rng, q_start, ompl_seed)
         return result
 
@@ -812,6 +823,12 @@ class OMPLPlanner:
         ompl_seed: int,
     ) -> PlanResult:
         checker = problem_checker(problem)
+        if self.settings.goal_selection != "ik":
+            # the near goal's descent is compiled: its kernels are loaded (or compiled)
+            # before the tracker starts, as the checker's core is
+            from plannerlab.planners._descent_core import warm_up
+
+            warm_up()
         guard = _Guard(checker, BudgetTracker(budget, checker))
         try:
             return self._plan(problem, leg, rng, q_start, ompl_seed, guard)
@@ -871,11 +888,23 @@ class OMPLPlanner:
         c_pool = checker.checks
         per_slot = max(1, s.max_goal_attempts // max(s.goal_samples, 1))
         pool_cut_short = ""
-        for _ in range(s.goal_samples):
+        selection = s.goal_selection
+        if selection == "near_or_ik":
+            # the near goal first; when its descent finds none, the IK pool
+            q_near = (
+                None
+                if guard.exhausted() is not None
+                else _near_goal(problem, leg, q0, checker, tracker)
+            )
+            extra["goal_near_found"] = q_near is not None
+            if q_near is not None:
+                pool.append(wrap_to_pi(q_near, robot.continuous))
+            selection = "near" if pool else "ik"
+        for _ in range(s.goal_samples if not pool else 0):
             if guard.exhausted() is not None:
                 pool_cut_short = guard.exhausted() or ""
                 break
-            if s.goal_selection == "near":
+            if selection == "near":
                 q_goal = _near_goal(problem, leg, q0, checker, tracker)
             else:
                 q_goal = sample_goal_state(

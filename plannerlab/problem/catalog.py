@@ -2,7 +2,7 @@
 
 :func:`load_problem` parses and validates a problem file (see :mod:`plannerlab.problem.load`);
 it imports no engine. Whether the start state is collision-free is checked where planning
-starts (:func:`plannerlab.bench.task.solve_legs`), once.
+starts (:func:`plannerlab.run.pipeline.solve_legs`), once.
 """
 
 from __future__ import annotations
@@ -63,5 +63,5 @@ def resolve_problem_path(name_or_path: str | Path, cwd: Path | None = None) -> P
 def load_problem(name_or_path: str | Path) -> Problem:
     """Parse and validate a problem (by bundled name or by path). Needs no engine: the
     start state is collision-checked where planning starts
-    (:func:`plannerlab.bench.task.solve_legs`)."""
+    (:func:`plannerlab.run.pipeline.solve_legs`)."""
     return parse_problem(resolve_problem_path(name_or_path))

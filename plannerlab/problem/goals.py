@@ -9,12 +9,13 @@ steer by: below 1 in both terms means inside.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 from numpy.typing import NDArray
 
-from plannerlab.robots.base import Array, Robot
+from plannerlab.robots.base import Array, Robot, joint_difference
+from plannerlab.robots.registry import reach_function
 
 
 @dataclass(frozen=True, eq=False)
@@ -94,6 +95,76 @@ class GoalRegion:
         return np.maximum(scaled - 1.0, 0.0)
 
 
+@dataclass(frozen=True, eq=False)
+class JointGoal(GoalRegion):
+    """A goal state (MotionBenchMaker's joint goals): inside when every joint is within
+    ``tol_rad`` of ``q_rad`` (continuous joints wrapped).
+
+    It is a :class:`GoalRegion` whose tip target is the tip at ``q_rad`` and whose tip
+    tolerances are the ones ``tol_rad`` implies to first order (``pos_tol_m = tol_rad ·
+    Σ_i |∂p/∂q_i|``, the angle likewise), so code that looks at the tip (tip errors in the
+    records, the execution's goal verdict, tip-steering planners) sees the same target;
+    :meth:`contains` and :meth:`distance`, which decide "solved" for every planner, are
+    the joint distance's. Build it with :meth:`at`.
+
+    Args:
+        q_rad: (dof,) the goal state [rad, m for prismatic joints].
+        tol_rad: the largest joint difference still inside, > 0.
+        continuous: (dof,) which joints wrap.
+    """
+
+    q_rad: Array = field(default_factory=lambda: np.zeros(0))
+    tol_rad: float = 1e-3
+    continuous: NDArray[np.bool_] = field(default_factory=lambda: np.zeros(0, dtype=bool))
+
+    def __post_init__(self) -> None:
+        super().__post_init__()
+        q = np.array(self.q_rad, dtype=float).reshape(-1)
+        if not np.all(np.isfinite(q)):
+            raise ValueError("goal state must be finite")
+        if not (self.tol_rad > 0 and np.isfinite(self.tol_rad)):
+            raise ValueError("tol_rad must be a positive number")
+        cont = np.array(self.continuous, dtype=bool).reshape(-1)
+        if cont.shape != q.shape:
+            raise ValueError("continuous must have one flag per joint")
+        q.setflags(write=False)
+        cont.setflags(write=False)
+        object.__setattr__(self, "q_rad", q)
+        object.__setattr__(self, "continuous", cont)
+
+    @classmethod
+    def at(cls, robot: Robot, name: str, q_rad: Array, tol_rad: float) -> JointGoal:
+        """The goal state ``q_rad`` of ``robot`` with joint tolerance ``tol_rad``."""
+        q = np.asarray(q_rad, dtype=float).reshape(robot.dof)
+        p, n = robot.tip(q)
+        J_p, J_n = robot.tip_jacobian(q)
+        pos_tol_m = max(tol_rad * float(np.sum(np.linalg.norm(J_p, axis=0))), 1e-9)
+        angle_tol_deg = float(np.degrees(tol_rad * np.sum(np.linalg.norm(J_n, axis=0))))
+        return cls(
+            name=name,
+            p_world_m=p,
+            n_world=n,
+            pos_tol_m=pos_tol_m,
+            angle_tol_deg=min(max(angle_tol_deg, 1e-9), 180.0),
+            q_rad=q,
+            tol_rad=float(tol_rad),
+            continuous=np.asarray(robot.continuous, dtype=bool),
+        )
+
+    def joint_error(self, q: Array) -> Array:
+        """Largest joint difference from the goal state [rad or m]: scalar or (k,)."""
+        d = joint_difference(np.asarray(q, dtype=float), self.q_rad, self.continuous)
+        return np.max(np.abs(d), axis=-1)
+
+    def contains(self, robot: Robot, q: Array) -> NDArray[np.bool_]:
+        """True where every joint of q is within ``tol_rad`` of the goal state."""
+        return np.asarray(self.joint_error(q) <= self.tol_rad)
+
+    def distance(self, robot: Robot, q: Array) -> Array:
+        """Normalised joint distance: max |q_i − q_goal_i| / tol_rad − 1, clipped at 0."""
+        return np.maximum(self.joint_error(q) / self.tol_rad - 1.0, 0.0)
+
+
 def unreachable_reason(robot: Robot, goal: GoalRegion) -> str | None:
     """Why no state of ``robot`` can put its tip in ``goal``'s position ball, or None.
 
@@ -105,16 +176,15 @@ def unreachable_reason(robot: Robot, goal: GoalRegion) -> str | None:
     """
     p = np.asarray(goal.p_world_m, dtype=float)
     T = np.asarray(robot.T_world_base, dtype=float)
-    if robot.kind == "irb6":
-        lo, hi = robot.track_range_m  # type: ignore[attr-defined]
-        p_s = T[:3, :3].T @ (p - T[:3, 3])
-        h = robot.shoulder_height_m  # type: ignore[attr-defined]
-        closest = np.array([0.0, h, min(max(p_s[2], lo), hi)])
-        dist = float(np.linalg.norm(p_s - closest))
-        reach = float(
-            robot.lower_arm_m + robot.upper_arm_m + robot.wrist_to_flange_m  # type: ignore[attr-defined]
-        )
-        where = f"the shoulder's line along the track (λ0 in [{lo:g}, {hi:g}] m)"
+    reach_from = reach_function(robot.kind)
+    if reach_from is not None:
+        dist, reach, where = reach_from(robot, p)
+    elif getattr(robot, "max_reach_m", None) is not None:
+        # a robot that bounds its own reach (a URDF chain: its collision spheres are no
+        # measure of its length)
+        reach = float(robot.max_reach_m)  # type: ignore[attr-defined]
+        dist = float(np.linalg.norm(p - T[:3, 3]))
+        where = "the base"
     else:
         q = np.zeros(robot.dof)
         seg = np.asarray(robot.link_segments(q), dtype=float)

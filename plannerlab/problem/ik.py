@@ -17,15 +17,15 @@ Only numpy is used here; a collision checker is passed in (anything with
 
 from __future__ import annotations
 
-import importlib
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from typing import Any, Protocol
 
 import numpy as np
 
-from plannerlab.problem.goals import GoalRegion
+from plannerlab.problem.goals import GoalRegion, JointGoal
 from plannerlab.robots.base import Array, Robot, wrap_to_pi
+from plannerlab.robots.registry import goal_sampler
 
 
 class ValidityChecker(Protocol):
@@ -80,7 +80,8 @@ def solve_ik(
     ``max_step_rad``. The descent aims at ``target_fraction`` of the tolerances (deeper
     than needed, so the result is robustly inside) and stops early once there.
 
-    A robot kind with an analytic IK has a sampler in :data:`ANALYTIC_GOAL_SAMPLERS`
+    A robot family with an analytic IK registers its sampler
+    (:attr:`plannerlab.robots.registry.RobotFamily.goal_sampler`)
     (``sampler(robot, goal, rng, seeds)``: a state inside the region, collision ignored,
     or None); it is used instead of the numeric descent, and each candidate is
     collision-checked here.
@@ -144,19 +145,9 @@ def solve_ik(
     return IKResult(q, True, iterations, "inside both tolerances", pos_err, ang_err)
 
 
-#: robot kind -> "module:function" sampling its goal regions through an analytic IK,
-#: called as ``function(robot, goal, rng, seeds=...)`` (imported on first use)
-ANALYTIC_GOAL_SAMPLERS: dict[str, str] = {
-    "irb6": "plannerlab.robots.irb6.goals:sample_goal_state",
-}
-
-
 def _analytic_goal_sampler(robot: Any) -> Any:
-    target = ANALYTIC_GOAL_SAMPLERS.get(getattr(robot, "kind", ""))
-    if target is None:
-        return None
-    module_name, func = target.split(":")
-    return getattr(importlib.import_module(module_name), func)
+    """The robot family's analytic goal sampler (:mod:`plannerlab.robots.registry`)."""
+    return goal_sampler(getattr(robot, "kind", ""))
 
 
 def sample_goal_state(
@@ -173,6 +164,8 @@ def sample_goal_state(
     stop: Callable[[], bool] | None = None,
 ) -> Array | None:
     """A collision-free state inside both tolerances of ``goal``, or None.
+
+    A :class:`~plannerlab.problem.goals.JointGoal` is its goal state (if it is valid).
 
     Restart schedule, attempt ``k = 0, 1, …``: with probability ``uniform_fraction`` (never
     on the first attempt of each seed round when seeds are given) a uniformly random state;
@@ -195,7 +188,8 @@ def sample_goal_state(
     plain IK is not enough for A-E; a collision-aware (null-space) repair is what is
     missing here.
 
-    A robot kind with an analytic IK has a sampler in :data:`ANALYTIC_GOAL_SAMPLERS`
+    A robot family with an analytic IK registers its sampler
+    (:attr:`plannerlab.robots.registry.RobotFamily.goal_sampler`)
     (``sampler(robot, goal, rng, seeds)``: a state inside the region, collision ignored,
     or None); it is used instead of the numeric descent, and each candidate is
     collision-checked here.
@@ -216,6 +210,11 @@ def sample_goal_state(
         (dof,) state inside the region and collision-free, or None after ``attempts``
         (or once ``stop`` says so).
     """
+    if isinstance(goal, JointGoal):
+        # a goal state is its own (only) sample: one check
+        if stop is not None and stop():
+            return None
+        return np.array(goal.q_rad) if checker.is_valid(goal.q_rad) else None
     seed_list = [np.asarray(s, dtype=float).reshape(robot.dof) for s in seeds]
     analytic = _analytic_goal_sampler(robot)
     if analytic is not None:

@@ -9,11 +9,13 @@ Checks that need the collision checker (a start in collision) are made by
 File layout (every key is documented in ``docs/problem-format.md``)::
 
     [problem]   name, description
-    [robot]     type = "armz" | "irb6" | "continuum_chain", then the type's parameters
+    [robot]     type = "armz" | "irb6" | "continuum_chain" | "urdf", then the type's
+                parameters
     [start]     q | q_deg | fill | fill_deg
     [[obstacles]] name, type = "box" | "cylinder" | "sphere", center_m, rpy_deg,
                   size_m | radius_m, length_m
-    [[goals]]   name, p_m, n, pos_tol_m, angle_tol_deg     (one per leg, in order)
+    [[goals]]   name, p_m, n, pos_tol_m, angle_tol_deg     (one per leg, in order), or
+                name, q | q_deg, joint_tol_rad              (a goal state)
     [budget]    max_iterations, max_collision_checks, time_limit_s
     [checking]  joint_step       (largest joint step between checked states on an edge)
     [planning]  safety_margin_m  (clearance every plan keeps; edge resolution in metres)
@@ -29,7 +31,6 @@ File layout (every key is documented in ``docs/problem-format.md``)::
 
 from __future__ import annotations
 
-import importlib
 import math
 import tomllib
 from collections.abc import Mapping
@@ -40,9 +41,10 @@ from typing import Any
 import numpy as np
 
 from plannerlab.errors import ProblemError, UnknownNameError, did_you_mean
-from plannerlab.problem.goals import GoalRegion
+from plannerlab.problem.goals import GoalRegion, JointGoal
 from plannerlab.problem.scene import OBSTACLE_TYPES, Box, Cylinder, Obstacle, Scene, Sphere
 from plannerlab.robots.base import Array, Robot, pose_matrix
+from plannerlab.robots.registry import FAMILIES, gravity_off_reason, robot_table
 from plannerlab.robots.schema import COMMON_KEYS, Key, RobotTable, TableValueError
 
 KNOWN_TABLES = (
@@ -318,7 +320,13 @@ def _obstacle(reader: TableReader) -> Obstacle:
     return Sphere(name, T, reader.number("radius_m", positive=True))
 
 
-def _goal(reader: TableReader) -> GoalRegion:
+#: default ``[[goals]] joint_tol_rad`` of a goal state [rad, m for prismatic joints]
+DEFAULT_JOINT_TOL_RAD = 1e-3
+
+
+def _goal(reader: TableReader, robot: Robot) -> GoalRegion:
+    if reader.has("q") or reader.has("q_deg"):
+        return _joint_goal(reader, robot)
     reader.unknown_keys(("name", "p_m", "n", "pos_tol_m", "angle_tol_deg", "note"))
     p = reader.vector("p_m", 3)
     n = reader.vector("n", 3)
@@ -341,6 +349,36 @@ def _goal(reader: TableReader) -> GoalRegion:
         pos_tol_m=reader.number("pos_tol_m", positive=True),
         angle_tol_deg=angle_tol_deg,
     )
+
+
+def _joint_goal(reader: TableReader, robot: Robot) -> JointGoal:
+    """A goal state: ``q`` (rad, m for prismatic joints) or ``q_deg``, ``joint_tol_rad``."""
+    reader.unknown_keys(("name", "q", "q_deg", "joint_tol_rad", "note"))
+    if reader.has("q") and reader.has("q_deg"):
+        raise reader.fail("q", "one of q, q_deg (a goal state), not both")
+    name = reader.string("name")
+    if not name.strip():
+        raise reader.fail("name", "a non-empty name (legs are chosen by it: --legs NAME)")
+    q = _joint_values(reader, robot, "q" if reader.has("q") else "q_deg")
+    tol = reader.number("joint_tol_rad", DEFAULT_JOINT_TOL_RAD, positive=True)
+    return JointGoal.at(robot, name, q, tol)
+
+
+def _joint_values(reader: TableReader, robot: Robot, k: str) -> Array:
+    """One value per joint under key ``k`` (``*_deg``: degrees), within the joint limits."""
+    q = reader.vector(k)
+    if q.shape != (robot.dof,):
+        raise reader.fail(k, f"{robot.dof} joint values for this {robot.kind} robot, got {q.size}")
+    if k.endswith("_deg"):
+        q = np.deg2rad(q)
+    lo, hi = robot.lower, robot.upper
+    bad = np.flatnonzero(~robot.continuous & ((q < lo - 1e-12) | (q > hi + 1e-12)))
+    if bad.size:
+        i = int(bad[0])
+        raise reader.fail(
+            k, f"joint {robot.joint_names[i]} within [{lo[i]:.6g}, {hi[i]:.6g}], got {q[i]:.6g}"
+        )
+    return q
 
 
 def _start(reader: TableReader, robot: Robot) -> Array:
@@ -454,15 +492,12 @@ def _continuum(reader: TableReader, obstacle_names: list[str]) -> None:
 
 def _simulation(top: TableReader, robot: Robot) -> SimSettings:
     if not top.has("simulation"):
-        if robot.kind == "armz":
-            # Under gravity a 16-m Arm-Z bent sideways needs far more torque than its
-            # joints have and collapses in PyBullet; every bundled Arm-Z problem turns
-            # gravity off (see the comment in problems/armz_pocket.toml).
-            return SimSettings(
-                (0.0, 0.0, 0.0),
-                origin="gravity off: the Arm-Z default when [simulation] is absent "
-                "(as in every bundled Arm-Z problem); set gravity_mps2 to change it",
-            )
+        # a family may default to no gravity: under gravity a 16-m Arm-Z bent sideways
+        # needs far more torque than its joints have and collapses in PyBullet, and every
+        # bundled Arm-Z problem turns gravity off (see problems/armz_pocket.toml)
+        off = gravity_off_reason(robot.kind)
+        if off is not None:
+            return SimSettings((0.0, 0.0, 0.0), origin=off)
         return SimSettings(origin="gravity -9.81 m/s² along -z: the default")
     sim = TableReader(top.source, "simulation", top.raw("simulation"))
     sim.unknown_keys(("gravity_mps2", "max_track_err_rad", "max_deviation_m", "note"))
@@ -479,29 +514,6 @@ def _simulation(top: TableReader, robot: Robot) -> SimSettings:
         max_deviation_m=sim.number("max_deviation_m", 0.01, positive=True),
         origin=origin,
     )
-
-
-#: robot type in a problem file -> "module:attribute" of its table declaration
-#: (:class:`~plannerlab.robots.schema.RobotTable`, beside the robot's model); a family is
-#: imported only when a problem asks for it
-ROBOT_TYPES: dict[str, str] = {
-    "armz": "plannerlab.robots.armz.schema:TABLE",
-    "irb6": "plannerlab.robots.irb6.schema:TABLE",
-    "continuum_chain": "plannerlab.robots.continuum.schema:TABLE",
-}
-
-
-def robot_table(kind: str) -> RobotTable:
-    """The ``[robot]`` table declaration of robot type ``kind`` (imports its family).
-
-    Raises:
-        UnknownNameError: for a type that is not in :data:`ROBOT_TYPES`.
-    """
-    if kind not in ROBOT_TYPES:
-        raise UnknownNameError("robot type", kind, ROBOT_TYPES)
-    module_name, attribute = ROBOT_TYPES[kind].split(":")
-    table: RobotTable = getattr(importlib.import_module(module_name), attribute)
-    return table
 
 
 def _table_value(reader: TableReader, key: Key) -> Any:
@@ -530,7 +542,25 @@ def _table_value(reader: TableReader, key: Key) -> Any:
                 name, f"[lower, upper] with lower <= upper{unit}, got {[float(x) for x in v]}"
             )
         return v
+    if key.kind == "pairs":
+        raw = reader.raw(name, list(key.default))  # type: ignore[arg-type]
+        ok = isinstance(raw, list) and all(
+            isinstance(p, list) and len(p) == 2 and all(isinstance(x, str) for x in p) for p in raw
+        )
+        if not ok:
+            raise reader.fail(name, f"a list of [name, name] pairs of strings, got {raw!r:.80}")
+        return tuple((a, b) for a, b in raw)
     s = reader.string(name, key.default)
+    if key.kind == "path":
+        if not s:
+            return ""
+        folder = Path(reader.source).parent if reader.source != "<memory>" else Path.cwd()
+        resolved = (folder / s).resolve()
+        if not resolved.is_file():
+            raise reader.fail(
+                name, f"an existing file, relative to the problem file; {resolved} does not exist"
+            )
+        return str(resolved)
     if key.choices and s not in key.choices:
         choices = " or ".join(
             f'"{c}"' + (" (the default)" if c == key.default else "") for c in key.choices
@@ -548,6 +578,9 @@ def parse_robot_table(reader: TableReader, table: RobotTable) -> dict[str, Any]:
             among its choices.
     """
     reader.unknown_keys((COMMON_KEYS[0], *table.names, *COMMON_KEYS[1:]))
+    for key in table.keys:
+        if key.required and not reader.has(key.name):
+            raise reader.fail(key.name, f"is missing ({key.meaning})")
     return {key.name: _table_value(reader, key) for key in table.keys}
 
 
@@ -555,12 +588,12 @@ def build_robot(reader: TableReader) -> Robot:
     """Build the robot described by a problem file's ``[robot]`` table: its type's declared
     keys are parsed here, then its family's constructor builds it."""
     kind = reader.string("type")
-    if kind not in ROBOT_TYPES:
+    if kind not in FAMILIES:
         import difflib
 
-        close = difflib.get_close_matches(kind, ROBOT_TYPES, n=1)
+        close = difflib.get_close_matches(kind, FAMILIES, n=1)
         hint = f" (did you mean {close[0]!r}?)" if close else ""
-        raise reader.fail("type", f"one of {', '.join(ROBOT_TYPES)}, got {kind!r}{hint}")
+        raise reader.fail("type", f"one of {', '.join(FAMILIES)}, got {kind!r}{hint}")
     table = robot_table(kind)
     values = parse_robot_table(reader, table)
     try:
@@ -596,7 +629,9 @@ def problem_from_dict(data: Mapping[str, Any], source: str) -> Problem:
     raw_goals = top.raw("goals")
     if not isinstance(raw_goals, list) or not raw_goals:
         raise top.fail("goals", "a non-empty array of tables [[goals]] (one per leg)")
-    goals = tuple(_goal(TableReader(source, f"goals[{i}]", g)) for i, g in enumerate(raw_goals))
+    goals = tuple(
+        _goal(TableReader(source, f"goals[{i}]", g), robot) for i, g in enumerate(raw_goals)
+    )
     goal_names = [g.name for g in goals]
     for i, n in enumerate(goal_names):
         if goal_names.index(n) != i:

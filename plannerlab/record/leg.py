@@ -19,6 +19,7 @@ import numpy as np
 
 from plannerlab.errors import PlanFileError
 from plannerlab.record.codec import read_float, to_data
+from plannerlab.record.contact_plan import ContactPlan, as_contact_plan
 from plannerlab.robots.base import Array
 
 
@@ -79,6 +80,10 @@ class PlanResult:
         seed: the trial's seed (None if not seeded by a trial).
         settings: the planner's settings as data.
         extra: planner-specific numbers (path length before/after simplification, …).
+        contact_plan: a contact-permitting plan's record of its contacts (the continuum's
+            ``chord_arc``: :class:`~plannerlab.record.contact_plan.ContactPlan`), which the
+            executor, the figures and the CLI read; None for every other planner. A leg
+            with one is executed by the contact executor, without the FCL re-check.
     """
 
     planner: str
@@ -102,9 +107,11 @@ class PlanResult:
     seed: int | None = None
     settings: Mapping[str, Any] = field(default_factory=dict)
     extra: Mapping[str, Any] = field(default_factory=dict)
+    contact_plan: ContactPlan | None = None
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "status", Status(self.status))
+        object.__setattr__(self, "contact_plan", as_contact_plan(self.contact_plan))
         path = np.atleast_2d(np.array(self.path, dtype=float))
         path.setflags(write=False)
         object.__setattr__(self, "path", path)
@@ -136,6 +143,10 @@ class PlanResult:
                 hundreds of legs) and writes ``path_points`` and ``path_sha256`` instead.
         """
         d: dict[str, Any] = {f.name: getattr(self, f.name) for f in dataclasses.fields(self)}
+        if self.contact_plan is None:
+            del d["contact_plan"]
+        else:
+            d["contact_plan"] = self.contact_plan.to_dict()
         if not include_path:
             del d["path"], d["trace"]
             d["path_points"] = len(self.path)

@@ -92,7 +92,7 @@ class Plan:
         segment are left out, as executing densifies every segment again), so a plan file
         stays small (an interpolated OMPL path of 14 000 states is a few dozen corners).
         That is the canonical form every execution runs
-        (:func:`plannerlab.bench.task.execute_results`) and :func:`~plannerlab.bench.task.
+        (:func:`plannerlab.run.pipeline.execute_results`) and :func:`~plannerlab.run.pipeline.
         solve_legs` returns, and JSON's shortest-repr floats read back bit for bit: the
         file is lossless, it executes as the plan in memory does."""
         return {

@@ -148,7 +148,7 @@ def waypoints(path: Array, tol_rad: float = 1e-9) -> Array:
     The result is a fixed point (``waypoints(waypoints(p))`` equals ``waypoints(p)`` bit
     for bit): a pass that drops states is repeated on what it kept until none drops. It is
     the canonical form of a planned path: what a plan file holds and what every execution
-    runs (:func:`plannerlab.bench.task.execute_results`), so a saved plan executes exactly
+    runs (:func:`plannerlab.run.pipeline.execute_results`), so a saved plan executes exactly
     as the plan in memory did.
 
     Args:

@@ -26,8 +26,10 @@ import numpy as np
 from plannerlab.errors import PlannerlabError
 from plannerlab.robots.base import Array, pose_matrix
 
-#: the kinds of value a key may hold
-KINDS = ("number", "integer", "vector", "string")
+#: the kinds of value a key may hold: a ``path`` is a string naming a file relative to the
+#: problem file (resolved and checked to exist by the loader; "" when absent), ``pairs`` a
+#: list of ``[name, name]`` string pairs
+KINDS = ("number", "integer", "vector", "string", "path", "pairs")
 
 #: keys every ``[robot]`` table may have besides its family's: the type and a free note
 COMMON_KEYS = ("type", "note")
@@ -51,6 +53,7 @@ class Key:
         length: how many numbers a vector holds.
         ordered: a vector is ``[lower, upper]`` with lower <= upper.
         choices: the values a string may take.
+        required: the key must be given (its default is never used).
     """
 
     name: str
@@ -65,6 +68,7 @@ class Key:
     length: int | None = None
     ordered: bool = False
     choices: tuple[str, ...] = ()
+    required: bool = False
 
     def __post_init__(self) -> None:
         def wrong(what: str) -> ValueError:
@@ -83,7 +87,7 @@ class Key:
             raise wrong("length and ordered apply to vectors only")
         if self.choices and self.kind != "string":
             raise wrong("choices apply to strings only")
-        if self.kind in ("vector", "string") and (
+        if self.kind in ("vector", "string", "path", "pairs") and (
             self.positive or self.minimum is not None or self.maximum is not None
         ):
             raise wrong("positive, minimum and maximum apply to numbers and integers only")

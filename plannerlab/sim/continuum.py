@@ -10,7 +10,7 @@ point after every physics step and classifies it:
 * **expected**: a robot link touching the obstacle that owns one of the *chosen*
   solution's collision points, with the contact point within ``tolerance_m`` of that
   collision point (in the robot's plane). The default is the planner's
-  ``extra["contact_tolerance_m"]`` = 2·link radius + ``contact_margin_m`` (10 mm): the
+  ``contact_plan.contact_tolerance_m`` = 2·link radius + ``contact_margin_m`` (10 mm): the
   capsule's axis passes through the corner, so the capsule overlaps the obstacle there by
   up to one radius, and when the robot meets the corner at a shallow angle ``α`` to one of
   its edges the overlap runs ``r / tan(α)`` along that edge (measured up to 7.6 mm for
@@ -58,7 +58,7 @@ target; the goals of the paper's cases constrain position only), every contact a
 ``collision_point``), and the rest (chosen solution, tolerance, closest approaches) in
 ``extra``. ``path_valid`` is None: an FCL re-check of the path is not made here, it
 reports the collision-point contacts by design; the planner's
-``extra["expected_contacts"]`` holds its classification.
+``contact_plan.expected_contacts`` holds its classification.
 :attr:`~plannerlab.record.execution.Execution.success` = the tip ends inside the goal
 region, no contact is unexpected and the chain followed the path within the problem's
 ``[simulation] max_deviation_m``: the largest deviation of its capsules from the
@@ -75,7 +75,8 @@ from __future__ import annotations
 
 import math
 import time
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
@@ -167,6 +168,209 @@ def densify_chord_arc_path(path: Array, settings: Mapping[str, Any]) -> Array:
     return scaled * steps
 
 
+def _note_approaches(
+    world: Any,
+    watched: Mapping[int, str],
+    points: Mapping[int, tuple[float, float]],
+    owners: Mapping[int, str],
+    tol: float,
+    approach_m: float,
+    closest: dict[str, dict[str, Any]],
+) -> None:
+    """Update ``closest`` (per obstacle name) with the chain's closest points to each
+    watched obstacle within ``approach_m``, and the nearest chosen collision point."""
+    for uid, name in watched.items():
+        for pt in world.client.getClosestPoints(world.body, uid, approach_m):
+            d = float(pt[8])
+            rec = closest.get(name)
+            if rec is not None and d >= rec["distance_m"]:
+                continue
+            p = tuple(float(v) for v in pt[5])
+            best = min(
+                (
+                    (float(np.hypot(p[0] - xy[0], p[1] - xy[1])), i)
+                    for i, xy in points.items()
+                    if owners[i] == name
+                ),
+                default=(math.inf, None),
+            )
+            closest[name] = {
+                "obstacle": name,
+                "distance_m": d,
+                "link": world.link_name(pt[3])[0],
+                "p_world_m": list(p),
+                "collision_point": best[1],
+                "point_distance_m": None if best[1] is None else best[0],
+                "at_collision_point": best[0] <= tol,
+            }
+
+
+def _contact_records(
+    seen: Mapping[tuple[str, str, bool, bool], list[Any]],
+) -> tuple[ContactRecord, ...]:
+    """The contact pairs seen, in order of their first time: (link, other, other is a
+    link, expected) -> [deepest depth, first time, point, collision point, distance]."""
+    return tuple(
+        ContactRecord(
+            link_name=link,
+            other_name=other,
+            other_is_link=is_link,
+            max_depth_m=float(rec[0]),
+            first_time_s=float(rec[1]),
+            p_world_m=as_xyz(rec[2]),
+            expected=ok,
+            collision_point=rec[3],
+            distance_m=None if rec[4] is None else float(rec[4]),
+        )
+        for (link, other, is_link, ok), rec in sorted(seen.items(), key=lambda kv: kv[1][1])
+    )
+
+
+def _verdict_words(
+    contacts: Sequence[ContactRecord],
+    closest: Mapping[str, Mapping[str, Any]],
+    points: Sequence[int],
+    tip_err_m: float,
+    reached: bool,
+    pos_tol_m: float,
+) -> list[str]:
+    """The execution's reason in words: the tip, the expected and unexpected contacts,
+    the closest approach to each watched obstacle."""
+    unexpected = [c for c in contacts if not c.expected]
+    words = [
+        f"tip {tip_err_m * 1e3:.3g} mm from the target"
+        + ("" if reached else f" (outside the {pos_tol_m * 1e3:g} mm goal region)"),
+        f"{len(contacts) - len(unexpected)} expected contact pair(s) at collision "
+        f"point(s) {list(points)}",
+    ]
+    if unexpected:
+        u = max(unexpected, key=lambda c: c.max_depth_m)
+        if u.other_is_link:
+            where = "self-contact"
+        elif u.distance_m is None:
+            where = "no chosen collision point on it"
+        else:
+            where = f"{u.distance_m * 1e3:.3g} mm from point {u.collision_point}"
+        words.append(
+            f"{len(unexpected)} UNEXPECTED, deepest {u.link_name} x {u.other_name} "
+            f"{u.max_depth_m * 1e3:.2g} mm at "
+            f"{np.round(u.p_world_m[:2], 4).tolist()} ({where})"
+        )
+    else:
+        words.append("no unexpected contact")
+    for name in sorted(closest):
+        a = closest[name]
+        where = (
+            f"at collision point {a['collision_point']}"
+            if a["at_collision_point"]
+            else "AWAY from the collision points"
+        )
+        words.append(f"closest to {name}: {a['distance_m'] * 1e3:.2f} mm, {where}")
+    return words
+
+
+@dataclass(frozen=True)
+class _ContactRules:
+    """How a contact is judged: the chosen collision points (index -> (x, y) [m]), the
+    obstacle each lies on, the tolerance [m] and the guide obstacles."""
+
+    points: Mapping[int, tuple[float, float]]
+    owners: Mapping[int, str]
+    tol: float
+    guides: frozenset[str]
+
+
+@dataclass(frozen=True)
+class _Run:
+    """What one simulated run of a path gave (see :func:`_simulate`)."""
+
+    q_act: Array
+    t_s: Array
+    q_start: Array
+    q_final: Array
+    sim_time_s: float
+    gravity_mps2: tuple[float, float, float]
+    seen: dict[tuple[str, str, bool, bool], list[Any]]
+    closest: dict[str, dict[str, Any]]
+
+
+def _simulate(
+    problem: Problem,
+    path: Array,
+    rules: _ContactRules,
+    *,
+    gravity_mps2: tuple[float, float, float],
+    dt_s: float,
+    steps_per_waypoint: int,
+    settle_steps: int,
+    position_gain: float | None,
+    velocity_gain: float | None,
+    solver: str,
+    solver_iterations: int | None,
+    min_depth_m: float,
+    approach_m: float,
+    gui: bool,
+) -> _Run:
+    """Run ``path`` in a fresh world: each waypoint for ``steps_per_waypoint`` steps, then
+    ``settle_steps``; every contact judged by ``rules`` at every step, the closest
+    approaches read after every waypoint."""
+    seen: dict[tuple[str, str, bool, bool], list[Any]] = {}
+    closest: dict[str, dict[str, Any]] = {}
+    q_act = np.empty_like(path)
+    t_s = np.empty(len(path))
+    robot = problem.robot
+    points, owners, tol, guides = rules.points, rules.owners, rules.tol, rules.guides
+    with SimWorld(
+        robot,
+        problem.scene,
+        gui=gui,
+        dt_s=dt_s,
+        gravity_mps2=gravity_mps2,
+        position_gain=position_gain,
+        velocity_gain=velocity_gain,
+    ) as world:
+
+        def run(n: int) -> None:
+            for _ in range(n):
+                world.step(1)
+                t = world.steps_taken * world.dt_s
+                for c in world.contacts(min_depth_m=min_depth_m):
+                    if not c.other_is_link and c.other_name in guides:
+                        ok, near, dist = True, None, None  # sliding in the sleeve
+                    else:
+                        ok, near, dist = classify_point(c, points, owners, tol)
+                    key = (c.link_name, c.other_name, c.other_is_link, ok)
+                    rec = seen.get(key)
+                    if rec is None:
+                        seen[key] = [c.depth_m, t, c.p_world_m, near, dist]
+                    elif c.depth_m > rec[0]:
+                        rec[0], rec[2], rec[3], rec[4] = c.depth_m, c.p_world_m, near, dist
+
+        world.client.setPhysicsEngineParameter(constraintSolverType=SOLVERS[solver])
+        if solver_iterations is not None:
+            world.client.setPhysicsEngineParameter(numSolverIterations=int(solver_iterations))
+        watched = {uid: n for uid, n in world.obstacle_names.items() if n not in guides}
+
+        def approach() -> None:
+            _note_approaches(world, watched, points, owners, tol, approach_m, closest)
+
+        world.reset(path[0])
+        steps0 = world.steps_taken
+        q_start = world.state()
+        for k, q in enumerate(path):
+            world.command(q)
+            run(steps_per_waypoint)
+            approach()
+            q_act[k] = world.state()
+            t_s[k] = (world.steps_taken - steps0) * world.dt_s
+        run(settle_steps)
+        q_final = world.state()
+        sim_time = (world.steps_taken - steps0) * world.dt_s
+        gravity_used = world.gravity_mps2
+
+    return _Run(q_act, t_s, q_start, q_final, sim_time, gravity_used, seen, closest)
+
+
 def execute_chord_arc(
     problem: Problem,
     result: PlanResult,
@@ -211,10 +415,11 @@ def execute_chord_arc(
 
     Args:
         problem: the problem the plan was made for.
-        result: the leg: its ``path``, ``leg``, ``settings`` and ``extra`` (``chosen``,
-            ``solutions`` (their ``contact_indices``, ``contact_points_m``,
-            ``contact_obstacles``), ``contact_tolerance_m``, ``guide_obstacles``).
-        tolerance_m: expected-contact radius [m]; default ``extra["contact_tolerance_m"]``.
+        result: the leg: its ``path``, ``leg``, ``settings`` and ``contact_plan`` (the
+            chosen solution's collision points and their obstacles, the contact
+            tolerance, the guide obstacles).
+        tolerance_m: expected-contact radius [m]; default the contact plan's
+            ``contact_tolerance_m``.
         dt_s: physics time step [s].
         steps_per_waypoint: physics steps per waypoint.
         settle_steps: physics steps holding the last waypoint.
@@ -230,18 +435,19 @@ def execute_chord_arc(
         gui: PyBullet's GUI instead of DIRECT.
 
     Raises:
-        PlannerlabError: no chosen solution in ``extra`` (not a chord_arc plan, or
+        PlannerlabError: no chosen solution in a ``contact_plan`` (not a chord_arc plan, or
             nothing was solved), a path of the wrong shape, or a bad parameter.
     """
     t0 = time.perf_counter()
-    extra = result.extra
-    chosen = extra.get("chosen") if isinstance(extra, Mapping) else None
-    if chosen is None or "solutions" not in extra:
+    contact_plan = result.contact_plan
+    sol = None if contact_plan is None else contact_plan.chosen_solution
+    if contact_plan is None or sol is None:
         raise PlannerlabError(
             f"{problem.name} leg {result.leg}: execute_chord_arc needs a chord_arc plan "
-            "with a chosen solution (extra['chosen'] and extra['solutions']); "
+            "with a chosen solution (its contact_plan); "
             f"this leg is {result.status.value}"
         )
+    chosen = contact_plan.chosen
     if solver not in SOLVERS:
         raise PlannerlabError(f"solver must be one of {', '.join(SOLVERS)}, got {solver!r}")
     if steps_per_waypoint < 1 or settle_steps < 0 or not dt_s > 0:
@@ -257,93 +463,34 @@ def execute_chord_arc(
             f"path must be (m >= 1, {robot.dof}) for {problem.name}, got {path.shape}"
         )
     path = densify_chord_arc_path(path, result.settings)
-    sol = extra["solutions"][int(chosen)]
-    tol = float(extra["contact_tolerance_m"] if tolerance_m is None else tolerance_m)
-    idx = [int(i) for i in sol["contact_indices"]]
-    points = {
-        i: (float(p[0]), float(p[1])) for i, p in zip(idx, sol["contact_points_m"], strict=True)
-    }
-    owners = dict(zip(idx, sol["contact_obstacles"], strict=True))
+    tol = float(contact_plan.contact_tolerance_m if tolerance_m is None else tolerance_m)
+    idx = list(sol.contact_indices)
+    points = dict(zip(idx, sol.contact_points_m, strict=True))
+    owners = dict(zip(idx, sol.contact_obstacles, strict=True))
     goal = problem.goal(leg)
     gravity = problem.simulation.gravity_mps2 if gravity_mps2 is None else gravity_mps2
-    guides = frozenset(str(n) for n in extra.get("guide_obstacles", ()))
+    guides = frozenset(contact_plan.guide_obstacles)
 
-    seen: dict[tuple[str, str, bool, bool], list[Any]] = {}
-    closest: dict[str, dict[str, Any]] = {}
     tips_cmd = robot.tip(path)[0]
-    q_act = np.empty_like(path)
-    t_s = np.empty(len(path))
-    with SimWorld(
-        robot,
-        problem.scene,
-        gui=gui,
-        dt_s=dt_s,
+    run = _simulate(
+        problem,
+        path,
+        _ContactRules(points, owners, tol, guides),
         gravity_mps2=gravity,
+        dt_s=dt_s,
+        steps_per_waypoint=steps_per_waypoint,
+        settle_steps=settle_steps,
         position_gain=position_gain,
         velocity_gain=velocity_gain,
-    ) as world:
-
-        def run(n: int) -> None:
-            for _ in range(n):
-                world.step(1)
-                t = world.steps_taken * world.dt_s
-                for c in world.contacts(min_depth_m=min_depth_m):
-                    if not c.other_is_link and c.other_name in guides:
-                        ok, near, dist = True, None, None  # sliding in the sleeve
-                    else:
-                        ok, near, dist = classify_point(c, points, owners, tol)
-                    key = (c.link_name, c.other_name, c.other_is_link, ok)
-                    rec = seen.get(key)
-                    if rec is None:
-                        seen[key] = [c.depth_m, t, c.p_world_m, near, dist]
-                    elif c.depth_m > rec[0]:
-                        rec[0], rec[2], rec[3], rec[4] = c.depth_m, c.p_world_m, near, dist
-
-        world.client.setPhysicsEngineParameter(constraintSolverType=SOLVERS[solver])
-        if solver_iterations is not None:
-            world.client.setPhysicsEngineParameter(numSolverIterations=int(solver_iterations))
-        watched = {uid: n for uid, n in world.obstacle_names.items() if n not in guides}
-
-        def approach() -> None:
-            for uid, name in watched.items():
-                for pt in world.client.getClosestPoints(world.body, uid, approach_m):
-                    d = float(pt[8])
-                    rec = closest.get(name)
-                    if rec is not None and d >= rec["distance_m"]:
-                        continue
-                    p = tuple(float(v) for v in pt[5])
-                    best = min(
-                        (
-                            (float(np.hypot(p[0] - xy[0], p[1] - xy[1])), i)
-                            for i, xy in points.items()
-                            if owners[i] == name
-                        ),
-                        default=(math.inf, None),
-                    )
-                    closest[name] = {
-                        "obstacle": name,
-                        "distance_m": d,
-                        "link": world.link_name(pt[3])[0],
-                        "p_world_m": list(p),
-                        "collision_point": best[1],
-                        "point_distance_m": None if best[1] is None else best[0],
-                        "at_collision_point": best[0] <= tol,
-                    }
-
-        world.reset(path[0])
-        steps0 = world.steps_taken
-        q_start = world.state()
-        for k, q in enumerate(path):
-            world.command(q)
-            run(steps_per_waypoint)
-            approach()
-            q_act[k] = world.state()
-            t_s[k] = (world.steps_taken - steps0) * world.dt_s
-        run(settle_steps)
-        q_final = world.state()
-        sim_time = (world.steps_taken - steps0) * world.dt_s
-        gravity_used = world.gravity_mps2
-
+        solver=solver,
+        solver_iterations=solver_iterations,
+        min_depth_m=min_depth_m,
+        approach_m=approach_m,
+        gui=gui,
+    )
+    seen, closest = run.seen, run.closest
+    q_act, t_s, q_start, q_final = run.q_act, run.t_s, run.q_start, run.q_final
+    sim_time, gravity_used = run.sim_time_s, run.gravity_mps2
     tip_track = np.linalg.norm(robot.tip(q_act)[0] - tips_cmd, axis=1)
     # The deviation where the chain should have arrived: the end of every waypoint's
     # window, and after settling (each waypoint moves it by at most path_step_m).
@@ -358,50 +505,8 @@ def execute_chord_arc(
     pe, ae = goal.errors(robot, q_final)
     tip_err = float(pe)
     reached = bool(goal.contains(robot, q_final))
-    contacts = tuple(
-        ContactRecord(
-            link_name=link,
-            other_name=other,
-            other_is_link=is_link,
-            max_depth_m=float(rec[0]),
-            first_time_s=float(rec[1]),
-            p_world_m=as_xyz(rec[2]),
-            expected=ok,
-            collision_point=rec[3],
-            distance_m=None if rec[4] is None else float(rec[4]),
-        )
-        for (link, other, is_link, ok), rec in sorted(seen.items(), key=lambda kv: kv[1][1])
-    )
-    unexpected = [c for c in contacts if not c.expected]
-    words = [
-        f"tip {tip_err * 1e3:.3g} mm from the target"
-        + ("" if reached else f" (outside the {goal.pos_tol_m * 1e3:g} mm goal region)"),
-        f"{len(contacts) - len(unexpected)} expected contact pair(s) at collision "
-        f"point(s) {sorted(points)}",
-    ]
-    if unexpected:
-        u = max(unexpected, key=lambda c: c.max_depth_m)
-        if u.other_is_link:
-            where = "self-contact"
-        elif u.distance_m is None:
-            where = "no chosen collision point on it"
-        else:
-            where = f"{u.distance_m * 1e3:.3g} mm from point {u.collision_point}"
-        words.append(
-            f"{len(unexpected)} UNEXPECTED, deepest {u.link_name} x {u.other_name} "
-            f"{u.max_depth_m * 1e3:.2g} mm at "
-            f"{np.round(u.p_world_m[:2], 4).tolist()} ({where})"
-        )
-    else:
-        words.append("no unexpected contact")
-    for name in sorted(closest):
-        a = closest[name]
-        where = (
-            f"at collision point {a['collision_point']}"
-            if a["at_collision_point"]
-            else "AWAY from the collision points"
-        )
-        words.append(f"closest to {name}: {a['distance_m'] * 1e3:.2f} mm, {where}")
+    contacts = _contact_records(seen)
+    words = _verdict_words(contacts, closest, sorted(points), tip_err, reached, goal.pos_tol_m)
     track_limit = problem.simulation.max_track_err_rad
     words.append(f"deviation <= {max_dev * 1e3:.3g} mm")
     if max_dev > dev_limit:
@@ -453,7 +558,7 @@ def execute_chord_arc(
         solver=solver,
         extra={
             "executor": "chord_arc",
-            "chosen": int(chosen),
+            "chosen": chosen,
             "collision_points_used": idx,
             "contact_tolerance_m": tol,
             "guide_obstacles": sorted(guides),

@@ -215,11 +215,15 @@ class SimWorld:
             self.urdf_link_names[j] = info[12].decode()
         self._pb_link = {name: j for j, name in self.urdf_link_names.items()}
         robot_links = list(robot.link_names)
+        # the URDF link of each robot link: its name, unless the robot says otherwise (a
+        # URDF robot has several capsules per URDF link; the first one stands for them
+        # all, their self-collision pairs being excluded or not alike)
+        urdf_of_link = list(getattr(robot, "link_urdf_names", robot_links))
         # PyBullet link index -> robot link index
         self._robot_link: dict[int, int] = {
-            j: robot_links.index(name)
+            j: urdf_of_link.index(name)
             for j, name in self.urdf_link_names.items()
-            if name in robot_links
+            if name in urdf_of_link
         }
         if -1 not in self._robot_link:
             unmatched = [i for i, n in enumerate(robot_links) if n not in self._pb_link]

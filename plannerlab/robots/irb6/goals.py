@@ -45,6 +45,20 @@ class GoalRegion(Protocol):
     def angle_tol_deg(self) -> float: ...
 
 
+def reach_from_track(robot: IRb6, p_world_m: Array) -> tuple[float, float, str]:
+    """How far ``p_world_m`` is from the shoulder's line along the track, and the most the
+    flange reaches from it (lower arm + upper arm + wrist-to-flange) [m]: the IRb-6's
+    reach bound (:attr:`plannerlab.robots.registry.RobotFamily.reach`)."""
+    T = np.asarray(robot.T_world_base, dtype=float)
+    lo, hi = robot.track_range_m
+    p_s = T[:3, :3].T @ (np.asarray(p_world_m, dtype=float) - T[:3, 3])
+    h = robot.shoulder_height_m
+    closest = np.array([0.0, h, min(max(p_s[2], lo), hi)])
+    dist = float(np.linalg.norm(p_s - closest))
+    reach = float(robot.lower_arm_m + robot.upper_arm_m + robot.wrist_to_flange_m)
+    return dist, reach, f"the shoulder's line along the track (λ0 in [{lo:g}, {hi:g}] m)"
+
+
 def _perpendicular_basis(c: Array) -> tuple[Array, Array]:
     helper = np.array([1.0, 0.0, 0.0]) if abs(c[0]) < 0.9 else np.array([0.0, 1.0, 0.0])
     e1 = np.cross(c, helper)

@@ -70,6 +70,31 @@ def _check_problem_start(problem: Problem) -> None:
         raise ProblemError(problem.source, "start", f"a collision-free start state; {reason}")
 
 
+def legs_from_spec(problem: Problem, spec: str | None) -> list[int] | None:
+    """The legs a ``--legs`` text names (indices or goal names, comma-separated; ``all`` or
+    None: every leg).
+
+    Raises:
+        PlannerlabError: an unknown leg (the problem's legs listed) or one named twice.
+    """
+    if spec is None or spec.strip() == "all":
+        return None
+    legs = []
+    for x in spec.split(","):
+        x = x.strip()
+        try:
+            legs.append(problem.resolve_leg(x))
+        except (IndexError, KeyError) as exc:
+            names = ", ".join(f"{i} {g.name}" for i, g in enumerate(problem.goals))
+            raise PlannerlabError(
+                f"--legs: unknown leg {x!r} of {problem.name} ({problem.source}); "
+                f"its legs are: {names}"
+            ) from exc
+    if len(set(legs)) != len(legs):
+        raise PlannerlabError(f"--legs: {spec!r} names a leg twice")
+    return legs
+
+
 def solve_legs(
     problem: Problem,
     planner_name: str,
@@ -149,8 +174,8 @@ def execute_results(
 
     Ordinary legs run in one world, each from where the previous one really ended
     (:func:`plannerlab.sim.execute.execute_legs`). Legs of a contact-permitting planner
-    (``extra["allows_contact"]``: ``chord_arc``, whose paths touch the collision points
-    on purpose) run in :func:`plannerlab.sim.continuum.execute_chord_arc`, which sorts
+    (a leg with a ``contact_plan``: ``chord_arc``, whose paths touch the collision
+    points on purpose) run in :func:`plannerlab.sim.continuum.execute_chord_arc`, which sorts
     expected from unexpected contacts; each of them starts from its path's first state.
 
     Raises:
@@ -159,7 +184,7 @@ def execute_results(
     if not results:
         raise PlannerlabError("nothing to execute: the plan has no legs")
     results = [canonical_result(r) for r in results]
-    if any(r.extra.get("allows_contact") for r in results):
+    if any(r.contact_plan is not None for r in results):
         from plannerlab.sim.continuum import execute_chord_arc
 
         return [execute_chord_arc(problem, r, gui=gui) for r in results]

@@ -3,10 +3,10 @@
 ``plannerlab compare … --backend ray [--address ADDR]`` hands every trial to Ray. The
 task is declared with ``max_calls=1``: Ray starts a new worker process for it and ends
 the process after it, so OMPL's process-global seed is set (first thing in
-:func:`plannerlab.bench.trials.run_trial`) before any OMPL object exists, exactly as in
+:func:`plannerlab.comparison.trial.run_trial`) before any OMPL object exists, exactly as in
 the local backend, and the same seeds give the same table. Everything else (the store,
 resuming, the per-trial time limit, the progress display, the reports) belongs to
-:func:`plannerlab.bench.trials.run_comparison` and does not depend on the backend.
+:func:`plannerlab.comparison.runner.run_comparison` and does not depend on the backend.
 
 Decisions:
 
@@ -35,7 +35,7 @@ from plannerlab.errors import PlannerlabError
 
 def _ray_trial(trial: Any, launched_at: float, run: Callable[[Any], dict[str, Any]]) -> dict:
     """The Ray task: ``run(trial)`` in this (fresh) worker process."""
-    from plannerlab.bench.local import _import_trial_modules
+    from plannerlab.comparison.local import _import_trial_modules
 
     _import_trial_modules()
     startup_s = time.time() - launched_at
@@ -48,7 +48,7 @@ class RayBackend:
     """Trials as Ray tasks (see the module docstring).
 
     Args:
-        run: what a task calls with the trial (:func:`plannerlab.bench.trials.run_trial`,
+        run: what a task calls with the trial (:func:`plannerlab.comparison.trial.run_trial`,
             passed in so that this module does not import the runner that imports it).
         address: a Ray cluster's address, or None for a local instance.
         num_cpus: CPUs of a private local instance (None: Ray's default, all of them).

@@ -1,6 +1,6 @@
 """The local trial backend: one fresh process per trial, forked from a warm fork server.
 
-:func:`plannerlab.bench.trials.run_comparison` hands each trial to a backend and takes
+:func:`plannerlab.comparison.runner.run_comparison` hands each trial to a backend and takes
 its record back. This backend runs every trial in its own process on this machine.
 
 Decisions:
@@ -11,7 +11,7 @@ Decisions:
   modules and plannerlab's planners, task runner and simulator) and then forks one child
   per trial. Importing creates no OMPL object, so each child still seeds OMPL's
   process-global generator before any OMPL object exists
-  (:func:`plannerlab.bench.trials.run_trial` does so first), and a trial's result does
+  (:func:`plannerlab.comparison.trial.run_trial` does so first), and a trial's result does
   not depend on which child ran it or on ``jobs``. The child skips the 0.6–0.7 s of
   imports a spawned interpreter pays. ``start_method="spawn"`` keeps the old behaviour.
 * **A trial is a process**: a child that dies (a segfault in a native library) is an
@@ -52,8 +52,9 @@ PRELOAD_MODULES: tuple[str, ...] = (
     "plannerlab.planners.ompl",
     "plannerlab.planners.gradient",
     "plannerlab.planners.hybrid",
-    "plannerlab.bench.task",
-    "plannerlab.bench.trials",
+    "plannerlab.run.pipeline",
+    "plannerlab.comparison.trial",
+    "plannerlab.comparison.runner",
     "plannerlab.sim.execute",
     "plannerlab.record.files",
     "toppra",  # imported by retiming on first use; itself imports scipy.interpolate
@@ -169,7 +170,7 @@ class LocalBackend:
         work_dir: folder for the children's captured output (created; emptied of stale
             files; removed by :meth:`close` when empty).
         run: what a trial's process calls with the trial, returning its record
-            (:func:`plannerlab.bench.trials.run_trial`; passed in, pickled by reference,
+            (:func:`plannerlab.comparison.trial.run_trial`; passed in, pickled by reference,
             so that this module does not import the runner that imports it).
         start_method: ``"forkserver"`` (default) or ``"spawn"``.
     """

@@ -1,12 +1,13 @@
 """Tables backed by files: a comparison's CSV, Markdown and OMPL benchmark log.
 
-Everything here turns trial records (:func:`plannerlab.bench.trials.run_trial`) and summary rows
-(:func:`plannerlab.bench.trials.summarise`) into text, and :func:`write_reports` writes them
-atomically (:func:`plannerlab.record.files.write_text_atomic`) into the comparison's folder:
+Everything here turns trial records (:func:`plannerlab.comparison.trial.run_trial`) and
+summary rows (:func:`plannerlab.comparison.statistics.summarise`) into text, and
+:func:`write_reports` writes them atomically (:func:`plannerlab.record.files.write_text_atomic`)
+into the comparison's folder:
 
 * ``trials.csv``: one row per trial; ``legs.csv``: one row per leg of every trial;
   ``summary.csv``: one row per (problem, planner), columns
-  :data:`plannerlab.bench.trials.SUMMARY_COLUMNS`;
+  :data:`plannerlab.comparison.statistics.SUMMARY_COLUMNS`;
 * ``report.md``: a table per problem, with the exact command, seeds, budget, settings,
   package versions and the machine;
 * ``meta.json``: the same metadata as data;
@@ -60,7 +61,8 @@ from collections.abc import Iterable, Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
-from plannerlab.bench.trials import ERROR_STATUS, SUMMARY_COLUMNS, TOTAL_KEYS
+from plannerlab.comparison.statistics import SUMMARY_COLUMNS
+from plannerlab.comparison.trial import ERROR_STATUS, TOTAL_KEYS
 from plannerlab.record.files import write_json_atomic, write_text_atomic
 from plannerlab.record.leg import Status
 

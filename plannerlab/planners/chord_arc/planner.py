@@ -2,7 +2,7 @@
 
 Source: ``003_d410ec97f064abf9.txt`` (digest in ``docs/papers.md`` §3). The search itself,
 the contact-type check and the motion sequence live in
-:mod:`plannerlab.planners.chord_arc_search` (pure functions over planar data); this module
+:mod:`.search` and :mod:`.motion` (pure functions over planar data, :mod:`.geometry`); this module
 wraps them behind the planner contract ``solve(problem, leg, budget, rng) -> PlanResult``
 for a :class:`~plannerlab.robots.continuum.model.ContinuumChain` problem.
 
@@ -14,13 +14,16 @@ Build, then solve:
   its yaw; a vertical cylinder: a circle; a sphere: the circle of its cross-section; shapes
   that miss the plane are left out), the collision points of the problem file's
   ``[continuum] collision_points_m`` and the leg's goal position as the target.
-* :meth:`ChordArcPlanner.solve` runs :func:`~plannerlab.planners.chord_arc_search.
+* :meth:`ChordArcPlanner.solve` runs :func:`~plannerlab.planners.chord_arc.motion.
   solve_chord_arc` and turns **every** solution that survives into data, then picks one
   (``choose``) and returns its motion sequence as the joint path.
 
-**Every solution is returned** (``extra["solutions"]``: bend angles, arc lengths,
-curvatures, collision points used, their obstacles and contact types), not only the first.
-Solutions are dropped, with the reason kept (``extra["dropped"]``), when
+The leg's :attr:`~plannerlab.record.leg.PlanResult.contact_plan` (a
+:class:`~plannerlab.record.contact_plan.ContactPlan`) is the typed record of what it found,
+which the executor, the figures and the CLI read. **Every solution is returned**
+(``contact_plan.solutions``: arcs, collision points used, their obstacles and contact
+types), not only the first. Solutions are dropped, with the reason kept
+(``contact_plan.dropped``), when
 
 1. a contact does not behave as its type requires, or the initial push or the re-bend
    sweeps into an obstacle (the search module's motion check), or
@@ -30,7 +33,7 @@ Solutions are dropped, with the reason kept (``extra["dropped"]``), when
    away from the solution's collision points somewhere along the motion (below).
 
 **The path** is the joint path (m, dof) of the chosen solution's motion sequence: each
-:class:`~plannerlab.planners.chord_arc_search.MotionStep` is sampled so that neither the
+:class:`~plannerlab.planners.chord_arc.motion.MotionStep` is sampled so that neither the
 robot's inserted length nor the last arc's length changes by more than ``path_step_m``
 between waypoints, and no joint by more than ``path_joint_step_rad`` (resampled finer if
 it would), and every shape is mapped to joints by ``ContinuumChain.q_from_arcs`` (the
@@ -60,7 +63,7 @@ the obstacles' cuts lie in one plane, so a capsule touches an obstacle exactly w
 axis comes closer than r to the cut; it gives the same pairs as python-fcl state by
 state, 30-40 times faster); a touching (link, obstacle) pair is *expected* when the
 link's axis passes within ``contact_tolerance_m`` (= 2·r + ``contact_margin_m``) of one
-of the solution's collision points on that obstacle; ``extra["expected_contacts"]``
+of the solution's collision points on that obstacle; ``contact_plan.expected_contacts``
 lists the chosen solution's expected pairs. Any other touching pair drops the solution
 (3. above). Every state checked counts as one of ``collision_checks``.
 
@@ -85,7 +88,7 @@ from typing import Any
 
 import numpy as np
 
-from plannerlab.errors import PlannerlabError, ProblemError
+from plannerlab.errors import PlannerlabError
 from plannerlab.planners.base import (
     BudgetTracker,
     LegRun,
@@ -94,22 +97,36 @@ from plannerlab.planners.base import (
     Stepper,
     with_overrides,
 )
-from plannerlab.planners.chord_arc_search import (
-    CHOICES,
+from plannerlab.planners.chord_arc.geometry import (
     ChordArcInputError,
-    ChordArcPlan,
     ChordArcQuery,
-    ChordArcResult,
-    ChordArcSettings,
     ChordArcSolution,
     Circle,
-    ConvexPolygon,
-    MotionStep,
     PlanarObstacle,
+)
+from plannerlab.planners.chord_arc.motion import (
+    ChordArcPlan,
+    ChordArcResult,
+    MotionStep,
     solve_chord_arc,
 )
-from plannerlab.planners.chord_arc_search import prepare as prepare_check
-from plannerlab.problem.scene import Box, Cylinder, Scene, Sphere
+from plannerlab.planners.chord_arc.scene import (
+    _point_segment_distance,
+    capsule_distances,
+    collision_points,
+    grow_query,
+    guide_obstacles,
+    planar_obstacles,
+    thickness_cuts,
+)
+from plannerlab.planners.chord_arc.settings import ChordArcSettings
+from plannerlab.record.contact_plan import (
+    ContactPlan,
+    ContactSolution,
+    PlanarArc,
+    PlanarShape,
+    PlannedContact,
+)
 from plannerlab.robots.base import Array
 from plannerlab.robots.continuum.model import ContinuumChain
 
@@ -131,194 +148,125 @@ PAPER_TABLE: dict[str, PaperCase] = {
 }
 
 
-# --------------------------------------------------------------------------- building
+def _shape(o: PlanarObstacle) -> PlanarShape:
+    """An obstacle's cut as record data."""
+    if isinstance(o, Circle):
+        return PlanarShape(o.name, center_m=o.center_m, radius_m=o.radius_m)
+    return PlanarShape(o.name, vertices_m=o.vertices_m)
 
 
-def _planar_obstacles(scene: Scene, z_m: float, tol: float = 1e-9) -> tuple[PlanarObstacle, ...]:
-    """The scene cut by the plane z = ``z_m``: rectangles and circles (see module doc).
-
-    Raises:
-        ChordArcInputError: a box or cylinder that is not upright (its cut is not a
-            rectangle or a circle).
-    """
-    out: list[PlanarObstacle] = []
-    for o in scene.obstacles:
-        T = o.T_world_obstacle
-        c = T[:3, 3]
-        dz = abs(float(c[2]) - z_m)
-        if isinstance(o, Sphere):
-            if dz < o.radius_m:
-                out.append(Circle((c[0], c[1]), math.sqrt(o.radius_m**2 - dz**2), o.name))
-            continue
-        if abs(abs(float(T[2, 2])) - 1.0) > tol:
-            raise ChordArcInputError(
-                f"obstacle {o.name!r}: only upright boxes and vertical cylinders can be cut "
-                f"by the robot's plane (local z = {T[:3, 2].round(6).tolist()})"
-            )
-        if isinstance(o, Box):
-            if dz < o.size_m[2] / 2.0:
-                yaw = math.atan2(float(T[1, 0]), float(T[0, 0]))
-                out.append(
-                    ConvexPolygon.rectangle((c[0], c[1]), (o.size_m[0], o.size_m[1]), yaw, o.name)
-                )
-        elif isinstance(o, Cylinder):
-            if dz < o.length_m / 2.0:
-                out.append(Circle((c[0], c[1]), o.radius_m, o.name))
-        else:  # pragma: no cover - Scene only holds the three types
-            raise ChordArcInputError(f"obstacle {o.name!r}: unknown type {type(o).__name__}")
-    return tuple(out)
-
-
-def _grown_polygon(poly: ConvexPolygon, r: float) -> ConvexPolygon:
-    """The polygon grown by ``r``, corners chamfered by the tangent at ``r`` along each
-    corner's bisector (it contains the exact, rounded Minkowski sum)."""
-    v = np.array(poly.vertices_m)  # counter-clockwise
-    d = np.roll(v, -1, axis=0) - v
-    n = np.stack([d[:, 1], -d[:, 0]], axis=1) / np.hypot(d[:, 0], d[:, 1])[:, None]
-    out = []
-    for i in range(len(v)):
-        n_in, n_out = n[i - 1], n[i]  # normals of the edges into and out of vertex i
-        b = (n_in + n_out) / np.linalg.norm(n_in + n_out)
-        for m in (n_in, n_out):
-            out.append(v[i] + r * (m + b) / (1.0 + float(m @ b)))
-    return ConvexPolygon(tuple(map(tuple, out)), poly.name)
-
-
-def grow_query(
-    query: ChordArcQuery, radius_m: float, boundary_tol_m: float = 1e-6
-) -> ChordArcQuery:
-    """The query for the axis of a robot of radius ``radius_m`` (configuration space).
-
-    Circles grow by the radius; convex polygons grow by it with chamfered corners
-    (:func:`_grown_polygon`); each collision point moves out of its obstacle by the radius,
-    against the direction into the obstacle (a corner's bisector, an edge's normal, a
-    circle's radius), which puts a corner's point on the middle of its chamfer.
-    """
-    prep = prepare_check(query, ChordArcSettings(boundary_tol_m=boundary_tol_m))
-    obstacles: list[PlanarObstacle] = []
-    for o in query.obstacles:
-        if isinstance(o, Circle):
-            obstacles.append(Circle(o.center_m, o.radius_m + radius_m, o.name))
-        else:
-            obstacles.append(_grown_polygon(o, radius_m))
-    points = tuple(
-        tuple((np.asarray(p) - radius_m * prep.into[i]).tolist())
-        for i, p in enumerate(query.collision_points_m)
-    )
-    return ChordArcQuery(
-        query.base_xy_m,
-        query.base_tangent,
-        query.total_length_m,
-        tuple(obstacles),
-        points,
-        query.target_xy_m,
+def _solution(
+    sol: ChordArcSolution,
+    real: ChordArcQuery,
+    *,
+    plan: ChordArcPlan | None = None,
+    path_waypoints: int = 0,
+    expected_contacts: Sequence[PlannedContact] = (),
+    reason: str = "",
+    stage: str = "",
+    unexpected_contacts: Sequence[PlannedContact] = (),
+    cuts_radius_m: float = 0.0,
+) -> ContactSolution:
+    """A solution as record data; ``contact_points_m`` are the problem's collision points
+    (the obstacle corners), ``axis_points_m`` where the robot's axis passes them;
+    ``cuts_radius_m`` > 0 records where a robot of that radius along this zero-thickness
+    curve would cut an obstacle (:func:`thickness_cuts`)."""
+    cuts = thickness_cuts(real, sol, cuts_radius_m) if cuts_radius_m > 0 else np.zeros((0, 2))
+    return ContactSolution(
+        contact_indices=tuple(sol.contact_indices),
+        contact_points_m=tuple(real.collision_points_m[i] for i in sol.contact_indices),
+        axis_points_m=tuple(sol.contact_points_m),
+        arcs=tuple(
+            PlanarArc(a.start_xy_m, a.start_tangent, a.theta_rad, a.length_m) for a in sol.arcs
+        ),
+        total_length_m=sol.total_length_m,
+        leftover_m=sol.leftover_m,
+        contact_obstacles=() if plan is None else tuple(ck.obstacle for ck in plan.contacts),
+        contact_types=() if plan is None else tuple(ck.contact_type for ck in plan.contacts),
+        contact_sides=() if plan is None else tuple(ck.side for ck in plan.contacts),
+        motion=() if plan is None else tuple((m.kind, m.description) for m in plan.motion),
+        path_waypoints=path_waypoints,
+        expected_contacts=tuple(expected_contacts),
+        reason=reason,
+        stage=stage,
+        unexpected_contacts=tuple(unexpected_contacts),
+        cuts_xy_m=tuple((float(x), float(y)) for x, y in cuts),
     )
 
 
-def thickness_cuts(
-    query: ChordArcQuery,
-    solution: ChordArcSolution,
-    radius_m: float,
-    near_m: float | None = None,
-    step_m: float = 5e-4,
-) -> Array:
-    """Points (k, 2) of a zero-thickness solution where a robot of radius ``radius_m``
-    following it would cut an obstacle: the curve comes closer than the radius to an
-    obstacle farther than ``near_m`` (default 2·radius) from the solution's collision
-    points (at those points the curve passes through the corner by design).
-    """
-    near = 2.0 * radius_m if near_m is None else near_m
-    geo = prepare_check(query, ChordArcSettings()).geometry
-    pts = np.vstack(
-        [
-            a.points(np.linspace(0.0, 1.0, max(2, math.ceil(a.length_m / step_m))))
-            for a in solution.arcs
-        ]
+def _candidate_solution(c: _Candidate, real: ChordArcQuery, cut_r: float) -> ContactSolution:
+    """A chain-checked solution as record data: kept (its path and expected contacts) or
+    dropped by the chain's check (its reason and unexpected contacts)."""
+    if c.reason:
+        return _solution(
+            c.plan.solution,
+            real,
+            plan=c.plan,
+            reason=c.reason,
+            stage="chain",
+            unexpected_contacts=c.unexpected,
+            cuts_radius_m=cut_r,
+        )
+    return _solution(
+        c.plan.solution,
+        real,
+        plan=c.plan,
+        path_waypoints=len(c.path),
+        expected_contacts=c.expected,
+        cuts_radius_m=cut_r,
     )
-    sd = geo.signed_distance(pts).min(axis=1)
-    corners = np.asarray(solution.contact_points_m, dtype=float).reshape(-1, 2)
-    if len(corners):
-        d = np.linalg.norm(pts[:, None, :] - corners[None], axis=-1).min(axis=1)
-    else:
-        d = np.full(len(pts), math.inf)
-    return pts[(sd < radius_m - 1e-9) & (d > near)]
 
 
-def collision_points(problem: Any) -> tuple[tuple[float, float], ...]:
-    """``[continuum] collision_points_m`` of a problem: (x, y) or (x, y, z) each [m].
-
-    Raises:
-        ProblemError: the table or key is missing, or a point is not 2 or 3 numbers.
-    """
-    key = "continuum.collision_points_m"
-    table = problem.extras.get("continuum")
-    if not isinstance(table, dict) or "collision_points_m" not in table:
-        raise ProblemError(
-            problem.source,
-            key,
-            "is missing: the chord_arc planner needs the points where contact "
-            "is allowed ([continuum] collision_points_m = [[x, y], ...])",
-        )
-    raw = table["collision_points_m"]
-    pts: list[tuple[float, float]] = []
-    if not isinstance(raw, list):
-        raise ProblemError(problem.source, key, f"a list of [x, y] points, got {raw!r}")
-    for i, p in enumerate(raw):
-        ok = (
-            isinstance(p, list | tuple)
-            and len(p) in (2, 3)
-            and all(
-                isinstance(v, int | float) and not isinstance(v, bool) and math.isfinite(v)
-                for v in p
-            )
-        )
-        if not ok:
-            raise ProblemError(
-                problem.source,
-                f"{key}[{i}]",
-                f"two or three finite numbers (x, y[, z]) [m], got {p!r}",
-            )
-        pts.append((float(p[0]), float(p[1])))
-    return tuple(pts)
+def _empty_record(
+    problem: Any, real: ChordArcQuery, query: ChordArcQuery, tol: float, inflated: bool
+) -> ContactPlan:
+    """The leg's contact plan before the search: the plane, the points, the tolerances."""
+    robot = problem.robot
+    return ContactPlan(
+        base_xy_m=real.base_xy_m,
+        base_tangent=real.base_tangent,
+        target_xy_m=real.target_xy_m,
+        obstacles=tuple(_shape(o) for o in real.obstacles),
+        planning_obstacles=tuple(_shape(o) for o in query.obstacles),
+        collision_points_m=real.collision_points_m,
+        link_radius_m=robot.link_radius_m,
+        inflated_by_m=robot.link_radius_m if inflated else 0.0,
+        contact_tolerance_m=tol,
+        guide_obstacles=tuple(sorted(guide_obstacles(problem))),
+    )
 
 
-def guide_obstacles(problem: Any) -> frozenset[str]:
-    """``[continuum] guide_obstacles`` of a problem: obstacles that guide the robot (the
-    insertion sleeve), whose contacts are expected. Empty if absent.
-
-    Raises:
-        ProblemError: not a list of names of the problem's obstacles.
-    """
-    key = "continuum.guide_obstacles"
-    table = problem.extras.get("continuum")
-    raw = table.get("guide_obstacles", []) if isinstance(table, dict) else []
-    names = set(problem.scene.names)
-    if not isinstance(raw, list) or not all(isinstance(n, str) for n in raw):
-        raise ProblemError(problem.source, key, f"a list of obstacle names, got {raw!r}")
-    unknown = [n for n in raw if n not in names]
-    if unknown:
-        raise ProblemError(
-            problem.source,
-            key,
-            f"names of obstacles in this problem ({', '.join(sorted(names))}); "
-            f"unknown: {', '.join(unknown)}",
-        )
-    return frozenset(raw)
-
-
-def _shape_dict(sol: ChordArcSolution, real: ChordArcQuery) -> dict[str, Any]:
-    """A solution as data; ``contact_points_m`` are the problem's collision points (the
-    obstacle corners), ``axis_points_m`` where the robot's axis passes them."""
+def _search_counts(srch: Any, search_s: float) -> dict[str, Any]:
+    """The search's counters as record data."""
     return {
-        "contact_indices": list(sol.contact_indices),
-        "contact_points_m": [list(real.collision_points_m[i]) for i in sol.contact_indices],
-        "axis_points_m": [list(p) for p in sol.contact_points_m],
-        "bend_angles_rad": [a.theta_rad for a in sol.arcs],
-        "arc_lengths_m": [a.length_m for a in sol.arcs],
-        "curvatures_per_m": [a.curvature_per_m for a in sol.arcs],
-        "total_length_m": sol.total_length_m,
-        "leftover_m": sol.leftover_m,
+        "time_s": search_s,
+        "expansions": srch.expansions,
+        "arcs_built": srch.arcs_built,
+        "arcs_checked": srch.arcs_checked,
+        "rejected_bend": srch.arcs_rejected_bend,
+        "rejected_length": srch.arcs_rejected_length,
+        "rejected_obstacle": srch.arcs_rejected_obstacle,
+        "depth_reached": srch.depth_reached,
+        "budget_exhausted": srch.budget_exhausted,
+        "geometric_solutions": len(srch.solutions),
     }
+
+
+def _nothing_kept(srch: Any, dropped: Sequence[ContactSolution], n_pts: int) -> tuple[Status, str]:
+    """Status and reason of a leg without a solution to execute."""
+    if not srch.solutions:
+        status = Status.BUDGET_EXHAUSTED if srch.budget_exhausted else Status.FAILED
+        return status, (
+            f"no chord-arc shape reaches the target through the {n_pts} "
+            f"collision points ({srch.expansions} expansions, depth "
+            f"{srch.depth_reached}"
+            + (", expansion budget used up)" if srch.budget_exhausted else ")")
+        )
+    why = "; ".join(d.reason for d in dropped[:3])
+    return Status.FAILED, (
+        f"all {len(srch.solutions)} geometric solution(s) dropped: {why}"
+        + (" …" if len(dropped) > 3 else "")
+    )
 
 
 def _capped(settings: ChordArcSettings, max_iterations: int | None) -> ChordArcSettings:
@@ -341,94 +289,8 @@ class _Candidate:
     path: Array  # (m, dof)
     step_of: Array  # (m,) motion step index of each waypoint (-1: the start)
     reason: str  # why it is dropped; "" if it holds
-    expected: tuple[dict[str, Any], ...]
-    unexpected: tuple[dict[str, Any], ...]
-
-
-def _point_segment_distance(p: Array, a: Array, b: Array) -> Array:
-    """Distance (...) from points ``p`` to segments ``a``-``b`` (..., 2), broadcasting."""
-    dx, dy = b[..., 0] - a[..., 0], b[..., 1] - a[..., 1]
-    px, py = p[..., 0] - a[..., 0], p[..., 1] - a[..., 1]
-    t = np.clip((px * dx + py * dy) / np.maximum(dx * dx + dy * dy, 1e-300), 0.0, 1.0)
-    ex, ey = px - t * dx, py - t * dy
-    return np.sqrt(ex * ex + ey * ey)
-
-
-def _cross(u: Array, v: Array) -> Array:
-    return u[..., 0] * v[..., 1] - u[..., 1] * v[..., 0]
-
-
-def _segment_polygon_distance(a: Array, b: Array, vertices_m: Array) -> Array:
-    """Distance (k,) from segments ``a``-``b`` (k, 2) to a convex polygon (n, 2) CCW."""
-    v0 = vertices_m
-    v1 = np.roll(v0, -1, axis=0)
-    e = v1 - v0
-    A, B = a[:, None, :], b[:, None, :]  # (k, 1, 2) against the n edges
-    inside_a = np.all(_cross(e, A - v0) > 0.0, axis=-1)
-    inside_b = np.all(_cross(e, B - v0) > 0.0, axis=-1)
-    o1, o2 = _cross(B - A, v0 - A), _cross(B - A, v1 - A)
-    o3, o4 = _cross(e, A - v0), _cross(e, B - v0)
-    crosses = np.any((o1 * o2 <= 0.0) & (o3 * o4 <= 0.0), axis=-1)
-    d = np.minimum(
-        np.minimum(_point_segment_distance(A, v0, v1), _point_segment_distance(B, v0, v1)),
-        _point_segment_distance(v0, A, B),
-    ).min(axis=-1)
-    return np.where(inside_a | inside_b | crosses, 0.0, d)
-
-
-def capsule_distances(
-    seg_m: Array, obstacles: Sequence[PlanarObstacle], reach_m: float = math.inf
-) -> Array:
-    """Distance from link axes to planar obstacles, for a whole path at once.
-
-    The robot lies in the plane and every obstacle is its cut by that plane (upright boxes
-    and vertical cylinders reach across it), so a capsule of radius r touches an obstacle
-    exactly when its axis segment comes closer than r to the obstacle's cut.
-
-    Args:
-        seg_m: (..., 2, 2) axis segments (start, end) in the plane [m], e.g. (states,
-            links, 2, 2).
-        obstacles: convex polygons and circles (:func:`_planar_obstacles`).
-        reach_m: only distances up to this are computed exactly; segments whose bounding
-            box stays farther than this from an obstacle's bounding box get ``inf``.
-
-    Returns:
-        (..., O) distance from each segment to each obstacle [m]; 0 when the segment
-        meets the obstacle.
-    """
-    flat = np.asarray(seg_m, dtype=float).reshape(-1, 2, 2)
-    a, b = flat[:, 0], flat[:, 1]
-    out = np.full((len(flat), len(obstacles)), math.inf)
-    if not len(obstacles) or not len(flat):
-        return out.reshape(np.shape(seg_m)[:-2] + (len(obstacles),))
-    o_lo = np.empty((len(obstacles), 2))
-    o_hi = np.empty((len(obstacles), 2))
-    for o, obs in enumerate(obstacles):
-        if isinstance(obs, Circle):
-            c = np.asarray(obs.center_m)
-            o_lo[o], o_hi[o] = c - obs.radius_m, c + obs.radius_m
-        else:
-            v = np.asarray(obs.vertices_m)
-            o_lo[o], o_hi[o] = v.min(axis=0), v.max(axis=0)
-    o_lo -= reach_m
-    o_hi += reach_m
-    lo, hi = np.minimum(a, b), np.maximum(a, b)
-    near_all = (
-        (lo[:, None, 0] <= o_hi[None, :, 0])
-        & (hi[:, None, 0] >= o_lo[None, :, 0])
-        & (lo[:, None, 1] <= o_hi[None, :, 1])
-        & (hi[:, None, 1] >= o_lo[None, :, 1])
-    )  # (N, O)
-    for o in np.flatnonzero(near_all.any(axis=0)).tolist():
-        obs = obstacles[o]
-        near = np.flatnonzero(near_all[:, o])
-        if isinstance(obs, Circle):
-            c = np.asarray(obs.center_m)
-            d = np.maximum(_point_segment_distance(c, a[near], b[near]) - obs.radius_m, 0.0)
-        else:
-            d = _segment_polygon_distance(a[near], b[near], np.asarray(obs.vertices_m))
-        out[near, o] = d
-    return out.reshape(np.shape(seg_m)[:-2] + (len(obstacles),))
+    expected: tuple[PlannedContact, ...]
+    unexpected: tuple[PlannedContact, ...]
 
 
 # --------------------------------------------------------------------------- planner
@@ -469,7 +331,7 @@ class ChordArcPlanner:
             base_xy_m=(float(T[0, 3]), float(T[1, 3])),
             base_tangent=(float(T[0, 0]), float(T[1, 0])),
             total_length_m=robot.length_m,
-            obstacles=_planar_obstacles(problem.scene, float(T[2, 3])),
+            obstacles=planar_obstacles(problem.scene, float(T[2, 3])),
             collision_points_m=collision_points(problem),
             target_xy_m=(
                 float(problem.goal(leg).p_world_m[0]),
@@ -539,7 +401,7 @@ class ChordArcPlanner:
         query: ChordArcQuery,
         path: Array,
         tol: float,
-    ) -> tuple[list[dict[str, Any]], list[dict[str, Any]], bool]:
+    ) -> tuple[list[PlannedContact], list[PlannedContact], bool]:
         """Contacts of the chain's capsules along a path, split into expected and
         unexpected (link, obstacle) pairs, in one batched planar test
         (:func:`capsule_distances`: every state × link × obstacle at once).
@@ -579,23 +441,79 @@ class ChordArcPlanner:
         near, nearest, away = near[order], nearest[order], away[order]
         starts = np.flatnonzero(np.r_[True, key[1:] != key[:-1]])
         ends = np.r_[starts[1:], len(key)]
-        expected: list[dict[str, Any]] = []
-        unexpected: list[dict[str, Any]] = []
+        expected: list[PlannedContact] = []
+        unexpected: list[PlannedContact] = []
         for a0, a1 in zip(starts, ends, strict=True):
             hits = np.flatnonzero(away[a0:a1])
             k = a0 + (int(hits[0]) if len(hits) else 0)
             ci = int(nearest[k])
-            rec = {
-                "link": robot.link_names[int(li[k])],
-                "obstacle": names[int(ob[k])],
-                "first_state": int(st[k]),
-                "collision_point": None if ci < 0 else ci,
-                "distance_m": None if ci < 0 else float(near[k]),
-            }
+            rec = PlannedContact(
+                link=robot.link_names[int(li[k])],
+                obstacle=names[int(ob[k])],
+                first_state=int(st[k]),
+                collision_point=None if ci < 0 else ci,
+                distance_m=None if ci < 0 else float(near[k]),
+            )
             (unexpected if len(hits) else expected).append(rec)
-        expected.sort(key=lambda r: r["first_state"])
-        unexpected.sort(key=lambda r: r["first_state"])
+        expected.sort(key=lambda r: r.first_state)
+        unexpected.sort(key=lambda r: r.first_state)
         return expected, unexpected, False
+
+    def _chain_check(
+        self,
+        robot: ContinuumChain,
+        tracker: BudgetTracker,
+        plans: Sequence[ChordArcPlan],
+        real: ChordArcQuery,
+        tol: float,
+    ) -> tuple[list[_Candidate], bool]:
+        """Each searched solution as the chain moves it: its joint path, whether a joint
+        leaves its bounds, and its contacts (:meth:`_classify`); a candidate with a
+        ``reason`` is dropped. Returns the candidates and whether the check budget cut the
+        contact classification short."""
+        cands: list[_Candidate] = []
+        cut_short = False
+        for plan in plans:
+            path, owner = self.motion_path(robot, plan.motion)
+            reason = ""
+            lo_ok = path >= robot.lower - 1e-12
+            hi_ok = path <= robot.upper + 1e-12
+            if not (lo_ok.all() and hi_ok.all()):
+                k, j = np.argwhere(~(lo_ok & hi_ok))[0]
+                reason = (
+                    f"the chain cannot follow it: {robot.joint_names[j]} would reach "
+                    f"{path[k, j]:.3g} (bounds [{robot.lower[j]:.3g}, "
+                    f"{robot.upper[j]:.3g}]) during step {owner[k]} "
+                    f"({plan.motion[owner[k]].kind})"
+                )
+            exp: list[PlannedContact] = []
+            unexp: list[PlannedContact] = []
+            if not reason and self.settings.check_contacts and not cut_short:
+                exp, unexp, cut_short = self._classify(robot, tracker, plan, real, path, tol)
+                if unexp:
+                    u = unexp[0]
+                    reason = (
+                        f"the {robot.link_radius_m * 1e3:.3g} mm-radius chain touches "
+                        f"{u.obstacle!r} with {u.link} away from the solution's "
+                        f"collision points (waypoint {u.first_state}; "
+                        f"{len(unexp)} such pair(s))"
+                    )
+            cands.append(_Candidate(plan, path, owner, reason, tuple(exp), tuple(unexp)))
+        return cands, cut_short
+
+    def _choose(self, kept: Sequence[_Candidate]) -> int:
+        """The index of the solution to execute (``settings.choose``)."""
+        if self.settings.choose == "shortest":
+            return min(range(len(kept)), key=lambda i: kept[i].plan.solution.total_length_m)
+        if self.settings.choose == "fewest_contacts":
+            return min(
+                range(len(kept)),
+                key=lambda i: (
+                    len(kept[i].plan.solution.contact_indices),
+                    kept[i].plan.solution.total_length_m,
+                ),
+            )
+        return 0
 
     # ------------------------------------------------------------------ solve
     def solve(
@@ -633,17 +551,7 @@ class ChordArcPlanner:
         q0 = np.asarray(problem.q_start if q_start is None else q_start, dtype=float)
         q0 = q0.reshape(robot.dof)
         tol = 2.0 * robot.link_radius_m + s.contact_margin_m
-        base_extra: dict[str, Any] = {
-            "collision_points_m": [list(p) for p in real.collision_points_m],
-            "inflated_by_m": robot.link_radius_m if s.inflate_by_radius else 0.0,
-            "contact_tolerance_m": tol,
-            "solutions": [],
-            "dropped": [],
-            "chosen": None,
-            "expected_contacts": [],
-            "allows_contact": True,
-            "guide_obstacles": sorted(guide_obstacles(problem)),
-        }
+        record = _empty_record(problem, real, query, tol, s.inflate_by_radius)
 
         # progress: the search starts at the straight robot, at time 0 with no checks
         run.progress.note(float(goal.distance(robot, q0)), time_s=0.0, checks=0)
@@ -654,17 +562,10 @@ class ChordArcPlanner:
             path: Array,
             iterations: int = 0,
             trace: Array | None = None,
-            extra: dict[str, Any] | None = None,
         ) -> PlanResult:
             """The leg's result, with what the search found so far."""
-            return run.result(
-                status,
-                reason,
-                path,
-                iterations=iterations,
-                trace=trace,
-                extra={**base_extra, **(extra or {})},
-            )
+            r = run.result(status, reason, path, iterations=iterations, trace=trace)
+            return r.replace(contact_plan=record)
 
         straight = robot.q_from_arcs([], insertion_m=0.0)
         if not np.allclose(q0, straight, atol=1e-9):
@@ -693,22 +594,11 @@ class ChordArcPlanner:
             return result(Status.INVALID_GOAL, str(exc) + grown, q0[None])
         search_s = time.perf_counter() - t_search
         srch = res.search
-        base_extra["search"] = {
-            "time_s": search_s,
-            "expansions": srch.expansions,
-            "arcs_built": srch.arcs_built,
-            "arcs_checked": srch.arcs_checked,
-            "rejected_bend": srch.arcs_rejected_bend,
-            "rejected_length": srch.arcs_rejected_length,
-            "rejected_obstacle": srch.arcs_rejected_obstacle,
-            "depth_reached": srch.depth_reached,
-            "budget_exhausted": srch.budget_exhausted,
-            "geometric_solutions": len(srch.solutions),
-        }
-        dropped: list[dict[str, Any]] = [
-            {"reason": d.reason, "stage": "contact_type", **_shape_dict(d.solution, real)}
-            for d in res.dropped
+        search = _search_counts(srch, search_s)
+        dropped: list[ContactSolution] = [
+            _solution(d.solution, real, reason=d.reason, stage="contact_type") for d in res.dropped
         ]
+        record = dataclasses.replace(record, search=search, dropped=tuple(dropped))
         iters = srch.expansions
         if budget.time_limit_s is not None and search_s >= budget.time_limit_s:
             return result(
@@ -719,58 +609,13 @@ class ChordArcPlanner:
                 iters,
             )
 
-        # the chain's view of each surviving solution: joint bounds, then FCL contacts
-        cands: list[_Candidate] = []
-        cut_short = False
-        for plan in res.plans:
-            path, owner = self.motion_path(robot, plan.motion)
-            reason = ""
-            lo_ok = path >= robot.lower - 1e-12
-            hi_ok = path <= robot.upper + 1e-12
-            if not (lo_ok.all() and hi_ok.all()):
-                k, j = np.argwhere(~(lo_ok & hi_ok))[0]
-                reason = (
-                    f"the chain cannot follow it: {robot.joint_names[j]} would reach "
-                    f"{path[k, j]:.3g} (bounds [{robot.lower[j]:.3g}, "
-                    f"{robot.upper[j]:.3g}]) during step {owner[k]} "
-                    f"({plan.motion[owner[k]].kind})"
-                )
-            exp: list[dict[str, Any]] = []
-            unexp: list[dict[str, Any]] = []
-            if not reason and s.check_contacts and not cut_short:
-                exp, unexp, cut_short = self._classify(robot, tracker, plan, real, path, tol)
-                if unexp:
-                    u = unexp[0]
-                    reason = (
-                        f"the {robot.link_radius_m * 1e3:.3g} mm-radius chain touches "
-                        f"{u['obstacle']!r} with {u['link']} away from the solution's "
-                        f"collision points (waypoint {u['first_state']}; "
-                        f"{len(unexp)} such pair(s))"
-                    )
-            cands.append(_Candidate(plan, path, owner, reason, tuple(exp), tuple(unexp)))
-        for c in cands:
-            if c.reason:
-                dropped.append(
-                    {
-                        "reason": c.reason,
-                        "stage": "chain",
-                        **_shape_dict(c.plan.solution, real),
-                        "unexpected_contacts": list(c.unexpected),
-                    }
-                )
+        # the chain's view of each surviving solution: joint bounds, then its contacts
+        cands, cut_short = self._chain_check(robot, tracker, res.plans, real, tol)
+        cut_r = 0.0 if s.inflate_by_radius else robot.link_radius_m
         kept = [c for c in cands if not c.reason]
-        solutions = []
-        for c in kept:
-            d = _shape_dict(c.plan.solution, real)
-            d["contact_obstacles"] = [ck.obstacle for ck in c.plan.contacts]
-            d["contact_types"] = [ck.contact_type for ck in c.plan.contacts]
-            d["contact_sides"] = [ck.side for ck in c.plan.contacts]
-            d["motion"] = [{"kind": m.kind, "description": m.description} for m in c.plan.motion]
-            d["path_waypoints"] = len(c.path)
-            d["expected_contacts"] = list(c.expected)
-            solutions.append(d)
-        base_extra["solutions"] = solutions
-        base_extra["dropped"] = dropped
+        solutions = tuple(_candidate_solution(c, real, cut_r) for c in kept)
+        dropped += [_candidate_solution(c, real, cut_r) for c in cands if c.reason]
+        record = dataclasses.replace(record, solutions=solutions, dropped=tuple(dropped))
         n_pts = len(query.collision_points_m)
 
         if cut_short:
@@ -782,42 +627,16 @@ class ChordArcPlanner:
                 iters,
             )
         if not kept:
-            why = "; ".join(d["reason"] for d in dropped[:3])
-            if not srch.solutions:
-                status = Status.BUDGET_EXHAUSTED if srch.budget_exhausted else Status.FAILED
-                reason = (
-                    f"no chord-arc shape reaches the target through the {n_pts} "
-                    f"collision points ({srch.expansions} expansions, depth "
-                    f"{srch.depth_reached}"
-                    + (", expansion budget used up)" if srch.budget_exhausted else ")")
-                )
-            else:
-                status = Status.FAILED
-                reason = f"all {len(srch.solutions)} geometric solution(s) dropped: {why}" + (
-                    " …" if len(dropped) > 3 else ""
-                )
+            status, reason = _nothing_kept(srch, dropped, n_pts)
             return result(status, reason, q0[None], iters)
 
-        if s.choose == "shortest":
-            chosen = min(range(len(kept)), key=lambda i: kept[i].plan.solution.total_length_m)
-        elif s.choose == "fewest_contacts":
-            chosen = min(
-                range(len(kept)),
-                key=lambda i: (
-                    len(kept[i].plan.solution.contact_indices),
-                    kept[i].plan.solution.total_length_m,
-                ),
-            )
-        else:
-            chosen = 0
+        chosen = self._choose(kept)
         c = kept[chosen]
         tips = robot.tip(c.path)[0]
         trace = np.linalg.norm(tips - goal.p_world_m, axis=1)
-        extra = {
-            "chosen": chosen,
-            "expected_contacts": list(c.expected),
-            "motion_step_of_waypoint": c.step_of.tolist(),
-        }
+        record = dataclasses.replace(
+            record, chosen=chosen, motion_step_of_waypoint=tuple(int(k) for k in c.step_of)
+        )
         q_end = c.path[-1]
         summary = (
             f"{len(kept)} solution(s) of {len(srch.solutions)} geometric "
@@ -835,7 +654,6 @@ class ChordArcPlanner:
                 c.path,
                 iters,
                 trace,
-                extra,
             )
         return result(
             Status.SOLVED,
@@ -843,7 +661,6 @@ class ChordArcPlanner:
             c.path,
             iters,
             trace,
-            extra,
         )
 
 
@@ -852,18 +669,3 @@ def make(name: str, overrides: dict[str, Any]) -> ChordArcPlanner:
     if name != "chord_arc":
         raise PlannerlabError(f"{name} is not served by plannerlab.planners.chord_arc")
     return ChordArcPlanner(name, with_overrides(ChordArcSettings(), overrides, name))
-
-
-__all__ = [
-    "CHOICES",
-    "PAPER_TABLE",
-    "ChordArcPlanner",
-    "ChordArcSettings",
-    "PaperCase",
-    "capsule_distances",
-    "collision_points",
-    "grow_query",
-    "guide_obstacles",
-    "make",
-    "thickness_cuts",
-]

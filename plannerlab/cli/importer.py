@@ -1,0 +1,132 @@
+"""`plannerlab import mbm`: MotionBenchMaker problems (MoveIt scene + request YAML) as
+plannerlab problem files (:mod:`plannerlab.problem.mbm`)."""
+
+from __future__ import annotations
+
+import argparse
+from pathlib import Path
+from typing import Any
+
+from rich.console import Console
+from rich.markup import escape
+
+
+def cmd_import_mbm(args: argparse.Namespace, console: Console) -> int:
+    from plannerlab.errors import PlannerlabError
+    from plannerlab.problem import mbm
+
+    urdf, srdf = args.urdf, args.srdf
+    sources: list[Path] = list(args.source)
+    if args.fetch:
+        got = mbm.fetch_vamp_panda(args.cache)
+        console.print(
+            f"vamp-planner 0.6.4 (Apache-2.0, licence {escape(str(got.licence))}): Panda URDF "
+            f"{escape(str(got.urdf))}, SRDF {escape(str(got.srdf))}, problems in "
+            f"{escape(str(got.problems))}",
+            highlight=False,
+        )
+        urdf = urdf or got.urdf
+        srdf = srdf or got.srdf
+        if not sources:
+            sources = [got.problems / f"{s}_panda" for s in mbm.MBM_SCENARIOS]
+    if not sources:
+        if args.fetch:
+            return 0
+        raise PlannerlabError(
+            "import mbm: give scenario folders or scene+request files, or --fetch"
+        )
+    if urdf is None:
+        raise PlannerlabError("import mbm: --urdf is needed (or --fetch for the Panda's)")
+    pairs: list[tuple[Path, Path, str]] = []
+    files = [s for s in sources if not s.is_dir()]
+    if files:
+        if len(files) != 2 or len(sources) != 2:
+            raise PlannerlabError(
+                "import mbm: give scenario folders, or one scene file and one request file"
+            )
+        scene, request = files
+        pairs.append((scene, request, args.name or scene.stem))
+    for folder in (s for s in sources if s.is_dir()):
+        found = mbm.problem_pairs(folder)
+        if not found:
+            raise PlannerlabError(f"{folder}: no sceneNNNN.yaml + requestNNNN.yaml pairs")
+        scenario = folder.name.removesuffix("_panda")
+        for scene, request in found[: args.limit]:
+            pairs.append((scene, request, f"{scenario}_{scene.stem.removeprefix('scene')}"))
+    out: Path = args.out
+    if out.exists() and not out.is_dir():
+        raise PlannerlabError(f"--out {out}: a folder (problem files are written into it)")
+    out.mkdir(parents=True, exist_ok=True)
+    for scene, request, name in pairs:
+        target = out / f"{name}.toml"
+        text = mbm.problem_toml(
+            scene,
+            request,
+            out_path=target,
+            urdf=Path(urdf),
+            srdf=Path(srdf) if srdf else None,
+            tip_link=args.tip_link,
+            name=name,
+            safety_margin_m=args.margin_m,
+            joint_step_rad=args.joint_step,
+        )
+        target.write_text(text, encoding="utf-8")
+    console.print(f"{len(pairs)} problem files written to {escape(str(out))}", highlight=False)
+    return 0
+
+
+def mbm_default_joint_step() -> float:
+    from plannerlab.problem.mbm import DEFAULT_JOINT_STEP_RAD
+
+    return DEFAULT_JOINT_STEP_RAD
+
+
+def add_parser(sub: Any) -> None:
+    p = sub.add_parser(
+        "import",
+        help="turn other benchmarks' problems into plannerlab problem files",
+    )
+    kinds = p.add_subparsers(dest="import_kind", required=True, metavar="KIND")
+    m = kinds.add_parser(
+        "mbm",
+        help="MotionBenchMaker (MoveIt scene + request YAML) -> problem files",
+        description=(
+            "MotionBenchMaker problems (MoveIt scene + request YAML, joint goals) -> plannerlab "
+            "problem files for a URDF robot. SOURCE: scenario folders of sceneNNNN.yaml + "
+            "requestNNNN.yaml pairs, or one scene file and one request file. --fetch gets "
+            "the Panda set, URDF and SRDF from the vamp-planner 0.6.4 source distribution "
+            "(pip download) into a cache and says where."
+        ),
+    )
+    m.add_argument("source", nargs="*", type=Path, help="scenario folders, or scene + request")
+    m.add_argument("--out", type=Path, default=Path("problems/mbm"), help="folder to write to")
+    m.add_argument("--urdf", type=Path, default=None, help="the robot's URDF")
+    m.add_argument("--srdf", type=Path, default=None, help="the robot's SRDF (optional)")
+    m.add_argument("--tip-link", default="panda_hand", help="URDF link carrying the tip")
+    m.add_argument("--name", default=None, help="problem name (one scene + request)")
+    m.add_argument("--limit", type=int, default=None, help="at most N problems per folder")
+    m.add_argument(
+        "--margin-m",
+        type=float,
+        default=0.0,
+        help="[planning] safety_margin_m of the files (MotionBenchMaker's states are valid "
+        "with no margin)",
+    )
+    m.add_argument(
+        "--joint-step",
+        type=float,
+        default=mbm_default_joint_step(),
+        help="[checking] joint_step of the files [rad]",
+    )
+    m.add_argument(
+        "--fetch",
+        action="store_true",
+        help="download the Panda set (vamp-planner 0.6.4 sdist, pip) into --cache first",
+    )
+    m.add_argument(
+        "--cache",
+        type=Path,
+        default=None,
+        help="cache folder for --fetch (default $PLANNERLAB_CACHE/mbm or ~/.cache/plannerlab/mbm)",
+    )
+    m.set_defaults(func=cmd_import_mbm)

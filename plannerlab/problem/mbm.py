@@ -1,0 +1,443 @@
+"""MotionBenchMaker problems (MoveIt scene + request YAML) as plannerlab problem files.
+
+A MotionBenchMaker problem is a pair of files: ``sceneNNNN.yaml`` (a MoveIt planning scene:
+collision objects made of boxes, cylinders and spheres at world poses, an allowed-collision
+matrix) and ``requestNNNN.yaml`` (a MoveIt motion plan request: the start state and a goal
+given as joint constraints). :func:`problem_toml` turns one pair into the text of a
+problem file for a ``type = "urdf"`` robot: the URDF (and SRDF) named by paths relative
+to the written file, the start state, every primitive as an obstacle, the allowed pairs of
+the scene's matrix as ``allowed_collisions``, and the joint goal as a goal state
+(``[[goals]] q``, ``joint_tol_rad`` from the constraints' tolerances).
+
+MoveIt conventions read here: a box's ``dimensions`` are its full edge lengths (x, y, z), a
+cylinder's ``[height, radius]`` along its local z, a sphere's ``[radius]``; orientations are
+quaternions ``[x, y, z, w]``; an object may have a ``pose`` of its own, to which its
+``primitive_poses`` are relative.
+
+:func:`fetch_vamp_panda` gets the Panda set (7 scenarios × 100 problems), its spherized
+URDF and SRDF from the ``vamp-planner`` 0.6.4 source distribution through pip into a
+cache folder outside the repository (Apache-2.0; nothing of it is committed but the
+Panda URDF, SRDF and licence in ``problems/urdf/panda``).
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import os
+import subprocess
+import sys
+import tarfile
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from plannerlab.errors import PlannerlabError
+from plannerlab.robots.base import Array, matrix_to_rpy
+
+#: the source distribution that ships the Panda set, and what it holds
+VAMP_REQUIREMENT = "vamp-planner==0.6.4"
+VAMP_SDIST = "vamp_planner-0.6.4.tar.gz"
+VAMP_ROOT = "vamp_planner-0.6.4"
+#: MotionBenchMaker's Panda scenarios (each a folder ``<name>_panda`` of 100 problems)
+MBM_SCENARIOS = (
+    "bookshelf_small",
+    "bookshelf_tall",
+    "bookshelf_thin",
+    "box",
+    "cage",
+    "table_pick",
+    "table_under_pick",
+)
+#: ``[checking] joint_step`` of imported problems [rad]: with no margin the edges are
+#: checked at it and re-checked at a quarter of it; at 0.05 (plannerlab's default) RRT-Connect
+#: paths on table_under_pick failed the re-check (a sphere 1 m out moves 5 cm per step)
+DEFAULT_JOINT_STEP_RAD = 0.02
+#: the goal tolerance when the request gives none [rad]
+DEFAULT_JOINT_TOL_RAD = 1e-3
+
+
+class MbmFileError(PlannerlabError):
+    """A MotionBenchMaker file plannerlab cannot read; names the file and the key."""
+
+    def __init__(self, source: str, key: str, expected: str) -> None:
+        super().__init__(f"{source}: [{key}] {expected}")
+
+
+def default_cache() -> Path:
+    """``$PLANNERLAB_CACHE/mbm`` or ``~/.cache/plannerlab/mbm``."""
+    base = os.environ.get("PLANNERLAB_CACHE")
+    return (Path(base) if base else Path.home() / ".cache" / "plannerlab") / "mbm"
+
+
+@dataclass(frozen=True)
+class VampPanda:
+    """Where :func:`fetch_vamp_panda` put the Panda set."""
+
+    folder: Path  #: ``resources/panda`` of the distribution
+    urdf: Path
+    srdf: Path
+    problems: Path  #: the folder of the ``<scenario>_panda`` folders
+    licence: Path
+
+
+def fetch_vamp_panda(cache: Path | None = None) -> VampPanda:
+    """Download (``pip download --no-deps vamp-planner==0.6.4``, once) and unpack the
+    Panda set into ``cache`` (default :func:`default_cache`)."""
+    cache = default_cache() if cache is None else Path(cache)
+    cache.mkdir(parents=True, exist_ok=True)
+    sdist = cache / VAMP_SDIST
+    if not sdist.is_file():
+        cmd = [sys.executable, "-m", "pip", "download", "--no-deps", VAMP_REQUIREMENT]
+        done = subprocess.run([*cmd, "-d", str(cache)], capture_output=True, text=True, check=False)
+        if done.returncode != 0 or not sdist.is_file():
+            raise PlannerlabError(
+                f"{' '.join(cmd)} failed (exit {done.returncode}): {done.stderr.strip()[-400:]}"
+            )
+    root = cache / VAMP_ROOT
+    panda = root / "resources" / "panda"
+    if not (panda / "panda_spherized.urdf").is_file():
+        with tarfile.open(sdist) as tar:
+            wanted = [
+                m
+                for m in tar.getmembers()
+                if m.name.startswith(f"{VAMP_ROOT}/resources/panda/")
+                or m.name == f"{VAMP_ROOT}/LICENSE.txt"
+            ]
+            tar.extractall(cache, members=wanted, filter="data")
+    problems = panda / "problems"
+    if not (problems / f"{MBM_SCENARIOS[0]}_panda").is_dir():
+        with tarfile.open(panda / "problems.tar.bz2") as tar:
+            tar.extractall(panda, filter="data")
+    return VampPanda(
+        folder=panda,
+        urdf=panda / "panda_spherized.urdf",
+        srdf=panda / "panda.srdf",
+        problems=problems,
+        licence=root / "LICENSE.txt",
+    )
+
+
+def problem_pairs(folder: Path) -> list[tuple[Path, Path]]:
+    """``(sceneNNNN.yaml, requestNNNN.yaml)`` pairs of a scenario folder, by number."""
+    folder = Path(folder)
+    pairs = []
+    for scene in sorted(folder.glob("scene*.yaml")):
+        request = folder / scene.name.replace("scene", "request", 1)
+        if request.is_file():
+            pairs.append((scene, request))
+    return pairs
+
+
+# ---------------------------------------------------------------------- reading
+def read_yaml(path: Path) -> Mapping[str, Any]:
+    import yaml
+
+    try:
+        data = yaml.safe_load(Path(path).read_text(encoding="utf-8"))
+    except FileNotFoundError:
+        raise MbmFileError(str(path), "<file>", "an existing YAML file") from None
+    except yaml.YAMLError as exc:
+        raise MbmFileError(str(path), "<syntax>", f"valid YAML: {exc}") from None
+    if not isinstance(data, dict):
+        raise MbmFileError(str(path), "<file>", f"a YAML mapping, got {type(data).__name__}")
+    return data
+
+
+def _get(data: Any, source: str, key: str) -> Any:
+    """``data[a][b]...`` for a dotted key, with an error naming the file and the key."""
+    cur = data
+    for part in key.split("."):
+        if not isinstance(cur, dict) or part not in cur:
+            raise MbmFileError(source, key, "is missing")
+        cur = cur[part]
+    return cur
+
+
+def _numbers(v: Any, source: str, key: str, n: int | None = None) -> Array:
+    ok = isinstance(v, list) and all(
+        isinstance(x, int | float) and not isinstance(x, bool) for x in v
+    )
+    if not ok or (n is not None and len(v) != n):
+        raise MbmFileError(source, key, f"a list of {n or 'some'} numbers, got {v!r:.80}")
+    a = np.array(v, dtype=float)
+    if not np.all(np.isfinite(a)):
+        raise MbmFileError(source, key, f"finite numbers, got {v!r:.80}")
+    return a
+
+
+def quaternion_matrix(xyzw: Array) -> Array:
+    """Rotation (3, 3) of a quaternion ``[x, y, z, w]`` (normalised here)."""
+    x, y, z, w = np.asarray(xyzw, dtype=float) / np.linalg.norm(xyzw)
+    return np.array(
+        [
+            [1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
+            [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
+            [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)],
+        ]
+    )
+
+
+def _pose(p: Any, source: str, key: str) -> Array:
+    if not isinstance(p, dict):
+        raise MbmFileError(source, key, f"a pose (position, orientation), got {p!r:.80}")
+    T = np.eye(4)
+    T[:3, 3] = _numbers(p.get("position"), source, f"{key}.position", 3)
+    q = _numbers(p.get("orientation", [0, 0, 0, 1]), source, f"{key}.orientation", 4)
+    if np.linalg.norm(q) < 1e-9:
+        raise MbmFileError(source, f"{key}.orientation", "a non-zero quaternion [x, y, z, w]")
+    T[:3, :3] = quaternion_matrix(q)
+    return T
+
+
+@dataclass(frozen=True)
+class MbmObstacle:
+    """One primitive of a collision object, in plannerlab's terms."""
+
+    name: str
+    type: str  #: box, cylinder or sphere
+    T_world: Array
+    size_m: tuple[float, ...]  #: box: edges; cylinder: (radius, length); sphere: (radius,)
+
+
+def scene_obstacles(scene: Mapping[str, Any], source: str) -> list[MbmObstacle]:
+    """Every primitive of the scene's collision objects (meshes and planes refused)."""
+    objects = _get(scene, source, "world.collision_objects")
+    if not isinstance(objects, list):
+        raise MbmFileError(source, "world.collision_objects", "a list of collision objects")
+    out: list[MbmObstacle] = []
+    for i, obj in enumerate(objects):
+        key = f"world.collision_objects[{i}]"
+        if not isinstance(obj, dict):
+            raise MbmFileError(source, key, "a collision object (a mapping)")
+        oid = str(obj.get("id", f"object{i}"))
+        T_obj = _pose(obj["pose"], source, f"{key}.pose") if "pose" in obj else np.eye(4)
+        prims = obj.get("primitives", [])
+        poses = obj.get("primitive_poses", [])
+        if obj.get("meshes") or obj.get("planes"):
+            raise MbmFileError(
+                source, f"{key}.meshes", "boxes, cylinders and spheres only (no meshes, planes)"
+            )
+        if not isinstance(prims, list) or not isinstance(poses, list) or len(prims) != len(poses):
+            raise MbmFileError(
+                source, f"{key}.primitive_poses", "one pose per primitive (two lists, one length)"
+            )
+        for k, (prim, pose) in enumerate(zip(prims, poses, strict=True)):
+            pkey = f"{key}.primitives[{k}]"
+            kind = prim.get("type") if isinstance(prim, dict) else None
+            dims = _numbers(
+                prim.get("dimensions") if isinstance(prim, dict) else None,
+                source,
+                f"{pkey}.dimensions",
+            )
+            name = oid if len(prims) == 1 else f"{oid}#{k}"
+            T = T_obj @ _pose(pose, source, f"{key}.primitive_poses[{k}]")
+            if kind == "box" and len(dims) == 3:
+                size: tuple[float, ...] = tuple(float(d) for d in dims)
+            elif kind == "cylinder" and len(dims) == 2:
+                size = (float(dims[1]), float(dims[0]))  # MoveIt: [height, radius]
+            elif kind == "sphere" and len(dims) == 1:
+                size = (float(dims[0]),)
+            else:
+                raise MbmFileError(
+                    source,
+                    pkey,
+                    "a box (3 dimensions), cylinder ([height, radius]) or sphere ([radius]), "
+                    f"got {kind!r} with {len(dims)} dimensions",
+                )
+            if min(size) <= 0:
+                raise MbmFileError(source, f"{pkey}.dimensions", "positive dimensions")
+            out.append(MbmObstacle(name, str(kind), T, size))
+    return out
+
+
+def allowed_pairs(scene: Mapping[str, Any], source: str, links: Sequence[str]) -> list[list[str]]:
+    """The scene's allowed-collision matrix as link pairs (only links of the robot)."""
+    acm = scene.get("allowed_collision_matrix")
+    if acm is None:
+        return []
+    names = _get(scene, source, "allowed_collision_matrix.entry_names")
+    values = _get(scene, source, "allowed_collision_matrix.entry_values")
+    if not (
+        isinstance(names, list)
+        and isinstance(values, list)
+        and len(values) == len(names)
+        and all(isinstance(r, list) and len(r) == len(names) for r in values)
+    ):
+        raise MbmFileError(
+            source, "allowed_collision_matrix.entry_values", "a square matrix, one row per name"
+        )
+    known = set(links)
+    out = []
+    for i, a in enumerate(names):
+        for j in range(i + 1, len(names)):
+            b = names[j]
+            if (values[i][j] is True or values[j][i] is True) and a in known and b in known:
+                out.append([str(a), str(b)])
+    return out
+
+
+def request_states(
+    request: Mapping[str, Any], source: str, joint_names: Sequence[str]
+) -> tuple[Array, Array, float]:
+    """Start state, goal state (in ``joint_names`` order) and goal tolerance [rad]."""
+    names = _get(request, source, "start_state.joint_state.name")
+    position = _get(request, source, "start_state.joint_state.position")
+    if not isinstance(names, list) or not isinstance(position, list):
+        raise MbmFileError(source, "start_state.joint_state", "name and position lists")
+    pos = _numbers(position, source, "start_state.joint_state.position", len(names))
+    by_name = dict(zip(names, pos, strict=True))
+    missing = [n for n in joint_names if n not in by_name]
+    if missing:
+        raise MbmFileError(
+            source, "start_state.joint_state.name", f"every joint of the robot; missing {missing}"
+        )
+    q_start = np.array([by_name[n] for n in joint_names])
+    goals = _get(request, source, "goal_constraints")
+    if not isinstance(goals, list) or not goals:
+        raise MbmFileError(source, "goal_constraints", "a non-empty list")
+    if len(goals) > 1:
+        raise MbmFileError(source, "goal_constraints", "one goal (a set of joint constraints)")
+    cons = goals[0].get("joint_constraints") if isinstance(goals[0], dict) else None
+    if not isinstance(cons, list) or not cons:
+        raise MbmFileError(
+            source, "goal_constraints[0].joint_constraints", "joint constraints (a joint goal)"
+        )
+    goal: dict[str, float] = {}
+    tols = []
+    for k, c in enumerate(cons):
+        ck = f"goal_constraints[0].joint_constraints[{k}]"
+        if not isinstance(c, dict) or "joint_name" not in c or "position" not in c:
+            raise MbmFileError(source, ck, "joint_name and position")
+        goal[str(c["joint_name"])] = float(_numbers([c["position"]], source, f"{ck}.position")[0])
+        for t in ("tolerance_above", "tolerance_below"):
+            if t in c:
+                tols.append(float(c[t]))
+    missing = [n for n in joint_names if n not in goal]
+    if missing:
+        raise MbmFileError(
+            source,
+            "goal_constraints[0].joint_constraints",
+            f"a constraint on every joint of the robot; missing {missing}",
+        )
+    q_goal = np.array([goal[n] for n in joint_names])
+    positive = [t for t in tols if t > 0]
+    tol = min(positive) if positive else DEFAULT_JOINT_TOL_RAD
+    return q_start, q_goal, tol
+
+
+# ---------------------------------------------------------------------- writing
+def _f(x: float) -> str:
+    return repr(float(x))
+
+
+def _vec(v: Any) -> str:
+    return "[" + ", ".join(_f(x) for x in np.asarray(v, dtype=float).reshape(-1)) + "]"
+
+
+def _rel(target: Path, out_dir: Path) -> str:
+    return Path(os.path.relpath(Path(target).resolve(), Path(out_dir).resolve())).as_posix()
+
+
+def problem_toml(
+    scene_path: Path,
+    request_path: Path,
+    *,
+    out_path: Path,
+    urdf: Path,
+    tip_link: str,
+    srdf: Path | None = None,
+    name: str | None = None,
+    safety_margin_m: float = 0.0,
+    joint_step_rad: float = DEFAULT_JOINT_STEP_RAD,
+) -> str:
+    """The text of a plannerlab problem file (to be written at ``out_path``) for one
+    MotionBenchMaker problem. The robot is read from ``urdf`` (for its joint order and
+    links); paths in the file are relative to ``out_path``'s folder.
+
+    ``safety_margin_m`` is the file's ``[planning] safety_margin_m``: 0 by default, as
+    MotionBenchMaker's states are valid with no margin (a margin can make them collide).
+    With no margin, edges are checked every ``joint_step_rad`` (``[checking] joint_step``)
+    and re-checked at a quarter of it.
+    """
+    from plannerlab.robots.urdf.model import UrdfChain, UrdfError
+
+    try:
+        robot = UrdfChain(Path(urdf), tip_link, srdf_path=srdf)
+    except UrdfError as exc:
+        raise PlannerlabError(f"{urdf}: {exc}") from None
+    scene_src, request_src = str(scene_path), str(request_path)
+    scene = read_yaml(scene_path)
+    request = read_yaml(request_path)
+    obstacles = scene_obstacles(scene, scene_src)
+    allowed = allowed_pairs(scene, scene_src, sorted({n.split("#")[0] for n in robot.link_names}))
+    q_start, q_goal, tol = request_states(request, request_src, robot.joint_names)
+    out_dir = Path(out_path).parent
+    stem = name or Path(out_path).stem
+    lines = [
+        f"# imported from MotionBenchMaker: {Path(scene_path).name}, {Path(request_path).name}",
+        "# (plannerlab import mbm)",
+        "[problem]",
+        f"name = {json.dumps(stem)}",
+        f'description = "MotionBenchMaker {Path(scene_path).parent.name}/'
+        f'{Path(scene_path).stem}: joint goal, {len(obstacles)} obstacles"',
+        "",
+        "[robot]",
+        'type = "urdf"',
+        f'urdf = "{_rel(urdf, out_dir)}"',
+        f'tip_link = "{tip_link}"',
+    ]
+    if srdf is not None:
+        lines.append(f'srdf = "{_rel(srdf, out_dir)}"')
+    if allowed:
+        pairs = ", ".join(f'["{a}", "{b}"]' for a, b in allowed)
+        lines.append(f"allowed_collisions = [{pairs}]")
+    lines += ["", "[start]", f"q = {_vec(q_start)}", ""]
+    lines += ["[planning]", f"safety_margin_m = {_f(safety_margin_m)}", ""]
+    lines += ["[checking]", f"joint_step = {_f(joint_step_rad)}", ""]
+    for o in obstacles:
+        rpy_deg = np.degrees(matrix_to_rpy(o.T_world[:3, :3]))
+        lines += [
+            "[[obstacles]]",
+            f'name = "{o.name}"',
+            f'type = "{o.type}"',
+            f"center_m = {_vec(o.T_world[:3, 3])}",
+            f"rpy_deg = {_vec(rpy_deg)}",
+        ]
+        if o.type == "box":
+            lines.append(f"size_m = {_vec(o.size_m)}")
+        elif o.type == "cylinder":
+            lines += [f"radius_m = {_f(o.size_m[0])}", f"length_m = {_f(o.size_m[1])}"]
+        else:
+            lines.append(f"radius_m = {_f(o.size_m[0])}")
+        lines.append("")
+    lines += [
+        "[[goals]]",
+        'name = "goal"',
+        f"q = {_vec(q_goal)}",
+        f"joint_tol_rad = {_f(tol)}",
+        "",
+    ]
+    if not math.isfinite(safety_margin_m) or safety_margin_m < 0:
+        raise PlannerlabError(f"safety_margin_m must be >= 0, got {safety_margin_m}")
+    return "\n".join(lines)
+
+
+__all__ = [
+    "MBM_SCENARIOS",
+    "MbmFileError",
+    "MbmObstacle",
+    "VampPanda",
+    "allowed_pairs",
+    "default_cache",
+    "fetch_vamp_panda",
+    "problem_pairs",
+    "problem_toml",
+    "quaternion_matrix",
+    "read_yaml",
+    "request_states",
+    "scene_obstacles",
+]

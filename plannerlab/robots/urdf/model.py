@@ -1,0 +1,543 @@
+"""Any serial chain read from a URDF: kinematics, Jacobians and collision geometry.
+
+The URDF is read with ``yourdfpy`` (parsing only: no meshes are loaded). The chain runs
+from the URDF's root link to ``tip_link``; its movable joints (revolute, continuous,
+prismatic) are the robot's joints, in chain order. Fixed joints are folded into the
+transforms between them. A movable joint *off* that chain (a gripper finger, say) is
+frozen at 0 (clipped into its limits) and listed in :attr:`UrdfChain.frozen_joints`; the
+URDF given to the simulator has it fixed there.
+
+Bodies and frames
+-----------------
+Body 0 is the root link; body ``i`` (1 … dof) is the child link of the ``i``-th movable
+joint, and every link hung on a body by fixed (or frozen) joints moves with it.
+:meth:`UrdfChain.fk` returns the frames of the ``dof + 1`` bodies and then the tip link's
+frame (``dof + 2`` frames; :attr:`UrdfChain.link_frame_names` names their URDF links).
+The tip is the point ``tip_offset_m`` of the tip link's frame and its normal the unit
+vector ``tip_axis`` of that frame.
+
+Collision geometry
+------------------
+Every ``<collision>`` element becomes one capsule (a plannerlab "link", named
+``<urdf link>`` or ``<urdf link>#k`` when the link has several):
+
+* a sphere: a capsule of zero length (exact);
+* a cylinder: the capsule along its axis with the cylinder's radius and length
+  (it covers the cylinder; the rounded ends stick out by one radius);
+* a box: the capsule along its longest edge, radius the half-diagonal of the other two
+  (covers the box, conservative);
+* a mesh: refused (spherize the robot, as MotionBenchMaker's Panda is).
+
+Capsules on the root body are fixed (never checked against the scene). Self-collision
+is not checked between capsules on one body, between capsules of neighbouring bodies
+(parent and child of a movable joint), nor between links named in the SRDF's
+``<disable_collisions>`` or in the problem's allowed-collision pairs.
+
+Only numpy (and ``yourdfpy`` for parsing) is used here.
+"""
+
+from __future__ import annotations
+
+import difflib
+import math
+import xml.etree.ElementTree as ET
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from plannerlab.errors import PlannerlabError
+from plannerlab.robots.base import Array, urdf_origin
+
+MOVABLE = ("revolute", "continuous", "prismatic")
+
+
+class UrdfError(PlannerlabError):
+    """A URDF, SRDF or link name the family cannot use; ``key`` is the ``[robot]`` key
+    to blame (``urdf``, ``tip_link``, ``srdf``, ``allowed_collisions``)."""
+
+    def __init__(self, key: str, expected: str) -> None:
+        self.key = key
+        self.expected = expected
+        super().__init__(f"[robot.{key}] {expected}")
+
+
+def _hint(name: str, names: list[str]) -> str:
+    close = difflib.get_close_matches(name, names, n=1)
+    return f" (did you mean {close[0]!r}?)" if close else ""
+
+
+def axis_motion(axis: Array, q: Array, prismatic: bool) -> Array:
+    """Joint motions (..., 4, 4) for values q (...,) about/along a unit axis (3,)."""
+    q = np.asarray(q, dtype=float)
+    T = np.broadcast_to(np.eye(4), q.shape + (4, 4)).copy()
+    if prismatic:
+        T[..., :3, 3] = q[..., None] * axis
+        return T
+    x, y, z = axis
+    K = np.array([[0.0, -z, y], [z, 0.0, -x], [-y, x, 0.0]])
+    s = np.sin(q)[..., None, None]
+    c = np.cos(q)[..., None, None]
+    T[..., :3, :3] = np.eye(3) + s * K + (1.0 - c) * (K @ K)
+    return T
+
+
+def read_srdf_disabled(path: Path) -> list[tuple[str, str]]:
+    """The ``<disable_collisions link1= link2=>`` pairs of an SRDF file."""
+    try:
+        root = ET.parse(path).getroot()
+    except (OSError, ET.ParseError) as exc:
+        raise UrdfError("srdf", f"a readable SRDF (XML) file; {path}: {exc}") from None
+    return [(str(e.get("link1")), str(e.get("link2"))) for e in root.iter("disable_collisions")]
+
+
+@dataclass(frozen=True, eq=False)
+class UrdfChain:
+    """A serial chain from a URDF file (implements :class:`plannerlab.robots.base.Robot`).
+
+    Args:
+        urdf_path: the URDF file.
+        tip_link: the URDF link carrying the tip (the chain ends there).
+        tip_axis: (3,) the tip normal in the tip link's frame (normalised here).
+        tip_offset_m: (3,) the tip point in the tip link's frame [m].
+        srdf_path: an SRDF whose ``disable_collisions`` pairs are not checked, or None.
+        allowed_collisions: more URDF link pairs that are not checked.
+        T_world_base: (4, 4) pose of the root link in the world.
+    """
+
+    urdf_path: Path
+    tip_link: str
+    tip_axis: tuple[float, float, float] = (0.0, 0.0, 1.0)
+    tip_offset_m: tuple[float, float, float] = (0.0, 0.0, 0.0)
+    srdf_path: Path | None = None
+    allowed_collisions: tuple[tuple[str, str], ...] = ()
+    T_world_base: Array = field(default_factory=lambda: np.eye(4))
+
+    kind: str = field(default="urdf", init=False)
+    dof: int = field(init=False)
+    joint_names: tuple[str, ...] = field(init=False)
+    link_names: tuple[str, ...] = field(init=False)
+    lower: Array = field(init=False, repr=False)
+    upper: Array = field(init=False, repr=False)
+    continuous: NDArray[np.bool_] = field(init=False, repr=False)
+    link_radii_m: Array = field(init=False, repr=False)
+    fixed_links: frozenset[int] = field(init=False, repr=False)
+    excluded_pairs: frozenset[tuple[int, int]] = field(init=False, repr=False)
+    #: movable joints off the chain, frozen at the value given (URDF joint name -> value)
+    frozen_joints: dict[str, float] = field(init=False, repr=False)
+    #: the URDF link of each capsule (the simulator's link of each plannerlab link)
+    link_urdf_names: tuple[str, ...] = field(init=False, repr=False)
+    #: an upper bound of the tip's distance from the root link's origin [m]
+    max_reach_m: float = field(init=False, repr=False)
+    # the chain's fixed data (see __post_init__)
+    _body_links: tuple[str, ...] = field(init=False, repr=False)
+    _parent_body: Any = field(init=False, repr=False)
+    _pre: Any = field(init=False, repr=False)
+    _axes: Any = field(init=False, repr=False)
+    _prismatic: tuple[bool, ...] = field(init=False, repr=False)
+    _tip_body: int = field(init=False, repr=False)
+    _T_body_tip: Any = field(init=False, repr=False)
+    _n_body_tip: Any = field(init=False, repr=False)
+    _cap_body: Any = field(init=False, repr=False)
+    _cap_a: Any = field(init=False, repr=False)
+    _cap_b: Any = field(init=False, repr=False)
+
+    def __post_init__(self) -> None:
+        import yourdfpy
+
+        path = Path(self.urdf_path)
+        object.__setattr__(self, "urdf_path", path)
+        if not path.is_file():
+            raise UrdfError("urdf", f"an existing URDF file; {path} does not exist")
+        try:  # yourdfpy would recover from broken XML and read part of it
+            ET.parse(path)
+        except ET.ParseError as exc:
+            raise UrdfError("urdf", f"a well-formed URDF (XML); {path}: {exc}") from None
+        try:
+            model = yourdfpy.URDF.load(
+                str(path),
+                build_scene_graph=False,
+                build_collision_scene_graph=False,
+                load_meshes=False,
+                load_collision_meshes=False,
+            )
+        except Exception as exc:  # yourdfpy raises many kinds for a malformed file
+            raise UrdfError("urdf", f"a valid URDF; {path}: {exc}") from None
+        urdf = model.robot
+        links = {link.name: link for link in urdf.links}
+        joint_of_child = {j.child: j for j in urdf.joints}
+        children = set(joint_of_child)
+        roots = [n for n in links if n not in children]
+        if len(roots) != 1:
+            raise UrdfError("urdf", f"a URDF tree with one root link; {path} has {roots}")
+        root = roots[0]
+        if self.tip_link not in links:
+            raise UrdfError(
+                "tip_link",
+                f"a link of {path.name}, got {self.tip_link!r}{_hint(self.tip_link, list(links))}; "
+                f"its links: {', '.join(links)}",
+            )
+        # the chain: root -> tip
+        chain: list[Any] = []
+        name = self.tip_link
+        while name != root:
+            j = joint_of_child[name]
+            chain.append(j)
+            name = j.parent
+        chain.reverse()
+        for j in chain:
+            if j.type not in MOVABLE + ("fixed",):
+                raise UrdfError(
+                    "urdf", f"revolute, continuous, prismatic or fixed joints; {j.name} is {j.type}"
+                )
+            if j.type in MOVABLE and j.mimic is not None:
+                raise UrdfError("urdf", f"no mimic joint on the chain; {j.name} mimics one")
+        movable = [j for j in chain if j.type in MOVABLE]
+        chain_names = {j.name for j in movable}
+        frozen: dict[str, float] = {}
+        for j in urdf.joints:
+            if j.type in MOVABLE and j.name not in chain_names:
+                lo, hi = self._limits(j)
+                frozen[j.name] = float(np.clip(0.0, lo, hi))
+            elif j.type not in MOVABLE + ("fixed",):
+                raise UrdfError(
+                    "urdf", f"revolute, continuous, prismatic or fixed joints; {j.name} is {j.type}"
+                )
+        body_of_joint = {j.name: i + 1 for i, j in enumerate(movable)}
+
+        # every link: (body, T_body_link)
+        placed: dict[str, tuple[int, Array]] = {root: (0, np.eye(4))}
+
+        def place(link: str) -> tuple[int, Array]:
+            if link in placed:
+                return placed[link]
+            j = joint_of_child[link]
+            origin = np.eye(4) if j.origin is None else np.asarray(j.origin, dtype=float)
+            if j.name in body_of_joint:
+                out = (body_of_joint[j.name], np.eye(4))
+            else:
+                b, T = place(j.parent)
+                T = T @ origin
+                if j.name in frozen:
+                    T = T @ axis_motion(
+                        self._axis(j), np.asarray(frozen[j.name]), j.type == "prismatic"
+                    )
+                out = (b, T)
+            placed[link] = out
+            return out
+
+        for link in links:
+            place(link)
+        # movable joint i: its parent body and the fixed transform to the joint frame
+        parent_body, pre, axes, prismatic = [], [], [], []
+        lower, upper, cont = [], [], []
+        for j in movable:
+            b, T = placed[j.parent]
+            origin = np.eye(4) if j.origin is None else np.asarray(j.origin, dtype=float)
+            parent_body.append(b)
+            pre.append(T @ origin)
+            axes.append(self._axis(j))
+            prismatic.append(j.type == "prismatic")
+            lo, hi = self._limits(j)
+            lower.append(lo)
+            upper.append(hi)
+            cont.append(j.type == "continuous")
+        dof = len(movable)
+        if dof == 0:
+            raise UrdfError(
+                "tip_link", f"a link with movable joints between it and {root}; {self.tip_link}"
+            )
+        tip_body, T_body_tip = placed[self.tip_link]
+        T_body_tip = T_body_tip.copy()
+        T_body_tip[:3, 3] = T_body_tip[:3, :3] @ np.asarray(self.tip_offset_m) + T_body_tip[:3, 3]
+        tip_axis = np.asarray(self.tip_axis, dtype=float)
+        norm = float(np.linalg.norm(tip_axis))
+        if not (norm > 1e-9 and math.isfinite(norm)):
+            raise UrdfError("tip_axis", f"a non-zero axis, got {list(self.tip_axis)}")
+        R_body_tip = T_body_tip[:3, :3] @ (tip_axis / norm)
+
+        # capsules
+        cap_names: list[str] = []
+        cap_link: list[str] = []
+        cap_body: list[int] = []
+        cap_a: list[Array] = []
+        cap_b: list[Array] = []
+        radii: list[float] = []
+        for lname, link in links.items():
+            b, T_link = placed[lname]
+            cols = list(link.collisions)
+            for k, col in enumerate(cols):
+                T = T_link @ (np.eye(4) if col.origin is None else np.asarray(col.origin, float))
+                g = col.geometry
+                if g.sphere is not None:
+                    r, half = float(g.sphere.radius), np.zeros(3)
+                elif g.cylinder is not None:
+                    r = float(g.cylinder.radius)
+                    half = np.array([0.0, 0.0, float(g.cylinder.length) / 2.0])
+                elif g.box is not None:
+                    h = np.asarray(g.box.size, dtype=float) / 2.0
+                    a = int(np.argmax(h))
+                    others = np.delete(h, a)
+                    r = float(np.linalg.norm(others))
+                    half = np.zeros(3)
+                    half[a] = h[a]
+                else:
+                    raise UrdfError(
+                        "urdf",
+                        f"collision geometry a plannerlab robot can check (sphere, cylinder, "
+                        f"box); link {lname} of {path.name} has a mesh: use a spherized URDF",
+                    )
+                c = T[:3, 3]
+                d = T[:3, :3] @ half
+                cap_names.append(lname if len(cols) == 1 else f"{lname}#{k}")
+                cap_link.append(lname)
+                cap_body.append(b)
+                cap_a.append(c - d)
+                cap_b.append(c + d)
+                radii.append(r)
+        if not cap_names:
+            raise UrdfError("urdf", f"collision elements; {path.name} has none")
+
+        # pairs never checked
+        disabled: set[frozenset[str]] = set()
+        if self.srdf_path is not None:
+            for l1, l2 in read_srdf_disabled(Path(self.srdf_path)):
+                disabled.add(frozenset((l1, l2)))
+        for l1, l2 in self.allowed_collisions:
+            for n in (l1, l2):
+                if n not in links:
+                    raise UrdfError(
+                        "allowed_collisions",
+                        f"pairs of links of {path.name}; {n!r} is not one{_hint(n, list(links))}",
+                    )
+            disabled.add(frozenset((l1, l2)))
+        neighbours = {frozenset((parent_body[i], i + 1)) for i in range(dof)}
+        excluded = set()
+        L = len(cap_names)
+        for i in range(L):
+            for j2 in range(i + 1, L):
+                bi, bj = cap_body[i], cap_body[j2]
+                if (
+                    bi == bj
+                    or frozenset((bi, bj)) in neighbours
+                    or frozenset((cap_link[i], cap_link[j2])) in disabled
+                ):
+                    excluded.add((i, j2))
+
+        T_wb = np.array(self.T_world_base, dtype=float)
+        if T_wb.shape != (4, 4) or not np.all(np.isfinite(T_wb)):
+            raise UrdfError("base_rpy_deg", "a finite base pose")
+        reach = sum(float(np.linalg.norm(P[:3, 3])) for P in pre)
+        reach += float(np.linalg.norm(T_body_tip[:3, 3]))
+        reach += sum(
+            max(abs(lo), abs(hi)) for lo, hi, p in zip(lower, upper, prismatic, strict=True) if p
+        )
+
+        def frozen_array(a: Any, dtype: Any = float) -> Any:
+            out = np.array(a, dtype=dtype)
+            out.setflags(write=False)
+            return out
+
+        s = object.__setattr__
+        s(self, "T_world_base", frozen_array(T_wb))
+        s(self, "dof", dof)
+        s(self, "joint_names", tuple(j.name for j in movable))
+        s(self, "link_names", tuple(cap_names))
+        s(self, "link_urdf_names", tuple(cap_link))
+        s(self, "lower", frozen_array(np.where(cont, -np.pi, lower)))
+        s(self, "upper", frozen_array(np.where(cont, np.pi, upper)))
+        s(self, "continuous", frozen_array(cont, bool))
+        s(self, "link_radii_m", frozen_array(radii))
+        s(self, "fixed_links", frozenset(i for i in range(L) if cap_body[i] == 0))
+        s(self, "excluded_pairs", frozenset(excluded))
+        s(self, "frozen_joints", frozen)
+        s(self, "max_reach_m", float(reach))
+        s(self, "_body_links", (root, *(j.child for j in movable)))
+        s(self, "_parent_body", np.array(parent_body, dtype=int))
+        s(self, "_pre", frozen_array(pre))
+        s(self, "_axes", frozen_array(axes))
+        s(self, "_prismatic", tuple(prismatic))
+        s(self, "_tip_body", int(tip_body))
+        s(self, "_T_body_tip", frozen_array(T_body_tip))
+        s(self, "_n_body_tip", frozen_array(R_body_tip))
+        s(self, "_cap_body", np.array(cap_body, dtype=int))
+        s(self, "_cap_a", frozen_array(cap_a))
+        s(self, "_cap_b", frozen_array(cap_b))
+
+    @staticmethod
+    def _axis(j: Any) -> Array:
+        a = np.array([1.0, 0.0, 0.0] if j.axis is None else j.axis, dtype=float)
+        n = float(np.linalg.norm(a))
+        if n < 1e-12:
+            raise UrdfError("urdf", f"a non-zero axis on joint {j.name}")
+        return a / n
+
+    @staticmethod
+    def _limits(j: Any) -> tuple[float, float]:
+        if j.type == "continuous":
+            return (-math.pi, math.pi)
+        lim = j.limit
+        if lim is None or lim.lower is None or lim.upper is None:
+            raise UrdfError("urdf", f"lower and upper limits on joint {j.name} ({j.type})")
+        lo, hi = float(lim.lower), float(lim.upper)
+        if not (math.isfinite(lo) and math.isfinite(hi) and lo <= hi):
+            raise UrdfError("urdf", f"limits lower <= upper on joint {j.name}, got {lo}, {hi}")
+        return lo, hi
+
+    # ------------------------------------------------------------------ kinematics
+    @property
+    def link_frame_names(self) -> tuple[str, ...]:
+        """URDF links of the ``fk`` frames: the root, each movable joint's child, the tip."""
+        return (*self._body_links, self.tip_link)
+
+    def _check_q(self, q: Array) -> Array:
+        q = np.asarray(q, dtype=float)
+        if q.shape[-1:] != (self.dof,) or q.ndim not in (1, 2):
+            raise PlannerlabError(
+                f"urdf robot: q must have shape ({self.dof},) or (k, {self.dof}), got {q.shape}"
+            )
+        return q
+
+    def _bodies(self, q: Array) -> Array:
+        """Body frames in the world (..., dof + 1, 4, 4)."""
+        q = self._check_q(q)
+        pre, axes, parent, prismatic = self._pre, self._axes, self._parent_body, self._prismatic
+        frames = [np.broadcast_to(self.T_world_base, q.shape[:-1] + (4, 4))]
+        for i in range(self.dof):
+            M = axis_motion(axes[i], q[..., i], prismatic[i])
+            frames.append(frames[parent[i]] @ pre[i] @ M)
+        return np.stack(frames, axis=-3)
+
+    def fk(self, q: Array) -> Array:
+        """Frames ``T_world_frame`` of :attr:`link_frame_names`: (dof + 2, 4, 4) for q
+        (dof,), (k, dof + 2, 4, 4) for (k, dof)."""
+        B = self._bodies(q)
+        tip = B[..., self._tip_body, :, :] @ self._T_body_tip
+        return np.concatenate([B, tip[..., None, :, :]], axis=-3)
+
+    def tip(self, q: Array) -> tuple[Array, Array]:
+        """Tip position ``p_world`` [m] and unit normal ``n_world``: (3,) each, or (k, 3)."""
+        B = self._bodies(q)
+        Tb = B[..., self._tip_body, :, :]
+        T_bt, n_b = self._T_body_tip, self._n_body_tip
+        p = Tb[..., :3, :3] @ T_bt[:3, 3] + Tb[..., :3, 3]
+        n = Tb[..., :3, :3] @ n_b
+        return p, n
+
+    def tip_jacobian(self, q: Array) -> tuple[Array, Array]:
+        """Analytic ``dp/dq`` and ``dn/dq`` (3, dof) each, world frame, at one q (dof,)."""
+        q = self._check_q(q)
+        if q.ndim != 1:
+            raise PlannerlabError("urdf robot: tip_jacobian takes one q of shape (dof,)")
+        B = self._bodies(q)
+        p, n = self.tip(q)
+        axes, prismatic = self._axes, self._prismatic
+        Jp = np.zeros((3, self.dof))
+        Jn = np.zeros((3, self.dof))
+        # only the joints between the root and the tip body move the tip
+        on_path = self._path_joints()
+        for i in on_path:
+            F = B[i + 1]
+            w = F[:3, :3] @ axes[i]
+            if prismatic[i]:
+                Jp[:, i] = w
+            else:
+                Jp[:, i] = np.cross(w, p - F[:3, 3])
+                Jn[:, i] = np.cross(w, n)
+        return Jp, Jn
+
+    def _path_joints(self) -> list[int]:
+        parent = self._parent_body
+        out = []
+        b = int(self._tip_body)
+        while b > 0:
+            out.append(b - 1)
+            b = int(parent[b - 1])
+        return out
+
+    def chain_data(self) -> tuple[Any, ...]:
+        """The chain as plain arrays, for compiled kinematics
+        (:mod:`plannerlab.collision.chain`): per movable joint its parent body (dof,), the
+        fixed transform body -> joint frame (dof, 4, 4), the unit axis (dof, 3) and whether
+        it slides (dof,); per capsule its body (L,) and its end points in that body's frame
+        (L, 3) twice."""
+        return (
+            self._parent_body,
+            self._pre,
+            self._axes,
+            np.array(self._prismatic, dtype=bool),
+            self._cap_body,
+            self._cap_a,
+            self._cap_b,
+        )
+
+    def link_segments(self, q: Array) -> Array:
+        """Capsule axes in the world: (L, 2, 3) for one q, (k, L, 2, 3) for a batch."""
+        B = self._bodies(q)
+        Fb = B[..., self._cap_body, :, :]
+        R, t = Fb[..., :3, :3], Fb[..., :3, 3]
+        a = np.einsum("...lij,lj->...li", R, self._cap_a) + t
+        b = np.einsum("...lij,lj->...li", R, self._cap_b) + t
+        return np.stack([a, b], axis=-2)
+
+    # ------------------------------------------------------------------ URDF
+    def urdf(self) -> str:
+        """The URDF text for the simulator: the file as it is, with relative mesh paths
+        made absolute, visuals whose mesh file is missing left out (they are only looks;
+        PyBullet refuses a file naming a missing mesh) and the frozen joints (see the
+        module) made fixed at their value."""
+        tree = ET.parse(self.urdf_path)
+        root = tree.getroot()
+        folder = self.urdf_path.resolve().parent
+        for link in root.iter("link"):
+            for visual in link.findall("visual"):
+                for mesh in visual.iter("mesh"):
+                    fn = mesh.get("filename", "")
+                    if fn and "://" not in fn and not Path(fn).is_absolute():
+                        mesh.set("filename", str(folder / fn))
+                    if "://" in fn or not Path(mesh.get("filename", "")).is_file():
+                        # a visual whose mesh is not there (PyBullet refuses the file)
+                        link.remove(visual)
+                        break
+        for joint in root.iter("joint"):
+            name = joint.get("name", "")
+            if name not in self.frozen_joints:
+                continue
+            value = self.frozen_joints[name]
+            if value != 0.0:
+                from plannerlab.robots.base import pose_matrix
+
+                o = joint.find("origin")
+                xyz = (
+                    [0.0, 0.0, 0.0]
+                    if o is None
+                    else [float(v) for v in o.get("xyz", "0 0 0").split()]
+                )
+                rpy = (
+                    [0.0, 0.0, 0.0]
+                    if o is None
+                    else [float(v) for v in o.get("rpy", "0 0 0").split()]
+                )
+                ax = joint.find("axis")
+                axis = np.array(
+                    [1.0, 0.0, 0.0]
+                    if ax is None
+                    else [float(v) for v in ax.get("xyz", "1 0 0").split()]
+                )
+                motion = axis_motion(
+                    axis / np.linalg.norm(axis), np.asarray(value), joint.get("type") == "prismatic"
+                )
+                T = np.asarray(pose_matrix(xyz, rpy)) @ motion
+                if o is not None:
+                    joint.remove(o)
+                joint.append(ET.fromstring(urdf_origin(T)))
+            joint.set("type", "fixed")
+            for tag in ("mimic", "limit"):
+                for e in joint.findall(tag):
+                    joint.remove(e)
+        return ET.tostring(root, encoding="unicode")
+
+
+__all__ = ["UrdfChain", "UrdfError", "axis_motion", "read_srdf_disabled"]

@@ -1,0 +1,84 @@
+"""The ``[robot]`` table of a robot read from a URDF (``type = "urdf"``): its keys and
+its constructor.
+
+``urdf`` (a path relative to the problem file) and ``tip_link`` are required; the tip is
+the point ``tip_offset_m`` of the tip link's frame, its normal ``tip_axis`` in that frame.
+``srdf`` (optional, a path relative to the problem file) and ``allowed_collisions`` (URDF
+link pairs) name link pairs whose self-collision is not checked, besides links on one body
+and neighbouring bodies. The root link's pose in the world is ``base_xyz_m`` [m] and
+``base_rpy_deg`` [deg]. The table in ``docs/problem-format.md`` lists the same keys.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from pathlib import Path
+from typing import Any
+
+from plannerlab.robots.schema import Key, RobotTable, TableValueError, base_pose, base_pose_keys
+from plannerlab.robots.urdf.model import UrdfChain, UrdfError
+
+
+def build(values: Mapping[str, Any]) -> UrdfChain:
+    """The chain from the table's validated values (paths already resolved).
+
+    Raises:
+        TableValueError: the URDF or SRDF cannot be read or used, or a link named in
+            ``tip_link`` or ``allowed_collisions`` is not in it (on that key).
+    """
+    srdf = values["srdf"]
+    try:
+        return UrdfChain(
+            urdf_path=Path(values["urdf"]),
+            tip_link=values["tip_link"],
+            tip_axis=tuple(float(v) for v in values["tip_axis"]),  # type: ignore[arg-type]
+            tip_offset_m=tuple(float(v) for v in values["tip_offset_m"]),  # type: ignore[arg-type]
+            srdf_path=Path(srdf) if srdf else None,
+            allowed_collisions=tuple((str(a), str(b)) for a, b in values["allowed_collisions"]),
+            T_world_base=base_pose(values),
+        )
+    except UrdfError as exc:
+        raise TableValueError(exc.key, exc.expected) from None
+
+
+TABLE = RobotTable(
+    type="urdf",
+    keys=(
+        Key("urdf", "path", "", "", "the URDF file, relative to the problem file", required=True),
+        Key("tip_link", "string", "", "", "the URDF link carrying the tip", required=True),
+        Key(
+            "tip_axis",
+            "vector",
+            (0.0, 0.0, 1.0),
+            "",
+            "the tip normal, in the tip link's frame",
+            length=3,
+        ),
+        Key(
+            "tip_offset_m",
+            "vector",
+            (0.0, 0.0, 0.0),
+            "m",
+            "the tip point, in the tip link's frame",
+            length=3,
+        ),
+        Key(
+            "srdf",
+            "path",
+            "",
+            "",
+            "an SRDF whose disable_collisions pairs are not checked, relative to the problem file",
+        ),
+        Key(
+            "allowed_collisions",
+            "pairs",
+            (),
+            "",
+            "URDF link pairs whose self-collision is not checked",
+        ),
+        *base_pose_keys("root link"),
+    ),
+    build=build,
+)
+
+__all__ = ["TABLE", "build"]

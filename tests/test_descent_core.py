@@ -1,0 +1,98 @@
+"""The compiled clearance descent (``backend = "compiled"``) against the numpy one: the
+same field, step and hold at single states, and the same path on fixed problems."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from plannerlab.errors import PlannerlabError
+from plannerlab.planners import make_planner
+from plannerlab.planners.base import Status
+from plannerlab.problem.catalog import load_problem
+from plannerlab.problem.load import Budget
+
+
+def _models(problem, **overrides):
+    numpy_model = make_planner("gradient.clearance", {"backend": "numpy", **overrides}).model(
+        problem
+    )
+    compiled = make_planner("gradient.clearance", {"backend": "compiled", **overrides}).model(
+        problem
+    )
+    assert type(numpy_model).__name__ == "_NumpyModel"
+    assert type(compiled).__name__ == "_CompiledModel"
+    return numpy_model, compiled
+
+
+@pytest.mark.parametrize("direction", ["gauss_newton", "gradient"])
+def test_compiled_field_step_and_hold_equal_numpy_at_states_near_walls(direction):
+    """States drawn round the start of the pocket (walls and self pairs close): F, f, the
+    tip errors, the clearance cost and gradient, every distance below the margin, the step
+    and the hold's projection agree to rounding. The clearance floor is raised to 0.1 m
+    (the hold acts on pairs closer than 0.11 m) so that the hold has pairs to hold."""
+    problem = load_problem("armz_pocket")
+    numpy_model, compiled = _models(problem, direction=direction, min_clearance_m=0.1)
+    goal = problem.goal(0)
+    rng = np.random.default_rng(7)
+    margin = 0.3
+    held = 0
+    for _ in range(25):
+        q = problem.q_start + rng.normal(0.0, 0.5, problem.robot.dof)
+        a, b = numpy_model.point(goal, q), compiled.point(goal, q)
+        for name in ("F", "f", "pos_err_m", "ang_err_deg", "cost"):
+            assert getattr(b, name) == pytest.approx(getattr(a, name), rel=1e-10, abs=1e-12)
+        np.testing.assert_allclose(b.gradient, a.gradient, rtol=1e-9, atol=1e-10)
+        near = a.distances_m < margin
+        np.testing.assert_allclose(b.distances_m[near], a.distances_m[near], atol=1e-12)
+        assert np.all(b.distances_m[~near] >= margin)
+        np.testing.assert_allclose(b.direction, a.direction, rtol=1e-8, atol=1e-10)
+        # the hold projects a step that closes the nearest pairs (up the clearance cost)
+        step = a.gradient if a.cost > 0 else a.direction
+        h_a, h_b = numpy_model.hold(q, step), compiled.hold(q, step)
+        held += int(not np.allclose(h_a, step))
+        # the hold solves G Gᵀ λ = … regularised by only 1e-9 (sphere rows of one link
+        # pair are nearly dependent): rounding grows by up to ~1e7 there
+        np.testing.assert_allclose(h_b, h_a, rtol=1e-5, atol=1e-6 * np.abs(h_a).max())
+    assert held > 0  # some states were within the clearance floor: the hold was exercised
+
+
+@pytest.mark.parametrize(
+    ("problem_name", "leg", "status"),
+    [
+        ("armz_inspection", 0, Status.SOLVED),  # approach, descent, settle
+        ("armz_inspection", 3, Status.LOCAL_MINIMUM),  # holds along walls, then a stall
+    ],
+)
+def test_compiled_descent_takes_the_numpy_descents_path(problem_name, leg, status):
+    """Same iterates: the whole path of a leg to 1e-9 rad, on an iteration budget."""
+    problem = load_problem(problem_name)
+    budget = Budget(max_iterations=1000)
+    paths = {}
+    for backend in ("numpy", "compiled"):
+        planner = make_planner("gradient.clearance", {"backend": backend})
+        r = planner.solve(problem, leg, budget, np.random.default_rng(0))
+        assert r.status is status
+        paths[backend] = (r.path, r.iterations, r.collision_checks)
+    (p_np, it_np, c_np), (p_c, it_c, c_c) = paths["numpy"], paths["compiled"]
+    assert (it_c, c_c) == (it_np, c_np)
+    assert p_c.shape == p_np.shape and len(p_c) > 100
+    np.testing.assert_allclose(p_c, p_np, rtol=0.0, atol=1e-9)
+
+
+def test_backend_setting_is_checked():
+    with pytest.raises(PlannerlabError, match="backend setting"):
+        make_planner("gradient.clearance", {"backend": "cuda"})
+
+
+def test_robots_other_than_armz_descend_in_numpy_and_say_so():
+    problem = load_problem("irb6_case1")
+    r = make_planner("gradient.clearance").solve(
+        problem, 0, Budget(max_iterations=5), np.random.default_rng(0)
+    )
+    assert r.extra["descent_backend"] == "numpy"
+    arm = load_problem("armz_pocket")
+    r = make_planner("gradient.clearance").solve(
+        arm, 0, Budget(max_iterations=5), np.random.default_rng(0)
+    )
+    assert r.extra["descent_backend"] == "compiled"
