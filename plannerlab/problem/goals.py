@@ -89,7 +89,7 @@ class GoalRegion:
             pos = math.sqrt(dx * dx + dy * dy + dz * dz)
             c = nx * float(gn[0]) + ny * float(gn[1]) + nz * float(gn[2])
             ang = math.degrees(math.acos(min(max(c, -1.0), 1.0)))
-            return np.float64(max(max(pos / self.pos_tol_m, ang / self.angle_tol_deg) - 1.0, 0.0))
+            return np.asarray(max(max(pos / self.pos_tol_m, ang / self.angle_tol_deg) - 1.0, 0.0))
         pos_err, ang_err = self.errors_from_tip(p_world_m, n_world)
         scaled = np.maximum(pos_err / self.pos_tol_m, ang_err / self.angle_tol_deg)
         return np.maximum(scaled - 1.0, 0.0)
