@@ -921,34 +921,34 @@ def armz_path_advance(
             edge_rates(d, W, Pr, v_link, v_pair)
         t = 0.0
         dt = dt_min
-        if adaptive:
-            if not have_seg:  # the edge's start: measured, not checked (the caller's)
-                if queries >= limit:
-                    return queries, 2, e, 0.0
-                armz_segments_axes(P[e], T0, T1, M, seg[0], z_axes)
-                queries += 1
-            dt = armz_advance_dt(
-                seg[0],
-                d,
-                z_axes,
-                radii,
-                radii_self,
-                moving,
-                allowed,
-                kinds,
-                Rs,
-                cs,
-                hs,
-                olo,
-                ohi,
-                v_link,
-                v_pair,
-                margin,
-                1.0,
-                buf,
-                rho,
-            )
+        if adaptive and not have_seg:  # the edge's start: measured, not checked (the caller's)
+            if queries >= limit:
+                return queries, 2, e, 0.0
+            armz_segments_axes(P[e], T0, T1, M, seg[0], z_axes)
+            queries += 1
         while True:
+            if adaptive:
+                dt = armz_advance_dt(
+                    seg[0],
+                    d,
+                    z_axes,
+                    radii,
+                    radii_self,
+                    moving,
+                    allowed,
+                    kinds,
+                    Rs,
+                    cs,
+                    hs,
+                    olo,
+                    ohi,
+                    v_link,
+                    v_pair,
+                    margin,
+                    1.0 - t,
+                    buf,
+                    rho,
+                )
             step = max(dt_min, min(dt, dt_cap))
             tn = t + step
             if tn >= 1.0 - 1e-9:
@@ -979,28 +979,6 @@ def armz_path_advance(
                 return queries, 1, e, tn
             if tn == 1.0:
                 break
-            if adaptive:
-                dt = armz_advance_dt(
-                    seg[0],
-                    d,
-                    z_axes,
-                    radii,
-                    radii_self,
-                    moving,
-                    allowed,
-                    kinds,
-                    Rs,
-                    cs,
-                    hs,
-                    olo,
-                    ohi,
-                    v_link,
-                    v_pair,
-                    margin,
-                    1.0 - tn,
-                    buf,
-                    rho,
-                )
             t = tn
         have_seg = True
     return queries, 0, m - 1, 1.0
