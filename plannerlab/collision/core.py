@@ -75,6 +75,7 @@ CPU time, both from the bench's own lines; the machine shared by about five jobs
     + OMPL states read in one binding call                14 888   0.113     1.95x, 1.89x
     + joint axes with the capsule axes, leaner calls,
       scalar goal distance                                14 888   0.096     2.14x, 2.34x
+    the same, merged with main 689e916 (a second run)     14 888   0.096     2.19x, 2.19x
 
 Where a solve's time went before these (cProfile with CPU time, and timers around the
 callbacks): edge checks about a third (their compiled part ~2.5 µs per visited state, of
