@@ -26,10 +26,12 @@ get the same range number; the metrics differ (MPlib: Euclidean in R^11; planner
 OMPL's compound SO(2) metric, the L1 sum of joint angle changes, so the same number
 means shorter steps for plannerlab). Edges: plannerlab keeps the problem's default
 clearance margin (``[planning] safety_margin_m``, 1 cm: capsules inflated by it) and
-checks its edges, while planning and in the re-check alike, so that no point of the arm
-moves more than that centimetre between checked states (and no joint more than
-``joint_step``, 0.05 rad); MPlib checks no margin, at its OMPL default resolution in
-joint space. ``--margin 0`` gives plannerlab's former setting (no margin, radian steps).
+checks its edges, while planning and in the re-check alike, in metres: by conservative
+advancement on the compiled core (every checked state keeps the margin, every state
+between two checked ones at least half of it; no joint moves more than ``joint_step``,
+0.05 rad, between checked states; see :mod:`plannerlab.collision.core`); MPlib checks no
+margin, at its OMPL default resolution in joint space. ``--margin 0`` gives plannerlab's
+former setting (no margin, radian steps).
 """
 
 from __future__ import annotations

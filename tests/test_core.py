@@ -250,3 +250,31 @@ def test_every_colliding_pair_is_found_in_the_checkers_order(n_modules):
         assert pairs == ref.colliding_pairs(q)
         many += len(pairs) >= 5
     assert many >= 10
+
+
+@pytest.mark.parametrize("name", ["armz_pocket", "irb6_track_obstacle", "continuum_case3"])
+def test_path_measurements_in_one_call_equal_the_state_by_state_ones(name):
+    p = load_problem(name)
+    checker = CollisionChecker(p.robot, p.scene, margin_m=0.01)
+    rng = np.random.default_rng(5)
+    q0 = np.asarray(p.q_start, dtype=float)
+    Q = np.clip(q0 + rng.normal(0.0, 0.05, (40, p.robot.dof)), p.robot.lower, p.robot.upper)
+    for include_self in (True, False):
+        c0 = checker.checks
+        one_call = checker.min_clearance(Q, include_self)
+        assert checker.checks - c0 == len(Q)  # one check per state, as clearance counts
+        each = min(checker.clearance(q, include_self) for q in Q)
+        assert one_call == pytest.approx(each, abs=1e-12)
+    assert checker.min_clearance(Q[:0]) == np.inf
+    # the tip from the checker (compiled for Arm-Z) is the robot's, and costs no check
+    c0 = checker.checks
+    for q in Q[:10]:
+        p_c, n_c = checker.tip(q)
+        p_r, n_r = p.robot.tip(q)
+        assert np.abs(p_c - p_r).max() < 1e-9 and np.abs(n_c - n_r).max() < 1e-12
+    assert checker.checks == c0
+    # the grid is counted without being made
+    path = np.vstack([q0, Q[:6]])
+    for step in (p.joint_step, p.joint_step / 4.0):
+        assert checker.grid_states(path, step) == len(checker.densify(path, step)[0])
+    assert checker.grid_states(path[:1], p.joint_step) == 1

@@ -3,8 +3,10 @@
 * Every registered planner's solved path keeps the margin: no state of it is closer than
   the margin to the scene (or a link pair closer than the margin to each other), by the
   FCL reference's distance on the robot's true capsules; ``min_clearance_m`` says so.
-* Edges are checked in metres: between two states a checker with a margin checks, no
-  point of the robot moves further than the margin (Arm-Z, IRb-6 and the continuum chain).
+* Edges are checked in metres: on the grid (``edge_check="grid"``) no point of the robot
+  moves further than the margin between two checked states (Arm-Z, IRb-6 and the
+  continuum chain); by conservative advancement (``"advance"``, the default on the core)
+  every state between two checked states keeps half the margin, with far fewer states.
 """
 
 from __future__ import annotations
@@ -13,6 +15,8 @@ import numpy as np
 import pytest
 from test_planner_contract import PARAMS, _result, problem_for
 
+from plannerlab.collision.agreement import sample_states
+from plannerlab.collision.core import Core
 from plannerlab.collision.fcl_checker import CollisionChecker
 from plannerlab.planners import make_planner
 from plannerlab.problem.catalog import load_problem
@@ -56,7 +60,7 @@ def test_no_point_moves_more_than_the_margin_between_checked_states(problem_name
     problem = load_problem(problem_name)
     # the continuum files turn the margin off (a sleeve they touch): check 1 cm there too
     margin = problem.safety_margin_m or 0.01
-    checker = CollisionChecker(problem.robot, problem.scene, margin_m=margin)
+    checker = CollisionChecker(problem.robot, problem.scene, margin_m=margin, edge_check="grid")
     robot = problem.robot
     rng = np.random.default_rng(3)
     q0 = np.asarray(problem.q_start, dtype=float)
@@ -78,3 +82,78 @@ def test_no_point_moves_more_than_the_margin_between_checked_states(problem_name
     n, bad = checker.check_edge(q0, q1, problem.joint_step / 4.0, max_states=0)
     assert n == len(checker.densify(path[:2], problem.joint_step / 4.0)[0]) - 1
     assert bad is None
+
+
+def _near_contact_edges(problem_name: str, n: int, seed: int):
+    """Edges that start at valid states within ~1 mm of the margin's contact."""
+    problem = load_problem(problem_name)
+    robot = problem.robot
+    margin = problem.safety_margin_m
+    advance = CollisionChecker(robot, problem.scene, margin_m=margin)
+    rng = np.random.default_rng(seed)
+    starts = sample_states(advance._core, "contact", 3 * n, rng)
+    starts = starts[advance._core.valid(starts)][:n]
+    ends = starts + rng.normal(0.0, 0.02, starts.shape)
+    return problem, advance, starts, ends
+
+
+@pytest.mark.parametrize("problem_name", ["armz_pocket", "irb6_case1"])
+def test_advance_keeps_half_the_margin_between_checked_states(problem_name: str) -> None:
+    problem, advance, starts, ends = _near_contact_edges(problem_name, 24, seed=7)
+    margin = problem.safety_margin_m
+    assert advance.edge_check == "advance"
+    grid = CollisionChecker(problem.robot, problem.scene, margin_m=margin, edge_check="grid")
+    true = Core(problem.robot, problem.scene, 0.0)  # no margin: the real capsules
+    step = problem.joint_step / 4.0
+    t = np.linspace(0.0, 1.0, 401)[:, None]
+    n_valid = used = grid_used = 0
+    for a, b in zip(starts, ends, strict=True):
+        c0 = advance.checks
+        check = advance.check_path(np.array([a, b]), step)
+        # one check per state, and one more to name the pairs of a colliding one
+        assert advance.checks - c0 == check.states_checked + (not check.valid)
+        g = grid.check_path(np.array([a, b]), step)
+        assert check.states_checked <= len(grid.densify(np.array([a, b]), step)[0])
+        used += check.states_checked
+        grid_used += g.states_checked
+        if check.valid:
+            n_valid += 1
+            between = min(true.clearance(q) for q in a + t * (b - a))
+            assert between >= margin / 2 - 1e-9, (between, margin)
+    assert 0 < n_valid < len(starts)  # both verdicts met
+    if problem_name == "armz_pocket":
+        assert used * 3 < grid_used  # the point of it: far fewer states than the grid
+
+
+def test_advance_finds_every_collision_the_margin_free_grid_finds() -> None:
+    problem, advance, starts, _ = _near_contact_edges("armz_pocket", 30, seed=8)
+    plain = CollisionChecker(problem.robot, problem.scene)  # no margin, radian steps
+    rng = np.random.default_rng(9)
+    ends = starts + rng.normal(0.0, 0.05, starts.shape)
+    step = problem.joint_step / 4.0
+    hits = 0
+    for a, b in zip(starts, ends, strict=True):
+        if not plain.check_path(np.array([a, b]), step).valid:
+            hits += 1
+            assert not advance.check_path(np.array([a, b]), step).valid
+            n, bad = advance.check_edge(a, b, step)
+            assert bad is not None and bad == n - 1
+    assert hits > 0
+
+
+def test_advance_edge_check_stops_at_its_limit() -> None:
+    problem = load_problem("armz_pocket")
+    advance = CollisionChecker(problem.robot, problem.scene, margin_m=problem.safety_margin_m)
+    a = np.asarray(problem.q_start, dtype=float)
+    b = a + 0.05
+    step = problem.joint_step / 4.0
+    n_all, bad_all = advance.check_edge(a, b, step)
+    assert bad_all is None and n_all > 2  # valid, and more than two states
+    c0 = advance.checks
+    n, bad = advance.check_edge(a, b, step, max_states=2)
+    assert advance.checks - c0 == 2
+    assert n > 2 and bad is None  # unfinished: more than the limit is needed
+    with pytest.raises(ValueError, match="edge_check"):
+        CollisionChecker(problem.robot, problem.scene, edge_check="fast")
+    with pytest.raises(ValueError, match="margin"):
+        CollisionChecker(problem.robot, problem.scene, edge_check="advance")

@@ -272,3 +272,34 @@ def test_sample_goal_state_gives_up_with_none() -> None:
         )
         is None
     )
+
+
+# ---------------------------------------------------------------------------- states
+@pytest.mark.parametrize("case", ["armz", "irb6", "mixed"])
+@pytest.mark.parametrize("lifted", [False, True])
+def test_states_read_in_one_call_equal_the_joint_by_joint_reading(case: str, lifted: bool) -> None:
+    from types import SimpleNamespace
+
+    from plannerlab.planners.ompl import _Space
+    from plannerlab.problem.catalog import load_problem
+
+    if case == "armz":
+        robot = ArmZ(n_modules=12)
+    elif case == "irb6":
+        robot = load_problem("irb6_case1").robot
+    else:  # continuous joints between bounded ones: SO2 values first, then the block
+        cont = np.array([True, False, True, False, False, True])
+        robot = SimpleNamespace(
+            dof=6, continuous=cont, lower=np.full(6, -2.0), upper=np.full(6, 2.0)
+        )
+    space = _Space(robot, lifted=lifted, center=np.zeros(robot.dof))
+    assert space.to_q.__name__ in ("read", "read_permuted")  # the one-call reading is used
+    state = space.space.allocState()
+    rng = np.random.default_rng(0)
+    for _ in range(20):
+        q = rng.uniform(np.maximum(robot.lower, -3.0), np.minimum(robot.upper, 3.0))
+        space.set_state(state, q)
+        a = space.to_q(state)
+        assert np.array_equal(a, space._read(state))
+        assert np.allclose(a, q, rtol=0.0, atol=1e-12)  # |q| < pi: no turn to wrap
+        assert space.to_q(state) is not a  # a new array each time

@@ -18,6 +18,71 @@ True``: compiled once per machine into ``__pycache__``, loaded in later processe
 
 The pairs checked are the checker's: moving links against every obstacle, and the robot's
 link pairs except ``excluded_pairs`` and pairs of two fixed links.
+
+**Edges in metres by conservative advancement** (:meth:`Core.path_advance`; the checker's
+``edge_check="advance"``, its default with a margin on the core). With a clearance margin
+``m`` an edge must be checked so that nothing slips between two checked states. The grid
+(``edge_check="grid"``, :meth:`~plannerlab.collision.fcl_checker.CollisionChecker.densify`)
+cuts each edge into equal steps over which no point moves more than ``m`` (the bound
+``Σ |Δq_i| r_i`` of :func:`~plannerlab.collision.reach.joint_reach_m`): about 40 times the
+states of radian steps on the 16-m Arm-Z. Conservative advancement measures instead, at
+each checked state, the distance ``d_p`` of every checked pair with the capsules inflated
+(:func:`advance_dt`), and steps as far as a bound ``v_p`` of how fast that distance can
+change allows: ``Δt = min_p (d_p + m) / v_p``, never less than the grid's step and never
+more than ``joint_step`` on any joint. The guarantee is the grid's, pair by pair:
+
+* every checked state keeps the margin (the ordinary inflated check, unchanged);
+* every state between two checked ones keeps at least ``m / 2`` to the scene and between
+  links: a pair at ``t + s`` is at least ``d_p + m − v_p s`` from the left and at least
+  ``m − v_p (Δt − s)`` from the right, whose larger is ``≥ m / 2`` when
+  ``v_p Δt ≤ d_p + m``. (The grid gives the same ``m / 2`` against the scene, and ``≥ 0``
+  between two links, both of which move.)
+
+The rates ``v_p`` (:func:`edge_rates`, from :func:`~plannerlab.collision.reach.
+reach_bounds`): per joint and link, how fast the link's points move (the chain sum of
+``joint_reach_m`` stopped at that link), and per link pair only the joints that move one
+link and not the other (a joint that turns both rigidly leaves their distance alone). On
+Arm-Z the bound is taken at the configuration (:func:`armz_advance_dt`): a link's speed
+from joint ``f`` is ``|Δq_f|`` times the link's real distance from ``f``'s axis, which is
+grown along the step by how far the link can move relative to that axis (a quadratic
+term, sound), instead of the length of the chain behind the joint.
+
+Counting: each state visited is one check (its validity, plus its pair distances when
+the step needs them), and an edge measured at its start costs one more. A visited state
+costs more than a plain check (a distance pass, with box pruning, after it); its cost
+ratio has not been measured in isolation: the wall times in the table are the honest
+account. A path's states never
+outnumber its grid's (each step is at least the grid's), so a planner's re-check reserve
+computed from the grid (``_recheck_cost`` in planners/ompl.py) stays an upper bound.
+
+Measured on ``bench/mplib_bench.py --seeds 10`` (12-module Arm-Z, ``ompl.rrtconnect``,
+margin 0.01 m; median per solve, this 2-core machine under other jobs, ``nice -n 19``)::
+
+    option                                          checks/solve  wall s  MPlib/pl  solved
+    grid, Σ|Δq_i| r_i ≤ m (main at bc741f5)               479 003   0.643     0.40x   10/10
+    advance, per-link chain bounds                         44 803   0.302        -    10/10
+    advance, + bounds at the configuration (Arm-Z)         14 888   0.181     1.13x   10/10
+    ... + joint and link bounds in one pass                14 888   0.157     1.31x   10/10
+
+Then, on main f729c34 (the same checks per solve; ``MPlib/pl`` is now given for wall and
+CPU time, both from the bench's own lines; the machine shared by about five jobs, load
+4-10, so wall times vary by about ±30 % from run to run)::
+
+    option                                          checks/solve  CPU s   MPlib/pl wall, CPU
+    rebased, as above                                     14 888   0.173     1.57x, 1.35x
+    + reach bounds vectorised, goal distance from the
+      compiled tip, path clearance in one call            14 888   ~0.141         -
+    + OMPL states read in one binding call                14 888   0.113     1.95x, 1.89x
+    + joint axes with the capsule axes, leaner calls,
+      scalar goal distance                                14 888   0.096     2.14x, 2.34x
+    the same, merged with main 689e916 (a second run)     14 888   0.096     2.19x, 2.19x
+
+Where a solve's time went before these (cProfile with CPU time, and timers around the
+callbacks): edge checks about a third (their compiled part ~2.5 µs per visited state, of
+which the distance pass 1.5 µs), reading OMPL states joint by joint ~20 %, the goal
+heuristic's NumPy kinematics ~15 %, building the checker's reach bounds ~10 %, the
+planned clearance ~5 %; OMPL itself (nearest neighbours on the SO(2) compound metric)
+about a fifth.
 """
 
 from __future__ import annotations
@@ -38,6 +103,7 @@ from plannerlab.collision.geometry import (
     capsule_obstacle_hit,
     seg_seg,
 )
+from plannerlab.collision.reach import pair_rates
 from plannerlab.problem.scene import Box, Cylinder, Scene, Sphere
 from plannerlab.robots.base import Array, Robot, joint_difference
 from plannerlab.robots.paths import (
@@ -111,6 +177,38 @@ def armz_segments(Q, T0, T1, M, out):
         for i in range(3):
             out[s, dof, 1, i] = p[i]
     return out
+
+
+@njit(cache=True, nogil=True)
+def armz_segments_axes(q, T0, T1, M, seg, z):
+    """:func:`armz_segments` of one state q (dof,) → seg (dof + 1, 2, 3), and the joints'
+    axis directions z (dof, 3) (joint ``f`` turns about ``z[f]`` through ``seg[f, 1]``);
+    the same floats as :func:`armz_segments`."""
+    dof = q.shape[0]
+    R = np.empty((3, 3))
+    p = np.empty(3)
+    for i in range(3):
+        seg[0, 0, i] = T0[i, 3]
+        p[i] = T1[i, 3]
+        for j in range(3):
+            R[i, j] = T1[i, j]
+    for f in range(dof):
+        c = math.cos(q[f])
+        sn = math.sin(q[f])
+        for i in range(3):
+            seg[f, 1, i] = p[i]
+            seg[f + 1, 0, i] = p[i]
+            z[f, i] = R[i, 2]
+        for i in range(3):
+            g0 = c * R[i, 0] + sn * R[i, 1]
+            g1 = -sn * R[i, 0] + c * R[i, 1]
+            g2 = R[i, 2]
+            p[i] += g0 * M[0, 3] + g1 * M[1, 3] + g2 * M[2, 3]
+            R[i, 0] = g0 * M[0, 0] + g1 * M[1, 0] + g2 * M[2, 0]
+            R[i, 1] = g0 * M[0, 1] + g1 * M[1, 1] + g2 * M[2, 1]
+            R[i, 2] = g0 * M[0, 2] + g1 * M[1, 2] + g2 * M[2, 2]
+    for i in range(3):
+        seg[dof, 1, i] = p[i]
 
 
 # ---------------------------------------------------------------------- broad + narrow phase
@@ -517,6 +615,377 @@ def armz_edge_first_invalid(
 
 
 @njit(cache=True, nogil=True)
+def _box_gap(lo, hi, i, olo, ohi, j):
+    """A lower bound of the distance between the shapes in boxes i and j: the boxes' gap."""
+    g2 = 0.0
+    for c in range(3):
+        x = max(olo[j, c] - hi[i, c], lo[i, c] - ohi[j, c], 0.0)
+        g2 += x * x
+    return math.sqrt(g2)
+
+
+@njit(cache=True, nogil=True)
+def advance_dt(
+    seg,
+    radii,
+    radii_self,
+    moving,
+    allowed,
+    kinds,
+    Rs,
+    cs,
+    hs,
+    olo,
+    ohi,
+    v_link,
+    v_pair,
+    margin,
+    dt_max,
+    buf,
+):
+    """Conservative advancement from one valid state: the largest ``dt <= dt_max`` with
+    ``v_p · dt <= d_p + margin`` for every checked pair ``p``.
+
+    ``d_p``: the pair's distance with the capsules inflated (by the margin against the
+    scene, by half of it each against each other; clamped at 0), ``v_p``: an upper bound
+    of how fast the pair's distance changes per unit of the edge parameter (``v_link``
+    (L,) for a link against the scene, ``v_pair`` (L, L) for a link pair). Pairs whose
+    boxes are so far apart that they cannot limit the step are not measured.
+    """
+    lo, hi, w, lo2, hi2, _ = buf
+    L = seg.shape[0]
+    n_obs = kinds.shape[0]
+    _link_boxes(seg, radii, lo, hi)
+    nv = np.empty(3)
+    best = dt_max
+    for li in range(L):
+        v = v_link[li]
+        if not moving[li] or v <= 0.0:
+            continue
+        for oi in range(n_obs):
+            if _box_gap(lo, hi, li, olo, ohi, oi) + margin >= best * v:
+                continue
+            dist, _ = capsule_obstacle(
+                kinds[oi],
+                Rs[oi],
+                cs[oi],
+                hs[oi],
+                seg[li, 0],
+                seg[li, 1],
+                radii[li],
+                False,
+                nv,
+                w,
+            )
+            dt = (max(dist, 0.0) + margin) / v
+            if dt < best:
+                best = dt
+    _link_boxes(seg, radii_self, lo2[:L], hi2[:L])
+    for i in range(L):
+        for j in range(i + 1, L):
+            v = v_pair[i, j]
+            if v <= 0.0 or not allowed[i, j]:
+                continue
+            if _box_gap(lo2, hi2, i, lo2, hi2, j) + margin >= best * v:
+                continue
+            d2, _, _ = seg_seg(seg[i, 0], seg[i, 1], seg[j, 0], seg[j, 1])
+            dist = math.sqrt(d2) - radii_self[i] - radii_self[j]
+            dt = (max(dist, 0.0) + margin) / v
+            if dt < best:
+                best = dt
+    return best
+
+
+@njit(cache=True, nogil=True)
+def edge_rates(d, W, Pr, v_link, v_pair):
+    """Per unit of the edge parameter, bounds of how fast each link (against the scene)
+    and each link pair moves along an edge of joint change ``d``: ``|d| @ W``, ``|d| @ Pr``."""
+    dof, L = W.shape
+    for li in range(L):
+        v_link[li] = 0.0
+        for j in range(L):
+            v_pair[li, j] = 0.0
+    for k in range(dof):
+        a = abs(d[k])
+        if a == 0.0:
+            continue
+        for li in range(L):
+            v_link[li] += a * W[k, li]
+            for j in range(li + 1, L):
+                v_pair[li, j] += a * Pr[k, li, j]
+
+
+@njit(cache=True, nogil=True)
+def _quad_step(u, c2, c):
+    """Largest s with ``u s + c2 s² / 2 <= c`` (u, c2 >= 0; inf when both are 0)."""
+    if c2 <= 0.0:
+        return c / u if u > 0.0 else np.inf
+    return 2.0 * c / (u + math.sqrt(u * u + 2.0 * c2 * c))
+
+
+@njit(cache=True, nogil=True)
+def armz_advance_dt(
+    seg,
+    d,
+    z_axes,
+    radii,
+    radii_self,
+    moving,
+    allowed,
+    kinds,
+    Rs,
+    cs,
+    hs,
+    olo,
+    ohi,
+    v_link,
+    v_pair,
+    margin,
+    dt_max,
+    buf,
+    rho,
+):
+    """:func:`advance_dt` for Arm-Z with bounds taken at this configuration.
+
+    Joint ``f`` turns links ``f+1 ..`` about its axis, so a point of link ``l`` moves at
+    ``|d_f| · ρ_fl`` per unit of the edge parameter from it, ``ρ_fl`` the largest distance
+    of link ``l``'s axis points from joint ``f``'s axis (at an end point: the distance to
+    a line is convex). Along the step ``ρ_fl`` grows at most as fast as link ``l`` moves
+    relative to joint ``f``, at most ``v_link[l]``; so over a step ``s`` link ``l`` moves
+    at most ``u s + a v s² / 2`` (``u = Σ_f |d_f| ρ_fl``, ``a = Σ_f |d_f|``), and at most
+    ``v_link[l] · s`` (the configuration-free bound): the step is the larger of the two
+    that keeps ``d + margin``. A link pair ``(i, j)`` is the same with the joints between
+    them (``i <= f < j``) moving ``j`` relative to ``i``.
+    """
+    lo, hi, w, lo2, hi2, _ = buf
+    L = seg.shape[0]
+    dof = L - 1
+    n_obs = kinds.shape[0]
+    # joint f's axis: direction z_axes[f] through seg[f, 1] (armz_segments_axes)
+    for f in range(dof):
+        ox, oy, oz = seg[f, 1, 0], seg[f, 1, 1], seg[f, 1, 2]
+        zx, zy, zz = z_axes[f, 0], z_axes[f, 1], z_axes[f, 2]
+        for li in range(f + 1, L):
+            best_r = 0.0
+            for e in range(2):
+                x = seg[li, e, 0] - ox
+                y = seg[li, e, 1] - oy
+                z = seg[li, e, 2] - oz
+                t = x * zx + y * zy + z * zz
+                r2 = x * x + y * y + z * z - t * t
+                if r2 > best_r:
+                    best_r = r2
+            rho[f, li] = math.sqrt(best_r)
+    _link_boxes(seg, radii, lo, hi)
+    nv = np.empty(3)
+    best = dt_max
+    for li in range(L):
+        v = v_link[li]
+        if not moving[li] or v <= 0.0:
+            continue
+        u = 0.0
+        a = 0.0
+        for f in range(li):
+            u += abs(d[f]) * rho[f, li]
+            a += abs(d[f])
+        for oi in range(n_obs):
+            cc = _box_gap(lo, hi, li, olo, ohi, oi) + margin
+            if cc / v >= best or _quad_step(u, a * v, cc) >= best:  # max(..) >= best
+                continue
+            dist, _ = capsule_obstacle(
+                kinds[oi],
+                Rs[oi],
+                cs[oi],
+                hs[oi],
+                seg[li, 0],
+                seg[li, 1],
+                radii[li],
+                False,
+                nv,
+                w,
+            )
+            cc = max(dist, 0.0) + margin
+            dt = max(cc / v, _quad_step(u, a * v, cc))
+            if dt < best:
+                best = dt
+    _link_boxes(seg, radii_self, lo2[:L], hi2[:L])
+    for j in range(L):
+        u = 0.0
+        a = 0.0
+        for i in range(j - 1, -1, -1):
+            u += abs(d[i]) * rho[i, j]
+            a += abs(d[i])
+            v = v_pair[i, j]
+            if v <= 0.0 or not allowed[i, j]:
+                continue
+            cc = _box_gap(lo2, hi2, i, lo2, hi2, j) + margin
+            c2 = a * v_link[j]
+            if cc / v >= best or _quad_step(u, c2, cc) >= best:  # max(..) >= best
+                continue
+            d2, _, _ = seg_seg(seg[i, 0], seg[i, 1], seg[j, 0], seg[j, 1])
+            cc = max(math.sqrt(d2) - radii_self[i] - radii_self[j], 0.0) + margin
+            dt = max(cc / v, _quad_step(u, c2, cc))
+            if dt < best:
+                best = dt
+    return best
+
+
+@njit(cache=True, nogil=True)
+def armz_path_advance(
+    P,
+    first,
+    joint_step,
+    limit,
+    continuous,
+    cap,
+    weights,
+    W,
+    Pr,
+    margin,
+    T0,
+    T1,
+    M,
+    radii,
+    radii_self,
+    moving,
+    allowed,
+    tree,
+    kinds,
+    Rs,
+    cs,
+    hs,
+    olo,
+    ohi,
+):
+    """An Arm-Z path (m, dof) checked edge by edge with conservative advancement (see
+    :meth:`Core.path_advance`): returns (queries, status, edge, t), status 0 all valid,
+    1 the state ``P[edge] + t · d_edge`` is invalid, 2 ``limit`` queries were spent first,
+    3 edge ``edge``'s grid would have more than ``cap`` states (nothing checked on it).
+    """
+    m, dof = P.shape
+    L = dof + 1
+    seg = np.empty((1, L, 2, 3))
+    buf = _scratch(L)
+    pairs = np.empty((1, 3), dtype=np.int64)
+    d = np.empty(dof)
+    q = np.empty((1, dof))
+    v_link = np.empty(L)
+    v_pair = np.empty((L, L))
+    rho = np.zeros((dof, L))
+    z_axes = np.empty((dof, 3))  # the joints' axes at the state seg holds
+    queries = 0
+    have_seg = False  # seg holds the current vertex, validity known
+    if first == 2:  # queried already by the caller: measured again, not counted
+        armz_segments_axes(P[0], T0, T1, M, seg[0], z_axes)
+        have_seg = True
+    if first == 1:
+        if limit < 1:
+            return queries, 2, 0, 0.0
+        armz_segments_axes(P[0], T0, T1, M, seg[0], z_axes)
+        queries += 1
+        have_seg = True
+        if _state_hits(
+            seg[0],
+            radii,
+            radii_self,
+            moving,
+            allowed,
+            tree,
+            kinds,
+            Rs,
+            cs,
+            hs,
+            olo,
+            ohi,
+            buf,
+            True,
+            pairs,
+        ):
+            return queries, 1, 0, 0.0
+    for e in range(m - 1):
+        span = 0.0
+        metric = 0.0
+        for i in range(dof):
+            x = P[e + 1, i] - P[e, i]
+            if continuous[i]:
+                x = (x + np.pi) % (2.0 * np.pi) - np.pi
+            d[i] = x
+            span = max(span, abs(x))
+            metric += weights[i] * abs(x)
+        n = max(1.0, math.ceil(span / joint_step - 1e-12), math.ceil(metric - 1e-12))
+        if n > cap:
+            return queries, 3, e, 0.0
+        dt_min = 1.0 / n
+        dt_cap = joint_step / span if span > 0.0 else 1.0
+        adaptive = dt_cap > dt_min * (1.0 + 1e-12)
+        if adaptive:
+            edge_rates(d, W, Pr, v_link, v_pair)
+        t = 0.0
+        dt = dt_min
+        if adaptive and not have_seg:  # the edge's start: measured, not checked (the caller's)
+            if queries >= limit:
+                return queries, 2, e, 0.0
+            armz_segments_axes(P[e], T0, T1, M, seg[0], z_axes)
+            queries += 1
+        while True:
+            if adaptive:
+                dt = armz_advance_dt(
+                    seg[0],
+                    d,
+                    z_axes,
+                    radii,
+                    radii_self,
+                    moving,
+                    allowed,
+                    kinds,
+                    Rs,
+                    cs,
+                    hs,
+                    olo,
+                    ohi,
+                    v_link,
+                    v_pair,
+                    margin,
+                    1.0 - t,
+                    buf,
+                    rho,
+                )
+            step = max(dt_min, min(dt, dt_cap))
+            tn = t + step
+            if tn >= 1.0 - 1e-9:
+                tn = 1.0
+            if queries >= limit:
+                return queries, 2, e, t
+            for i in range(dof):
+                q[0, i] = P[e, i] + tn * d[i]
+            armz_segments_axes(q[0], T0, T1, M, seg[0], z_axes)
+            queries += 1
+            if _state_hits(
+                seg[0],
+                radii,
+                radii_self,
+                moving,
+                allowed,
+                tree,
+                kinds,
+                Rs,
+                cs,
+                hs,
+                olo,
+                ohi,
+                buf,
+                True,
+                pairs,
+            ):
+                return queries, 1, e, tn
+            if tn == 1.0:
+                break
+            t = tn
+        have_seg = True
+    return queries, 0, m - 1, 1.0
+
+
+@njit(cache=True, nogil=True)
 def all_hits(seg, radii, radii_self, moving, allowed, tree, kinds, Rs, cs, hs, olo, ohi):
     """Every colliding pair of one state (L, 2, 3): (m, 3) rows (link, other, other_is_link)."""
     L = seg.shape[0]
@@ -623,6 +1092,24 @@ def pair_distances_kernel(
     return idx[:m].copy(), d[:m].copy(), tl[:m].copy(), to[:m].copy(), n[:m].copy()
 
 
+@njit(cache=True, nogil=True)
+def min_clearance_kernel(
+    segs, radii, radii_self, moving, allowed, tree, kinds, Rs, cs, hs, olo, ohi, include_self
+):
+    """Smallest signed distance [m] over every checked pair of every state (k, L, 2, 3)
+    (link pairs only with ``include_self``; inf when none): :func:`pair_distances_kernel`
+    state by state."""
+    best = np.inf
+    for s in range(segs.shape[0]):
+        idx, d, _, _, _ = pair_distances_kernel(
+            segs[s], radii, radii_self, moving, allowed, tree, kinds, Rs, cs, hs, olo, ohi, np.inf
+        )
+        for m in range(d.shape[0]):
+            if (include_self or idx[m, 2] == 0) and d[m] < best:
+                best = d[m]
+    return best
+
+
 # ---------------------------------------------------------------------- Python front
 
 
@@ -667,6 +1154,7 @@ class Core:
         scene: Scene,
         margin_m: float = 0.0,
         edge_weights: Array | None = None,
+        link_rates: tuple[Array, Array] | None = None,
     ) -> None:
         if not supports(scene):
             raise ValueError("the core tests boxes, cylinders and spheres only")
@@ -714,6 +1202,15 @@ class Core:
         self.olo = np.ascontiguousarray(lo, dtype=float).reshape(n, 3)
         self.ohi = np.ascontiguousarray(hi, dtype=float).reshape(n, 3)
         self.tree = chain_tree(allowed)
+        #: conservative advancement (:meth:`path_advance`): per joint and link, and per
+        #: joint and link pair, bounds of how fast they move (see reach.py); None: off
+        self._rates: tuple[np.ndarray, np.ndarray] | None = None
+        if link_rates is not None:
+            W, rigid = link_rates
+            self._rates = (
+                np.ascontiguousarray(W, dtype=float),
+                np.ascontiguousarray(pair_rates(np.asarray(W), np.asarray(rigid), allowed)),
+            )
         self._geo = (
             self.radii,
             self.radii_self,
@@ -739,6 +1236,20 @@ class Core:
             self._T0 = T0
             self._T1 = T0 @ armz._T_base_j1
             self._M = np.ascontiguousarray(armz._M, dtype=np.float64)
+        #: armz_path_advance's arguments after (P, first, joint_step, limit)
+        self._advance_args: tuple[Any, ...] = ()
+        if self._armz and self._rates is not None:
+            self._advance_args = (
+                self._continuous,
+                MAX_EDGE_STATES,
+                self.edge_weights,
+                *self._rates,
+                self.margin_m,
+                self._T0,
+                self._T1,
+                self._M,
+                *self._geo,
+            )
         self._warm_up()
 
     def _warm_up(self) -> None:
@@ -747,11 +1258,13 @@ class Core:
         here, when the checker is built, and not inside a planner's time limit."""
         kernels: tuple[Any, ...] = (
             (armz_frames, armz_segments, armz_first_invalid, armz_edge_first_invalid)
+            + ((armz_path_advance,) if self._rates is not None else ())
             if self._armz
             else (first_invalid, edge_states, chain_segments, chain_first_invalid)
             if self._chain is not None
             else (first_invalid, edge_states)
-        ) + (valid_batch, all_hits, pair_distances_kernel)
+            + ((advance_dt, edge_rates) if self._rates is not None else ())
+        ) + (valid_batch, all_hits, pair_distances_kernel, min_clearance_kernel)
         if all(k.signatures for k in kernels):
             return  # compiled or loaded already in this process
         q = np.clip(np.zeros(self.robot.dof), self.robot.lower, self.robot.upper)
@@ -763,6 +1276,11 @@ class Core:
         self.edge_first_invalid(q, q, 1.0)
         self.hits(q)
         self.pair_distances(q, 0.0)
+        self.min_clearance(q2)
+        if self._rates is not None:
+            q1 = q.copy()
+            q1[0] += 0.5 if q[0] + 0.5 <= self.robot.upper[0] else -0.5
+            self.path_advance(np.vstack([q, q1]), 1, 0.05, None)
 
     # ------------------------------------------------------------------ kinematics
     def _Q(self, Q: Array) -> np.ndarray:
@@ -780,6 +1298,14 @@ class Core:
         out = np.empty((len(Qc), self.robot.dof + 2, 4, 4))
         armz_frames(Qc, self._T0, self._T1, self._M, out)
         return out[0] if single else out
+
+    def tip(self, q: Array) -> tuple[Array, Array]:
+        """The robot's ``tip(q)`` (position [m], face normal) for one q (dof,): compiled for
+        Arm-Z (its last frame, as ``ArmZ.tip``), else the robot's own."""
+        if not self._armz:
+            return self.robot.tip(q)
+        F = self.fk(q)[-1]
+        return F[:3, 3].copy(), F[:3, 2].copy()
 
     def segments(self, Q: Array) -> np.ndarray:
         """Capsule axes (k, L, 2, 3) for Q (k, dof)."""
@@ -802,7 +1328,15 @@ class Core:
 
     def is_valid(self, q: Array) -> bool:
         """Validity of one state q (dof,): one compiled call for Arm-Z."""
-        Qc = self._Q(q)
+        if (
+            type(q) is np.ndarray
+            and q.shape == (self.robot.dof,)
+            and q.dtype == np.float64
+            and q.flags.c_contiguous
+        ):
+            Qc = q.reshape(1, -1)  # a view: what _Q would make, without its checks
+        else:
+            Qc = self._Q(q)
         if len(Qc) != 1:
             raise ValueError(f"q must be one state ({self.robot.dof},), got shape {np.shape(q)}")
         if self._armz:
@@ -867,6 +1401,140 @@ class Core:
             raise edge_too_long(span, step, max(n, edge_steps(qa, qb, step, self._continuous)))
         return int(n), int(bad)
 
+    def path_advance(
+        self, path: Array, first: int, joint_step: float, limit: int | None
+    ) -> tuple[int, int, int, float]:
+        """Check a path (m, dof) edge by edge with conservative advancement.
+
+        Along each edge ``q(t) = P[e] + t · d_e`` (the short way round for continuous
+        joints), from a valid state at ``t`` the next checked state is at
+        ``t + max(1/n, min(dt_ca, joint_step / span))``: ``n`` the edge's uniform count
+        (:func:`edge_states`, radian and metric steps), ``dt_ca`` the conservative
+        advancement step (:func:`advance_dt`). Each state visited is one query (its
+        validity, plus its pair distances when the step needs them). The first state:
+        ``first`` 1 checks it (one query), 0 only measures it when a step needs it (one
+        query then), 2 measures it without counting (the caller queried it already: a
+        path checked in pieces). At most ``limit`` queries (None: no limit).
+
+        Returns (queries, status, edge, t): status 0 every checked state valid, 1 the
+        state at ``t`` on edge ``edge`` invalid, 2 the limit was reached first.
+
+        Raises:
+            PlannerlabError: as ``interpolate_edge``, an edge whose grid would have more
+                than ``MAX_EDGE_STATES`` states (the edges before it are checked).
+        """
+        if self._rates is None:
+            raise ValueError("path_advance needs link rates (a checker with a margin)")
+        P = path
+        if not (
+            type(P) is np.ndarray and P.ndim == 2 and P.dtype == np.float64 and P.flags.c_contiguous
+        ):
+            P = np.ascontiguousarray(np.atleast_2d(np.asarray(path, dtype=float)))
+        lim = _NO_LIMIT if limit is None else max(int(limit), 0)
+        step = float(joint_step)
+        require_joint_step(step)
+        if self._armz:
+            qn, status, e, t = armz_path_advance(P, int(first), step, lim, *self._advance_args)
+        else:
+            qn, status, e, t = self._path_advance_py(P, int(first), step, lim)
+        if status == 3:
+            qa, qb = P[e], P[e + 1]
+            span = float(np.max(np.abs(joint_difference(qb, qa, self._continuous))))
+            raise edge_too_long(
+                span, step, max(MAX_EDGE_STATES + 1, edge_steps(qa, qb, step, self._continuous))
+            )
+        return int(qn), int(status), int(e), float(t)
+
+    def _path_advance_py(
+        self, P: np.ndarray, first: int, joint_step: float, limit: int
+    ) -> tuple[int, int, int, float]:
+        """:meth:`path_advance` for robots whose kinematics are not compiled: the same
+        steps, one compiled call per state."""
+        W, Pr = self._rates  # type: ignore[misc]
+        r, rs, moving, allowed, tree, kinds, Rs, cs, hs, olo, ohi = self._geo
+        L = self.n_links
+        buf = _scratch(L)
+        v_link = np.empty(L)
+        v_pair = np.empty((L, L))
+        queries = 0
+        seg: np.ndarray | None = self.segments(P[0]) if first == 2 else None
+        if first == 1:
+            if limit < 1:
+                return queries, 2, 0, 0.0
+            seg = self.segments(P[0])
+            queries += 1
+            if first_invalid(seg, *self._geo) >= 0:
+                return queries, 1, 0, 0.0
+        for e in range(len(P) - 1):
+            d = joint_difference(P[e + 1], P[e], self._continuous)
+            span = float(np.max(np.abs(d), initial=0.0))
+            metric = float(np.abs(d) @ self.edge_weights)
+            n = max(1.0, math.ceil(span / joint_step - 1e-12), math.ceil(metric - 1e-12))
+            if n > MAX_EDGE_STATES:
+                return queries, 3, e, 0.0
+            dt_min = 1.0 / n
+            dt_cap = joint_step / span if span > 0.0 else 1.0
+            adaptive = dt_cap > dt_min * (1.0 + 1e-12)
+            t, dt = 0.0, dt_min
+            if adaptive:
+                edge_rates(d, W, Pr, v_link, v_pair)
+                if seg is None:
+                    if queries >= limit:
+                        return queries, 2, e, 0.0
+                    seg = self.segments(P[e])
+                    queries += 1
+                dt = advance_dt(
+                    seg[0],
+                    r,
+                    rs,
+                    moving,
+                    allowed,
+                    kinds,
+                    Rs,
+                    cs,
+                    hs,
+                    olo,
+                    ohi,
+                    v_link,
+                    v_pair,
+                    self.margin_m,
+                    1.0,
+                    buf,
+                )
+            while True:
+                tn = t + max(dt_min, min(dt, dt_cap))
+                if tn >= 1.0 - 1e-9:
+                    tn = 1.0
+                if queries >= limit:
+                    return queries, 2, e, t
+                seg = self.segments(P[e] + tn * d)
+                queries += 1
+                if first_invalid(seg, *self._geo) >= 0:
+                    return queries, 1, e, tn
+                if tn == 1.0:
+                    break
+                if adaptive:
+                    dt = advance_dt(
+                        seg[0],
+                        r,
+                        rs,
+                        moving,
+                        allowed,
+                        kinds,
+                        Rs,
+                        cs,
+                        hs,
+                        olo,
+                        ohi,
+                        v_link,
+                        v_pair,
+                        self.margin_m,
+                        1.0 - tn,
+                        buf,
+                    )
+                t = tn
+        return queries, 0, len(P) - 1, 1.0
+
     def hits(self, q: Array) -> np.ndarray:
         """Every colliding pair at q: (m, 3) rows (link, other, other_is_link)."""
         h = all_hits(self.segments(q)[0], *self._geo)
@@ -886,6 +1554,11 @@ class Core:
             t_other=to,
             n_world=n,
         )
+
+    def min_clearance(self, Q: Array, include_self: bool = True) -> float:
+        """:meth:`clearance`'s smallest over the states Q (k, dof), in one compiled call
+        (inf when there is no state or no pair)."""
+        return float(min_clearance_kernel(self.segments(Q), *self._geo, bool(include_self)))
 
     def clearance(self, q: Array, include_self: bool = True) -> float:
         """Smallest signed distance [m] over every checked pair (inf when none)."""

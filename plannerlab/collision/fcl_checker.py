@@ -28,12 +28,10 @@ import numpy as np
 
 from plannerlab.collision.core import Core, PairDistances
 from plannerlab.collision.core import supports as core_supports
-from plannerlab.collision.reach import joint_reach_m
+from plannerlab.collision.reach import joint_reach_m, reach_bounds
 from plannerlab.problem.scene import Box, Cylinder, Scene, Sphere
 from plannerlab.robots.base import Array, Robot
-from plannerlab.robots.paths import (
-    densify,
-)
+from plannerlab.robots.paths import densify, edge_counts
 
 
 @dataclass(frozen=True)
@@ -81,10 +79,17 @@ class CollisionChecker:
     """
 
     def __init__(
-        self, robot: Robot, scene: Scene, backend: str = "auto", margin_m: float = 0.0
+        self,
+        robot: Robot,
+        scene: Scene,
+        backend: str = "auto",
+        margin_m: float = 0.0,
+        edge_check: str = "auto",
     ) -> None:
         if backend not in ("auto", "core", "fcl"):
             raise ValueError(f"backend must be 'auto', 'core' or 'fcl', got {backend!r}")
+        if edge_check not in ("auto", "grid", "advance"):
+            raise ValueError(f"edge_check must be 'auto', 'grid' or 'advance', got {edge_check!r}")
         if backend == "core" and not core_supports(scene):
             raise ValueError("backend 'core' covers boxes, cylinders and spheres only")
         if not (margin_m >= 0.0 and np.isfinite(margin_m)):
@@ -95,13 +100,33 @@ class CollisionChecker:
         #: per joint, how fast the geometry moves [m per rad or m] (see reach.py); with a
         #: margin, edges are checked so that no point moves more than the margin between
         #: two checked states (on top of the radian step asked for)
-        self.reach_m: np.ndarray | None = joint_reach_m(robot) if margin_m > 0 else None
+        use_core = backend == "core" or (backend == "auto" and core_supports(scene))
+        advance = margin_m > 0 and use_core and edge_check in ("auto", "advance")
+        rates: tuple[np.ndarray, np.ndarray] | None = None
+        self.reach_m: np.ndarray | None = None
+        if advance:
+            self.reach_m, W, rigid = reach_bounds(robot)
+            rates = (W, rigid)
+        elif margin_m > 0:
+            self.reach_m = joint_reach_m(robot)
         self.edge_weights: np.ndarray | None = (
             None if self.reach_m is None else self.reach_m / self.margin_m
         )
+        if edge_check == "advance" and not advance:
+            raise ValueError("edge_check 'advance' needs a margin > 0 and the core backend")
+        #: how edges and paths are checked: "grid" (every state of :meth:`densify`) or
+        #: "advance" (conservative advancement on the core, see core.Core.path_advance:
+        #: fewer states, the same guarantee, at most as many checks as the grid)
+        self.edge_check = "advance" if advance else "grid"
         self._core: Core | None = None
-        if backend == "core" or (backend == "auto" and core_supports(scene)):
-            self._core = Core(robot, scene, self.margin_m, self.edge_weights)
+        if use_core:
+            self._core = Core(
+                robot,
+                scene,
+                self.margin_m,
+                self.edge_weights,
+                rates,
+            )
         #: which backend answers the queries: "core" or "fcl"
         self.backend = "core" if self._core is not None else "fcl"
         self.robot = robot
@@ -286,6 +311,8 @@ class CollisionChecker:
         :meth:`first_invalid` does. On the core, interpolation, kinematics and checks are
         one compiled call.
         """
+        if self.edge_check == "advance":
+            return self._check_edge_advance(q_a, q_b, joint_step, max_states)
         if self._core is not None:
             n, bad = self._core.edge_first_invalid(q_a, q_b, joint_step, max_states)
             m = n if max_states is None else min(n, max(int(max_states), 0))
@@ -294,6 +321,22 @@ class CollisionChecker:
         states = self.densify(np.array([q_a, q_b], dtype=float), joint_step)[0][1:]
         m = len(states) if max_states is None else min(len(states), max(int(max_states), 0))
         return len(states), (self.first_invalid(states[:m]) if m > 0 else None)
+
+    def _check_edge_advance(
+        self, q_a: Array, q_b: Array, joint_step: float, max_states: int | None
+    ) -> tuple[int, int | None]:
+        """:meth:`check_edge` by conservative advancement: n is the number of queries made
+        (q_a's measurement included when a step needs it), or ``max_states + 1`` when
+        ``max_states`` did not suffice (the edge is then unfinished)."""
+        assert self._core is not None
+        path = np.empty((2, self.robot.dof))
+        path[0] = q_a
+        path[1] = q_b
+        q, status, _, _ = self._core.path_advance(path, 0, joint_step, max_states)
+        self.checks += q
+        if status == 2:
+            return (max(int(max_states or 0), q) + 1), None
+        return q, (q - 1 if status == 1 else None)
 
     def colliding_pairs(self, q: Array) -> tuple[tuple[str, str], ...]:
         """Every colliding pair at q: (link name, obstacle name) or (link name, link name)."""
@@ -309,6 +352,14 @@ class CollisionChecker:
             (self._link_names[a], self._link_names[b] if is_link else names[b])
             for a, b, is_link in hits
         )
+
+    def tip(self, q: Array) -> tuple[Array, Array]:
+        """The robot's ``tip(q)`` (position [m], face normal) for one q (dof,), from the
+        core's compiled kinematics when it has them (Arm-Z), else the robot's. Not a
+        collision check (not counted)."""
+        if self._core is not None:
+            return self._core.tip(q)
+        return self.robot.tip(q)
 
     def clearance(self, q: Array, include_self: bool = True) -> float:
         """Smallest signed distance [m] over every checked pair; negative = penetration.
@@ -333,6 +384,15 @@ class CollisionChecker:
                 best = min(best, self._signed_distance(self._links_self[i], self._links_self[j]))
         self.checks += 1
         return float(best)
+
+    def min_clearance(self, Q: Array, include_self: bool = True) -> float:
+        """The smallest :meth:`clearance` over the states Q (k, dof) (inf when k = 0),
+        counting one check per state; on the core in one compiled call."""
+        Q = np.atleast_2d(np.asarray(Q, dtype=float))
+        if self._core is None:
+            return min((self.clearance(q, include_self) for q in Q), default=float("inf"))
+        self.checks += len(Q)
+        return self._core.min_clearance(Q, include_self)
 
     def pair_distances(self, q: Array, margin_m: float) -> PairDistances:
         """Every checked pair at q (dof,) whose signed distance is below ``margin_m`` [m].
@@ -371,6 +431,23 @@ class CollisionChecker:
         ``Σ |Δq_i| · reach_i``). Returns (states, owning edge of each)."""
         return densify(path, joint_step, self.robot.continuous, self.edge_weights)
 
+    def grid_states(self, path: Array, joint_step: float) -> int:
+        """``len(self.densify(path, joint_step)[0])``, without making the states: the most
+        checks :meth:`check_path` makes on the path (the grid's; conservative advancement
+        makes at most as many)."""
+        path = np.atleast_2d(np.asarray(path, dtype=float))
+        if len(path) < 2:
+            return len(path)
+        _, n = edge_counts(path, joint_step, self.robot.continuous, self.edge_weights)
+        return 1 + int(n.sum())
+
+    def _edge_counts(self, path: Array, joint_step: float) -> tuple[Array, np.ndarray]:
+        """Per edge of a path (m ≥ 2 states): the joint change and the grid's number of
+        states (:func:`~plannerlab.robots.paths.edge_counts`, radian and metric steps).
+        Raises as ``interpolate_edge`` on a too long edge."""
+        assert self.edge_weights is not None
+        return edge_counts(path, joint_step, self.robot.continuous, self.edge_weights)
+
     def check_path(
         self,
         path: Array,
@@ -383,7 +460,13 @@ class CollisionChecker:
         ``stop`` (a time limit, say) is asked before each ``chunk`` of states; once it says
         True the check ends, incomplete (``complete`` False). The same states are checked,
         and counted, as without it.
+
+        With ``edge_check == "advance"`` the states are those of conservative advancement
+        (:meth:`~plannerlab.collision.core.Core.path_advance`), at most as many as
+        :meth:`densify` gives (the reserve planners keep for this check stays sound).
         """
+        if self.edge_check == "advance":
+            return self._check_path_advance(path, joint_step, stop, chunk)
         states, owners = self.densify(path, joint_step)
         step = len(states) if stop is None else max(int(chunk), 1)
         bad = None
@@ -407,6 +490,57 @@ class CollisionChecker:
             pairs=self.colliding_pairs(q_bad),
             backend=self.backend,
         )
+
+    def _check_path_advance(
+        self, path: Array, joint_step: float, stop: Callable[[], bool] | None, chunk: int
+    ) -> PathCheck:
+        """:meth:`check_path` by conservative advancement, in pieces of whole edges of
+        at most ``chunk`` grid states when ``stop`` is given."""
+        assert self._core is not None
+        P = np.atleast_2d(np.asarray(path, dtype=float))
+        if len(P) == 1:
+            ok = self.is_valid(P[0])
+            return PathCheck(
+                valid=ok,
+                states_checked=1,
+                first_invalid_edge=None if ok else 0,
+                first_invalid_state=None if ok else P[0].copy(),
+                pairs=() if ok else self.colliding_pairs(P[0]),
+                backend=self.backend,
+            )
+        d, n = self._edge_counts(P, joint_step)
+        pieces = [(0, len(d))]
+        if stop is not None:  # edges grouped so that a piece's grid holds ≤ chunk states
+            pieces, a, acc = [], 0, 0
+            for e, k in enumerate(n):
+                if acc and acc + k > max(int(chunk), 1):
+                    pieces.append((a, e))
+                    a, acc = e, 0
+                acc += int(k)
+            pieces.append((a, len(d)))
+        done = 0
+        for a, b in pieces:
+            if stop is not None and stop():
+                return PathCheck(
+                    valid=False, states_checked=done, backend=self.backend, complete=False
+                )
+            q, status, e, t = self._core.path_advance(
+                P[a : b + 1], 1 if a == 0 else 2, joint_step, None
+            )
+            self.checks += q
+            done += q
+            if status == 1:
+                edge = a + e
+                q_bad = P[edge] + t * d[edge] if t > 0.0 else P[edge].copy()
+                return PathCheck(
+                    valid=False,
+                    states_checked=done,
+                    first_invalid_edge=edge,
+                    first_invalid_state=q_bad,
+                    pairs=self.colliding_pairs(q_bad),
+                    backend=self.backend,
+                )
+        return PathCheck(valid=True, states_checked=done, backend=self.backend)
 
 
 def problem_checker(problem: Any, backend: str = "auto") -> CollisionChecker:

@@ -46,9 +46,10 @@ def _skew(p: Array) -> Array:
     )
 
 
-def joint_reach_m(robot: Robot) -> Array:
-    """Per joint, an upper bound [m per rad, or m per m] of how fast any point of the
-    robot's collision geometry moves when that joint moves alone (see the module)."""
+def _motions(robot: Robot) -> tuple[Array, Array, Array, Array]:
+    """The states the bounds are taken at, their capsule axes S (k, L, 2, 3), the axes'
+    velocities per joint V (k, dof, L, 2, 3) by a one-sided finite difference, and the
+    upper joint limits used (all in two batched ``link_segments`` calls)."""
     dof = robot.dof
     cont = np.asarray(robot.continuous, dtype=bool)
     lo = np.where(cont, -np.pi, robot.lower)
@@ -57,39 +58,118 @@ def joint_reach_m(robot: Robot) -> Array:
     states = np.vstack(
         [np.clip(np.zeros(dof), robot.lower, robot.upper), rng.uniform(lo, hi, (_SAMPLES, dof))]
     )
+    k = len(states)
+    S = np.asarray(robot.link_segments(states), dtype=float)
+    h = np.where(states + _H <= hi, _H, -_H)  # (k, dof)
+    Qp = np.repeat(states[:, None, :], dof, axis=1)
+    idx = np.arange(dof)
+    Qp[:, idx, idx] += h
+    Sp = np.asarray(robot.link_segments(Qp.reshape(k * dof, dof)), dtype=float)
+    V = (Sp.reshape((k, dof) + S.shape[1:]) - S[:, None]) / h[:, :, None, None, None]
+    return states, S, V, hi
+
+
+def joint_reach_m(robot: Robot) -> Array:
+    """Per joint, an upper bound [m per rad, or m per m] of how fast any point of the
+    robot's collision geometry moves when that joint moves alone (see the module): the
+    first of :func:`reach_bounds`."""
+    return reach_bounds(robot)[0]
+
+
+def reach_bounds(robot: Robot) -> tuple[Array, Array, Array]:
+    """Per joint and link, an upper bound [m per rad, or m per m] of how fast any point of
+    that link's capsule moves when the joint moves alone, and per joint whether it moves
+    the links it moves rigidly (one rotation or translation for all of them).
+
+    Returns ``(reach (dof,), W (dof, L), rigid (dof,) bool)``: ``reach`` is the whole
+    chain's bound of the module (:func:`joint_reach_m`). ``W[i, l]`` is
+    zero when joint ``i`` never moves link ``l``; ``W[i].max() <= reach[i]``: for a revolute
+    joint the chain sum of :func:`joint_reach_m` is stopped at link ``l`` (the first moved
+    link's start from the axis, plus the moved links up to ``l`` and the gaps between them,
+    plus ``l``'s radius). This is what lets a link near the base, or a link pair joined by
+    few joints, take larger steps than the whole chain's bound allows (conservative
+    advancement, :mod:`plannerlab.collision.core`). ``rigid``: the moved links keep their
+    shapes and relative poses, so the distance between two links that both move with joint
+    ``i`` does not change with it.
+
+    Every (state, joint) at once: the rigid motions are fitted in one batched
+    pseudo-inverse (:func:`numpy.linalg.pinv` with :func:`numpy.linalg.lstsq`'s cutoff),
+    the chain sums are masked cumulative sums over the moved links.
+    """
+    dof = robot.dof
+    _, S, V, _ = _motions(robot)  # S (k, L, 2, 3), V (k, dof, L, 2, 3)
     radii = np.asarray(robot.link_radii_m, dtype=float)
-    reach = np.zeros(dof)
-    for q in states:
-        S = np.asarray(robot.link_segments(q), dtype=float)  # (L, 2, 3)
-        lengths = np.linalg.norm(S[:, 1] - S[:, 0], axis=-1)
-        for i in range(dof):
-            h = _H if q[i] + _H <= hi[i] else -_H
-            qp = q.copy()
-            qp[i] += h
-            V = (np.asarray(robot.link_segments(qp), dtype=float) - S) / h  # (L, 2, 3)
-            speed = np.linalg.norm(V, axis=-1)  # (L, 2)
-            moved = np.flatnonzero(speed.max(axis=1) > _MOVES)
-            if len(moved) == 0:
-                continue
-            f = int(moved[0])
-            # rigid motion of the moved links: v(p) = ω × (p − a_f) + v(a_f)
-            P = S[moved].reshape(-1, 3) - S[f, 0]
-            Vr = V[moved].reshape(-1, 3) - V[f, 0]
-            A = -_skew(P).reshape(-1, 3)
-            omega = np.linalg.lstsq(A, Vr.reshape(-1), rcond=None)[0]
-            w = float(np.linalg.norm(omega))
-            if w < 1e-6:  # a translation: every moved point at the same speed
-                bound = float(speed[moved].max())
-            else:
-                gaps = np.linalg.norm(S[moved[1:], 0] - S[moved[:-1], 1], axis=-1)
-                chain = (
-                    float(np.linalg.norm(V[f, 0])) / w  # a_f's distance from the axis
-                    + float(lengths[moved].sum())
-                    + float(gaps.sum())
-                    + float(radii[moved].max())
-                )
-                # a rotation about an axis that also slides (none here) adds its speed
-                along = abs(float(np.dot(V[f, 0], omega))) / w
-                bound = w * chain + along
-            reach[i] = max(reach[i], bound)
-    return reach
+    k, L = S.shape[0], S.shape[1]
+    ks = np.arange(k)[:, None]
+    js = np.arange(dof)[None, :]
+    speed = np.linalg.norm(V, axis=-1)  # (k, dof, L, 2)
+    moved = speed.max(axis=-1) > _MOVES  # (k, dof, L)
+    n_moved = moved.sum(axis=-1)  # (k, dof)
+    f = np.argmax(moved, axis=-1)  # first moved link (k, dof)
+    S_f0 = S[ks, f, 0]  # (k, dof, 3)
+    V_f0 = V[ks, js, f, 0]  # (k, dof, 3)
+    mask = moved[..., None, None]
+    P = np.where(mask, S[:, None] - S_f0[:, :, None, None, :], 0.0)  # (k, dof, L, 2, 3)
+    Vr = np.where(mask, V - V_f0[:, :, None, None, :], 0.0)
+    # rigid motion of the moved links: v(p) = ω × (p − a_f) + v(a_f), least squares over
+    # the moved links' end points (the other rows are zero: they change nothing)
+    A = -_skew(P.reshape(-1, 3)).reshape(k, dof, L * 2 * 3, 3)
+    b = Vr.reshape(k, dof, L * 2 * 3)
+    rcond = np.finfo(float).eps * np.maximum(6 * n_moved, 3)  # numpy.linalg.lstsq's
+    omega = np.einsum("kjab,kjb->kja", np.linalg.pinv(A, rcond=rcond), b)  # (k, dof, 3)
+    w = np.linalg.norm(omega, axis=-1)  # (k, dof)
+    # the finite difference is exact to ~h·speed²: a rigid motion fits to that
+    tol = 1e-4 * np.maximum(1.0, speed.max(axis=(-2, -1)))
+    resid = np.abs(np.einsum("kjra,kja->kjr", A, omega) - b).max(axis=-1)
+    any_moved = n_moved > 0
+    rigid = ~np.any(any_moved & (resid > tol), axis=0)
+    lengths = np.linalg.norm(S[:, :, 1] - S[:, :, 0], axis=-1)  # (k, L)
+    # the gap before each moved link: from the previous moved link's end (0 for the first)
+    idx = np.where(moved, np.arange(L), -1)
+    last = np.maximum.accumulate(idx, axis=-1)
+    prev = np.concatenate([np.full((k, dof, 1), -1), last[..., :-1]], axis=-1)
+    S_prev_end = S[ks[..., None], np.maximum(prev, 0), 1]  # (k, dof, L, 3)
+    gaps = np.where(
+        moved & (prev >= 0),
+        np.linalg.norm(S[:, None, :, 0] - S_prev_end, axis=-1),
+        0.0,
+    )
+    ml = np.where(moved, lengths[:, None, :], 0.0)
+    rotates = w >= 1e-6
+    w_safe = np.where(rotates, w, 1.0)
+    start = np.linalg.norm(V_f0, axis=-1) / w_safe  # a_f's distance from the axis
+    # a rotation about an axis that also slides (none here) adds its speed
+    along = np.abs(np.einsum("kja,kja->kj", V_f0, omega)) / w_safe
+    chain = start[..., None] + np.cumsum(ml, axis=-1) + np.cumsum(gaps, axis=-1) + radii
+    r_max = np.where(moved, radii, 0.0).max(axis=-1)
+    whole = start + ml.sum(axis=-1) + gaps.sum(axis=-1) + r_max
+    link_speed = speed.max(axis=-1)  # (k, dof, L)
+    bound = np.where(rotates[..., None], w[..., None] * chain + along[..., None], link_speed)
+    bound = np.where(moved, bound, 0.0)
+    reach_kj = np.where(rotates, w * whole + along, np.where(moved, link_speed, 0.0).max(axis=-1))
+    reach_kj = np.where(any_moved, reach_kj, 0.0)
+    return reach_kj.max(axis=0), bound.max(axis=0), rigid
+
+
+def link_reach_m(robot: Robot) -> tuple[Array, Array]:
+    """``(W, rigid)`` of :func:`reach_bounds`."""
+    _, W, rigid = reach_bounds(robot)
+    return W, rigid
+
+
+def pair_rates(W: Array, rigid: Array, allowed: Array) -> Array:
+    """Per joint and link pair, an upper bound of how fast the pair's distance changes
+    when the joint moves alone: (dof, L, L), zero outside ``allowed`` (upper triangle).
+
+    A joint that moves neither link, or moves both rigidly, does not change it; one that
+    moves one link changes it at most by that link's speed; one that moves both
+    non-rigidly, at most by the sum of their speeds."""
+    moves = W > 0.0
+    a = W[:, :, None]
+    b = W[:, None, :]
+    one = np.where(moves[:, :, None] & ~moves[:, None, :], a, 0.0) + np.where(
+        ~moves[:, :, None] & moves[:, None, :], b, 0.0
+    )
+    loose = np.logical_not(np.asarray(rigid, dtype=bool))
+    both = np.where(moves[:, :, None] & moves[:, None, :] & loose[:, None, None], a + b, 0.0)
+    return np.where(np.triu(allowed, 1)[None], one + both, 0.0)

@@ -180,7 +180,11 @@ def planned_clearance_m(checker: Any, path: Array) -> float:
         return math.nan
     checks = checker.checks
     try:
-        inflated = min(checker.clearance(q) for q in np.atleast_2d(path))
+        P = np.atleast_2d(path)
+        if hasattr(checker, "min_clearance"):  # one call for the whole path
+            inflated = checker.min_clearance(P)
+        else:
+            inflated = min(checker.clearance(q) for q in P)
     finally:
         checker.checks = checks
     return float(inflated + getattr(checker, "margin_m", 0.0))

@@ -96,6 +96,7 @@ Design (measured on ``armz_inspection``, 23 continuous joints):
 
 from __future__ import annotations
 
+import ctypes
 import dataclasses
 import logging
 import math
@@ -400,13 +401,10 @@ def _ompl_logging(logger: logging.Logger) -> Iterator[None]:
 
 # ---------------------------------------------------------------------------- helpers
 def _recheck_cost(path: Array, joint_step: float, checker: CollisionChecker) -> int:
-    """Collision checks ``checker.check_path(path, joint_step)`` will make (all states of
-    the path as the checker densifies it, metric edge resolution included), computed
-    without checking anything."""
-    path = np.atleast_2d(np.asarray(path, dtype=float))
-    if len(path) < 2:
-        return len(path)
-    return len(checker.densify(path, joint_step)[0])
+    """Collision checks ``checker.check_path(path, joint_step)`` will make at most (all
+    states of the path as the checker densifies it, metric edge resolution included;
+    conservative advancement makes no more), computed without checking anything."""
+    return checker.grid_states(path, joint_step)
 
 
 def _goal_chain(data: Any, space: _Space) -> Array | None:
@@ -431,6 +429,14 @@ def _reach_m(robot: Robot, q: Array) -> float:
     """An upper bound of the tip's distance from the base [m]: the sum of link lengths."""
     seg = robot.link_segments(np.asarray(q, dtype=float))
     return float(np.sum(np.linalg.norm(seg[:, 1] - seg[:, 0], axis=-1)))
+
+
+#: most states of a path handed to OMPL's PathSimplifier.simplify (its collapseCloseVertices
+#: takes time cubic in them, with no termination condition polled)
+_SIMPLIFY_MAX_STATES = 400
+
+#: the capsule name nanobind reads a ``void *`` argument from (see ``_Space._fast_reader``)
+_NB_HANDLE = b"nb_handle"
 
 
 class _Space:
@@ -459,6 +465,7 @@ class _Space:
             hi = np.where(cont, self.center + 2.0 * np.pi, robot.upper)
             self.space = self._real_vector(lo, hi)
             self.compound = False
+            self._use_fast_reader()
             return
         self.cont_idx = [int(i) for i in np.flatnonzero(cont)]
         self.bound_idx = [int(i) for i in np.flatnonzero(~cont)]
@@ -474,6 +481,53 @@ class _Space:
         else:
             space = self._real_vector(robot.lower, robot.upper)
         self.space = space
+        self._use_fast_reader()
+
+    def _use_fast_reader(self) -> None:
+        reader = self._fast_reader()
+        if reader is not None:
+            self.to_q = reader  # type: ignore[method-assign, assignment]
+
+    def _fast_reader(self) -> Callable[[Any], Array] | None:
+        """One-call reading of a state, or None: OMPL's ``StateSpace::serialize`` writes
+        the state's reals (SO2 values, then the RealVector block: :meth:`to_q`'s order)
+        into a buffer this space owns, passed as the ``void *`` capsule nanobind accepts;
+        one binding call instead of two per joint. Used only if the layout is confirmed on
+        a test state (else None, and :meth:`to_q` reads joint by joint)."""
+        buf = np.zeros(self.dof)
+        try:
+            if int(self.space.getSerializationLength()) != buf.nbytes:
+                return None
+            new = ctypes.pythonapi.PyCapsule_New
+            new.restype = ctypes.py_object
+            new.argtypes = (ctypes.c_void_p, ctypes.c_char_p, ctypes.c_void_p)
+            capsule = new(buf.ctypes.data, _NB_HANDLE, None)
+            serialize = self.space.serialize
+            probe = self.space.allocState()  # freed with its Python object
+            q = wrap_to_pi(self.center + 0.1 + 0.01 * np.arange(self.dof), self.robot.continuous)
+            self.set_state(probe, q)
+            serialize(capsule, probe)
+            order = self.cont_idx + self.bound_idx  # the joint of each serialized real
+            ok = np.array_equal(buf[np.argsort(order)], self._read(probe))
+        except (TypeError, AttributeError, ValueError):
+            return None
+        if not ok:
+            return None
+        self._buf = buf  # the capsule points into it: kept alive with this space
+        if order == list(range(self.dof)):
+
+            def read(state: Any) -> Array:
+                serialize(capsule, state)
+                return buf.copy()
+
+            return read
+        joint_of = np.argsort(order)  # q = buf[joint_of] (a new array)
+
+        def read_permuted(state: Any) -> Array:
+            serialize(capsule, state)
+            return buf[joint_of]
+
+        return read_permuted
 
     @staticmethod
     def _real_vector(lower: Array, upper: Array) -> Any:
@@ -487,6 +541,11 @@ class _Space:
         return rv
 
     def to_q(self, state: Any) -> Array:
+        """The joint vector (dof,) of an OMPL state (a new array)."""
+        return self._read(state)
+
+    def _read(self, state: Any) -> Array:
+        """:meth:`to_q` joint by joint (two binding calls per joint)."""
         q = np.empty(self.dof)
         if self.compound:
             for k, i in enumerate(self.cont_idx):
@@ -885,9 +944,15 @@ class OMPLPlanner:
 
         best = [math.inf]
 
+        tip = checker.tip  # compiled kinematics where the checker has them
+        # a goal whose distance is GoalRegion's (the tip's) takes the compiled tip; a goal
+        # with a distance of its own (a joint goal, say) is asked as it is
+        by_tip = type(goal).distance is GoalRegion.distance
+
         def distance(state: Any) -> float:
             fk[0] += 1
-            d = float(goal.distance(robot, space.to_q(state)))
+            q = space.to_q(state)
+            d = float(goal.distance_from_tip(*tip(q)) if by_tip else goal.distance(robot, q))
             if d < best[0]:
                 best[0] = d
                 trace.append(d)
@@ -1124,7 +1189,24 @@ class OMPLPlanner:
         if s.simplify and guard.exhausted() is None:
             simplifier = og.PathSimplifier(si, goal_obj)
             c0 = checker.checks
-            simplifier.simplify(simplified, ob.PlannerTerminationCondition(simplify_done))
+            # OMPL's simplify runs one whole pass whatever the termination condition says,
+            # and its collapseCloseVertices compares every vertex pair at each of up to n
+            # steps without polling it: on the chain of hundreds of tiny edges an
+            # optimizing planner's dense tree gives (cheap edge checks make dense trees),
+            # that pass takes minutes. Such a path is thinned first by reduceVertices
+            # (random shortcuts, each a checked motion), and left as it is if it stays long.
+            thinning = 0
+            while (
+                simplified.getStateCount() > _SIMPLIFY_MAX_STATES
+                and thinning < 20
+                and not simplify_done()
+            ):
+                simplifier.reduceVertices(simplified)
+                thinning += 1
+            if thinning:
+                extra["thinning_passes"] = thinning
+            if simplified.getStateCount() <= _SIMPLIFY_MAX_STATES:
+                simplifier.simplify(simplified, ob.PlannerTerminationCondition(simplify_done))
             extra["simplify_checks"] = checker.checks - c0
         left = tracker.checks_left()
         if left is None or recheck_cost(simplified) <= left:

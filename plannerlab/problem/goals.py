@@ -8,6 +8,7 @@ steer by: below 1 in both terms means inside.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -74,7 +75,22 @@ class GoalRegion:
 
         Zero exactly inside the region; grows with the larger of the two scaled errors.
         """
-        pos_err, ang_err = self.errors(robot, q)
+        p, n = robot.tip(q)
+        return self.distance_from_tip(p, n)
+
+    def distance_from_tip(self, p_world_m: Array, n_world: Array) -> Array:
+        """:meth:`distance` of a tip pose (3,) or (k, 3) (one pose in scalar arithmetic:
+        a planner's goal heuristic asks for one at a time)."""
+        if np.ndim(p_world_m) == 1 and np.ndim(n_world) == 1:
+            px, py, pz = (float(v) for v in p_world_m)
+            nx, ny, nz = (float(v) for v in n_world)
+            gp, gn = self.p_world_m, self.n_world
+            dx, dy, dz = px - float(gp[0]), py - float(gp[1]), pz - float(gp[2])
+            pos = math.sqrt(dx * dx + dy * dy + dz * dz)
+            c = nx * float(gn[0]) + ny * float(gn[1]) + nz * float(gn[2])
+            ang = math.degrees(math.acos(min(max(c, -1.0), 1.0)))
+            return np.asarray(max(max(pos / self.pos_tol_m, ang / self.angle_tol_deg) - 1.0, 0.0))
+        pos_err, ang_err = self.errors_from_tip(p_world_m, n_world)
         scaled = np.maximum(pos_err / self.pos_tol_m, ang_err / self.angle_tol_deg)
         return np.maximum(scaled - 1.0, 0.0)
 

@@ -55,6 +55,32 @@ def interpolate_edge(q_a: Array, q_b: Array, joint_step: float, continuous: np.n
     return np.asarray(q_a, dtype=float)[None, :] + t * d[None, :]
 
 
+def edge_counts(
+    path: Array,
+    joint_step: float,
+    continuous: np.ndarray,
+    edge_weights: Array | None = None,
+) -> tuple[Array, np.ndarray]:
+    """Per edge of a path (m >= 2 states): its joint change (m - 1, dof) and the number of
+    steps :func:`densify` cuts it into (m - 1,) int: at most ``joint_step`` per joint and,
+    with ``edge_weights``, at least ``ceil(Σ |Δq_i| · edge_weights_i)``.
+
+    Raises:
+        PlannerlabError: an edge would need more than :data:`MAX_EDGE_STATES` states.
+    """
+    require_joint_step(joint_step)
+    d = joint_difference(path[1:], path[:-1], continuous)  # (m - 1, dof)
+    span = np.max(np.abs(d), axis=1, initial=0.0)
+    n_f = np.maximum(1.0, np.ceil(span / joint_step - 1e-12))  # steps per edge
+    if edge_weights is not None:
+        n_f = np.maximum(n_f, np.ceil(np.abs(d) @ np.asarray(edge_weights) - 1e-12))
+    worst = int(np.argmax(n_f))
+    if n_f[worst] > MAX_EDGE_STATES:
+        raise edge_too_long(float(span[worst]), joint_step, int(min(n_f[worst], 2**62)))
+    n: np.ndarray = n_f.astype(np.int64)
+    return d, n
+
+
 def densify(
     path: Array,
     joint_step: float,
@@ -78,16 +104,7 @@ def densify(
     path = np.atleast_2d(np.asarray(path, dtype=float))
     if len(path) == 1:
         return path.copy(), np.zeros(1, dtype=int)
-    require_joint_step(joint_step)
-    d = joint_difference(path[1:], path[:-1], continuous)  # (m - 1, dof)
-    span = np.max(np.abs(d), axis=1, initial=0.0)
-    n_f = np.maximum(1.0, np.ceil(span / joint_step - 1e-12))  # steps per edge
-    if edge_weights is not None:
-        n_f = np.maximum(n_f, np.ceil(np.abs(d) @ np.asarray(edge_weights) - 1e-12))
-    worst = int(np.argmax(n_f))
-    if n_f[worst] > MAX_EDGE_STATES:
-        raise edge_too_long(float(span[worst]), joint_step, int(min(n_f[worst], 2**62)))
-    n = n_f.astype(int)
+    d, n = edge_counts(path, joint_step, continuous, edge_weights)
     owners = np.repeat(np.arange(len(d)), n)
     j = np.arange(len(owners)) - np.repeat(np.cumsum(n) - n, n) + 1  # 1 .. n_i
     n_of = n[owners]
