@@ -122,13 +122,14 @@ from typing import Any
 import numpy as np
 
 from plannerlab.collision.fcl_checker import CollisionChecker, problem_checker
+from plannerlab.collision.reach import joint_reach_m
 from plannerlab.errors import PlannerlabError
 from plannerlab.problem.load import Problem
 from plannerlab.record.execution import ContactRecord, Execution
 from plannerlab.robots.base import Array, as_xyz, joint_difference
 from plannerlab.robots.paths import densify
 from plannerlab.sim.measure import geometry_deviation_m, sampled_clearance
-from plannerlab.sim.retime import GRID_PER_KNOT, retime, unwrap_path
+from plannerlab.sim.retime import GRID_PER_KNOT, INTERPOLANT, retime, unwrap_path
 from plannerlab.sim.world import DT_S, SimWorld
 
 #: physics steps per densified waypoint (0.1 s)
@@ -176,6 +177,7 @@ def _run(
     probe: SimWorld,
     max_deviation_m: float | None = None,
     grid_per_knot: int = GRID_PER_KNOT,
+    interpolant: str = INTERPOLANT,
 ) -> Execution:
     t0 = time.perf_counter()
     robot = problem.robot
@@ -232,6 +234,7 @@ def _run(
 
     timing_used = "waypoints"
     notes: list[str] = []
+    ref_dev = 0.0
     traj = None
     traj_check = None
     if timing == "toppra":
@@ -242,12 +245,15 @@ def _run(
             q_path = np.vstack([q_start[None, :], q_path])
         try:
             traj = retime(
-                world.to_urdf(q_path),
+                q_path,
                 velocity_limit=world.max_velocity,
                 effort_limit=world.max_force,
                 inverse_dynamics=world.inverse_dynamics,
                 knot_step=recheck_step,
                 grid_per_knot=grid_per_knot,
+                reach_m=checker.reach_m if checker.reach_m is not None else joint_reach_m(robot),
+                to_urdf=world.to_urdf,
+                interpolant=interpolant,
             )
             timing_used = "toppra"
         except Exception as exc:  # toppra or the simulator's inverse dynamics
@@ -265,6 +271,10 @@ def _run(
         # position target at t_k+1 would make the arm lead by one step, v·dt).
         qd_urdf = np.diff(q_urdf, axis=0) / world.dt_s
         q_all = world.from_urdf(q_urdf[1:])
+        # The plan's state at each step's path parameter: what the deviation is measured
+        # against (the reference is within traj.bound_m of it, measured below).
+        q_plan_all = traj.plan_states(t_all)
+        ref_dev = float(np.max(geometry_deviation_m(robot, q_plan_all, q_all), initial=0.0))
         # The commanded states are re-checked too, with the plan's margin: the spline must
         # keep the room the plan left. Every physics step's reference state is checked
         # (and the edges between them in metres): thinning them to one per joint step,
@@ -309,12 +319,16 @@ def _run(
         duration = M * steps_per_waypoint * world.dt_s
         steps_logged = steps_per_waypoint
 
-    # Deviation: every physics step of a retimed trajectory against the state commanded
-    # for it; with "waypoints" timing the arm moves towards each waypoint over its
-    # window, so it is measured where it should have arrived (the window's last step),
-    # and at every settling step.
+    # Deviation from the PLAN: every physics step of a retimed trajectory against the
+    # planned polyline's state at the reference's path parameter (so it holds the
+    # reference's own distance from the plan, reference_deviation_m, and the tracking);
+    # with "waypoints" timing the commands are the densified plan itself and the arm
+    # moves towards each waypoint over its window, so it is measured where it should
+    # have arrived (the window's last step), and at every settling step.
     states = np.array(q_step).reshape(len(q_step), robot.dof)
     targets = np.array(q_step_cmd).reshape(len(q_step), robot.dof)
+    if traj is not None:
+        targets = np.vstack([q_plan_all, targets[len(q_plan_all) :]])
     n_moving = len(states) - settle_steps
     if traj is not None:
         judged = np.arange(len(states))
@@ -391,9 +405,9 @@ def _run(
         )
     if max_dev > dev_limit:
         problems.append(
-            f"the robot strayed {max_dev * 1e3:.3g} mm from the commanded state at "
+            f"the robot strayed {max_dev * 1e3:.3g} mm from the plan at "
             f"t = {max_dev_t:.3f} s (limit {dev_limit * 1e3:g} mm, [simulation] "
-            "max_deviation_m)"
+            f"max_deviation_m; the reference within {ref_dev * 1e3:.3g} mm of the plan)"
         )
     if clear.clearance_m < 0:
         a, b = clear.pair or ("?", "?")
@@ -410,7 +424,8 @@ def _run(
             else f"executed {len(q_cmd)} waypoints"
         )
         reason = (
-            f"{moved} without contact; deviation <= {max_dev * 1e3:.3g} mm, clearance >= "
+            f"{moved} without contact; deviation from the plan <= {max_dev * 1e3:.3g} mm "
+            f"(reference <= {ref_dev * 1e3:.3g} mm), clearance >= "
             f"{clear.clearance_m * 1e3:.3g} mm"
         )
         if reached:
@@ -459,6 +474,7 @@ def _run(
         spline_dev=math.nan if traj is None else traj.max_dev,
         deviation_m=deviation,
         max_deviation_m=max_dev,
+        reference_deviation_m=ref_dev,
         max_deviation_time_s=max_dev_t,
         max_deviation_limit_m=dev_limit,
         min_clearance_m=clear.clearance_m,
@@ -488,6 +504,7 @@ def execute(
     solver_iterations: int | None = None,
     dt_s: float = DT_S,
     grid_per_knot: int = GRID_PER_KNOT,
+    interpolant: str = INTERPOLANT,
 ) -> Execution:
     """Re-check a path with FCL, then execute it in a fresh PyBullet world.
 
@@ -518,6 +535,8 @@ def execute(
         dt_s: physics time step [s].
         grid_per_knot: TOPP-RA grid points per knot interval
             (:data:`~plannerlab.sim.retime.GRID_PER_KNOT`).
+        interpolant: the reference's interpolant, "pchip" or "spline"
+            (:data:`~plannerlab.sim.retime.INTERPOLANT`).
         timing: ``"toppra"`` (default): the path is time-parameterised under the robot's
             velocity limits and half its torque limits (:mod:`plannerlab.sim.retime`)
             and tracked with position+velocity targets every physics step; when that is
@@ -569,6 +588,7 @@ def execute(
             probe=probe,
             max_deviation_m=max_deviation_m,
             grid_per_knot=grid_per_knot,
+            interpolant=interpolant,
         )
 
 
@@ -591,6 +611,7 @@ def execute_legs(
     solver_iterations: int | None = None,
     dt_s: float = DT_S,
     grid_per_knot: int = GRID_PER_KNOT,
+    interpolant: str = INTERPOLANT,
 ) -> list[Execution]:
     """Execute consecutive legs in ONE world, each from where the previous one ended.
 
@@ -640,6 +661,7 @@ def execute_legs(
                     probe=probe,
                     max_deviation_m=max_deviation_m,
                     grid_per_knot=grid_per_knot,
+                    interpolant=interpolant,
                 )
             )
     return out
