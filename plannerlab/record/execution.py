@@ -180,7 +180,7 @@ class Execution:
         spline_dev: largest distance between the retimed spline and the path's
             polyline at the knot-interval midpoints [rad or m] (NaN for ``"waypoints"``).
         deviation_m: (M,) per logged sample, the largest deviation of the robot's
-            collision geometry from the commanded state since the previous sample [m]
+            collision geometry from the plan since the previous sample [m]
             (settling excluded; empty in records made before it existed).
         max_deviation_m: largest displacement of any point of the robot's collision
             geometry (every link's capsule) between the commanded and the simulated

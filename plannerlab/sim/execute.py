@@ -8,7 +8,7 @@
 2. drives the simulated robot along it by position control with the Arm-Z paper's
    parameters (``000_a8ed938e94518caf.txt``: 1/240 s steps, 100 N·m motors, gravity on;
    see :mod:`plannerlab.sim.world`) on PyBullet's direct constraint solver, logging the
-   state reached at every step, the deviation from the commanded state, the tracking
+   state reached at every step, the deviation from the plan, the tracking
    error and every contact;
 3. measures the smallest simulated clearance along the execution, and the final tip
    error against the leg's goal.
@@ -550,7 +550,7 @@ def execute(
             (``track_err_limit_rad``; informational, it no longer decides the verdict);
             default: the problem's ``[simulation] max_track_err_rad``.
         max_deviation_m: the largest deviation of the robot's collision geometry from
-            the commanded state of a clean execution [m]; default: the problem's
+            the plan of a clean execution [m]; default: the problem's
             ``[simulation] max_deviation_m``.
         solver: PyBullet's constraint solver (:data:`SOLVER`, see the module docstring;
             "pgs" is PyBullet's default iterative one).
