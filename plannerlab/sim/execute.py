@@ -123,14 +123,17 @@ the direct solver (:data:`SOLVER`) and the finer TOPP-RA grid.
 measured against the reference, a natural cubic spline that, measured against the plan
 (at the same path parameter), strayed 47 / 33 / 19 / 40 / 20 / 15 / 41 mm on those seven
 legs. The reference is now a PCHIP with corner knots (:mod:`plannerlab.sim.retime`,
-bound 7.7 mm), and the deviation is measured against the plan: on the same legs
-1.7 / 1.6 / 2.0 / 1.8 / 1.9 / 1.6 / 1.7 mm (all of it the reference's; the arm tracks it
-exactly), smallest simulated clearance 24.3 mm, all seven clean (``compare --execute``
-at 370bd85). The price is time: a faithful reference turns the plan's corners, under
-the same torque budget: 501 s simulated instead of 224 s on these legs (2.2 x); the wall
-time follows the simulated time (v12's seven legs in one process, PCHIP with 5-mm
-corners against the spline: 127 s against 56 s, 2.3 x). That misses issue 17's "1.5 x
-today's execution wall time"; the alternatives measured (the table in
+bound 7.7 mm), and the deviation is measured against the plan. ``bench/execution_bench.py
+--options spline,chosen`` on that plan (the spline option: the old reference, measured
+against the plan): deviation per leg 1.7 / 1.6 / 2.0 / 1.8 / 1.9 / 1.4 / 1.7 mm against
+the spline's 47 / 33 / 19 / 40 / 20 / 15 / 41 mm (all of it the reference's: the arm
+tracks either exactly), all seven clean against none. The price is time: a faithful
+reference turns the plan's corners, under the same torque budget: 473 s simulated
+instead of 224 s (2.1 x). The wall time follows the physics steps (profiled on leg D:
+about 1 ms per step either way; retiming 2.9 s): the expected wall ratio is the
+simulated one, 2.1 x; the bench's own wall ratio, 5.4 x (216 s against 40 s), was taken
+under a load average of 4.5-10 on 2 cores and is not a measure. That misses issue 17's
+"1.5 x today's execution wall time"; the alternatives measured (the table in
 :mod:`plannerlab.sim.retime`) trade the distance from the plan for time, and none kept
 both.
 """

@@ -66,8 +66,8 @@ Decisions:
   torque budget (the duration is torque-bound: the whole budget, 1.0 instead of 0.5 of
   the effort, took leg E from 41.4 to 29.2 s; the grid is not what binds, 8 points per
   knot: 40.6 s). :data:`CORNER_M` = 2 cm is a middle: the a-priori bound stays under the
-  1-cm deviation limit (measured 1.6-2.0 mm on the paper's task), and the seven legs of
-  the paper's task take 501 s of simulated time instead of the spline's 224 s, 2.2 x
+  1-cm deviation limit (measured 1.4-2.0 mm on the paper's task), and the seven legs of
+  the paper's task take 473 s of simulated time instead of the spline's 224 s, 2.1 x
   (see :mod:`plannerlab.sim.execute` for the wall time).
   ``interpolant="spline"`` keeps the old reference for comparison.
   :attr:`Trajectory.max_dev` reports the interpolant's max-norm distance from the
