@@ -58,7 +58,8 @@ Decisions:
   the simulated geometry was from the plan, the reference's own distance from the plan
   included (recorded apart as ``reference_deviation_m``: at most
   :data:`~plannerlab.sim.retime.PCHIP_BOUND` × :data:`~plannerlab.sim.retime.CORNER_M`
-  = 7.7 mm by construction, measured 0.2-2 mm; see :mod:`plannerlab.sim.retime`). Until
+  = 7.7 mm by construction, at most 2.1 mm measured on the 20 room variants; see
+  :mod:`plannerlab.sim.retime`). Until
   issue 17's reference fix it was measured against the reference, which strayed 12-47 mm
   from the plan on the paper's task and room variant v12 while "0 mm" was reported; a
   plan's clearance minus ``max_deviation_m`` is now a true lower bound of the simulated

@@ -52,8 +52,9 @@ Decisions:
   end knots have their neighbours on the same straight edge, the slopes equal the secant
   and PCHIP *is* the chord (zero deviation). Hence ``Trajectory.bound_m = 0.385 ×
   CORNER_M`` = 7.7 mm, whatever the path; the execution measures the real distance at
-  every physics step (``reference_deviation_m``: 0.2-1.8 mm on v12 and the paper's
-  task) and counts it in the deviation the verdict judges.
+  every physics step (``reference_deviation_m``: at most 1.5-2.1 mm per problem on the
+  paper's task and its 20 room variants) and counts it in the deviation the verdict
+  judges.
 
   **What it costs, and the alternatives measured** (v12 leg C, 604 waypoints; reference's
   largest distance from the plan / TOPP-RA duration; ``/tmp``-scripts, one process):
