@@ -49,9 +49,9 @@ def test_compiled_field_step_and_hold_equal_numpy_at_states_near_walls(direction
         np.testing.assert_allclose(b.direction, a.direction, rtol=1e-8, atol=1e-10)
         # the hold projects a step that closes the nearest pairs (up the clearance cost)
         step = a.gradient if a.cost > 0 else a.direction
-        h_a, h_b = numpy_model.hold(q, step), compiled.hold(q, step)
+        h_a, h_b = numpy_model.hold(goal, q, step), compiled.hold(goal, q, step)
         held += int(not np.allclose(h_a, step))
-        # the hold solves G Gᵀ λ = … regularised by only 1e-9 (sphere rows of one link
+        # the hold solves G A⁻¹ Gᵀ λ = … regularised by only 1e-9 (sphere rows of one link
         # pair are nearly dependent): rounding grows by up to ~1e7 there
         np.testing.assert_allclose(h_b, h_a, rtol=1e-5, atol=1e-6 * np.abs(h_a).max())
     assert held > 0  # some states were within the clearance floor: the hold was exercised

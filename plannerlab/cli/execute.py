@@ -21,7 +21,7 @@ from plannerlab.record.codec import dumps
 
 def execution_table(legs: Any, executions: Any) -> Table:
     """One row per executed leg: FCL re-check, tip errors, the largest deviation of the
-    robot's collision geometry from the commanded state and the smallest simulated
+    robot's collision geometry from the plan and the smallest simulated
     clearance [mm], contacts, wall time, verdict (the joint tracking error, informational
     since the verdict is in metres, and the trajectory's duration are in ``--json``);
     which pairs collided or touched goes in the caption (names never cut)."""

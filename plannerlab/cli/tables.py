@@ -200,7 +200,7 @@ SUMMARY_COLUMNS: dict[str, SummaryColumn] = {
         "deviation\nmm",
         "num",
         lambda r: fmt(mm(r.get("exec_deviation_median_m"))),
-        "largest deviation of the robot's collision geometry from the commanded state in "
+        "largest deviation of the robot's collision geometry from the plan in "
         "PyBullet, median [mm]",
         executed=True,
     ),

@@ -375,8 +375,9 @@ def evaluate(
                 spacious = False
                 break
     direction = np.zeros(dof)
+    metric = np.eye(dof)  # the step's quadratic model (the identity for plain gradients)
     if not want_direction:
-        return F, f, dist, ang_err_deg, cost, grad, d, direction, spacious
+        return F, f, dist, ang_err_deg, cost, grad, d, direction, spacious, metric
 
     # tip Jacobians: dp/dθ_j = z_j × (p − o_j), dn/dθ_j = z_j × n
     Jp = np.empty((3, dof))
@@ -399,7 +400,7 @@ def evaluate(
                 g = (diff[0] * Jp[0, j] + diff[1] * Jp[1, j] + diff[2] * Jp[2, j]) / dist
             gn = n_goal[0] * Jn[0, j] + n_goal[1] * Jn[1, j] + n_goal[2] * Jn[2, j]
             direction[j] = -(r1 * g - 2.0 * r2 * cn * gn + weight * grad[j])
-        return F, f, dist, ang_err_deg, cost, grad, d, direction, spacious
+        return F, f, dist, ang_err_deg, cost, grad, d, direction, spacious, metric
 
     pos_scale = 1.0 / pos_tol
     ang_scale = 1.0 / math.radians(angle_tol_deg)
@@ -431,7 +432,7 @@ def evaluate(
     for j in range(dof):
         A[j, j] += damping**2
     direction = np.linalg.solve(A, b)
-    return F, f, dist, ang_err_deg, cost, grad, d, direction, spacious
+    return F, f, dist, ang_err_deg, cost, grad, d, direction, spacious, A
 
 
 @njit(cache=True, nogil=True)
@@ -458,10 +459,13 @@ def hold_clearance(
     lp_links,
     link_ends,
     floor_m,
+    metric,
 ):
     """``ClearanceDescent._hold_clearance``: ``direction`` changed as little as possible so
     that no pair closer than ``floor_m`` comes closer (to first order, it moves away at
-    0.1 of its gradient's rate); active-set projection, at most 10 rounds."""
+    0.1 of its gradient's rate); active-set projection, at most 10 rounds. "As little as
+    possible" in ``metric`` (A, dof x dof, the step's quadratic model):
+    ``dq = direction + A^-1 G^T lambda``."""
     dof = q.shape[0]
     Fr = _frames(q, F1, T0, M)
     P = _centres(Fr, link, t)
@@ -503,6 +507,7 @@ def hold_clearance(
         want[c] = 0.1 * math.sqrt(np.sum(G[c] * G[c])) * dnorm
     chosen = np.zeros(n_act, dtype=np.bool_)
     dq = direction.copy()
+    AiGt = np.linalg.solve(metric, np.ascontiguousarray(G.T))  # (dof, n_act)
     for _ in range(10):
         rate = G @ dq
         any_short = False
@@ -514,12 +519,16 @@ def hold_clearance(
             break
         idx = np.flatnonzero(chosen)
         Gs = G[idx]
-        rhs = want[idx] - Gs @ direction
-        lhs = Gs @ Gs.T
+        Ai = np.ascontiguousarray(AiGt[:, idx])
+        K = Gs @ Ai
+        tr = 0.0
         for c in range(idx.shape[0]):
-            lhs[c, c] += 1e-9
-        lam = np.linalg.solve(lhs, rhs)
-        dq = direction + Gs.T @ lam
+            tr += K[c, c]
+        reg = 1e-9 * max(tr / idx.shape[0], 1e-12)
+        for c in range(idx.shape[0]):
+            K[c, c] += reg
+        lam = np.linalg.solve(K, want[idx] - Gs @ direction)
+        dq = direction + Ai @ lam
     return dq
 
 
@@ -539,6 +548,8 @@ class Evaluation:
     direction: Array
     #: no pair below the clearance floor that came closer than in ``d_ref``
     spacious: bool
+    #: the step's quadratic model at q (dof, dof): Gauss-Newton's A, or the identity
+    metric: Array
 
 
 class CompiledField:
@@ -639,7 +650,7 @@ class CompiledField:
             self._no_ref if d_ref is None else d_ref,
             float(floor_m),
         )
-        F, f, pos_err, ang_err, cost, grad, d, direction, spacious = out
+        F, f, pos_err, ang_err, cost, grad, d, direction, spacious, metric = out
         return Evaluation(
             float(F),
             float(f),
@@ -650,10 +661,15 @@ class CompiledField:
             d,
             direction,
             bool(spacious),
+            metric,
         )
 
-    def hold_clearance(self, q: Array, direction: Array, floor_m: float) -> Array:
-        """:func:`hold_clearance` at q (dof,) for ``direction`` (dof,)."""
+    def hold_clearance(
+        self, q: Array, direction: Array, floor_m: float, metric: Array | None = None
+    ) -> Array:
+        """:func:`hold_clearance` at q (dof,) for ``direction`` (dof,), projected in
+        ``metric`` (dof, dof; None: the identity)."""
+        dof = len(direction)
         return hold_clearance(
             np.array(q, dtype=float),
             np.array(direction, dtype=float),
@@ -662,6 +678,7 @@ class CompiledField:
             *self._scene,
             *self._pair_spheres,
             float(floor_m),
+            np.eye(dof) if metric is None else np.ascontiguousarray(metric, dtype=float),
         )
 
 

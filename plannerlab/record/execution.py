@@ -115,6 +115,7 @@ _FLOAT_FIELDS = (
     "spline_dev",
     "recheck_joint_step",
     "max_deviation_m",
+    "reference_deviation_m",
     "max_deviation_time_s",
     "max_deviation_limit_m",
     "min_clearance_m",
@@ -179,13 +180,24 @@ class Execution:
         spline_dev: largest distance between the retimed spline and the path's
             polyline at the knot-interval midpoints [rad or m] (NaN for ``"waypoints"``).
         deviation_m: (M,) per logged sample, the largest deviation of the robot's
-            collision geometry from the commanded state since the previous sample [m]
+            collision geometry from the plan since the previous sample [m]
             (settling excluded; empty in records made before it existed).
         max_deviation_m: largest displacement of any point of the robot's collision
             geometry (every link's capsule) between the commanded and the simulated
             state over the whole execution, settling included [m]; see
             :mod:`plannerlab.sim.measure` for the bound and the states measured (NaN in
             records made before it existed).
+            Since the reference is interpolated (``"toppra"``), the commanded state
+            it is measured against is the *plan's*: the planned polyline's state at
+            the reference's path parameter, so it bounds how far the simulated
+            geometry was from the plan (the reference's own distance from the plan,
+            ``reference_deviation_m``, included).
+        reference_deviation_m: largest displacement of any point of the collision
+            geometry between the retimed reference and the plan's state at the same
+            path parameter, over every physics step [m] (0 for ``"waypoints"``, whose
+            commands are the plan; NaN in older records); a-priori at most
+            :data:`~plannerlab.sim.retime.PCHIP_BOUND` × ``CORNER_M`` (see
+            :mod:`plannerlab.sim.retime`).
         max_deviation_time_s: when it was met, from the leg's start [s].
         max_deviation_limit_m: the problem's ``[simulation] max_deviation_m`` that the
             verdict applied [m] (NaN in older records, judged by the joint tracking
@@ -240,6 +252,7 @@ class Execution:
     spline_dev: float = math.nan
     deviation_m: Array = field(default_factory=lambda: np.zeros(0))
     max_deviation_m: float = math.nan
+    reference_deviation_m: float = math.nan
     max_deviation_time_s: float = math.nan
     max_deviation_limit_m: float = math.nan
     min_clearance_m: float = math.nan
