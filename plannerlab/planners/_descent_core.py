@@ -311,11 +311,18 @@ def evaluate(
     want_direction,
     d_ref,
     floor_m,
+    joint_goal,
+    q_goal,
+    continuous,
+    tol_rad,
 ):
     """The descent's view of state q: (F, f, pos_err_m, ang_err_deg, cost, gradient (dof,),
-    distances (m,), direction (dof,); zeros unless ``want_direction``, spacious). Spacious:
-    every pair is at least ``floor_m`` apart or no closer than in ``d_ref`` (the distances
-    at the state the step starts from; empty: True)."""
+    distances (m,), direction (dof,); zeros unless ``want_direction``, spacious, joint_err).
+    Spacious: every pair is at least ``floor_m`` apart or no closer than in ``d_ref`` (the
+    distances at the state the step starts from; empty: True). With ``joint_goal`` the goal
+    is the state ``q_goal`` (dof,) (``continuous`` joints wrapped) with tolerance
+    ``tol_rad``: f = r1 |q − q_goal|, the Gauss-Newton residual (q_goal − q) / tol_rad, and
+    joint_err the largest joint difference (else 0)."""
     dof = q.shape[0]
     Fr = _frames(q, F1, T0, M)
     tip = dof + 1
@@ -327,6 +334,18 @@ def evaluate(
     cn = 1.0 - dot
     f = r1 * dist + r2 * cn**2
     ang_err_deg = math.degrees(math.acos(min(max(dot, -1.0), 1.0)))
+    dq = np.zeros(dof)
+    joint_err = 0.0
+    if joint_goal:
+        sq = 0.0
+        for j in range(dof):
+            dj = q[j] - q_goal[j]
+            if continuous[j]:
+                dj = (dj + math.pi) % (2.0 * math.pi) - math.pi
+            dq[j] = dj
+            sq += dj * dj
+            joint_err = max(joint_err, abs(dj))
+        f = r1 * math.sqrt(sq)
 
     P = _centres(Fr, link, t)
     d, nrm = _pairs(
@@ -367,7 +386,10 @@ def evaluate(
             _pair_gradient(Fr, P, link, nrm, A_idx[i], B_idx[i], i, gi)
             for j in range(dof):
                 grad[j] += wgt * gi[j]
-    F = r1 * dist + r2 * cn**2 + weight * cost
+    if joint_goal:
+        F = f + weight * cost
+    else:
+        F = r1 * dist + r2 * cn**2 + weight * cost
     spacious = True
     if d_ref.shape[0] == d.shape[0]:
         for i in range(d.shape[0]):
@@ -376,7 +398,30 @@ def evaluate(
                 break
     direction = np.zeros(dof)
     if not want_direction:
-        return F, f, dist, ang_err_deg, cost, grad, d, direction, spacious
+        return F, f, dist, ang_err_deg, cost, grad, d, direction, spacious, joint_err
+    if joint_goal:
+        direction = _joint_direction(
+            dq,
+            joint_err,
+            Fr,
+            P,
+            link,
+            nrm,
+            A_idx,
+            B_idx,
+            d,
+            margin,
+            grad,
+            n_close,
+            close,
+            r1,
+            weight,
+            gauss_newton,
+            damping,
+            goal_depth,
+            tol_rad,
+        )
+        return F, f, dist, ang_err_deg, cost, grad, d, direction, spacious, joint_err
 
     # tip Jacobians: dp/dθ_j = z_j × (p − o_j), dn/dθ_j = z_j × n
     Jp = np.empty((3, dof))
@@ -399,7 +444,7 @@ def evaluate(
                 g = (diff[0] * Jp[0, j] + diff[1] * Jp[1, j] + diff[2] * Jp[2, j]) / dist
             gn = n_goal[0] * Jn[0, j] + n_goal[1] * Jn[1, j] + n_goal[2] * Jn[2, j]
             direction[j] = -(r1 * g - 2.0 * r2 * cn * gn + weight * grad[j])
-        return F, f, dist, ang_err_deg, cost, grad, d, direction, spacious
+        return F, f, dist, ang_err_deg, cost, grad, d, direction, spacious, joint_err
 
     pos_scale = 1.0 / pos_tol
     ang_scale = 1.0 / math.radians(angle_tol_deg)
@@ -431,7 +476,63 @@ def evaluate(
     for j in range(dof):
         A[j, j] += damping**2
     direction = np.linalg.solve(A, b)
-    return F, f, dist, ang_err_deg, cost, grad, d, direction, spacious
+    return F, f, dist, ang_err_deg, cost, grad, d, direction, spacious, joint_err
+
+
+@njit(cache=True, nogil=True)
+def _joint_direction(
+    dq,
+    joint_err,
+    Fr,
+    P,
+    link,
+    nrm,
+    A_idx,
+    B_idx,
+    d,
+    margin,
+    grad,
+    n_close,
+    close,
+    r1,
+    weight,
+    gauss_newton,
+    damping,
+    goal_depth,
+    tol_rad,
+):
+    """The step towards a goal state (``ClearanceDescent._joint_direction``): steepest
+    descent on r1 |dq| + w · cost, or damped Gauss-Newton on the joint residual −dq / tol
+    (Jacobian I / tol) plus one residual per close pair; dq = q − q_goal (dof,)."""
+    dof = dq.shape[0]
+    direction = np.zeros(dof)
+    norm = math.sqrt(np.sum(dq * dq))
+    if not gauss_newton:
+        for j in range(dof):
+            g = r1 * dq[j] / norm if norm > 1e-12 else 0.0
+            direction[j] = -(g + weight * grad[j])
+        return direction
+    scale = 1.0 / tol_rad
+    A = np.zeros((dof, dof))
+    b = np.empty(dof)
+    deep = joint_err * scale < goal_depth
+    for j in range(dof):
+        A[j, j] = scale * scale
+        b[j] = 0.0 if deep else scale * (-dq[j] * scale)
+    if n_close > 0:
+        gi = np.empty(dof)
+        dd = np.empty((n_close, dof))
+        for c in range(n_close):
+            i = close[c]
+            _pair_gradient(Fr, P, link, nrm, A_idx[i], B_idx[i], i, gi)
+            dd[c] = gi
+        k2 = weight / margin
+        A = A + k2 * (dd.T @ dd)
+        for j in range(dof):
+            b[j] = b[j] - 0.5 * weight * grad[j]
+    for j in range(dof):
+        A[j, j] += damping**2
+    return np.linalg.solve(A, b)
 
 
 @njit(cache=True, nogil=True)
@@ -539,6 +640,8 @@ class Evaluation:
     direction: Array
     #: no pair below the clearance floor that came closer than in ``d_ref``
     spacious: bool
+    #: the largest joint difference from a goal state (0 for a tip goal)
+    joint_err: float = 0.0
 
 
 class CompiledField:
@@ -595,8 +698,9 @@ class CompiledField:
         #: pairs at least this far apart are reported at this distance (see _pairs)
         self.far_m = max(float(far_m), self.margin_m)
         self._no_ref = np.zeros(0)
-        #: the last goal asked about and its arrays (fresh, writeable: one numba version)
-        self._goal: tuple[object, Array, Array] = (None, self._no_ref, self._no_ref)
+        #: the last goal asked about and its arrays (fresh, writeable: one numba version;
+        #: see :func:`_goal_arrays`)
+        self._goal: tuple = (None,)
 
     def evaluate(
         self,
@@ -616,7 +720,7 @@ class CompiledField:
         step direction at q (dof,) towards ``goal`` (a GoalRegion); ``spacious`` against
         the distances ``d_ref`` (see :func:`evaluate`)."""
         if goal is not self._goal[0]:
-            self._goal = (goal, np.array(goal.p_world_m, dtype=float), np.array(goal.n_world))
+            self._goal = _goal_arrays(goal)
         out = evaluate(
             np.array(q, dtype=float),
             *self._chain,
@@ -638,8 +742,9 @@ class CompiledField:
             bool(want_direction),
             self._no_ref if d_ref is None else d_ref,
             float(floor_m),
+            *self._goal[3:],
         )
-        F, f, pos_err, ang_err, cost, grad, d, direction, spacious = out
+        F, f, pos_err, ang_err, cost, grad, d, direction, spacious, joint_err = out
         return Evaluation(
             float(F),
             float(f),
@@ -650,6 +755,7 @@ class CompiledField:
             d,
             direction,
             bool(spacious),
+            float(joint_err),
         )
 
     def hold_clearance(self, q: Array, direction: Array, floor_m: float) -> Array:
@@ -663,6 +769,21 @@ class CompiledField:
             *self._pair_spheres,
             float(floor_m),
         )
+
+
+def _goal_arrays(goal) -> tuple:
+    """A goal's arguments of :func:`evaluate`, after the goal itself: the tip target
+    (p, n), then whether it is a goal state, the state, its continuous joints and its
+    tolerance (empty arrays for a tip goal: one numba version for both)."""
+    from plannerlab.problem.goals import JointGoal
+
+    p = np.array(goal.p_world_m, dtype=float)
+    n = np.array(goal.n_world, dtype=float)
+    if isinstance(goal, JointGoal):
+        q = np.array(goal.q_rad, dtype=float)
+        cont = np.array(goal.continuous, dtype=np.bool_)
+        return (goal, p, n, True, q, cont, float(goal.tol_rad))
+    return (goal, p, n, False, np.zeros(0), np.zeros(0, dtype=np.bool_), 1.0)
 
 
 def warm_up() -> None:

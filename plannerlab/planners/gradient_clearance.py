@@ -60,7 +60,8 @@ from plannerlab.planners.base import (
     start_collision,
     with_overrides,
 )
-from plannerlab.planners.clearance import ClearanceField
+from plannerlab.planners.clearance import Clearance, ClearanceField
+from plannerlab.problem.goals import GoalRegion, JointGoal
 from plannerlab.robots.base import Array, joint_difference, wrap_to_pi
 from plannerlab.robots.paths import path_length
 
@@ -179,8 +180,10 @@ class ClearanceDescent:
 
     # ------------------------------------------------------------------ pieces
     def _f(self, robot, goal, q: Array) -> float:
-        p, n = robot.tip(q)
         s = self.settings
+        if isinstance(goal, JointGoal):
+            return float(s.r1 * np.linalg.norm(joint_difference(q, goal.q_rad, goal.continuous)))
+        p, n = robot.tip(q)
         return float(
             s.r1 * np.linalg.norm(p - goal.p_world_m) + s.r2 * (1.0 - n @ goal.n_world) ** 2
         )
@@ -189,6 +192,8 @@ class ClearanceDescent:
         """Descent direction (dof,) and F at q."""
         s = self.settings
         c = field(q)
+        if isinstance(goal, JointGoal):
+            return self._joint_direction(goal, field, q, c)
         p, n = robot.tip(q)
         J_p, J_n = robot.tip_jacobian(q)
         diff = p - goal.p_world_m
@@ -223,6 +228,35 @@ class ClearanceDescent:
             b = b - 0.5 * s.clearance_weight * c.gradient
         A = A + s.damping**2 * np.eye(robot.dof)
         return np.linalg.solve(A, b), F
+
+    def _joint_direction(
+        self, goal: JointGoal, field: ClearanceField, q: Array, c: Clearance
+    ) -> tuple[Array, float]:
+        """:meth:`_direction` towards a goal state: f = r1 |q − q_goal| (continuous joints
+        wrapped); Gauss-Newton on the joint residual (q_goal − q) / tol_rad (its Jacobian
+        I / tol_rad) plus the clearance residuals."""
+        s = self.settings
+        dq = joint_difference(q, goal.q_rad, goal.continuous)
+        dist = float(np.linalg.norm(dq))
+        F = s.r1 * dist + s.clearance_weight * c.cost
+        if s.direction == "gradient":
+            g = s.r1 * dq / dist if dist > 1e-12 else np.zeros(len(q))
+            return -(g + s.clearance_weight * c.gradient), F
+        scale = 1.0 / goal.tol_rad
+        e = -dq * scale
+        # aim only as deep as goal_depth of the tolerance: no pull once well inside
+        if float(np.max(np.abs(dq), initial=0.0)) * scale < s.goal_depth:
+            e[:] = 0.0
+        A = scale**2 * np.eye(len(q))
+        b = scale * e
+        if c.close_pairs:
+            dd = self._distance_gradients(field, q)
+            k2 = s.clearance_weight / s.margin_m
+            A = A + k2 * dd.T @ dd
+            b = b - 0.5 * s.clearance_weight * c.gradient
+        A = A + s.damping**2 * np.eye(len(q))
+        direction: Array = np.asarray(np.linalg.solve(A, b), dtype=float)
+        return direction, F
 
     @staticmethod
     def _distance_gradients(field: ClearanceField, q: Array) -> Array:
@@ -295,8 +329,7 @@ class ClearanceDescent:
             c_new = model.point(goal, q_new)
             if (
                 c_new.cost < c.cost
-                and c_new.pos_err_m <= s.settle_fraction * goal.pos_tol_m
-                and c_new.ang_err_deg <= s.settle_fraction * goal.angle_tol_deg
+                and _within(goal, c_new, s.settle_fraction)
                 and checker.is_valid(q_new)
             ):
                 q, c = q_new, c_new
@@ -359,12 +392,8 @@ class ClearanceDescent:
         direction, F_now = here.direction, here.F
         held = False
         while True:
-            pos_err, ang_err = here.pos_err_m, here.ang_err_deg
-            inside = pos_err <= goal.pos_tol_m and ang_err <= goal.angle_tol_deg
-            deep = (
-                pos_err <= s.goal_depth * goal.pos_tol_m
-                and ang_err <= s.goal_depth * goal.angle_tol_deg
-            )
+            inside = _within(goal, here, 1.0)
+            deep = _within(goal, here, s.goal_depth)
             stalled = iteration - best_iter >= s.stall_window or radius < s.min_step_rad
             # inside the region the descent goes on towards goal_depth of the tolerances
             # (an executed path then ends inside too), as long as it makes progress
@@ -460,14 +489,17 @@ class ClearanceDescent:
         point (the tip at ``p_d − approach_m · n_d`` with the goal's normal, within the
         sub-goal tolerances: the tip comes in along the inspection normal), then to the
         goal; if the approach stalls, the descent to the goal continues from there."""
-        from plannerlab.problem.goals import GoalRegion
-
         s = self.settings
         goal = problem.goal(leg)
         path = [np.array(q_start)]
         trace: list[float] = []
         iterations = 0
-        if s.approach_m > 0 and not goal.contains(problem.robot, q_start):
+        # a goal state says how the arm comes in: no approach point
+        if (
+            s.approach_m > 0
+            and not isinstance(goal, JointGoal)
+            and not goal.contains(problem.robot, q_start)
+        ):
             sub = GoalRegion(
                 "approach",
                 goal.p_world_m - s.approach_m * goal.n_world,
@@ -511,8 +543,6 @@ class ClearanceDescent:
         Returns the kept path from q_stall (its last state is in the goal region when the
         detour succeeded, else just [q_stall]), the iterations and how far it retracted.
         """
-        from plannerlab.problem.goals import GoalRegion
-
         s = self.settings
         robot = problem.robot
         iterations = 0
@@ -800,6 +830,11 @@ class _NumpyPoint:
         return self._errors[1]
 
     @cached_property
+    def joint_err(self) -> float:
+        """Largest joint difference from a goal state (:class:`JointGoal` only)."""
+        return float(self._goal.joint_error(self._q))
+
+    @cached_property
     def direction(self) -> Array:
         return self._descent._direction(self._field.robot, self._goal, self._field, self._q)[0]
 
@@ -862,6 +897,18 @@ class _CompiledModel:
 
 
 _Model = _NumpyModel | _CompiledModel
+
+
+def _within(goal: GoalRegion, point, fraction: float) -> bool:
+    """Whether the state ``point`` describes is within ``fraction`` of ``goal``'s
+    tolerances: the tip's position and angle errors, or for a goal state
+    (:class:`JointGoal`) the largest joint difference."""
+    if isinstance(goal, JointGoal):
+        return bool(point.joint_err <= fraction * goal.tol_rad)
+    return bool(
+        point.pos_err_m <= fraction * goal.pos_tol_m
+        and point.ang_err_deg <= fraction * goal.angle_tol_deg
+    )
 
 
 def _in_ball(rng: np.random.Generator, radius_m: float) -> Array:
