@@ -6,7 +6,8 @@ One call, :func:`evaluate`, gives everything the descent asks at a state: the ob
 ``f`` and ``F = f + w · cost``, the tip's position and angle errors, every sphere pair's
 distance (the ``spacious`` test compares them between states) and, when asked, the step
 direction (steepest descent or damped Gauss-Newton on the tip residuals plus one residual
-per close pair). :func:`hold_clearance` is the active-set projection of
+per close pair; towards a goal state, on the joint residual instead of the tip's).
+:func:`hold_clearance` is the active-set projection of
 ``ClearanceDescent._hold_clearance``. Both are the numpy code's arithmetic written as
 loops (same spheres, same pairs in the same order, same formulas), so the compiled descent
 takes the numpy descent's steps to rounding (``tests/test_descent_core.py`` holds the two

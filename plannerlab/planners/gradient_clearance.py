@@ -27,6 +27,13 @@ when the best ``f`` has not decreased by ``stall_min_decrease`` in ``stall_windo
 iterations, or the trust radius falls below ``min_step_rad``: status ``local_minimum``
 with ``extra["q_stall"]`` and ``extra["descent_rad"]`` (joint-space distance travelled).
 
+Towards a goal state (:class:`~plannerlab.problem.goals.JointGoal`) the tip terms give
+way to the joint distance: ``f = r1 |q − q_goal|`` (continuous joints wrapped), the
+Gauss-Newton residual is ``(q_goal − q) / tol_rad`` (its Jacobian ``I / tol_rad``) beside
+the clearance residuals, "inside" and "deep" are the largest joint difference against
+``tol_rad`` and ``goal_depth · tol_rad``, and there is no approach point (the goal state
+says how the arm comes in). Sub-goals of the escapes stay tip targets.
+
 Escapes from a stall (``escape`` setting): ``detour`` (sub-goals near the stall: the tip
 drawn back along its own body, ``retract_step``, ``2 retract_step``, … modules, each
 followed by the leg's descent; deterministic), ``rrtconnect`` (RRT-Connect from the stall
@@ -88,7 +95,8 @@ class ClearanceSettings:
         min_step_rad: trust radius below which the descent has stalled [rad].
         stall_window: iterations without improvement of the best f that make a stall.
         stall_min_decrease: improvement of the best f that resets the stall window.
-        goal_depth: aim at this fraction of the goal tolerances (Gauss-Newton residuals).
+        goal_depth: aim at this fraction of the goal tolerances (Gauss-Newton residuals;
+            of ``tol_rad`` for a goal state).
         escape: what to do at a stall: "none", "detour", "random_detour" or "rrtconnect"
             (see the module docstring); ``max_escapes`` stalls are escaped at most (for
             ``random_detour`` also the most draws from one stall).
@@ -488,7 +496,8 @@ class ClearanceDescent:
         """The descent of one leg: with ``approach_m`` > 0, first to the goal's approach
         point (the tip at ``p_d − approach_m · n_d`` with the goal's normal, within the
         sub-goal tolerances: the tip comes in along the inspection normal), then to the
-        goal; if the approach stalls, the descent to the goal continues from there."""
+        goal; if the approach stalls, the descent to the goal continues from there. A goal
+        state (:class:`JointGoal`) has no approach point."""
         s = self.settings
         goal = problem.goal(leg)
         path = [np.array(q_start)]
