@@ -98,8 +98,8 @@ def _joint_goal_variant():
 
 @pytest.mark.parametrize("direction", ["gauss_newton", "gradient"])
 def test_compiled_step_towards_a_goal_state_equals_numpy(direction):
-    """A goal state: f = r1 |q − q_goal|, the joint error and the step (joint residual
-    plus clearance) agree to rounding, at states drawn round the window where walls are
+    """A goal state: f = r1 |q − q_goal|, F = |(q − q_goal) / tol|² + w · cost, the
+    joint error and the step (joint residual plus clearance) agree to rounding, at states drawn round the window where walls are
     close. Gauss-Newton heads almost straight for the goal state (not for its tip pose);
     steepest descent is −∇F."""
     problem, W = _joint_goal_variant()
@@ -112,6 +112,9 @@ def test_compiled_step_towards_a_goal_state_equals_numpy(direction):
         a, b = numpy_model.point(goal, q), compiled.point(goal, q)
         dq = joint_difference(q, goal.q_rad, goal.continuous)
         assert a.f == pytest.approx(float(np.linalg.norm(dq)), rel=1e-12)
+        # accepted on the sum of squares the Gauss-Newton step models
+        e_sq = float(np.sum((dq / goal.tol_rad) ** 2))
+        assert a.F == pytest.approx(e_sq + 0.2 * a.cost, rel=1e-12)
         for name in ("F", "f", "joint_err", "cost"):
             assert getattr(b, name) == pytest.approx(getattr(a, name), rel=1e-10, abs=1e-12)
         assert b.joint_err == pytest.approx(float(np.max(np.abs(dq))), rel=1e-12)

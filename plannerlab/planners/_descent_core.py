@@ -322,8 +322,9 @@ def evaluate(
     Spacious: every pair is at least ``floor_m`` apart or no closer than in ``d_ref`` (the
     distances at the state the step starts from; empty: True). With ``joint_goal`` the goal
     is the state ``q_goal`` (dof,) (``continuous`` joints wrapped) with tolerance
-    ``tol_rad``: f = r1 |q − q_goal|, the Gauss-Newton residual (q_goal − q) / tol_rad, and
-    joint_err the largest joint difference (else 0)."""
+    ``tol_rad``: f = r1 |q − q_goal|, F = |(q − q_goal) / tol_rad|² + w · cost, the
+    Gauss-Newton residual (q_goal − q) / tol_rad, and joint_err the largest joint
+    difference (else 0)."""
     dof = q.shape[0]
     Fr = _frames(q, F1, T0, M)
     tip = dof + 1
@@ -337,6 +338,7 @@ def evaluate(
     ang_err_deg = math.degrees(math.acos(min(max(dot, -1.0), 1.0)))
     dq = np.zeros(dof)
     joint_err = 0.0
+    e_sq = 0.0  # |dq / tol_rad|²
     if joint_goal:
         sq = 0.0
         for j in range(dof):
@@ -345,6 +347,7 @@ def evaluate(
                 dj = (dj + math.pi) % (2.0 * math.pi) - math.pi
             dq[j] = dj
             sq += dj * dj
+            e_sq += (dj / tol_rad) ** 2
             joint_err = max(joint_err, abs(dj))
         f = r1 * math.sqrt(sq)
 
@@ -388,7 +391,7 @@ def evaluate(
             for j in range(dof):
                 grad[j] += wgt * gi[j]
     if joint_goal:
-        F = f + weight * cost
+        F = e_sq + weight * cost
     else:
         F = r1 * dist + r2 * cn**2 + weight * cost
     spacious = True
@@ -415,7 +418,6 @@ def evaluate(
             grad,
             n_close,
             close,
-            r1,
             weight,
             gauss_newton,
             damping,
@@ -495,7 +497,6 @@ def _joint_direction(
     grad,
     n_close,
     close,
-    r1,
     weight,
     gauss_newton,
     damping,
@@ -503,15 +504,13 @@ def _joint_direction(
     tol_rad,
 ):
     """The step towards a goal state (``ClearanceDescent._joint_direction``): steepest
-    descent on r1 |dq| + w · cost, or damped Gauss-Newton on the joint residual −dq / tol
-    (Jacobian I / tol) plus one residual per close pair; dq = q − q_goal (dof,)."""
+    descent on F = |dq / tol|² + w · cost, or damped Gauss-Newton on the joint residual
+    −dq / tol (Jacobian I / tol) plus one residual per close pair; dq = q − q_goal."""
     dof = dq.shape[0]
     direction = np.zeros(dof)
-    norm = math.sqrt(np.sum(dq * dq))
     if not gauss_newton:
         for j in range(dof):
-            g = r1 * dq[j] / norm if norm > 1e-12 else 0.0
-            direction[j] = -(g + weight * grad[j])
+            direction[j] = -(2.0 * dq[j] / tol_rad**2 + weight * grad[j])
         return direction
     scale = 1.0 / tol_rad
     A = np.zeros((dof, dof))

@@ -28,11 +28,18 @@ iterations, or the trust radius falls below ``min_step_rad``: status ``local_min
 with ``extra["q_stall"]`` and ``extra["descent_rad"]`` (joint-space distance travelled).
 
 Towards a goal state (:class:`~plannerlab.problem.goals.JointGoal`) the tip terms give
-way to the joint distance: ``f = r1 |q − q_goal|`` (continuous joints wrapped), the
-Gauss-Newton residual is ``(q_goal − q) / tol_rad`` (its Jacobian ``I / tol_rad``) beside
-the clearance residuals, "inside" and "deep" are the largest joint difference against
-``tol_rad`` and ``goal_depth · tol_rad``, and there is no approach point (the goal state
-says how the arm comes in). Sub-goals of the escapes stay tip targets.
+way to the joint residual ``e = (q_goal − q) / tol_rad`` (continuous joints wrapped; its
+Jacobian ``I / tol_rad``): the Gauss-Newton step is taken on it beside the clearance
+residuals, and a step is accepted when it lowers the sum of squares that step models,
+``F = |e|² + w · cost`` (``direction = "gradient"``: the step is −∇F). Accepting on
+``r1 |q − q_goal| + w · cost`` instead, whose balance with the clearance differs from the
+step's by ``|q − q_goal| / tol_rad²``, stalled the descent where the step closed on a wall
+(measured, ``gradient.clearance+detour``: 14 of the 56 legs of room variants v00-v07
+towards their witness states solved, against 40 of 56). ``f``, which the
+stall test and the trace follow, is ``r1 |q − q_goal|`` [rad]. "Inside" and "deep" are the
+largest joint difference against ``tol_rad`` and ``goal_depth · tol_rad``, and there is
+no approach point (the goal state says how the arm comes in). Sub-goals of the escapes
+stay tip targets.
 
 Escapes from a stall (``escape`` setting): ``detour`` (sub-goals near the stall: the tip
 drawn back along its own body, ``retract_step``, ``2 retract_step``, … modules, each
@@ -240,15 +247,15 @@ class ClearanceDescent:
     def _joint_direction(
         self, goal: JointGoal, field: ClearanceField, q: Array, c: Clearance
     ) -> tuple[Array, float]:
-        """:meth:`_direction` towards a goal state: f = r1 |q − q_goal| (continuous joints
-        wrapped); Gauss-Newton on the joint residual (q_goal − q) / tol_rad (its Jacobian
-        I / tol_rad) plus the clearance residuals."""
+        """:meth:`_direction` towards a goal state: F = |(q − q_goal) / tol_rad|² + w · cost
+        (continuous joints wrapped), the sum of squares whose Gauss-Newton step is taken:
+        the joint residual (q_goal − q) / tol_rad (its Jacobian I / tol_rad) and the
+        clearance residuals; or −∇F."""
         s = self.settings
         dq = joint_difference(q, goal.q_rad, goal.continuous)
-        dist = float(np.linalg.norm(dq))
-        F = s.r1 * dist + s.clearance_weight * c.cost
+        F = _joint_residual_sq(goal, q) + s.clearance_weight * c.cost
         if s.direction == "gradient":
-            g = s.r1 * dq / dist if dist > 1e-12 else np.zeros(len(q))
+            g = 2.0 * dq / goal.tol_rad**2
             return -(g + s.clearance_weight * c.gradient), F
         scale = 1.0 / goal.tol_rad
         e = -dq * scale
@@ -811,7 +818,10 @@ class _NumpyPoint:
 
     @property
     def F(self) -> float:  # noqa: N802 - the module docstring's F
-        return self.f + self._descent.settings.clearance_weight * self._clearance.cost
+        w = self._descent.settings.clearance_weight
+        if isinstance(self._goal, JointGoal):
+            return _joint_residual_sq(self._goal, self._q) + w * self._clearance.cost
+        return self.f + w * self._clearance.cost
 
     @property
     def cost(self) -> float:
@@ -906,6 +916,13 @@ class _CompiledModel:
 
 
 _Model = _NumpyModel | _CompiledModel
+
+
+def _joint_residual_sq(goal: JointGoal, q: Array) -> float:
+    """|(q − q_goal) / tol_rad|², continuous joints wrapped: the goal part of F towards a
+    goal state."""
+    e = joint_difference(q, goal.q_rad, goal.continuous) / goal.tol_rad
+    return float(e @ e)
 
 
 def _within(goal: GoalRegion, point, fraction: float) -> bool:
