@@ -285,7 +285,6 @@ MAX_FUNCTION_LINES = 150  # code lines: the docstring is not counted
 STILL_TOO_LONG = {
     "collision/core.py": "Arm-Z kernels to move out of the generic core",
     "planners/gradient_clearance.py": "settings, the numpy field and the escapes in one module",
-    "planners/_descent_core.py": "the numba kernels and their wrapper in one module",
     "planners/_descent_core.py:evaluate": "one fused numba kernel: spheres, pairs, cost, gradient",
     "planners/ompl.py": "space, goal pool, driver and roadmap planners in one module",
     "planners/ompl.py:_plan": "the OMPL driver in one function",

@@ -3,6 +3,8 @@ same field, step and hold at single states, and the same path on fixed problems.
 
 from __future__ import annotations
 
+import dataclasses
+
 import numpy as np
 import pytest
 
@@ -10,7 +12,9 @@ from plannerlab.errors import PlannerlabError
 from plannerlab.planners import make_planner
 from plannerlab.planners.base import Status
 from plannerlab.problem.catalog import load_problem
-from plannerlab.problem.load import Budget
+from plannerlab.problem.goals import JointGoal
+from plannerlab.problem.load import Budget, parse_problem
+from plannerlab.robots.base import joint_difference
 
 
 def _models(problem, **overrides):
@@ -73,6 +77,76 @@ def test_compiled_descent_takes_the_numpy_descents_path(problem_name, leg, statu
         planner = make_planner("gradient.clearance", {"backend": backend})
         r = planner.solve(problem, leg, budget, np.random.default_rng(0))
         assert r.status is status
+        paths[backend] = (r.path, r.iterations, r.collision_checks)
+    (p_np, it_np, c_np), (p_c, it_c, c_c) = paths["numpy"], paths["compiled"]
+    assert (it_c, c_c) == (it_np, c_np)
+    assert p_c.shape == p_np.shape and len(p_c) > 100
+    np.testing.assert_allclose(p_c, p_np, rtol=0.0, atol=1e-9)
+
+
+def _joint_goal_variant():
+    """``armz_inspection_v00`` with its witness states as goal states (0.01 rad)."""
+    from conftest import ROOT
+
+    problem = parse_problem(ROOT / "problems" / "variants" / "armz_inspection_v00.toml")
+    W = np.array(problem.extras["witness"]["goal_states_rad"], dtype=float)
+    goals = tuple(
+        JointGoal.at(problem.robot, g.name, w, 0.01) for g, w in zip(problem.goals, W, strict=True)
+    )
+    return dataclasses.replace(problem, goals=goals), W
+
+
+@pytest.mark.parametrize("direction", ["gauss_newton", "gradient"])
+def test_compiled_step_towards_a_goal_state_equals_numpy(direction):
+    """A goal state: f = r1 |q − q_goal|, F = |(q − q_goal) / tol|² + w · cost, the
+    joint error and the step (joint residual plus clearance) agree to rounding, at states
+    drawn round the window where walls are close. Gauss-Newton heads almost straight for
+    the goal state (not for its tip pose); steepest descent is −∇F."""
+    problem, W = _joint_goal_variant()
+    numpy_model, compiled = _models(problem, direction=direction)
+    goal = problem.goal(1)
+    rng = np.random.default_rng(3)
+    close = 0
+    for _ in range(25):
+        q = W[0] + rng.normal(0.0, 0.05, problem.robot.dof)
+        a, b = numpy_model.point(goal, q), compiled.point(goal, q)
+        dq = joint_difference(q, goal.q_rad, goal.continuous)
+        assert a.f == pytest.approx(float(np.linalg.norm(dq)), rel=1e-12)
+        # accepted on the sum of squares the Gauss-Newton step models
+        e_sq = float(np.sum((dq / goal.tol_rad) ** 2))
+        assert a.F == pytest.approx(e_sq + 0.2 * a.cost, rel=1e-12)
+        for name in ("F", "f", "joint_err", "cost"):
+            assert getattr(b, name) == pytest.approx(getattr(a, name), rel=1e-10, abs=1e-12)
+        assert b.joint_err == pytest.approx(float(np.max(np.abs(dq))), rel=1e-12)
+        np.testing.assert_allclose(b.direction, a.direction, rtol=1e-8, atol=1e-10)
+        if direction == "gauss_newton":
+            # the joint residual (in tolerances) outweighs the clearance: nearly straight
+            cos = float(-dq @ a.direction) / (np.linalg.norm(dq) * np.linalg.norm(a.direction))
+            assert cos > 0.9
+        else:  # −∇F: a short step along it lowers F
+            step = 1e-6 * a.direction / np.linalg.norm(a.direction)
+            assert numpy_model.point(goal, q + step).F < a.F
+        close += int(a.cost > 0)
+    assert close == 25  # the clearance term was in every step
+
+
+@pytest.mark.parametrize(
+    ("planner", "leg", "status"),
+    [
+        ("gradient.clearance", 0, Status.LOCAL_MINIMUM),  # through the window, stalls
+        ("gradient.clearance+detour", 4, Status.SOLVED),  # stalls, retracts, solves
+    ],
+)
+def test_compiled_descent_to_a_goal_state_takes_the_numpy_path(planner, leg, status):
+    """Same iterates towards a goal state: the whole path to 1e-9 rad."""
+    problem, W = _joint_goal_variant()
+    q0 = problem.q_start if leg == 0 else W[leg - 1]
+    paths = {}
+    for backend in ("numpy", "compiled"):
+        r = make_planner(planner, {"backend": backend}).solve(
+            problem, leg, Budget(max_iterations=3000), np.random.default_rng(0), q_start=q0
+        )
+        assert r.status is status, r.reason
         paths[backend] = (r.path, r.iterations, r.collision_checks)
     (p_np, it_np, c_np), (p_c, it_c, c_c) = paths["numpy"], paths["compiled"]
     assert (it_c, c_c) == (it_np, c_np)

@@ -123,8 +123,9 @@ def _entries() -> dict[str, PlannerEntry]:
     for name, summary, uses_rng in (
         (
             "gradient.clearance",
-            "the paper's objective plus a smooth clearance term (link distances to the scene "
-            "and each other): the descent slides along walls; no escape",
+            "the paper's objective (the joint distance towards a goal state) plus a smooth "
+            "clearance term (link distances to the scene and each other): the descent "
+            "slides along walls; no escape",
             False,
         ),
         (
