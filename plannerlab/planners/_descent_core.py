@@ -10,7 +10,7 @@ per close pair; towards a goal state, on the joint residual instead of the tip's
 :func:`hold_clearance` is the active-set projection of
 ``ClearanceDescent._hold_clearance``. Both are the numpy code's arithmetic written as
 loops (same spheres, same pairs in the same order, same formulas), so the compiled descent
-takes the numpy descent's steps to rounding (``tests/test_descent_core.py`` holds the two
+takes the numpy descent's steps to rounding (``tests/planners/test_descent_core.py`` holds the two
 paths to 1e-9 rad on a fixed problem).
 
 The chain's frames, the sphere centres and the pairs are in

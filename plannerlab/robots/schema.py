@@ -8,7 +8,7 @@ as ``str``; every key present, defaults filled in) and returns the robot. Nothin
 reads TOML: the problem loader parses every family's table with one function
 (:func:`plannerlab.problem.load.parse_robot_table`), so every key is checked, and named in
 errors, the same way. ``docs/problem-format.md`` lists the same keys, units and defaults
-(``tests/test_robot_schema.py`` compares them).
+(``tests/robots/test_robot_schema.py`` compares them).
 
 A constructor rejects a combination of values that each passed their key's checks by
 raising :class:`TableValueError` with the key to blame; the loader turns it into an error

@@ -24,7 +24,7 @@ from plannerlab.robots.urdf.model import UrdfChain
 PANDA = ROOT / "problems" / "urdf" / "panda"
 URDF = PANDA / "panda_spherized.urdf"
 SRDF = PANDA / "panda.srdf"
-MBM = Path(__file__).resolve().parent / "data" / "mbm"
+MBM = Path(__file__).resolve().parents[1] / "data" / "mbm"
 
 
 @pytest.fixture(scope="module")

@@ -13,7 +13,7 @@ from pathlib import Path
 
 import pytest
 
-PACKAGE = Path(__file__).resolve().parents[1] / "plannerlab"
+PACKAGE = Path(__file__).resolve().parents[2] / "plannerlab"
 
 #: engine -> the only place (a module path prefix, relative to the package) that may import it
 ENGINE_ROOMS = {

@@ -25,7 +25,7 @@ from plannerlab.problem.ik import sample_goal_state, solve_ik
 from plannerlab.problem.load import Budget
 from plannerlab.robots.armz.model import ArmZ
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 
 
 # ---------------------------------------------------------------------------- names

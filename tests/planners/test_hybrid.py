@@ -22,7 +22,7 @@ def _pocket_without_margin():
     stall 0.076 rad from the start, one RRT-Connect escape from it) on the trap as it was
     shaped. With the default 1-cm margin the descent meets more minima on its way (see
     :func:`test_gradient_rrtconnect_escapes_every_minimum_with_the_default_margin`);
-    ``tests/test_margin.py`` holds every planner to the margin."""
+    ``tests/planners/test_margin.py`` holds every planner to the margin."""
     return dataclasses.replace(load_problem("armz_pocket"), safety_margin_m=0.0)
 
 

@@ -33,7 +33,7 @@ from plannerlab.robots.continuum.model import (
     section_tip,
 )
 
-PROBLEMS = Path(__file__).resolve().parents[1] / "problems"
+PROBLEMS = Path(__file__).resolve().parents[2] / "problems"
 T0 = planar_frame([0.0, 0.0], [0.0, 1.0])  # section frame = world: tangent along +y
 
 

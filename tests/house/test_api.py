@@ -13,7 +13,7 @@ import nbformat
 
 import plannerlab
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 
 
 def test_every_export_resolves_and_nothing_else_does():

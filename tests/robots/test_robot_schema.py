@@ -17,7 +17,7 @@ from plannerlab.problem.load import TableReader, build_robot, parse_robot_table
 from plannerlab.robots.registry import FAMILIES, robot_table
 from plannerlab.robots.schema import Key, RobotTable, TableValueError
 
-DOC = Path(__file__).resolve().parents[1] / "docs" / "problem-format.md"
+DOC = Path(__file__).resolve().parents[2] / "docs" / "problem-format.md"
 
 
 def _doc_rows(kind: str) -> dict[str, tuple[str, str, str]]:

@@ -21,7 +21,7 @@ from plannerlab.problem.mbm import problem_toml
 from plannerlab.robots.paths import path_length
 
 PANDA = ROOT / "problems" / "urdf" / "panda"
-MBM = Path(__file__).resolve().parent / "data" / "mbm"
+MBM = Path(__file__).resolve().parents[1] / "data" / "mbm"
 
 
 def _recheck(problem, path: np.ndarray) -> None:

@@ -7,7 +7,7 @@ from pathlib import Path
 import nbformat
 from nbclient import NotebookClient
 
-NOTEBOOK = Path(__file__).resolve().parents[1] / "notebooks" / "compare.ipynb"
+NOTEBOOK = Path(__file__).resolve().parents[2] / "notebooks" / "compare.ipynb"
 
 
 def test_compare_notebook_runs_headless(tmp_path, monkeypatch):
