@@ -160,15 +160,29 @@ def mplib_spec(problem: Any) -> dict[str, Any]:
 
 
 # ---------------------------------------------------------------------- plannerlab side
-def recheck(problem: Any, path: Any, step_rad: float) -> bool:
-    """The path passes plannerlab's checker (no margin) at ``step_rad``, its ends included."""
+def recheck(problem: Any, path: Any, step_rad: float) -> str:
+    """Why the path fails plannerlab's checker (no margin) at ``step_rad``, its ends
+    included and the ends compared with the problem's start and goal; "" if it passes."""
     import numpy as np
 
     from plannerlab.collision.fcl_checker import CollisionChecker
 
     checker = CollisionChecker(problem.robot, problem.scene, backend="core", margin_m=0.0)
     P = np.atleast_2d(np.asarray(path, dtype=float))
-    return len(P) >= 2 and checker.check_path(P, step_rad).valid
+    if len(P) < 2:
+        return "fewer than two states"
+    if np.max(np.abs(P[0] - problem.q_start)) > 1e-6:
+        return "does not start at the start state"
+    goal = problem.goal(0)
+    if np.max(np.abs(P[-1] - goal.q_rad)) > goal.tol_rad + 1e-9:
+        return "does not end in the goal's tolerance"
+    check = checker.check_path(P, step_rad)
+    if check.valid:
+        return ""
+    n_edges = len(P) - 1
+    return f"edge {check.first_invalid_edge}/{n_edges}: " + ", ".join(
+        " x ".join(pair) for pair in check.pairs[:2]
+    )
 
 
 def plannerlab_runs(problems: list[Any], planner_name: str, time_limit_s: float, rng_range: float):
@@ -212,14 +226,17 @@ def summary(label: str, runs: list[dict[str, Any]], problems: dict[str, Any], st
     import numpy as np
 
     rechecked_fail = 0
+    failures: list[str] = []
     ok_times, ok_cpu = [], []
     for r in runs:
         if r["solved"]:
-            if recheck(problems[r["name"]], r["path"], step):
+            why = recheck(problems[r["name"]], r["path"], step)
+            if not why:
                 ok_times.append(r["wall_s"])
                 ok_cpu.append(r["cpu_s"])
             else:
                 rechecked_fail += 1
+                failures.append(f"{r['name']}: {why}")
     n = len(runs)
     t = np.array(ok_times) if ok_times else np.array([np.nan])
     c = np.array(ok_cpu) if ok_cpu else np.array([np.nan])
@@ -232,7 +249,8 @@ def summary(label: str, runs: list[dict[str, Any]], problems: dict[str, Any], st
         "p95_wall_ms": float(np.percentile(t, 95) * 1e3),
         "median_cpu_ms": float(np.median(c) * 1e3),
         "p95_cpu_ms": float(np.percentile(c, 95) * 1e3),
-        "statuses": sorted({r["status"] for r in runs}),
+        "statuses": {k: sum(r["status"] == k for r in runs) for k in {r["status"] for r in runs}},
+        "recheck_failures": failures,
     }
 
 
@@ -319,8 +337,8 @@ def main() -> None:
             )
     mplib_row = next((r for r in rows if r["label"].startswith("MPlib")), None)
     head = (
-        f"| planner | solved (re-checked) | failed re-check | median ms (wall) | p95 ms (wall) "
-        f"| median ms (CPU) | p95 ms (CPU) | median CPU / MPlib |"
+        "| planner | solved (re-checked) | failed re-check | median ms (wall) | p95 ms (wall) "
+        "| median ms (CPU) | p95 ms (CPU) | median CPU / MPlib |"
     )
     print(head)
     print("|" + "---|" * 8)
@@ -337,7 +355,9 @@ def main() -> None:
         )
     print(f"| {VAMP_PUBLISHED} | 699/700 | - | 0.035 | - | - | - | - |")
     for r in rows:
-        print(f"{r['label']}: statuses {', '.join(r['statuses'])}")
+        print(f"{r['label']}: statuses {r['statuses']}")
+        for f in r["recheck_failures"]:
+            print(f"  re-check failed: {f}")
     if args.json:
         args.json.write_text(json.dumps(rows, indent=1))
 
