@@ -249,6 +249,9 @@ def summary(label: str, runs: list[dict[str, Any]], problems: dict[str, Any], st
         "p95_wall_ms": float(np.percentile(t, 95) * 1e3),
         "median_cpu_ms": float(np.median(c) * 1e3),
         "p95_cpu_ms": float(np.percentile(c, 95) * 1e3),
+        "median_checks": float(np.median([r["checks"] for r in runs]))
+        if "checks" in runs[0]
+        else None,
         "statuses": {k: sum(r["status"] == k for r in runs) for k in {r["status"] for r in runs}},
         "recheck_failures": failures,
     }
@@ -355,7 +358,12 @@ def main() -> None:
         )
     print(f"| {VAMP_PUBLISHED} | 699/700 | - | 0.035 | - | - | - | - |")
     for r in rows:
-        print(f"{r['label']}: statuses {r['statuses']}")
+        checks = (
+            ""
+            if r["median_checks"] is None
+            else f", median collision checks {r['median_checks']:.0f}"
+        )
+        print(f"{r['label']}: statuses {r['statuses']}{checks}")
         for f in r["recheck_failures"]:
             print(f"  re-check failed: {f}")
     if args.json:
