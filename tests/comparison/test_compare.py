@@ -660,4 +660,10 @@ def test_the_api_checks_a_comparison_as_the_cli_does(tmp_path: Path) -> None:
         pl.compare(["armz_pocket"], ["gradient"], [0], store, budget={"max_collision_checks": 0})
     with pytest.raises(PlannerlabError, match="backend: expected one of local, ray"):
         pl.compare(["armz_pocket"], ["gradient"], [0], store, backend="slurm")
+    with pytest.raises(PlannerlabError, match="budget: unknown key.s. max_checks"):
+        pl.compare(["armz_pocket"], ["gradient"], [0], store, budget={"max_checks": 10})
+    with pytest.raises(PlannerlabError, match="settings for ompl.rrt, which is not among"):
+        pl.compare(["armz_pocket"], ["gradient"], [0], store, settings={"ompl.rrt": {"a": 1}})
+    with pytest.raises(PlannerlabError, match="seeds: give at least one seed"):
+        pl.compare(["armz_pocket"], ["gradient"], [], store)
     assert not store.exists()

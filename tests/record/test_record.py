@@ -65,3 +65,41 @@ def test_a_plan_file_without_legs_is_refused(tmp_path):
     bad.write_text(json.dumps({**plan, "legs": []}))
     with pytest.raises(PlanFileError, match=r"\[legs\] expected a non-empty list"):
         Plan.load(bad)
+
+
+@pytest.mark.parametrize(
+    ("contact_plan", "expected"),
+    [
+        ({"chosen": 0}, "not a contact plan: KeyError: 'base_xy_m'"),
+        ([1, 2], "not a contact plan: list"),
+    ],
+)
+def test_a_plan_file_with_a_broken_contact_plan_is_refused(tmp_path, contact_plan, expected):
+    """A chord_arc leg's contact plan is read back as a typed record: a broken one is
+    refused with the file named, not carried on as an untyped dict."""
+    bad = tmp_path / "plan.json"
+    plan = Plan("toy", "", "p", 1, {}, (_result(np.zeros((1, 2))),)).to_dict()
+    plan["legs"][0]["contact_plan"] = contact_plan
+    bad.write_text(json.dumps(plan))
+    with pytest.raises(PlanFileError, match=str(bad)) as err:
+        Plan.load(bad)
+    assert expected in str(err.value)
+
+
+def test_a_contact_plan_choosing_a_missing_solution_is_refused():
+    from plannerlab.record.contact_plan import ContactPlan
+
+    good = {
+        "base_xy_m": [0, 0],
+        "base_tangent": [0, 1],
+        "target_xy_m": [0, 1],
+        "obstacles": [],
+        "planning_obstacles": [],
+        "collision_points_m": [],
+        "link_radius_m": 0.002,
+        "inflated_by_m": 0.002,
+        "contact_tolerance_m": 0.014,
+    }
+    assert ContactPlan.from_dict(good).chosen_solution is None
+    with pytest.raises(PlanFileError, match="chosen = 2 but there are 0 solutions"):
+        ContactPlan.from_dict({**good, "chosen": 2})
