@@ -289,7 +289,6 @@ STILL_TOO_LONG = {
     "planners/ompl.py:_plan": "the OMPL driver in one function",
     "robots/urdf/model.py:__post_init__": "URDF reading, chain folding and capsules in one method",
     "robots/irb6/ik.py": "the analytic IK's cases",
-    "sim/execute.py:_run": "retiming, tracking and measuring in one function",
 }
 
 
