@@ -287,7 +287,6 @@ STILL_TOO_LONG = {
     "planners/_descent_core.py:evaluate": "one fused numba kernel: spheres, pairs, cost, gradient",
     "planners/ompl.py": "space, goal pool, driver and roadmap planners in one module",
     "planners/ompl.py:_plan": "the OMPL driver in one function",
-    "robots/irb6/ik.py": "the analytic IK's cases",
 }
 
 
