@@ -6,7 +6,7 @@ one-line meaning), and a constructor ``build(values)`` that takes the validated 
 values (a number as ``float``, an integer as ``int``, a vector as a float array, a string
 as ``str``; every key present, defaults filled in) and returns the robot. Nothing here
 reads TOML: the problem loader parses every family's table with one function
-(:func:`plannerlab.problem.load.parse_robot_table`), so every key is checked, and named in
+(:func:`plannerlab.problem.robot_table.parse_robot_table`), so every key is checked, and named in
 errors, the same way. ``docs/problem-format.md`` lists the same keys, units and defaults
 (``tests/robots/test_robot_schema.py`` compares them).
 

@@ -148,15 +148,24 @@ from typing import Any
 
 import numpy as np
 
-from plannerlab.collision.fcl_checker import CollisionChecker, problem_checker
-from plannerlab.collision.reach import joint_reach_m
+from plannerlab.collision.fcl_checker import CollisionChecker, PathCheck, problem_checker
 from plannerlab.errors import PlannerlabError
 from plannerlab.problem.load import Problem
 from plannerlab.record.execution import ContactRecord, Execution
-from plannerlab.robots.base import Array, as_xyz, joint_difference
-from plannerlab.robots.paths import densify
-from plannerlab.sim.measure import geometry_deviation_m, sampled_clearance
-from plannerlab.sim.retime import GRID_PER_KNOT, INTERPOLANT, retime, unwrap_path
+from plannerlab.robots.base import Array, Robot, joint_difference
+from plannerlab.sim.measure import (
+    Clearance,
+    plan_deviation,
+    sampled_clearance,
+)
+from plannerlab.sim.retime import GRID_PER_KNOT, INTERPOLANT
+from plannerlab.sim.track import (
+    StepRecorder,
+    Tracked,
+    retimed,
+    track_trajectory,
+    track_waypoints,
+)
 from plannerlab.sim.world import DT_S, SimWorld
 
 #: physics steps per densified waypoint (0.1 s)
@@ -165,12 +174,6 @@ STEPS_PER_WAYPOINT: int = 24
 SETTLE_STEPS: int = 240
 #: penetration depth above which a contact point counts [m]
 CONTACT_TOL_M: float = 0.0
-#: physics steps between logged samples of a retimed execution (20 Hz)
-LOG_EVERY_STEPS: int = 12
-#: PyBullet position gain when tracking a retimed trajectory: 1 corrects the whole
-#: position error within one step (PyBullet's default 0.1 lags); with the velocity
-#: feed-forward it kept the 24-module arm within 3e-4 rad on a 9.9 rad RRT-Connect path
-TRACK_POSITION_GAIN: float = 1.0
 #: PyBullet's constraint solver for executions (see the module docstring)
 SOLVER: str = "dantzig"
 
@@ -186,29 +189,17 @@ def _check_path(problem: Problem, path: Any) -> Array:
     return path
 
 
-def _run(
-    world: SimWorld,
-    checker: CollisionChecker,
+def _limits(
     problem: Problem,
-    path: Array,
-    leg: int | None,
-    carried_over: bool,
     joint_step: float | None,
     waypoint_step: float | None,
     steps_per_waypoint: int,
     settle_steps: int,
-    contact_tol_m: float,
     track_err_limit_rad: float | None,
-    timing: str,
-    *,
-    probe: SimWorld,
-    max_deviation_m: float | None = None,
-    grid_per_knot: int = GRID_PER_KNOT,
-    interpolant: str = INTERPOLANT,
-) -> Execution:
-    t0 = time.perf_counter()
-    robot = problem.robot
-    cont = np.asarray(robot.continuous, dtype=bool)
+    max_deviation_m: float | None,
+) -> tuple[float, float, float, float]:
+    """The run's settings, checked, the problem's where not given: (track_limit [rad],
+    dev_limit [m], recheck_step [rad], wp_step [rad])."""
     if steps_per_waypoint < 1 or settle_steps < 0:
         raise PlannerlabError(
             f"steps_per_waypoint >= 1 and settle_steps >= 0, got {steps_per_waypoint}, "
@@ -232,177 +223,84 @@ def _run(
     wp_step = float(waypoint_step) if waypoint_step is not None else problem.joint_step
     if not (recheck_step > 0 and wp_step > 0):
         raise PlannerlabError(f"joint steps must be positive, got {recheck_step}, {wp_step}")
-    check = checker.check_path(path, recheck_step)
+    return track_limit, dev_limit, recheck_step, wp_step
 
-    if not carried_over:
-        world.reset(path[0])
-    q_start = world.state()
-    start_offset = float(np.max(np.abs(joint_difference(q_start, path[0], cont)), initial=0.0))
 
-    steps0 = world.steps_taken
-    seen: dict[tuple[str, str, bool], list[Any]] = {}
-    # Every physics step's simulated state, and the state commanded for it.
-    q_step: list[Array] = []
-    q_step_cmd: list[Array] = []
+def _measure(
+    robot: Robot,
+    probe: SimWorld,
+    rec: StepRecorder,
+    tracked: Tracked,
+    settle_steps: int,
+    steps_per_waypoint: int,
+) -> tuple[Array, float, float, Clearance]:
+    """Every physics step's deviation from the plan (per log sample, the largest and its
+    time: :func:`~plannerlab.sim.measure.plan_deviation`) and the simulated clearance
+    sampled along them (in the probe world)."""
+    states = np.array(rec.q_step).reshape(len(rec.q_step), robot.dof)
+    deviation, max_dev, max_dev_t = plan_deviation(
+        robot,
+        states,
+        np.array(rec.q_step_cmd).reshape(len(rec.q_step), robot.dof),
+        tracked.t_s,
+        rec.world.dt_s,
+        q_plan=tracked.q_plan,
+        settle_steps=settle_steps,
+        window_steps=steps_per_waypoint,
+    )
+    return deviation, max_dev, max_dev_t, sampled_clearance(robot, probe, states)
 
-    def run_steps(n: int, q_target: Array) -> None:
-        for _ in range(n):
-            world.step(1)
-            q_step.append(world.state())
-            q_step_cmd.append(q_target)
-            t = (world.steps_taken - steps0) * world.dt_s
-            for c in world.contacts(min_depth_m=contact_tol_m):
-                key = (c.link_name, c.other_name, c.other_is_link)
-                rec = seen.get(key)
-                if rec is None:
-                    seen[key] = [c.depth_m, t, c.p_world_m]
-                elif c.depth_m > rec[0]:
-                    rec[0], rec[2] = c.depth_m, c.p_world_m
 
-    timing_used = "waypoints"
-    notes: list[str] = []
-    ref_dev = 0.0
-    traj = None
-    traj_check = None
-    if timing == "toppra":
-        # The path continues from where the arm really is (carried over from the previous
-        # leg: a short move to the path's first state is prepended).
-        q_path = unwrap_path(path, cont, q_from=q_start)
-        if start_offset > 1e-9:
-            q_path = np.vstack([q_start[None, :], q_path])
-        try:
-            traj = retime(
-                q_path,
-                velocity_limit=world.max_velocity,
-                effort_limit=world.max_force,
-                inverse_dynamics=world.inverse_dynamics,
-                knot_step=recheck_step,
-                grid_per_knot=grid_per_knot,
-                reach_m=checker.reach_m if checker.reach_m is not None else joint_reach_m(robot),
-                to_urdf=world.to_urdf,
-                interpolant=interpolant,
-            )
-            timing_used = "toppra"
-        except Exception as exc:  # toppra or the simulator's inverse dynamics
-            notes.append(f"not retimed ({exc}); executed along densified waypoints")
-    elif timing != "waypoints":
-        raise PlannerlabError(f"timing: expected 'toppra' or 'waypoints', got {timing!r}")
-
-    if traj is not None:
-        n = max(1, int(math.ceil(traj.duration_s / world.dt_s - 1e-9)))
-        t_all: Array = np.arange(1, n + 1, dtype=np.float64) * world.dt_s
-        q_urdf = traj.sample(np.concatenate([[0.0], t_all]))[0]
-        # Step k goes from t_k to t_k+1: the position target is the reference at t_k and
-        # the velocity target the reference's mean velocity over the step (PyBullet's
-        # motor adds gain × the *current* position error to the velocity target; a
-        # position target at t_k+1 would make the arm lead by one step, v·dt).
-        qd_urdf = np.diff(q_urdf, axis=0) / world.dt_s
-        q_all = world.from_urdf(q_urdf[1:])
-        # The plan's state at each step's path parameter: what the deviation is measured
-        # against (the reference is within traj.bound_m of it, measured below).
-        q_plan_all = traj.plan_states(t_all)
-        ref_dev = float(np.max(geometry_deviation_m(robot, q_plan_all, q_all), initial=0.0))
-        # The commanded states are re-checked too, with the plan's margin: the spline must
-        # keep the room the plan left. Every physics step's reference state is checked
-        # (and the edges between them in metres): thinning them to one per joint step,
-        # as before, joined the kept states by straight lines and missed the spline
-        # bulging between them (a room variant: re-check passed, the reference came
-        # within 4 mm of a wall the plan kept 28 mm from).
-        traj_check = checker.check_path(q_all, recheck_step)
-        err_all = np.empty(n)
-        logged = sorted(set(range(LOG_EVERY_STEPS - 1, n, LOG_EVERY_STEPS)) | {n - 1})
-        q_act_list: list[Array] = []
-        for k in range(n):
-            world.command_urdf(q_urdf[k], qd_urdf[k], position_gain=TRACK_POSITION_GAIN)
-            run_steps(1, q_all[k])
-            q_now = q_step[-1]
-            err_all[k] = np.max(np.abs(joint_difference(q_all[k], q_now, cont)), initial=0.0)
-            if k == logged[len(q_act_list)]:
-                q_act_list.append(q_now)
-        q_cmd = q_all[logged]
-        q_act = np.array(q_act_list)
-        t_s = t_all[logged]
-        window_track = np.maximum.reduceat(err_all, [0, *[k + 1 for k in logged[:-1]]])
-        world.command_urdf(q_urdf[-1], np.zeros(robot.dof), position_gain=TRACK_POSITION_GAIN)
-        run_steps(settle_steps, q_all[-1])
-        q_final = world.state()
-        duration = traj.duration_s
-        steps_logged = LOG_EVERY_STEPS
-        wp_step = recheck_step
-    else:
-        q_cmd, _ = densify(path, wp_step, cont)
-        M = len(q_cmd)
-        q_act = np.empty_like(q_cmd)
-        t_s = np.empty(M)
-        for k in range(M):
-            world.command(q_cmd[k])
-            run_steps(steps_per_waypoint, q_cmd[k])
-            q_act[k] = q_step[-1]
-            t_s[k] = (world.steps_taken - steps0) * world.dt_s
-        world.command(q_cmd[-1])
-        run_steps(settle_steps, q_cmd[-1])
-        q_final = world.state()
-        window_track = None
-        duration = M * steps_per_waypoint * world.dt_s
-        steps_logged = steps_per_waypoint
-
-    # Deviation from the PLAN: every physics step of a retimed trajectory against the
-    # planned polyline's state at the reference's path parameter (so it holds the
-    # reference's own distance from the plan, reference_deviation_m, and the tracking);
-    # with "waypoints" timing the commands are the densified plan itself and the arm
-    # moves towards each waypoint over its window, so it is measured where it should
-    # have arrived (the window's last step), and at every settling step.
-    states = np.array(q_step).reshape(len(q_step), robot.dof)
-    targets = np.array(q_step_cmd).reshape(len(q_step), robot.dof)
-    if traj is not None:
-        targets = np.vstack([q_plan_all, targets[len(q_plan_all) :]])
-    n_moving = len(states) - settle_steps
-    if traj is not None:
-        judged = np.arange(len(states))
-    else:
-        judged = np.concatenate(
-            [
-                np.arange(steps_per_waypoint - 1, n_moving, steps_per_waypoint),
-                np.arange(n_moving, len(states)),
-            ]
-        ).astype(int)
-    dev_steps = geometry_deviation_m(robot, targets[judged], states[judged])
-    worst_dev = int(np.argmax(dev_steps)) if len(dev_steps) else 0
-    max_dev = float(dev_steps[worst_dev]) if len(dev_steps) else 0.0
-    max_dev_t = float((judged[worst_dev] + 1) * world.dt_s) if len(dev_steps) else 0.0
-    # per log sample: the largest deviation since the previous sample (settling excluded)
-    step_of_sample = np.rint(t_s / world.dt_s).astype(int) - 1
-    dev_full = np.zeros(len(states))
-    dev_full[judged] = dev_steps
-    bounds = np.concatenate([[0], step_of_sample[:-1] + 1]) if len(t_s) else np.zeros(0, int)
-    deviation = np.maximum.reduceat(dev_full, bounds) if len(t_s) else np.zeros(0)
-    clear = sampled_clearance(robot, probe, states)
-    clear_t = float((clear.index + 1) * world.dt_s)
-
+def _tracking_errors(robot: Robot, tracked: Tracked) -> tuple[Array, Array, float, float]:
+    """Per logged sample the joint tracking error [rad] (over its window when the tracking
+    measured one) and the tip's [m]; the same of the final state."""
+    cont = np.asarray(robot.continuous, dtype=bool)
+    q_cmd, q_act, q_final = tracked.q_cmd, tracked.q_act, tracked.q_final
     track = (
-        window_track
-        if window_track is not None
+        tracked.window_track
+        if tracked.window_track is not None
         else np.max(np.abs(joint_difference(q_cmd, q_act, cont)), axis=1)
     )
     tip_track = np.linalg.norm(robot.tip(q_cmd)[0] - robot.tip(q_act)[0], axis=1)
     final_track = float(np.max(np.abs(joint_difference(q_cmd[-1], q_final, cont)), initial=0.0))
     final_tip_track = float(np.linalg.norm(robot.tip(q_cmd[-1])[0] - robot.tip(q_final)[0]))
+    return track, tip_track, final_track, final_tip_track
 
-    goal_name: str | None = None
-    pos_err = ang_err = math.nan
-    reached: bool | None = None
-    if leg is not None:
-        goal = problem.goal(leg)
-        goal_name = goal.name
-        pe, ae = goal.errors(robot, q_final)
-        pos_err, ang_err = float(pe), float(ae)
-        reached = bool(pos_err <= goal.pos_tol_m and ang_err <= goal.angle_tol_deg)
 
-    contacts = tuple(
-        ContactRecord(link, other, is_link, float(rec[0]), float(rec[1]), as_xyz(rec[2]))
-        for (link, other, is_link), rec in sorted(seen.items(), key=lambda kv: kv[1][1])
+def _goal_errors(
+    problem: Problem, leg: int | None, q_final: Array
+) -> tuple[str | None, float, float, bool | None, str | None]:
+    """The final state against the leg's goal: (goal name, tip position error [m], angle
+    error [deg], reached, why not in words); no goal without a leg."""
+    if leg is None:
+        return None, math.nan, math.nan, None, None
+    goal = problem.goal(leg)
+    pe, ae = goal.errors(problem.robot, q_final)
+    pos_err, ang_err = float(pe), float(ae)
+    reached = bool(pos_err <= goal.pos_tol_m and ang_err <= goal.angle_tol_deg)
+    missed = (
+        None
+        if reached
+        else f"final tip {pos_err:.3g} m / {ang_err:.3g} deg from goal {goal.name!r} "
+        f"(tolerance {goal.pos_tol_m:g} m / {goal.angle_tol_deg:g} deg)"
     )
+    return goal.name, pos_err, ang_err, reached, missed
 
+
+def _problems(
+    check: PathCheck,
+    traj_check: PathCheck | None,
+    recheck_step: float,
+    contacts: tuple[ContactRecord, ...],
+    missed_goal: str | None,
+    max_dev: float,
+    max_dev_t: float,
+    dev_limit: float,
+    ref_dev: float,
+    clear: Clearance,
+    clear_t: float,
+) -> list[str]:
+    """Why an execution is not clean, in words (empty: it is)."""
     problems: list[str] = []
     if not check.valid:
         listing = ", ".join(f"{a} x {b}" for a, b in check.pairs)
@@ -423,13 +321,8 @@ def _run(
             f"{worst.link_name} x {worst.other_name} "
             f"{worst.max_depth_m * 1e3:.1f} mm at t = {worst.first_time_s:.3f} s"
         )
-    if reached is False:
-        goal = problem.goal(leg)  # type: ignore[arg-type]
-        problems.append(
-            f"final tip {pos_err:.3g} m / {ang_err:.3g} deg from goal "
-            f"{goal.name!r} (tolerance {goal.pos_tol_m:g} m / "
-            f"{goal.angle_tol_deg:g} deg)"
-        )
+    if missed_goal is not None:
+        problems.append(missed_goal)
     if max_dev > dev_limit:
         problems.append(
             f"the robot strayed {max_dev * 1e3:.3g} mm from the plan at "
@@ -442,24 +335,110 @@ def _run(
             f"simulated clearance {clear.clearance_m * 1e3:.3g} mm ({a} x {b}) at "
             f"t = {clear_t:.3f} s"
         )
-    if problems:
-        reason = "; ".join(problems)
+    return problems
+
+
+def _run(
+    world: SimWorld,
+    checker: CollisionChecker,
+    problem: Problem,
+    path: Array,
+    leg: int | None,
+    carried_over: bool,
+    joint_step: float | None,
+    waypoint_step: float | None,
+    steps_per_waypoint: int,
+    settle_steps: int,
+    contact_tol_m: float,
+    track_err_limit_rad: float | None,
+    timing: str,
+    *,
+    probe: SimWorld,
+    max_deviation_m: float | None = None,
+    grid_per_knot: int = GRID_PER_KNOT,
+    interpolant: str = INTERPOLANT,
+) -> Execution:
+    """One leg: re-checked, retimed, tracked, measured and judged (see :func:`execute`)."""
+    t0 = time.perf_counter()
+    robot = problem.robot
+    track_limit, dev_limit, recheck_step, wp_step = _limits(
+        problem,
+        joint_step,
+        waypoint_step,
+        steps_per_waypoint,
+        settle_steps,
+        track_err_limit_rad,
+        max_deviation_m,
+    )
+    check = checker.check_path(path, recheck_step)
+    if not carried_over:
+        world.reset(path[0])
+    q_start = world.state()
+    offsets = joint_difference(q_start, path[0], np.asarray(robot.continuous, dtype=bool))
+    start_offset = float(np.max(np.abs(offsets), initial=0.0))
+    rec = StepRecorder(world, contact_tol_m)
+    notes: list[str] = []
+    traj = retimed(
+        world,
+        checker.reach_m,
+        path,
+        q_start,
+        start_offset,
+        timing,
+        recheck_step,
+        grid_per_knot,
+        interpolant,
+        notes,
+    )
+    traj_check = None
+    if traj is not None:
+        tracked = track_trajectory(world, rec, traj, settle_steps)
+        assert tracked.q_ref is not None
+        # The commanded states are re-checked too, with the plan's margin: the spline must
+        # keep the room the plan left. Every physics step's reference state is checked
+        # (and the edges between them in metres): thinning them to one per joint step,
+        # as before, joined the kept states by straight lines and missed the spline
+        # bulging between them (a room variant: re-check passed, the reference came
+        # within 4 mm of a wall the plan kept 28 mm from).
+        traj_check = checker.check_path(tracked.q_ref, recheck_step)
+        wp_step = recheck_step
     else:
+        tracked = track_waypoints(world, rec, path, wp_step, steps_per_waypoint, settle_steps)
+    t_s, q_cmd, q_act, q_final = tracked.t_s, tracked.q_cmd, tracked.q_act, tracked.q_final
+    ref_dev = tracked.reference_deviation_m
+    deviation, max_dev, max_dev_t, clear = _measure(
+        robot, probe, rec, tracked, settle_steps, steps_per_waypoint
+    )
+    clear_t = float((clear.index + 1) * world.dt_s)
+    track, tip_track, final_track, final_tip_track = _tracking_errors(robot, tracked)
+    goal_name, pos_err, ang_err, reached, missed_goal = _goal_errors(problem, leg, q_final)
+    contacts = rec.contacts()
+    problems = _problems(
+        check,
+        traj_check,
+        recheck_step,
+        contacts,
+        missed_goal,
+        max_dev,
+        max_dev_t,
+        dev_limit,
+        ref_dev,
+        clear,
+        clear_t,
+    )
+    if not problems:
         moved = (
-            f"executed a {duration:.3g} s trajectory (toppra)"
+            f"executed a {tracked.duration_s:.3g} s trajectory (toppra)"
             if traj is not None
             else f"executed {len(q_cmd)} waypoints"
         )
-        reason = (
+        done = f"; final tip {pos_err:.3g} m / {ang_err:.3g} deg from {goal_name!r}"
+        problems = [
             f"{moved} without contact; deviation from the plan <= {max_dev * 1e3:.3g} mm "
             f"(reference <= {ref_dev * 1e3:.3g} mm), clearance >= "
-            f"{clear.clearance_m * 1e3:.3g} mm"
-        )
-        if reached:
-            reason += f"; final tip {pos_err:.3g} m / {ang_err:.3g} deg from {goal_name!r}"
-
-    if notes:
-        reason = "; ".join([reason, *notes])
+            f"{clear.clearance_m * 1e3:.3g} mm" + (done if reached else "")
+        ]
+    reason = "; ".join([*problems, *notes])
 
     return Execution(
         problem=problem.name,
@@ -471,7 +450,7 @@ def _run(
         recheck_first_invalid_edge=check.first_invalid_edge,
         recheck_pairs=check.pairs,
         waypoint_step=wp_step,
-        steps_per_waypoint=int(steps_logged),
+        steps_per_waypoint=int(tracked.steps_logged),
         settle_steps=int(settle_steps),
         dt_s=world.dt_s,
         contact_tol_m=float(contact_tol_m),
@@ -491,12 +470,12 @@ def _run(
         final_pos_err_m=pos_err,
         final_angle_err_deg=ang_err,
         goal_reached=reached,
-        sim_time_s=(world.steps_taken - steps0) * world.dt_s,
+        sim_time_s=rec.elapsed_s(),
         wall_time_s=time.perf_counter() - t0,
         reason=reason,
         track_err_limit_rad=track_limit,
-        timing=timing_used,
-        duration_s=duration,
+        timing="waypoints" if traj is None else "toppra",
+        duration_s=tracked.duration_s,
         trajectory_valid=None if traj_check is None else traj_check.valid,
         spline_dev=math.nan if traj is None else traj.max_dev,
         deviation_m=deviation,

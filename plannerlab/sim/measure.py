@@ -3,7 +3,8 @@
 Two measures make the verdict of an execution (:mod:`plannerlab.sim.execute`):
 
 * :func:`geometry_deviation_m`: the largest displacement of any point of the robot's
-  collision geometry between two states (commanded and simulated), over every link;
+  collision geometry between two states (commanded and simulated), over every link
+  (:func:`plan_deviation`: over an execution's physics steps, against the plan);
 * :func:`sampled_clearance`: the smallest simulated clearance along a sequence of states,
   to the scene and between links, from PyBullet's closest points
   (``getClosestPoints``) in a *probe* world: a second :class:`~plannerlab.sim.world.SimWorld`
@@ -133,6 +134,54 @@ def geometry_deviation_m(robot: Robot, q_a: Array, q_b: Array) -> Array:
     return out
 
 
+def plan_deviation(
+    robot: Robot,
+    states: Array,
+    commanded: Array,
+    t_s: Array,
+    dt_s: float,
+    *,
+    q_plan: Array | None,
+    settle_steps: int,
+    window_steps: int,
+) -> tuple[Array, float, float]:
+    """The deviation of an execution's collision geometry from the PLAN: (per log sample
+    at ``t_s`` the largest since the previous sample; the largest [m]; its time [s]).
+
+    ``states`` (n, dof) are every physics step's simulated states, ``commanded`` the states
+    commanded for them. A retimed trajectory (``q_plan``: the planned polyline's state at
+    the reference's path parameter of each moving step) is measured at every step against
+    the plan (so it holds the reference's own distance from the plan and the tracking),
+    the settling steps against their command. With waypoints (``q_plan`` None) the
+    commands are the densified plan itself and the arm moves towards each waypoint over
+    its window of ``window_steps``, so it is measured where it should have arrived (the
+    window's last step), and at every settling step.
+    """
+    targets = commanded
+    if q_plan is not None:
+        targets = np.vstack([q_plan, targets[len(q_plan) :]])
+        judged = np.arange(len(states))
+    else:
+        n_moving = len(states) - settle_steps
+        judged = np.concatenate(
+            [
+                np.arange(window_steps - 1, n_moving, window_steps),
+                np.arange(n_moving, len(states)),
+            ]
+        ).astype(int)
+    dev_steps = geometry_deviation_m(robot, targets[judged], states[judged])
+    worst_dev = int(np.argmax(dev_steps)) if len(dev_steps) else 0
+    max_dev = float(dev_steps[worst_dev]) if len(dev_steps) else 0.0
+    max_dev_t = float((judged[worst_dev] + 1) * dt_s) if len(dev_steps) else 0.0
+    # per log sample: the largest deviation since the previous sample (settling excluded)
+    step_of_sample = np.rint(t_s / dt_s).astype(int) - 1
+    dev_full = np.zeros(len(states))
+    dev_full[judged] = dev_steps
+    bounds = np.concatenate([[0], step_of_sample[:-1] + 1]) if len(t_s) else np.zeros(0, int)
+    deviation = np.maximum.reduceat(dev_full, bounds) if len(t_s) else np.zeros(0)
+    return deviation, max_dev, max_dev_t
+
+
 @dataclass(frozen=True)
 class Clearance:
     """The smallest clearance met along a sequence of states.
@@ -252,5 +301,6 @@ __all__ = [
     "Clearance",
     "ClosestPoints",
     "geometry_deviation_m",
+    "plan_deviation",
     "sampled_clearance",
 ]

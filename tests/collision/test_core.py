@@ -6,8 +6,9 @@ import numpy as np
 import pytest
 
 from plannerlab.collision.agreement import KINDS, compare, sample_states
-from plannerlab.collision.core import Core, edge_states
+from plannerlab.collision.core import Core
 from plannerlab.collision.fcl_checker import CollisionChecker
+from plannerlab.collision.kernels import edge_states
 from plannerlab.errors import PlannerlabError
 from plannerlab.problem.catalog import load_problem
 from plannerlab.problem.scene import Box, Cylinder, Scene, Sphere

@@ -283,15 +283,10 @@ MAX_FUNCTION_LINES = 150  # code lines: the docstring is not counted
 #: modules and functions still over the limits, each to be split along its seams (issue
 #: 20, point 5); a module that gets under its limit must leave this list
 STILL_TOO_LONG = {
-    "collision/core.py": "Arm-Z kernels to move out of the generic core",
     "planners/gradient_clearance.py": "settings, the numpy field and the escapes in one module",
     "planners/_descent_core.py:evaluate": "one fused numba kernel: spheres, pairs, cost, gradient",
     "planners/ompl.py": "space, goal pool, driver and roadmap planners in one module",
     "planners/ompl.py:_plan": "the OMPL driver in one function",
-    "problem/load.py": "the loader per table",
-    "robots/urdf/model.py:__post_init__": "URDF reading, chain folding and capsules in one method",
-    "robots/irb6/ik.py": "the analytic IK's cases",
-    "sim/execute.py:_run": "retiming, tracking and measuring in one function",
 }
 
 

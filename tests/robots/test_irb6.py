@@ -19,10 +19,9 @@ from plannerlab.robots.irb6.ik import (
     pose_from_approach,
     solve_ik,
     solve_with_lambda0,
-    wrist_annulus_m,
-    wrist_radius_intervals_m,
 )
 from plannerlab.robots.irb6.model import IRb6
+from plannerlab.robots.irb6.wrist import wrist_annulus_m, wrist_radius_intervals_m
 
 # Hand-worked numbers for the default robot (λ1 = 0.700, l2 = 0.455, l3 = 0.670, λ5 = 0.095).
 # At the wrist height h_w = λ1 + l2·cos 40° = 0.700 + 0.455·0.766044 = 1.048550 m the slice of

@@ -13,7 +13,8 @@ import numpy as np
 import pytest
 
 from plannerlab.errors import ProblemError, UnknownNameError
-from plannerlab.problem.load import TableReader, build_robot, parse_robot_table
+from plannerlab.problem.reader import TableReader
+from plannerlab.problem.robot_table import build_robot, parse_robot_table
 from plannerlab.robots.registry import FAMILIES, robot_table
 from plannerlab.robots.schema import Key, RobotTable, TableValueError
 

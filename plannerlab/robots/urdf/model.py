@@ -93,6 +93,236 @@ def read_srdf_disabled(path: Path) -> list[tuple[str, str]]:
     return [(str(e.get("link1")), str(e.get("link2"))) for e in root.iter("disable_collisions")]
 
 
+def _joint_axis(j: Any) -> Array:
+    """A URDF joint's unit axis (x when none is given)."""
+    a = np.array([1.0, 0.0, 0.0] if j.axis is None else j.axis, dtype=float)
+    n = float(np.linalg.norm(a))
+    if n < 1e-12:
+        raise UrdfError("urdf", f"a non-zero axis on joint {j.name}")
+    return a / n
+
+
+def _joint_limits(j: Any) -> tuple[float, float]:
+    """A URDF joint's limits (a continuous joint's: one turn)."""
+    if j.type == "continuous":
+        return (-math.pi, math.pi)
+    lim = j.limit
+    if lim is None or lim.lower is None or lim.upper is None:
+        raise UrdfError("urdf", f"lower and upper limits on joint {j.name} ({j.type})")
+    lo, hi = float(lim.lower), float(lim.upper)
+    if not (math.isfinite(lo) and math.isfinite(hi) and lo <= hi):
+        raise UrdfError("urdf", f"limits lower <= upper on joint {j.name}, got {lo}, {hi}")
+    return lo, hi
+
+
+def _origin(x: Any) -> Array:
+    return np.eye(4) if x.origin is None else np.asarray(x.origin, dtype=float)
+
+
+def _load_urdf(path: Path) -> Any:
+    """The parsed URDF (``yourdfpy``'s ``Robot``: links and joints, no meshes)."""
+    import yourdfpy
+
+    if not path.is_file():
+        raise UrdfError("urdf", f"an existing URDF file; {path} does not exist")
+    try:  # yourdfpy would recover from broken XML and read part of it
+        ET.parse(path)
+    except ET.ParseError as exc:
+        raise UrdfError("urdf", f"a well-formed URDF (XML); {path}: {exc}") from None
+    try:
+        model = yourdfpy.URDF.load(
+            str(path),
+            build_scene_graph=False,
+            build_collision_scene_graph=False,
+            load_meshes=False,
+            load_collision_meshes=False,
+        )
+    except Exception as exc:  # yourdfpy raises many kinds for a malformed file
+        raise UrdfError("urdf", f"a valid URDF; {path}: {exc}") from None
+    return model.robot
+
+
+@dataclass(frozen=True)
+class _Tree:
+    """A URDF's links by name, each link's joint to its parent, the root link, the
+    movable joints from the root to the tip link in order, and the movable joints off
+    that chain with the value each is frozen at."""
+
+    links: dict[str, Any]
+    joint_of_child: dict[str, Any]
+    root: str
+    movable: list[Any]
+    frozen: dict[str, float]
+
+
+def _chain(urdf: Any, tip_link: str, path: Path) -> _Tree:
+    """The chain from the URDF's root link to ``tip_link``, its joints checked."""
+    links = {link.name: link for link in urdf.links}
+    joint_of_child = {j.child: j for j in urdf.joints}
+    children = set(joint_of_child)
+    roots = [n for n in links if n not in children]
+    if len(roots) != 1:
+        raise UrdfError("urdf", f"a URDF tree with one root link; {path} has {roots}")
+    root = roots[0]
+    if tip_link not in links:
+        raise UrdfError(
+            "tip_link",
+            f"a link of {path.name}, got {tip_link!r}{_hint(tip_link, list(links))}; "
+            f"its links: {', '.join(links)}",
+        )
+    # the chain: root -> tip
+    chain: list[Any] = []
+    name = tip_link
+    while name != root:
+        j = joint_of_child[name]
+        chain.append(j)
+        name = j.parent
+    chain.reverse()
+    for j in chain:
+        if j.type not in MOVABLE + ("fixed",):
+            raise UrdfError(
+                "urdf", f"revolute, continuous, prismatic or fixed joints; {j.name} is {j.type}"
+            )
+        if j.type in MOVABLE and j.mimic is not None:
+            raise UrdfError("urdf", f"no mimic joint on the chain; {j.name} mimics one")
+    movable = [j for j in chain if j.type in MOVABLE]
+    chain_names = {j.name for j in movable}
+    frozen: dict[str, float] = {}
+    for j in urdf.joints:
+        if j.type in MOVABLE and j.name not in chain_names:
+            lo, hi = _joint_limits(j)
+            frozen[j.name] = float(np.clip(0.0, lo, hi))
+        elif j.type not in MOVABLE + ("fixed",):
+            raise UrdfError(
+                "urdf", f"revolute, continuous, prismatic or fixed joints; {j.name} is {j.type}"
+            )
+    return _Tree(links, joint_of_child, root, movable, frozen)
+
+
+def _place_links(tree: _Tree) -> dict[str, tuple[int, Array]]:
+    """Every link's body and its pose on that body: (body, T_body_link) by link name."""
+    body_of_joint = {j.name: i + 1 for i, j in enumerate(tree.movable)}
+    placed: dict[str, tuple[int, Array]] = {tree.root: (0, np.eye(4))}
+
+    def place(link: str) -> tuple[int, Array]:
+        if link in placed:
+            return placed[link]
+        j = tree.joint_of_child[link]
+        origin = _origin(j)
+        if j.name in body_of_joint:
+            out = (body_of_joint[j.name], np.eye(4))
+        else:
+            b, T = place(j.parent)
+            T = T @ origin
+            if j.name in tree.frozen:
+                T = T @ axis_motion(
+                    _joint_axis(j), np.asarray(tree.frozen[j.name]), j.type == "prismatic"
+                )
+            out = (b, T)
+        placed[link] = out
+        return out
+
+    for link in tree.links:
+        place(link)
+    return placed
+
+
+@dataclass(frozen=True)
+class _Capsules:
+    """Per capsule: its name, its URDF link, its body, its axis end points a, b in the
+    body's frame [m] and its radius [m]."""
+
+    names: list[str]
+    link: list[str]
+    body: list[int]
+    a: list[Array]
+    b: list[Array]
+    radii: list[float]
+
+
+def _capsules(tree: _Tree, placed: dict[str, tuple[int, Array]], path: Path) -> _Capsules:
+    """One capsule per ``<collision>`` element (see the module docstring)."""
+    caps = _Capsules([], [], [], [], [], [])
+    for lname, link in tree.links.items():
+        b, T_link = placed[lname]
+        cols = list(link.collisions)
+        for k, col in enumerate(cols):
+            T = T_link @ (np.eye(4) if col.origin is None else np.asarray(col.origin, float))
+            g = col.geometry
+            if g.sphere is not None:
+                r, half = float(g.sphere.radius), np.zeros(3)
+            elif g.cylinder is not None:
+                r = float(g.cylinder.radius)
+                half = np.array([0.0, 0.0, float(g.cylinder.length) / 2.0])
+            elif g.box is not None:
+                h = np.asarray(g.box.size, dtype=float) / 2.0
+                a = int(np.argmax(h))
+                others = np.delete(h, a)
+                r = float(np.linalg.norm(others))
+                half = np.zeros(3)
+                half[a] = h[a]
+            else:
+                raise UrdfError(
+                    "urdf",
+                    f"collision geometry a plannerlab robot can check (sphere, cylinder, "
+                    f"box); link {lname} of {path.name} has a mesh: use a spherized URDF",
+                )
+            c = T[:3, 3]
+            d = T[:3, :3] @ half
+            caps.names.append(lname if len(cols) == 1 else f"{lname}#{k}")
+            caps.link.append(lname)
+            caps.body.append(b)
+            caps.a.append(c - d)
+            caps.b.append(c + d)
+            caps.radii.append(r)
+    if not caps.names:
+        raise UrdfError("urdf", f"collision elements; {path.name} has none")
+    return caps
+
+
+def _excluded_pairs(
+    caps: _Capsules,
+    parent_body: list[int],
+    links: dict[str, Any],
+    srdf_path: Path | None,
+    allowed_collisions: tuple[tuple[str, str], ...],
+    path: Path,
+) -> set[tuple[int, int]]:
+    """Capsule pairs never checked: on one body, on neighbouring bodies, or of links the
+    SRDF or the problem's allowed-collision pairs name."""
+    disabled: set[frozenset[str]] = set()
+    if srdf_path is not None:
+        for l1, l2 in read_srdf_disabled(Path(srdf_path)):
+            disabled.add(frozenset((l1, l2)))
+    for l1, l2 in allowed_collisions:
+        for n in (l1, l2):
+            if n not in links:
+                raise UrdfError(
+                    "allowed_collisions",
+                    f"pairs of links of {path.name}; {n!r} is not one{_hint(n, list(links))}",
+                )
+        disabled.add(frozenset((l1, l2)))
+    neighbours = {frozenset((parent_body[i], i + 1)) for i in range(len(parent_body))}
+    excluded = set()
+    L = len(caps.names)
+    for i in range(L):
+        for j2 in range(i + 1, L):
+            bi, bj = caps.body[i], caps.body[j2]
+            if (
+                bi == bj
+                or frozenset((bi, bj)) in neighbours
+                or frozenset((caps.link[i], caps.link[j2])) in disabled
+            ):
+                excluded.add((i, j2))
+    return excluded
+
+
+def _frozen_array(a: Any, dtype: Any = float) -> Any:
+    out = np.array(a, dtype=dtype)
+    out.setflags(write=False)
+    return out
+
+
 @dataclass(frozen=True, eq=False)
 class UrdfChain:
     """A serial chain from a URDF file (implements :class:`plannerlab.robots.base.Robot`).
@@ -145,109 +375,31 @@ class UrdfChain:
     _cap_b: Any = field(init=False, repr=False)
 
     def __post_init__(self) -> None:
-        import yourdfpy
-
+        """Read the URDF and fold it into the chain's fixed data (see the module
+        docstring): the chain, each link's place on its body, the joints, the tip, the
+        capsules and the pairs never checked."""
         path = Path(self.urdf_path)
         object.__setattr__(self, "urdf_path", path)
-        if not path.is_file():
-            raise UrdfError("urdf", f"an existing URDF file; {path} does not exist")
-        try:  # yourdfpy would recover from broken XML and read part of it
-            ET.parse(path)
-        except ET.ParseError as exc:
-            raise UrdfError("urdf", f"a well-formed URDF (XML); {path}: {exc}") from None
-        try:
-            model = yourdfpy.URDF.load(
-                str(path),
-                build_scene_graph=False,
-                build_collision_scene_graph=False,
-                load_meshes=False,
-                load_collision_meshes=False,
-            )
-        except Exception as exc:  # yourdfpy raises many kinds for a malformed file
-            raise UrdfError("urdf", f"a valid URDF; {path}: {exc}") from None
-        urdf = model.robot
-        links = {link.name: link for link in urdf.links}
-        joint_of_child = {j.child: j for j in urdf.joints}
-        children = set(joint_of_child)
-        roots = [n for n in links if n not in children]
-        if len(roots) != 1:
-            raise UrdfError("urdf", f"a URDF tree with one root link; {path} has {roots}")
-        root = roots[0]
-        if self.tip_link not in links:
-            raise UrdfError(
-                "tip_link",
-                f"a link of {path.name}, got {self.tip_link!r}{_hint(self.tip_link, list(links))}; "
-                f"its links: {', '.join(links)}",
-            )
-        # the chain: root -> tip
-        chain: list[Any] = []
-        name = self.tip_link
-        while name != root:
-            j = joint_of_child[name]
-            chain.append(j)
-            name = j.parent
-        chain.reverse()
-        for j in chain:
-            if j.type not in MOVABLE + ("fixed",):
-                raise UrdfError(
-                    "urdf", f"revolute, continuous, prismatic or fixed joints; {j.name} is {j.type}"
-                )
-            if j.type in MOVABLE and j.mimic is not None:
-                raise UrdfError("urdf", f"no mimic joint on the chain; {j.name} mimics one")
-        movable = [j for j in chain if j.type in MOVABLE]
-        chain_names = {j.name for j in movable}
-        frozen: dict[str, float] = {}
-        for j in urdf.joints:
-            if j.type in MOVABLE and j.name not in chain_names:
-                lo, hi = self._limits(j)
-                frozen[j.name] = float(np.clip(0.0, lo, hi))
-            elif j.type not in MOVABLE + ("fixed",):
-                raise UrdfError(
-                    "urdf", f"revolute, continuous, prismatic or fixed joints; {j.name} is {j.type}"
-                )
-        body_of_joint = {j.name: i + 1 for i, j in enumerate(movable)}
-
-        # every link: (body, T_body_link)
-        placed: dict[str, tuple[int, Array]] = {root: (0, np.eye(4))}
-
-        def place(link: str) -> tuple[int, Array]:
-            if link in placed:
-                return placed[link]
-            j = joint_of_child[link]
-            origin = np.eye(4) if j.origin is None else np.asarray(j.origin, dtype=float)
-            if j.name in body_of_joint:
-                out = (body_of_joint[j.name], np.eye(4))
-            else:
-                b, T = place(j.parent)
-                T = T @ origin
-                if j.name in frozen:
-                    T = T @ axis_motion(
-                        self._axis(j), np.asarray(frozen[j.name]), j.type == "prismatic"
-                    )
-                out = (b, T)
-            placed[link] = out
-            return out
-
-        for link in links:
-            place(link)
+        tree = _chain(_load_urdf(path), self.tip_link, path)
+        placed = _place_links(tree)
         # movable joint i: its parent body and the fixed transform to the joint frame
         parent_body, pre, axes, prismatic = [], [], [], []
         lower, upper, cont = [], [], []
-        for j in movable:
+        for j in tree.movable:
             b, T = placed[j.parent]
-            origin = np.eye(4) if j.origin is None else np.asarray(j.origin, dtype=float)
             parent_body.append(b)
-            pre.append(T @ origin)
-            axes.append(self._axis(j))
+            pre.append(T @ _origin(j))
+            axes.append(_joint_axis(j))
             prismatic.append(j.type == "prismatic")
-            lo, hi = self._limits(j)
+            lo, hi = _joint_limits(j)
             lower.append(lo)
             upper.append(hi)
             cont.append(j.type == "continuous")
-        dof = len(movable)
+        dof = len(tree.movable)
         if dof == 0:
             raise UrdfError(
-                "tip_link", f"a link with movable joints between it and {root}; {self.tip_link}"
+                "tip_link",
+                f"a link with movable joints between it and {tree.root}; {self.tip_link}",
             )
         tip_body, T_body_tip = placed[self.tip_link]
         T_body_tip = T_body_tip.copy()
@@ -257,75 +409,10 @@ class UrdfChain:
         if not (norm > 1e-9 and math.isfinite(norm)):
             raise UrdfError("tip_axis", f"a non-zero axis, got {list(self.tip_axis)}")
         R_body_tip = T_body_tip[:3, :3] @ (tip_axis / norm)
-
-        # capsules
-        cap_names: list[str] = []
-        cap_link: list[str] = []
-        cap_body: list[int] = []
-        cap_a: list[Array] = []
-        cap_b: list[Array] = []
-        radii: list[float] = []
-        for lname, link in links.items():
-            b, T_link = placed[lname]
-            cols = list(link.collisions)
-            for k, col in enumerate(cols):
-                T = T_link @ (np.eye(4) if col.origin is None else np.asarray(col.origin, float))
-                g = col.geometry
-                if g.sphere is not None:
-                    r, half = float(g.sphere.radius), np.zeros(3)
-                elif g.cylinder is not None:
-                    r = float(g.cylinder.radius)
-                    half = np.array([0.0, 0.0, float(g.cylinder.length) / 2.0])
-                elif g.box is not None:
-                    h = np.asarray(g.box.size, dtype=float) / 2.0
-                    a = int(np.argmax(h))
-                    others = np.delete(h, a)
-                    r = float(np.linalg.norm(others))
-                    half = np.zeros(3)
-                    half[a] = h[a]
-                else:
-                    raise UrdfError(
-                        "urdf",
-                        f"collision geometry a plannerlab robot can check (sphere, cylinder, "
-                        f"box); link {lname} of {path.name} has a mesh: use a spherized URDF",
-                    )
-                c = T[:3, 3]
-                d = T[:3, :3] @ half
-                cap_names.append(lname if len(cols) == 1 else f"{lname}#{k}")
-                cap_link.append(lname)
-                cap_body.append(b)
-                cap_a.append(c - d)
-                cap_b.append(c + d)
-                radii.append(r)
-        if not cap_names:
-            raise UrdfError("urdf", f"collision elements; {path.name} has none")
-
-        # pairs never checked
-        disabled: set[frozenset[str]] = set()
-        if self.srdf_path is not None:
-            for l1, l2 in read_srdf_disabled(Path(self.srdf_path)):
-                disabled.add(frozenset((l1, l2)))
-        for l1, l2 in self.allowed_collisions:
-            for n in (l1, l2):
-                if n not in links:
-                    raise UrdfError(
-                        "allowed_collisions",
-                        f"pairs of links of {path.name}; {n!r} is not one{_hint(n, list(links))}",
-                    )
-            disabled.add(frozenset((l1, l2)))
-        neighbours = {frozenset((parent_body[i], i + 1)) for i in range(dof)}
-        excluded = set()
-        L = len(cap_names)
-        for i in range(L):
-            for j2 in range(i + 1, L):
-                bi, bj = cap_body[i], cap_body[j2]
-                if (
-                    bi == bj
-                    or frozenset((bi, bj)) in neighbours
-                    or frozenset((cap_link[i], cap_link[j2])) in disabled
-                ):
-                    excluded.add((i, j2))
-
+        caps = _capsules(tree, placed, path)
+        excluded = _excluded_pairs(
+            caps, parent_body, tree.links, self.srdf_path, self.allowed_collisions, path
+        )
         T_wb = np.array(self.T_world_base, dtype=float)
         if T_wb.shape != (4, 4) or not np.all(np.isfinite(T_wb)):
             raise UrdfError("base_rpy_deg", "a finite base pose")
@@ -335,26 +422,23 @@ class UrdfChain:
             max(abs(lo), abs(hi)) for lo, hi, p in zip(lower, upper, prismatic, strict=True) if p
         )
 
-        def frozen_array(a: Any, dtype: Any = float) -> Any:
-            out = np.array(a, dtype=dtype)
-            out.setflags(write=False)
-            return out
-
+        frozen_array = _frozen_array
+        L = len(caps.names)
         s = object.__setattr__
         s(self, "T_world_base", frozen_array(T_wb))
         s(self, "dof", dof)
-        s(self, "joint_names", tuple(j.name for j in movable))
-        s(self, "link_names", tuple(cap_names))
-        s(self, "link_urdf_names", tuple(cap_link))
+        s(self, "joint_names", tuple(j.name for j in tree.movable))
+        s(self, "link_names", tuple(caps.names))
+        s(self, "link_urdf_names", tuple(caps.link))
         s(self, "lower", frozen_array(np.where(cont, -np.pi, lower)))
         s(self, "upper", frozen_array(np.where(cont, np.pi, upper)))
         s(self, "continuous", frozen_array(cont, bool))
-        s(self, "link_radii_m", frozen_array(radii))
-        s(self, "fixed_links", frozenset(i for i in range(L) if cap_body[i] == 0))
+        s(self, "link_radii_m", frozen_array(caps.radii))
+        s(self, "fixed_links", frozenset(i for i in range(L) if caps.body[i] == 0))
         s(self, "excluded_pairs", frozenset(excluded))
-        s(self, "frozen_joints", frozen)
+        s(self, "frozen_joints", tree.frozen)
         s(self, "max_reach_m", float(reach))
-        s(self, "_body_links", (root, *(j.child for j in movable)))
+        s(self, "_body_links", (tree.root, *(j.child for j in tree.movable)))
         s(self, "_parent_body", np.array(parent_body, dtype=int))
         s(self, "_pre", frozen_array(pre))
         s(self, "_axes", frozen_array(axes))
@@ -362,29 +446,9 @@ class UrdfChain:
         s(self, "_tip_body", int(tip_body))
         s(self, "_T_body_tip", frozen_array(T_body_tip))
         s(self, "_n_body_tip", frozen_array(R_body_tip))
-        s(self, "_cap_body", np.array(cap_body, dtype=int))
-        s(self, "_cap_a", frozen_array(cap_a))
-        s(self, "_cap_b", frozen_array(cap_b))
-
-    @staticmethod
-    def _axis(j: Any) -> Array:
-        a = np.array([1.0, 0.0, 0.0] if j.axis is None else j.axis, dtype=float)
-        n = float(np.linalg.norm(a))
-        if n < 1e-12:
-            raise UrdfError("urdf", f"a non-zero axis on joint {j.name}")
-        return a / n
-
-    @staticmethod
-    def _limits(j: Any) -> tuple[float, float]:
-        if j.type == "continuous":
-            return (-math.pi, math.pi)
-        lim = j.limit
-        if lim is None or lim.lower is None or lim.upper is None:
-            raise UrdfError("urdf", f"lower and upper limits on joint {j.name} ({j.type})")
-        lo, hi = float(lim.lower), float(lim.upper)
-        if not (math.isfinite(lo) and math.isfinite(hi) and lo <= hi):
-            raise UrdfError("urdf", f"limits lower <= upper on joint {j.name}, got {lo}, {hi}")
-        return lo, hi
+        s(self, "_cap_body", np.array(caps.body, dtype=int))
+        s(self, "_cap_a", frozen_array(caps.a))
+        s(self, "_cap_b", frozen_array(caps.b))
 
     # ------------------------------------------------------------------ kinematics
     @property
