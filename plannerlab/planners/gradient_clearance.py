@@ -63,18 +63,17 @@ from typing import Any
 
 import numpy as np
 
-from plannerlab.collision.fcl_checker import CollisionChecker, problem_checker
+from plannerlab.collision.fcl_checker import CollisionChecker
 from plannerlab.errors import PlannerlabError
 from plannerlab.planners.base import (
-    BudgetTracker,
     LegRun,
     Planner,
     PlanResult,
     Status,
-    start_collision,
     with_overrides,
 )
 from plannerlab.planners.clearance import Clearance, ClearanceField
+from plannerlab.planners.context import LegPlanner, PlanningContext, plan_in
 from plannerlab.problem.goals import GoalRegion, JointGoal
 from plannerlab.robots.base import Array, joint_difference, wrap_to_pi
 from plannerlab.robots.paths import path_length
@@ -178,7 +177,7 @@ class ClearanceSettings:
             raise PlannerlabError(f"stall_window must be >= 2, got {self.stall_window}")
 
 
-class ClearanceDescent:
+class ClearanceDescent(LegPlanner):
     """One descent of F from a start state (see the module docstring)."""
 
     def __init__(
@@ -406,23 +405,24 @@ class ClearanceDescent:
     # ------------------------------------------------------------------ solve
     def descend(
         self,
-        problem,
-        leg: int,
+        ctx: PlanningContext,
         q_start: Array,
-        checker: CollisionChecker | None,
-        tracker: BudgetTracker,
         goal=None,
         iterations_before: int = 0,
+        *,
+        checked: bool = True,
     ) -> tuple[Status, str, list[Array], list[float], int]:
-        """Descend from q_start; returns status, reason, path, f per iteration, iterations.
+        """Descend from q_start in the leg's context; returns status, reason, path, f per
+        iteration, iterations.
 
-        ``goal`` overrides the leg's goal region (sub-goals of escapes). ``checker`` None:
+        ``goal`` overrides the leg's goal region (sub-goals of escapes). ``checked`` False:
         the states are not checked (goal selection near q_start). ``iterations_before``:
-        iterations the leg has already used (the budget is the leg's).
+        iterations the leg has already used (the budget is the leg's, ``ctx.tracker``).
         """
         s = self.settings
-        robot = problem.robot
-        goal = goal if goal is not None else problem.goal(leg)
+        problem, robot, tracker = ctx.problem, ctx.robot, ctx.tracker
+        checker = ctx.checker if checked else None
+        goal = goal if goal is not None else ctx.goal
         model = self.model(problem)
         max_step = s.max_step_rad if s.max_step_rad > 0 else problem.joint_step / 2
         q = np.array(q_start, dtype=float)
@@ -509,27 +509,26 @@ class ClearanceDescent:
                 best, best_iter = f_now, iteration
 
     # ------------------------------------------------------------------ goals near q
-    def near_goal_state(
-        self, problem, leg: int, q: Array, checker: CollisionChecker, tracker: BudgetTracker
-    ) -> Array | None:
-        """A collision-free state in leg's goal region found by descending F from q with
-        the path left unchecked (the clearance term still steers): a goal *near* q, the
-        part of the arm that F does not need to move stays where it is. One check."""
-        status, _, path, _, _ = self.leg_descent(problem, leg, q, None, tracker)
+    def near_goal_state(self, ctx: PlanningContext, q: Array) -> Array | None:
+        """A collision-free state in the leg's goal region found by descending F from q
+        with the path left unchecked (the clearance term still steers): a goal *near* q,
+        the part of the arm that F does not need to move stays where it is. One check.
+        The goal finder (:data:`~plannerlab.planners.context.NearGoal`) this descent
+        hands its ``rrtconnect`` escape, with its own settings."""
+        status, _, path, _, _ = self.leg_descent(ctx, q, checked=False)
         q_goal = path[-1]
-        if status is Status.SOLVED and checker.is_valid(q_goal):
+        if status is Status.SOLVED and ctx.checker.is_valid(q_goal):
             return q_goal
         return None
 
     # ------------------------------------------------------------------ the leg's descent
     def leg_descent(
         self,
-        problem,
-        leg: int,
+        ctx: PlanningContext,
         q_start: Array,
-        checker: CollisionChecker | None,
-        tracker: BudgetTracker,
         used: int = 0,
+        *,
+        checked: bool = True,
     ) -> tuple[Status, str, list[Array], list[float], int]:
         """The descent of one leg: with ``approach_m`` > 0, first to the goal's approach
         point (the tip at ``p_d − approach_m · n_d`` with the goal's normal, within the
@@ -537,7 +536,7 @@ class ClearanceDescent:
         goal; if the approach stalls, the descent to the goal continues from there. A goal
         state (:class:`JointGoal`) has no approach point."""
         s = self.settings
-        goal = problem.goal(leg)
+        goal = ctx.goal
         path = [np.array(q_start)]
         trace: list[float] = []
         iterations = 0
@@ -545,7 +544,7 @@ class ClearanceDescent:
         if (
             s.approach_m > 0
             and not isinstance(goal, JointGoal)
-            and not goal.contains(problem.robot, q_start)
+            and not goal.contains(ctx.robot, q_start)
         ):
             sub = GoalRegion(
                 "approach",
@@ -554,16 +553,14 @@ class ClearanceDescent:
                 s.subgoal_pos_tol_m,
                 s.subgoal_angle_tol_deg,
             )
-            st, reason, seg, tr, it = self.descend(
-                problem, leg, path[-1], checker, tracker, sub, used
-            )
+            st, reason, seg, tr, it = self.descend(ctx, path[-1], sub, used, checked=checked)
             iterations += it
             path.extend(seg[1:])
             trace.extend(tr)
             if st not in (Status.SOLVED, Status.LOCAL_MINIMUM):
                 return st, reason, path, trace, iterations
         st, reason, seg, tr, it = self.descend(
-            problem, leg, path[-1], checker, tracker, None, used + iterations
+            ctx, path[-1], None, used + iterations, checked=checked
         )
         path.extend(seg[1:])
         trace.extend(tr)
@@ -572,11 +569,8 @@ class ClearanceDescent:
     # ------------------------------------------------------------------ escapes
     def _detour(
         self,
-        problem,
-        leg: int,
+        ctx: PlanningContext,
         q_stall: Array,
-        checker: CollisionChecker,
-        tracker: BudgetTracker,
         used: int,
         rng: np.random.Generator | None = None,
     ) -> tuple[list[Array], int, str]:
@@ -591,7 +585,7 @@ class ClearanceDescent:
         detour succeeded, else just [q_stall]), the iterations and how far it retracted.
         """
         s = self.settings
-        robot = problem.robot
+        robot, tracker = ctx.robot, ctx.tracker
         iterations = 0
         # retract along the body of the stall state
         F = robot.fk(q_stall)
@@ -612,15 +606,11 @@ class ClearanceDescent:
                 s.subgoal_pos_tol_m,
                 s.subgoal_angle_tol_deg,
             )
-            st, _, seg, _, it = self.descend(
-                problem, leg, q, checker, tracker, sub, used + iterations
-            )
+            st, _, seg, _, it = self.descend(ctx, q, sub, used + iterations)
             iterations += it
             kept.extend(seg[1:])
             q = kept[-1]
-            st2, _, seg2, _, it2 = self.leg_descent(
-                problem, leg, q, checker, tracker, used + iterations
-            )
+            st2, _, seg2, _, it2 = self.leg_descent(ctx, q, used + iterations)
             iterations += it2
             if st2 is Status.SOLVED:
                 return kept + seg2[1:], iterations, f"retract {back} modules"
@@ -641,11 +631,8 @@ class ClearanceDescent:
 
     def _random_detours(
         self,
-        problem,
-        leg: int,
+        ctx: PlanningContext,
         q_stall: Array,
-        checker: CollisionChecker,
-        tracker: BudgetTracker,
         used: int,
         rng: np.random.Generator,
     ) -> tuple[list[Array], int, str]:
@@ -654,141 +641,105 @@ class ClearanceDescent:
         iterations = 0
         how = "none"
         for draw in range(1, self.settings.max_escapes + 1):
-            if tracker.exhausted(used + iterations) is not None:
+            if ctx.tracker.exhausted(used + iterations) is not None:
                 break
-            esc, it, how = self._detour(
-                problem, leg, q_stall, checker, tracker, used + iterations, rng
-            )
+            esc, it, how = self._detour(ctx, q_stall, used + iterations, rng)
             iterations += it
             if len(esc) > 1:
                 return esc, iterations, f"{how} (draw {draw})"
         return [np.array(q_stall)], iterations, how
 
     def _rrtconnect(
-        self,
-        problem,
-        leg: int,
-        q_stall: Array,
-        tracker: BudgetTracker,
-        rng: np.random.Generator,
+        self, ctx: PlanningContext, q_stall: Array, rng: np.random.Generator
     ) -> tuple[list[Array], int, str]:
-        """RRT-Connect from the stall to a goal state found near it (see near_goal_state)
-        or, when the descent from the stall ends in no collision-free goal state, to
+        """RRT-Connect from the stall to a goal state found near it by this descent, with
+        its settings (:meth:`near_goal_state`, the sub-solve's goal finder) or, when the
+        descent from the stall ends in no collision-free goal state, to
         ``escape_goal_samples`` goal states drawn by IK (OMPL's ``near_or_ik`` goal
-        selection), with the checks and time left, at most ``escape_checks`` checks; its
-        iterations count in the leg's afterwards (the caller adds them)."""
+        selection), with the checks and time left, at most ``escape_checks`` checks: a
+        sub-solve in the leg's context (its checks are the leg's); its iterations count
+        in the leg's afterwards (the caller adds them)."""
         if self.escape_planner is None:
             raise PlannerlabError(
                 f"{self.name}: no escape planner given (make it by name, make_planner)"
             )
+        tracker = ctx.tracker
         sub = tracker.remaining(self.settings.escape_checks, limit_iterations=False)
         if sub is None:
             return [np.array(q_stall)], 0, f"not started: {tracker.exhausted() or 'no budget'}"
         rrt = self.escape_planner(
             {"goal_selection": "near_or_ik", "goal_samples": self.settings.escape_goal_samples}
         )
-        r = rrt.solve(problem, leg, sub, rng, q_start=q_stall)
-        tracker.charge_checks(r.collision_checks)  # the sub-planner's checks count here
+        r = plan_in(rrt, ctx.sub(sub, q_stall, near_goal=self.near_goal_state), rng)
         if r.solved:
             return list(r.path), r.iterations, "rrtconnect"
         return [np.array(q_stall)], r.iterations, f"rrtconnect: {r.status.value}"
 
     # ------------------------------------------------------------------ solve
-    def solve(
-        self,
-        problem,
-        leg: int,
-        budget,
-        rng: np.random.Generator,
-        q_start: Array | None = None,
-        stepper=None,
-    ) -> PlanResult:
-        """Descend F from q_start (default: the problem's start) into leg's goal region;
-        at a stall, escape from the stall state (``escape`` setting) and descend again."""
-        del stepper  # kinematic
+    def warm_up(self, problem, leg: int, q_start: Array) -> None:
+        """Build the field (and for the compiled backend, load or compile its core) before
+        the leg's tracker starts, like the checker: a one-off cost outside the limits."""
+        self.model(problem).warm_up(problem.goal(leg), q_start)
+
+    def plan(self, ctx: PlanningContext, rng: np.random.Generator) -> PlanResult:
+        """Descend F from the context's start into its leg's goal region; at a stall,
+        escape from the stall state (``escape`` setting) and descend again."""
         s = self.settings
-        robot = problem.robot
-        goal = problem.goal(leg)
-        checker = problem_checker(problem)
-        q0 = np.array(problem.q_start if q_start is None else q_start, dtype=float)
-        # the field (and for the compiled backend, loading or compiling its core) is built
-        # before the tracker starts, like the checker: a one-off cost outside the limits
-        self.model(problem).warm_up(goal, q0)
-        tracker = BudgetTracker(budget, checker)
-        run = LegRun(self.name, s, problem, leg, tracker)
-        path: list[Array] = [q0]
+        problem, robot, goal, tracker = ctx.problem, ctx.robot, ctx.goal, ctx.tracker
+        q0 = ctx.q_start
+        leg_path = LegPath(ctx.run(self.name, s), q0)
+        path = leg_path.path
         trace: list[float] = []
         escapes_log: list[dict] = []
-        iterations = 0
-        minima = escapes = 0
         descent_rad: list[float] = []
-
-        def note(states: list[Array]) -> None:
-            """Progress after a descent or an escape: the best goal distance it reached."""
-            if states:
-                run.progress.note(float(np.min(goal.distance(robot, np.asarray(states)))))
 
         def dist(a: Array, b: Array) -> float:
             return float(np.linalg.norm(joint_difference(a, b, robot.continuous)))
 
         def done(status: Status, reason: str) -> PlanResult:
             """The leg's result from the state of the loop."""
-            extra: dict = {
-                "descent_rad": descent_rad,
-                "escapes": escapes_log,
-                "path_rad": path_length(np.array(path), robot.continuous),
-                # what ran: "compiled" falls back to numpy for robots other than Arm-Z
-                "descent_backend": self.model(problem).backend,
-            }
-            if status is Status.LOCAL_MINIMUM:
-                extra["q_stall"] = np.asarray(path[-1], dtype=float).tolist()
-            return run.result(
+            return leg_path.result(
                 status,
                 reason,
-                path,
-                iterations=iterations,
                 trace=trace,
-                local_minima=minima,
-                escapes=escapes,
-                extra=extra,
+                extra={
+                    "descent_rad": descent_rad,
+                    "escapes": escapes_log,
+                    # what ran: "compiled" falls back to numpy for robots other than Arm-Z
+                    "descent_backend": self.model(problem).backend,
+                },
             )
 
-        why_not = start_collision(checker, q0)
-        if why_not is not None:
-            return done(Status.INVALID_START, why_not)
-        note([q0])
+        if ctx.start_problem is not None:
+            return done(Status.INVALID_START, ctx.start_problem)
+        leg_path.note([q0])
         q = q0
         while True:
-            st, reason, seg, tr, it = self.leg_descent(
-                problem, leg, q, checker, tracker, iterations
-            )
-            iterations += it
+            st, reason, seg, tr, it = self.leg_descent(ctx, q, leg_path.iterations)
+            leg_path.iterations += it
             trace.extend(tr)
-            note(list(seg))
-            path.extend(seg[1:])
+            leg_path.add(seg)
             descent_rad.append(path_length(np.array(seg), robot.continuous))
-            if st is Status.SOLVED:
+            minima, escapes = leg_path.minima, leg_path.escapes
+            if st is not Status.LOCAL_MINIMUM:  # solved, or out of budget
                 return done(st, f"{reason}; {minima} local minima met, {escapes} escaped")
-            if st is not Status.LOCAL_MINIMUM:
-                return done(st, f"{reason}; {minima} local minima met, {escapes} escaped")
-            minima += 1
+            leg_path.minima = minima = minima + 1
             q_stall = np.array(path[-1])
             if s.escape == "none":
                 return done(st, reason)
             if minima > s.max_escapes:
                 return done(st, f"{reason}; {minima} local minima met, {escapes} escaped; gave up")
             c0 = tracker.checks_used
+            used = leg_path.iterations
             if s.escape == "detour":
-                esc, it, how = self._detour(problem, leg, q_stall, checker, tracker, iterations)
+                esc, it, how = self._detour(ctx, q_stall, used)
             elif s.escape == "random_detour":
-                esc, it, how = self._random_detours(
-                    problem, leg, q_stall, checker, tracker, iterations, rng
-                )
+                esc, it, how = self._random_detours(ctx, q_stall, used, rng)
             else:
-                esc, it, how = self._rrtconnect(problem, leg, q_stall, tracker, rng)
-            iterations += it
+                esc, it, how = self._rrtconnect(ctx, q_stall, rng)
+            leg_path.iterations += it
             left_stall = len(esc) > 1
-            escapes += int(left_stall)
+            leg_path.escapes += int(left_stall)
             escapes_log.append(
                 {
                     "kind": s.escape,
@@ -806,14 +757,76 @@ class ClearanceDescent:
                     Status.LOCAL_MINIMUM,
                     f"{reason}; the {s.escape} escape from stall {minima} failed ({how})",
                 )
-            note(list(esc))
-            path.extend(esc[1:])
+            leg_path.add(esc)
             q = np.array(path[-1])
             if goal.contains(robot, q):
                 return done(
                     Status.SOLVED,
                     f"descent stalled {minima} times; escaped from the stall by {how}",
                 )
+
+
+class LegPath:
+    """A leg's path built from segments (descents, escapes, a leader's tracking), the
+    counts the planner keeps on it, and its result: the one home of the result of the
+    clearance family (``gradient.clearance*``, ``gradient.follow_leader*``).
+
+    Progress is noted after each segment (the best goal distance it reached); the result
+    adds ``extra["path_rad"]`` (the path's joint-space length) and, at a local minimum,
+    ``extra["q_stall"]`` (the state it stalled at) to the planner's own ``extra``.
+
+    Args:
+        run: the leg's :class:`~plannerlab.planners.base.LegRun`.
+        q0: (dof,) the leg's start, the path's first state.
+    """
+
+    def __init__(self, run: LegRun, q0: Array) -> None:
+        self.run = run
+        self.path: list[Array] = [q0]
+        #: the planner's counts, reported in the result
+        self.iterations = 0
+        self.minima = 0
+        self.escapes = 0
+
+    def note(self, states: Any) -> None:
+        """Progress after a segment: the best goal distance its states reach."""
+        if len(states):
+            run = self.run
+            run.progress.note(float(np.min(run.goal.distance(run.robot, np.asarray(states)))))
+
+    def add(self, segment: Any) -> None:
+        """Append a segment that starts at the path's last state (its first state is
+        dropped) and note its progress."""
+        self.note(list(segment))
+        self.path.extend(list(segment[1:]))
+
+    def result(
+        self,
+        status: Status,
+        reason: str,
+        *,
+        trace: Any = None,
+        extra: Mapping[str, Any] | None = None,
+    ) -> PlanResult:
+        """The leg's result: the path, the counts, the planner's ``extra`` with the
+        path's length and, at a local minimum, the stall state."""
+        robot = self.run.robot
+        out: dict[str, Any] = {
+            **(extra or {}),
+            "path_rad": path_length(np.array(self.path), robot.continuous),
+        }
+        if status is Status.LOCAL_MINIMUM:
+            out["q_stall"] = np.asarray(self.path[-1], dtype=float).tolist()
+        return self.run.result(
+            status,
+            reason,
+            self.path,
+            iterations=self.iterations,
+            trace=trace,
+            local_minima=self.minima,
+            escapes=self.escapes,
+            extra=out,
+        )
 
 
 class _NumpyPoint:

@@ -3,8 +3,10 @@
 This is the only module that imports ``ompl`` (the ``ompl`` 2.0.1 nanobind wheel). Every
 planner in :data:`plannerlab.planners.OMPL_PLANNERS` is served as ``ompl.<suffix>`` by
 :func:`make`. Everything OMPL-specific is kept here, and every OMPL object lives only
-inside one :meth:`OMPLPlanner.solve` call (none at module level: the wheel reports
-"leaked" objects still alive at interpreter exit).
+inside one :meth:`OMPLPlanner.plan` call (none at module level: the wheel reports
+"leaked" objects still alive at interpreter exit). A leg is planned in its
+:class:`~plannerlab.planners.context.PlanningContext` (its checker, tracker and start
+check); as an escape of another planner, in a sub-solve's context of the caller's leg.
 
 Design (measured on ``armz_inspection``, 23 continuous joints):
 
@@ -38,6 +40,10 @@ Design (measured on ``armz_inspection``, 23 continuous joints):
   is 1e-9) and whose ``sampleGoal`` hands out a pool of up to
   ``goal_samples`` goal states found by :func:`plannerlab.problem.ik.sample_goal_state`
   (seeded from the leg start) *before* planning, within the budget; their checks count.
+  With ``goal_selection = "near"`` (or ``"near_or_ik"``, IK when it finds none) the pool
+  holds the goal state a clearance descent finds near the start: the caller's, with its
+  settings, when OMPL is an escape of ``gradient.clearance+rrtconnect``
+  (``PlanningContext.near_goal``), else ``gradient.clearance``'s defaults.
 * **Budget.** A ``PlannerTerminationCondition(callable)`` stops on iterations, collision
   checks or time; in addition the validity checker and motion validator *refuse* (report
   invalid, without checking) once the check budget is spent, so no planner can overshoot
@@ -112,16 +118,15 @@ import ompl.base as ob
 import ompl.geometric as og
 import ompl.util as ou
 
-from plannerlab.collision.fcl_checker import CollisionChecker, problem_checker
+from plannerlab.collision.fcl_checker import CollisionChecker
 from plannerlab.errors import PlannerlabError
 from plannerlab.planners.base import (
     BudgetTracker,
-    LegRun,
     PlanResult,
     Status,
-    start_collision,
     with_overrides,
 )
+from plannerlab.planners.context import LegPlanner, NearGoal, PlanningContext
 from plannerlab.problem.goals import GoalRegion
 from plannerlab.problem.ik import sample_goal_state
 from plannerlab.robots.base import Array, Robot, joint_difference, wrap_to_pi
@@ -150,8 +155,9 @@ class OMPLSettings:
             ``"ompl"`` (OMPL's discrete motion validator).
         goal_selection: ``"ik"`` (numeric IK restarts seeded from the leg start, see
             :func:`~plannerlab.problem.ik.sample_goal_state`) or ``"near"`` (the goal state
-            ``gradient.clearance`` selects: its descent from the leg start with the path
-            unchecked, so the goal stays near the start; one state, one check) or
+            ``gradient.clearance`` selects, with the caller's settings when OMPL is its
+            escape: its descent from the leg start with the path unchecked, so the goal
+            stays near the start; one state, one check) or
             ``"near_or_ik"`` (that near state; when its descent ends in no collision-free
             goal state, ``goal_samples`` IK states as with ``"ik"``: the escape of
             ``gradient.clearance+rrtconnect``, which gave up with ``invalid_goal`` before).
@@ -740,49 +746,46 @@ def _projection(
     return proj
 
 
-def _near_goal(
-    problem: Any, leg: int, q0: Array, checker: CollisionChecker, tracker: BudgetTracker
-) -> Array | None:
-    """The goal state ``gradient.clearance`` selects near q0 (see ``goal_selection``)."""
+def _near_goal_finder(ctx: PlanningContext) -> NearGoal:
+    """How ``goal_selection = "near"`` finds a goal state near the start: the caller's
+    goal finder (an escape of the clearance descent: its descent, with its settings), or
+    else ``gradient.clearance``'s with its default settings."""
+    if ctx.near_goal is not None:
+        return ctx.near_goal
     from plannerlab.planners.gradient_clearance import make as make_clearance
 
-    return make_clearance("gradient.clearance", {}).near_goal_state(
-        problem, leg, q0, checker, tracker
-    )
+    return make_clearance("gradient.clearance", {}).near_goal_state
 
 
 # ---------------------------------------------------------------------------- planner
 @dataclass(frozen=True)
-class OMPLPlanner:
+class OMPLPlanner(LegPlanner):
     """One OMPL geometric planner with frozen settings (see the module docstring)."""
 
     name: str
     ompl_class: str
     settings: OMPLSettings
 
-    def solve(
-        self,
-        problem: Any,
-        leg: int,
-        budget: Any,
-        rng: np.random.Generator,
-        q_start: Array | None = None,
-        stepper: Any | None = None,
-    ) -> PlanResult:
-        """Plan leg ``leg`` of ``problem`` within ``budget``.
+    def warm_up(self, problem: Any, leg: int, q_start: Array) -> None:
+        """The near goal's descent is compiled: its kernels are loaded (or compiled)
+        before the tracker starts, as the checker's core is."""
+        if self.settings.goal_selection != "ik":
+            from plannerlab.planners._descent_core import warm_up
+
+            warm_up()
+
+    def plan(self, ctx: PlanningContext, rng: np.random.Generator) -> PlanResult:
+        """Plan the leg of ``ctx`` within its budget.
 
         Args:
-            problem: the problem (robot, scene, goals, joint_step).
-            leg: leg index.
-            budget: iterations / collision checks / time; at least one must be set.
+            ctx: the leg's context (problem, start, goal, checker; the budget's
+                iterations / collision checks / time: at least one must be set).
             rng: the trial's generator (IK pool, OMPL seed).
-            q_start: (dof,) start; default: the problem's start.
-            stepper: unused (OMPL planners are open-loop).
 
         Returns:
             A :class:`PlanResult`; failures are statuses with reasons.
         """
-        del stepper
+        budget = ctx.tracker.budget
         if (
             budget.max_iterations is None
             and budget.max_collision_checks is None
@@ -810,57 +813,33 @@ class OMPLPlanner:
             # process); every leg records the seed in effect, whether or not this took
             ou.RNG.setSeed(requested)
             ompl_seed = int(ou.RNG.getSeed())
-            result = self._solve(problem, leg, budget, rng, q_start, ompl_seed)
+            guard = _Guard(ctx.checker, ctx.tracker)
+            try:
+                result = self._plan(ctx, rng, ompl_seed, guard)
+            finally:
+                # Python callbacks held by OMPL objects reference the planner through this
+                # bound method: break the cycle so every OMPL object is freed with the solve.
+                guard.iteration_source = None
         return result
-
-    def _solve(
-        self,
-        problem: Any,
-        leg: int,
-        budget: Any,
-        rng: np.random.Generator,
-        q_start: Array | None,
-        ompl_seed: int,
-    ) -> PlanResult:
-        checker = problem_checker(problem)
-        if self.settings.goal_selection != "ik":
-            # the near goal's descent is compiled: its kernels are loaded (or compiled)
-            # before the tracker starts, as the checker's core is
-            from plannerlab.planners._descent_core import warm_up
-
-            warm_up()
-        guard = _Guard(checker, BudgetTracker(budget, checker))
-        try:
-            return self._plan(problem, leg, rng, q_start, ompl_seed, guard)
-        finally:
-            # Python callbacks held by OMPL objects reference the planner through this
-            # bound method: break the cycle so every OMPL object is freed with the solve.
-            guard.iteration_source = None
 
     # ------------------------------------------------------------------ internals
     def _plan(
         self,
-        problem: Any,
-        leg: int,
+        ctx: PlanningContext,
         rng: np.random.Generator,
-        q_start: Array | None,
         ompl_seed: int,
         guard: _Guard,
     ) -> PlanResult:
         s = self.settings
-        robot: Robot = problem.robot
-        goal: GoalRegion = problem.goal(leg)
+        problem = ctx.problem
+        robot: Robot = ctx.robot
+        goal: GoalRegion = ctx.goal
         checker, tracker = guard.checker, guard.tracker
         max_checks = tracker.budget.max_collision_checks
-        q0 = wrap_to_pi(
-            np.asarray(problem.q_start if q_start is None else q_start, dtype=float).reshape(
-                robot.dof
-            ),
-            robot.continuous,
-        )
+        q0 = wrap_to_pi(ctx.q_start.reshape(robot.dof), robot.continuous)
         fk = [0]
         trace: list[float] = []
-        run = LegRun(self.name, s, problem, leg, tracker)
+        run = ctx.run(self.name, s)
         progress = run.progress
         extra: dict[str, Any] = {"ompl_class": self.ompl_class, "ompl_seed": ompl_seed}
 
@@ -877,9 +856,8 @@ class OMPLPlanner:
                 extra=extra,
             )
 
-        start_problem = start_collision(checker, q0)
-        if start_problem is not None:
-            return result(Status.INVALID_START, start_problem, q0[None], 0)
+        if ctx.start_problem is not None:
+            return result(Status.INVALID_START, ctx.start_problem, q0[None], 0)
         fk[0] += 1
         progress.note(float(goal.distance(robot, q0)))  # where the search starts from
 
@@ -889,13 +867,11 @@ class OMPLPlanner:
         per_slot = max(1, s.max_goal_attempts // max(s.goal_samples, 1))
         pool_cut_short = ""
         selection = s.goal_selection
+        near_goal = _near_goal_finder(ctx) if selection != "ik" else None
         if selection == "near_or_ik":
+            assert near_goal is not None
             # the near goal first; when its descent finds none, the IK pool
-            q_near = (
-                None
-                if guard.exhausted() is not None
-                else _near_goal(problem, leg, q0, checker, tracker)
-            )
+            q_near = None if guard.exhausted() is not None else near_goal(ctx, q0)
             extra["goal_near_found"] = q_near is not None
             if q_near is not None:
                 pool.append(wrap_to_pi(q_near, robot.continuous))
@@ -905,7 +881,8 @@ class OMPLPlanner:
                 pool_cut_short = guard.exhausted() or ""
                 break
             if selection == "near":
-                q_goal = _near_goal(problem, leg, q0, checker, tracker)
+                assert near_goal is not None
+                q_goal = near_goal(ctx, q0)
             else:
                 q_goal = sample_goal_state(
                     robot, goal, guard, rng, seeds=[q0], attempts=per_slot, stop=guard.out_of_time
