@@ -31,8 +31,9 @@ follow-the-leader:
    (:meth:`~plannerlab.planners.gradient_clearance.ClearanceDescent.leg_descent`) from the
    state the tracking reached (its approach point, then the goal, with its settling); if
    it stalls, the ``+detour`` variant hands the stall to the descent's own ``plan`` with
-   its detour escape (a sub-solve in the leg's context). Where no leader's path exists (no way for the tip at that
-   clearance), the finish alone runs: the planner is then the clearance descent.
+   its detour escape (a sub-solve in the leg's context). Where no leader's path exists
+   (no way for the tip at that clearance), the finish alone runs: the planner is then the
+   clearance descent.
 
 The search and the tracking are deterministic (``gradient.follow_leader``: its seeds are
 one run). The randomised variant (``+random``, ``random_grid``) shifts the voxel grid by

@@ -18,7 +18,7 @@ PACKAGE = Path(__file__).resolve().parents[2] / "plannerlab"
 #: engine -> the only place (a module path prefix, relative to the package) that may import it
 ENGINE_ROOMS = {
     "fcl": ("collision/",),
-    "ompl": ("planners/ompl.py",),
+    "ompl": ("planners/ompl/",),
     "pybullet": ("sim/",),
     "matplotlib": ("plot/",),
 }
@@ -286,8 +286,6 @@ STILL_TOO_LONG = {
     "collision/core.py": "Arm-Z kernels to move out of the generic core",
     "planners/gradient_clearance.py": "settings, the numpy field and the escapes in one module",
     "planners/_descent_core.py:evaluate": "one fused numba kernel: spheres, pairs, cost, gradient",
-    "planners/ompl.py": "space, goal pool, driver and roadmap planners in one module",
-    "planners/ompl.py:_plan": "the OMPL driver in one function",
     "problem/load.py": "the loader per table",
     "robots/urdf/model.py:__post_init__": "URDF reading, chain folding and capsules in one method",
     "robots/irb6/ik.py": "the analytic IK's cases",
