@@ -7,6 +7,9 @@ PlanResult``. Failure is a status with a reason, never ``None`` or an exception 
 The pieces every planner shares: :class:`BudgetTracker` (the budget of one solve, its
 sub-solves charged to it), :class:`LegRun` (the one way to build a :class:`PlanResult`),
 :class:`Progress` (its progress rows) and :func:`start_collision` (the start-state check).
+plannerlab's planners are :class:`~plannerlab.planners.context.LegPlanner` subclasses: ``solve``
+builds the leg's :class:`~plannerlab.planners.context.PlanningContext` (checker, tracker,
+the start checked once) and plans in it with ``plan(ctx, rng)``.
 """
 
 from __future__ import annotations
