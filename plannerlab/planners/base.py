@@ -7,6 +7,9 @@ PlanResult``. Failure is a status with a reason, never ``None`` or an exception 
 The pieces every planner shares: :class:`BudgetTracker` (the budget of one solve, its
 sub-solves charged to it), :class:`LegRun` (the one way to build a :class:`PlanResult`),
 :class:`Progress` (its progress rows) and :func:`start_collision` (the start-state check).
+plannerlab's planners are :class:`~plannerlab.planners.context.LegPlanner` subclasses: ``solve``
+builds the leg's :class:`~plannerlab.planners.context.PlanningContext` (checker, tracker,
+the start checked once) and plans in it with ``plan(ctx, rng)``.
 """
 
 from __future__ import annotations
@@ -199,14 +202,22 @@ class BudgetTracker:
     elsewhere). Iterations are the planner's own count, passed to :meth:`exhausted`, or
     else :attr:`iterations`, the count charged from sub-solves.
 
+    A sub-solve on the same checker (a hybrid's descent, an escape) gets a
+    :meth:`child`: its own limits and clock; its checks are this tracker's too (they are
+    the shared checker's), and what it is charged is charged here as well.
+
     Args:
         budget: the limits (a field None: no limit of that kind).
         checker: the collision checker whose ``checks`` count (None: charged checks only).
+        parent: the tracker of the solve this one is a sub-solve of (:meth:`child`).
     """
 
-    def __init__(self, budget: Any, checker: Any | None = None) -> None:
+    def __init__(
+        self, budget: Any, checker: Any | None = None, parent: BudgetTracker | None = None
+    ) -> None:
         self.budget = budget
         self.checker = checker
+        self.parent = parent
         self._checks0 = checker.checks if checker is not None else 0
         self._t0 = time.perf_counter()
         #: iterations charged from sub-solves
@@ -277,15 +288,31 @@ class BudgetTracker:
             ch = checks_cap if ch is None else min(ch, checks_cap)
         return Budget(max_iterations=it, max_collision_checks=ch, time_limit_s=tl)
 
-    def charge(self, sub: PlanResult) -> None:
-        """Count a sub-solve's iterations, collision checks and FK calls as this solve's."""
+    def child(self, budget: Any) -> BudgetTracker:
+        """The tracker of a sub-solve on this tracker's checker within ``budget`` (a slice
+        of :meth:`remaining`): its clock and checks count from now; its checks are seen
+        here through the shared checker, and its charged checks are charged here too."""
+        return BudgetTracker(budget, self.checker, parent=self)
+
+    def charge(self, sub: PlanResult, *, checks: bool = True) -> None:
+        """Count a sub-solve's iterations, collision checks and FK calls as this solve's.
+
+        Args:
+            sub: the sub-solve's result.
+            checks: False for a sub-solve on a :meth:`child` of this tracker, whose
+                checks this tracker already counts (they are its checker's).
+        """
         self.iterations += sub.iterations
-        self.charged_checks += sub.collision_checks
+        if checks:
+            self.charge_checks(sub.collision_checks)
         self.fk_calls += sub.fk_calls
 
     def charge_checks(self, checks: int) -> None:
-        """Count collision checks made outside ``checker`` (another checker, a count)."""
+        """Count collision checks made outside ``checker`` (another checker, a count);
+        a child's are its parent's too."""
         self.charged_checks += int(checks)
+        if self.parent is not None:
+            self.parent.charge_checks(checks)
 
 
 class LegRun:

@@ -30,9 +30,10 @@ follow-the-leader:
 3. **The finish** is the clearance descent of the leg
    (:meth:`~plannerlab.planners.gradient_clearance.ClearanceDescent.leg_descent`) from the
    state the tracking reached (its approach point, then the goal, with its settling); if
-   it stalls, the ``+detour`` variant hands the stall to the descent's own ``solve`` with
-   its detour escape. Where no leader's path exists (no way for the tip at that
-   clearance), the finish alone runs: the planner is then the clearance descent.
+   it stalls, the ``+detour`` variant hands the stall to the descent's own ``plan`` with
+   its detour escape (a sub-solve in the leg's context). Where no leader's path exists
+   (no way for the tip at that clearance), the finish alone runs: the planner is then the
+   clearance descent.
 
 The search and the tracking are deterministic (``gradient.follow_leader``: its seeds are
 one run). The randomised variant (``+random``, ``random_grid``) shifts the voxel grid by
@@ -51,22 +52,18 @@ import numpy as np
 from scipy.sparse import coo_matrix
 from scipy.sparse.csgraph import dijkstra
 
-from plannerlab.collision.fcl_checker import problem_checker
 from plannerlab.errors import PlannerlabError
 from plannerlab.planners.base import (
-    BudgetTracker,
-    LegRun,
     Planner,
     PlanResult,
     Status,
     settings_dict,
-    start_collision,
     with_overrides,
 )
-from plannerlab.planners.gradient_clearance import ClearanceDescent, ClearanceSettings
+from plannerlab.planners.context import LegPlanner, PlanningContext
+from plannerlab.planners.gradient_clearance import ClearanceDescent, ClearanceSettings, LegPath
 from plannerlab.problem.scene import Box, Cylinder, Scene, Sphere
 from plannerlab.robots.base import Array, joint_difference
-from plannerlab.robots.paths import path_length
 
 
 @dataclass(frozen=True)
@@ -317,8 +314,10 @@ def _shortcut(points: Array, scene: Scene, clearance_m: float, step_m: float) ->
 
 
 # ---------------------------------------------------------------------- the planner
-class FollowLeader:
-    """Follow-the-leader with the clearance descent (see the module docstring)."""
+class FollowLeader(LegPlanner):
+    """Follow-the-leader with the clearance descent (see the module docstring). The
+    tracking, the finish and the detour are descents in the leg's context: one checker,
+    one tracker."""
 
     def __init__(
         self,
@@ -336,6 +335,13 @@ class FollowLeader:
         )
         self._finish = ClearanceDescent(name, replace(descent, escape="none"))
         self._detour = ClearanceDescent(name, replace(descent, escape="detour"), escape_planner)
+
+    def warm_up(self, problem, leg: int, q_start: Array) -> None:
+        """The fields of the tracking and the finishing descents (their compiled kernels
+        loaded), before the leg's tracker starts: one-off costs outside the limits."""
+        goal = problem.goal(leg)
+        for descent in (self._track, self._finish):
+            descent.model(problem).warm_up(goal, q_start)
 
     def leader_path(
         self,
@@ -421,14 +427,7 @@ class FollowLeader:
         return out
 
     def _follow(
-        self,
-        problem,
-        leg: int,
-        q0: Array,
-        leader: TipPath,
-        checker,
-        tracker: BudgetTracker,
-        used: int,
+        self, ctx: PlanningContext, q0: Array, leader: TipPath, used: int
     ) -> tuple[Status, str, list[Array], int]:
         """Descend to each sub-goal along the leader's path in turn (:meth:`subgoals`); a
         sub-goal the descent stalls before is passed over, two in a row end the tracking."""
@@ -443,9 +442,7 @@ class FollowLeader:
             sub = GoalRegion(
                 f"leader{k}", p_sub, n_sub, s.subgoal_pos_tol_m, s.subgoal_angle_tol_deg
             )
-            st, reason, seg, _, it = self._track.descend(
-                problem, leg, path[-1], checker, tracker, sub, used + iterations
-            )
+            st, reason, seg, _, it = self._track.descend(ctx, path[-1], sub, used + iterations)
             iterations += it
             path.extend(seg[1:])
             if st is Status.LOCAL_MINIMUM:
@@ -463,55 +460,25 @@ class FollowLeader:
             stalls = 0
         return Status.SOLVED, f"followed {len(goals)} sub-goals", path, iterations
 
-    def solve(
-        self,
-        problem,
-        leg: int,
-        budget,
-        rng: np.random.Generator,
-        q_start: Array | None = None,
-        stepper=None,
-    ) -> PlanResult:
+    def plan(self, ctx: PlanningContext, rng: np.random.Generator) -> PlanResult:
         """Plan the leader's path, follow it, finish with the leg's descent."""
-        del stepper  # kinematic
         s = self.settings
-        robot = problem.robot
-        goal = problem.goal(leg)
-        checker = problem_checker(problem)
-        q0 = np.array(problem.q_start if q_start is None else q_start, dtype=float)
-        tracker = BudgetTracker(budget, checker)
-        run = LegRun(self.name, s, problem, leg, tracker)
-        path: list[Array] = [q0]
-        iterations = 0
-        minima = escapes = 0
+        problem, leg, robot, goal, tracker = ctx.problem, ctx.leg, ctx.robot, ctx.goal, ctx.tracker
+        q0 = ctx.q_start
+        leg_path = LegPath(ctx.run(self.name, s), q0)
+        path = leg_path.path
         log: list[dict] = []
 
-        def note(states: list[Array]) -> None:
-            if states:
-                run.progress.note(float(np.min(goal.distance(robot, np.asarray(states)))))
-
         def done(status: Status, reason: str) -> PlanResult:
-            extra: dict = {
-                "leader": log,
-                "descent_settings": settings_dict(self.descent_settings),
-                "path_rad": path_length(np.array(path), robot.continuous),
-            }
-            if status is Status.LOCAL_MINIMUM:
-                extra["q_stall"] = np.asarray(path[-1], dtype=float).tolist()
-            return run.result(
+            return leg_path.result(
                 status,
                 reason,
-                path,
-                iterations=iterations,
-                local_minima=minima,
-                escapes=escapes,
-                extra=extra,
+                extra={"leader": log, "descent_settings": settings_dict(self.descent_settings)},
             )
 
-        why_not = start_collision(checker, q0)
-        if why_not is not None:
-            return done(Status.INVALID_START, why_not)
-        note([q0])
+        if ctx.start_problem is not None:
+            return done(Status.INVALID_START, ctx.start_problem)
+        leg_path.note([q0])
         draw_rng = rng if s.random_grid else None
         attempts = 1 + (s.max_replans if s.random_grid else 0)
         reason = ""
@@ -519,14 +486,14 @@ class FollowLeader:
             q = np.array(path[-1])
             if goal.contains(robot, q):
                 return done(Status.SOLVED, "in the goal region")
-            used = iterations
+            used = leg_path.iterations
 
             def stop(used: int = used) -> bool:
                 return tracker.exhausted(used) is not None
 
             leader = self.leader_path(problem, leg, q, draw_rng, stop)
-            if tracker.exhausted(iterations) is not None:
-                return done(Status.BUDGET_EXHAUSTED, str(tracker.exhausted(iterations)))
+            if tracker.exhausted(leg_path.iterations) is not None:
+                return done(Status.BUDGET_EXHAUSTED, str(tracker.exhausted(leg_path.iterations)))
             entry: dict = {
                 "attempt": attempt,
                 "from_leg_start_rad": float(
@@ -542,44 +509,41 @@ class FollowLeader:
             else:
                 entry["leader_m"] = float(leader.arc_m[-1])
                 entry["leader_clearance_m"] = leader.min_distance_m
-                st, reason, seg, it = self._follow(
-                    problem, leg, q, leader, checker, tracker, iterations
-                )
-                iterations += it
-                note(seg)
-                path.extend(seg[1:])
+                st, reason, seg, it = self._follow(ctx, q, leader, leg_path.iterations)
+                leg_path.iterations += it
+                leg_path.add(seg)
                 entry["follow"] = st.value
                 if st is Status.BUDGET_EXHAUSTED:
                     return done(st, reason)
             # finish: the clearance descent of the leg from here (approach point, goal)
             st2, reason2, seg2, _, it2 = self._finish.leg_descent(
-                problem, leg, np.array(path[-1]), checker, tracker, iterations
+                ctx, np.array(path[-1]), leg_path.iterations
             )
-            iterations += it2
-            note(seg2)
-            path.extend(seg2[1:])
+            leg_path.iterations += it2
+            leg_path.add(seg2)
             entry["finish"] = st2.value
             if st2 is Status.SOLVED:
                 return done(st2, f"followed the leader ({reason}); {reason2}")
             if st2 is not Status.LOCAL_MINIMUM:
                 return done(st2, reason2)
-            minima += 1
+            leg_path.minima += 1
             reason = f"{reason}; finish: {reason2}"
             if s.escape == "detour":
-                # the clearance descent's own solve from the stall, with its detour
+                # the clearance descent's own plan from the stall, with its detour: a
+                # sub-solve in the leg's context (its checks are the leg's)
                 sub = tracker.remaining(limit_iterations=False)
                 if sub is None:
-                    return done(Status.BUDGET_EXHAUSTED, str(tracker.exhausted(iterations)))
+                    return done(
+                        Status.BUDGET_EXHAUSTED, str(tracker.exhausted(leg_path.iterations))
+                    )
                 b = tracker.budget
                 if b.max_iterations is not None:
-                    sub = sub.replace(max_iterations=max(b.max_iterations - iterations, 1))
-                r = self._detour.solve(problem, leg, sub, rng, q_start=np.array(path[-1]))
-                tracker.charge_checks(r.collision_checks)
-                iterations += r.iterations
-                minima += r.local_minima
-                escapes += r.escapes
-                note(list(r.path))
-                path.extend(list(r.path[1:]))
+                    sub = sub.replace(max_iterations=max(b.max_iterations - leg_path.iterations, 1))
+                r = self._detour.plan(ctx.sub(sub, np.array(path[-1])), rng)
+                leg_path.iterations += r.iterations
+                leg_path.minima += r.local_minima
+                leg_path.escapes += r.escapes
+                leg_path.add(r.path)
                 entry["detour"] = r.extra.get("escapes", [])
                 if r.status is Status.SOLVED:
                     return done(r.status, f"followed the leader; {r.reason}")

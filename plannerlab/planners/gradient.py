@@ -39,18 +39,15 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.optimize import approx_fprime
 
-from plannerlab.collision.fcl_checker import CollisionChecker, problem_checker
+from plannerlab.collision.fcl_checker import CollisionChecker
 from plannerlab.errors import PlannerlabError
 from plannerlab.planners.base import (
-    BudgetTracker,
-    LegRun,
     PlanResult,
     Progress,
     Status,
-    Stepper,
-    start_collision,
     with_overrides,
 )
+from plannerlab.planners.context import LegPlanner, PlanningContext
 from plannerlab.planners.objective import Objective
 from plannerlab.robots.base import Array, wrap_to_pi
 from plannerlab.robots.paths import interpolate_edge
@@ -110,7 +107,7 @@ VARIANTS: dict[str, dict[str, object]] = {
 }
 
 
-class GradientPlanner:
+class GradientPlanner(LegPlanner):
     """The gradient method as a plannerlab planner (see the module docstring)."""
 
     def __init__(self, name: str, settings: GradientSettings) -> None:
@@ -149,28 +146,19 @@ class GradientPlanner:
         return (states[bad - 1] if bad > 0 else q), True
 
     # ------------------------------------------------------------------ solve
-    def solve(
-        self,
-        problem,
-        leg: int,
-        budget,
-        rng: np.random.Generator,
-        q_start: Array | None = None,
-        stepper: Stepper | None = None,
-    ) -> PlanResult:
-        """Descend f from q_start (default: the problem's start) towards leg's goal.
+    def plan(self, ctx: PlanningContext, rng: np.random.Generator) -> PlanResult:
+        """Descend f from the context's start towards its leg's goal.
 
         ``rng`` is unused: the method is deterministic (kept for the common signature).
         """
         del rng
         s = self.settings
-        robot = problem.robot
-        goal = problem.goal(leg)
-        checker = problem_checker(problem)
-        tracker = BudgetTracker(budget, checker)
-        run = LegRun(self.name, s, problem, leg, tracker)
-        q = np.array(problem.q_start if q_start is None else q_start, dtype=float)
-        f = self.objective(problem, leg, checker)
+        problem, robot, goal = ctx.problem, ctx.robot, ctx.goal
+        checker, tracker, stepper = ctx.checker, ctx.tracker, ctx.stepper
+        budget = tracker.budget
+        run = ctx.run(self.name, s)
+        q = ctx.q_start.copy()
+        f = self.objective(problem, ctx.leg, checker)
         closed = s.mode == "closed_loop"
         if closed:
             if stepper is None:
@@ -188,9 +176,8 @@ class GradientPlanner:
             dists = goal.distance(robot, np.array(path))
             return Progress.of_series(clock, checks, dists, run.cost(status, np.array(path)))
 
-        why_not = start_collision(checker, q)
-        if why_not is not None:
-            return run.result(Status.INVALID_START, why_not, [q], fk_calls=f.evaluations)
+        if ctx.start_problem is not None:
+            return run.result(Status.INVALID_START, ctx.start_problem, [q], fk_calls=f.evaluations)
 
         path = [q.copy()]
         value = f(q)

@@ -52,133 +52,40 @@ modules further than the last and aims at a point drawn uniformly in a ball of
 again from the same stall, up to ``max_escapes`` draws. Its seeds are different runs, so
 a success rate over seeds says how often such an escape works (the ``detour``'s seeds are
 one run repeated).
+
+The settings are in :mod:`~plannerlab.planners.descent_settings`, the step in numpy in
+:mod:`~plannerlab.planners.descent_step` (a base of :class:`ClearanceDescent`), the field
+and step on either engine in :mod:`~plannerlab.planners.descent_models`; this module holds
+the descent, its escapes and :class:`LegPath`, the clearance family's result.
 """
 
 from __future__ import annotations
 
 from collections.abc import Callable, Mapping
-from dataclasses import dataclass
-from functools import cached_property
 from typing import Any
 
 import numpy as np
 
-from plannerlab.collision.fcl_checker import CollisionChecker, problem_checker
+from plannerlab.collision.fcl_checker import CollisionChecker
 from plannerlab.errors import PlannerlabError
 from plannerlab.planners.base import (
-    BudgetTracker,
     LegRun,
     Planner,
     PlanResult,
     Status,
-    start_collision,
     with_overrides,
 )
-from plannerlab.planners.clearance import Clearance, ClearanceField
+from plannerlab.planners.clearance import ClearanceField
+from plannerlab.planners.context import LegPlanner, PlanningContext, plan_in
+from plannerlab.planners.descent_models import CompiledModel, Model, NumpyModel
+from plannerlab.planners.descent_settings import ClearanceSettings
+from plannerlab.planners.descent_step import DescentStep
 from plannerlab.problem.goals import GoalRegion, JointGoal
 from plannerlab.robots.base import Array, joint_difference, wrap_to_pi
 from plannerlab.robots.paths import path_length
 
-#: the escapes from a stall (``escape`` setting)
-ESCAPES = ("none", "detour", "random_detour", "rrtconnect")
-#: how the field and the step are computed (``backend`` setting)
-BACKENDS = ("compiled", "numpy")
 
-
-@dataclass(frozen=True)
-class ClearanceSettings:
-    """Settings of the clearance descent.
-
-    Attributes:
-        r1, r2: weights of the tip position and normal terms (paper: 1, 1).
-        clearance_weight: w, weight of the clearance term.
-        margin_m: m, distance below which a pair costs [m].
-        direction: "gradient" or "gauss_newton" (see the module docstring).
-        damping: Gauss-Newton damping λ (in tolerance units).
-        max_step_rad: largest joint change per step [rad]; 0 = half the problem's joint_step
-            (the executor commands every waypoint for the same time, so this halves the
-            arm's speed: measured on armz_inspection, tracking error <= 0.03 rad instead
-            of up to 0.53 rad with steps of a whole joint_step).
-        min_step_rad: trust radius below which the descent has stalled [rad].
-        stall_window: iterations without improvement of the best f that make a stall.
-        stall_min_decrease: improvement of the best f that resets the stall window.
-        goal_depth: aim at this fraction of the goal tolerances (Gauss-Newton residuals;
-            of ``tol_rad`` for a goal state).
-        escape: what to do at a stall: "none", "detour", "random_detour" or "rrtconnect"
-            (see the module docstring); ``max_escapes`` stalls are escaped at most (for
-            ``random_detour`` also the most draws from one stall).
-        retract_step: modules between the detour's retract sub-goals (``random_detour``:
-            its mean step is ``retract_step + 0.5``).
-        retract_jitter_m: radius of the ball round the body's face in which
-            ``random_detour`` draws each retract sub-goal's point [m].
-        escape_goal_samples: goal states the ``rrtconnect`` escape draws by IK (seeded
-            from the stall) when the descent near the stall finds no collision-free goal.
-        hold_clearance: when a step would take a pair below ``min_clearance_m``, try
-            once the same step with the part that closes such pairs taken out
-            (:meth:`ClearanceDescent._hold_clearance`) before shrinking the step; without
-            it the descent stalls against the clearance floor (measured on room
-            variants: the leave leg stalled at iteration 7 and no retract got out).
-        backend: "compiled" (the field and the step in numba,
-            :mod:`plannerlab.planners._descent_core`; Arm-Z only, other robots use numpy)
-            or "numpy" (the reference: the same iterates to rounding, 30-50 times slower;
-            `bench/descent_bench.py`).
-    """
-
-    r1: float = 1.0
-    r2: float = 1.0
-    clearance_weight: float = 0.2
-    margin_m: float = 0.3
-    direction: str = "gauss_newton"
-    damping: float = 0.1
-    max_step_rad: float = 0.0
-    min_step_rad: float = 1e-4
-    stall_window: int = 60
-    stall_min_decrease: float = 1e-3
-    goal_depth: float = 0.3
-    deepen_iterations: int = 100
-    min_clearance_m: float = 0.03
-    settle_iterations: int = 100
-    settle_fraction: float = 0.7
-    escape: str = "none"
-    max_escapes: int = 3
-    escape_checks: int = 50000
-    approach_m: float = 2.5
-    retract_step: int = 2
-    subgoal_pos_tol_m: float = 0.5
-    subgoal_angle_tol_deg: float = 30.0
-    retract_jitter_m: float = 0.5
-    escape_goal_samples: int = 4
-    hold_clearance: bool = True
-    backend: str = "compiled"
-
-    def __post_init__(self) -> None:
-        if self.direction not in ("gradient", "gauss_newton"):
-            raise PlannerlabError(
-                f"direction setting: 'gradient' or 'gauss_newton', got {self.direction!r}"
-            )
-        if not self.margin_m > 0:
-            raise PlannerlabError(f"margin_m must be > 0, got {self.margin_m}")
-        if self.backend not in BACKENDS:
-            raise PlannerlabError(
-                f"backend setting: one of {', '.join(map(repr, BACKENDS))}, got {self.backend!r}"
-            )
-        if self.escape not in ESCAPES:
-            raise PlannerlabError(
-                f"escape setting: one of {', '.join(map(repr, ESCAPES))}, got {self.escape!r}"
-            )
-        if not self.retract_jitter_m >= 0:
-            raise PlannerlabError(f"retract_jitter_m must be >= 0, got {self.retract_jitter_m}")
-        if self.escape_goal_samples < 1:
-            raise PlannerlabError(
-                f"escape_goal_samples must be >= 1, got {self.escape_goal_samples}"
-            )
-        if self.retract_step < 1:
-            raise PlannerlabError(f"retract_step must be >= 1, got {self.retract_step}")
-        if self.stall_window < 2:
-            raise PlannerlabError(f"stall_window must be >= 2, got {self.stall_window}")
-
-
-class ClearanceDescent:
+class ClearanceDescent(DescentStep, LegPlanner):
     """One descent of F from a start state (see the module docstring)."""
 
     def __init__(
@@ -191,168 +98,14 @@ class ClearanceDescent:
         self.settings = settings
         self.escape_planner = escape_planner
         #: (problem, its model): the field of the last problem solved (see :meth:`model`)
-        self._model_cache: tuple[Any, _Model] | None = None
+        self._model_cache: tuple[Any, Model] | None = None
 
     # ------------------------------------------------------------------ pieces
-    def _f(self, robot, goal, q: Array) -> float:
-        s = self.settings
-        if isinstance(goal, JointGoal):
-            return float(s.r1 * np.linalg.norm(joint_difference(q, goal.q_rad, goal.continuous)))
-        p, n = robot.tip(q)
-        return float(
-            s.r1 * np.linalg.norm(p - goal.p_world_m) + s.r2 * (1.0 - n @ goal.n_world) ** 2
-        )
-
-    def _direction(self, robot, goal, field: ClearanceField, q: Array) -> tuple[Array, float]:
-        """Descent direction (dof,) and F at q."""
-        s = self.settings
-        c = field(q)
-        if isinstance(goal, JointGoal):
-            return self._joint_direction(goal, field, q, c)
-        p, n = robot.tip(q)
-        J_p, J_n = robot.tip_jacobian(q)
-        diff = p - goal.p_world_m
-        dist = float(np.linalg.norm(diff))
-        cn = 1.0 - float(n @ goal.n_world)
-        F = s.r1 * dist + s.r2 * cn**2 + s.clearance_weight * c.cost
-        if s.direction == "gradient":
-            g_pos = (diff / dist) @ J_p if dist > 1e-12 else np.zeros(robot.dof)
-            g = s.r1 * g_pos - 2.0 * s.r2 * cn * (goal.n_world @ J_n)
-            g = g + s.clearance_weight * c.gradient
-            return -g, F
-        # Gauss-Newton on scaled tip residuals + clearance residuals
-        pos_scale = 1.0 / goal.pos_tol_m
-        ang_scale = 1.0 / np.deg2rad(goal.angle_tol_deg)
-        e = np.concatenate([(goal.p_world_m - p) * pos_scale, (goal.n_world - n) * ang_scale])
-        # aim only as deep as goal_depth of the tolerances: no pull once well inside
-        pos_err = dist / goal.pos_tol_m
-        ang_err = np.arccos(np.clip(1.0 - cn, -1.0, 1.0)) * ang_scale
-        if pos_err < s.goal_depth:
-            e[:3] = 0.0
-        if ang_err < s.goal_depth:
-            e[3:] = 0.0
-        J = np.vstack([J_p * pos_scale, J_n * ang_scale])
-        A = J.T @ J
-        b = J.T @ e
-        if c.close_pairs:
-            # residual r = k (m − d), k = √(w/m); J_r = −k ∇d; Gauss-Newton uses −J_r^T r
-            # = k² (m − d) ∇d = −(w/2) ∇cost, and J_r^T J_r = k² ∇d ∇d^T
-            dd = self._distance_gradients(field, q)
-            k2 = s.clearance_weight / s.margin_m
-            A = A + k2 * dd.T @ dd
-            b = b - 0.5 * s.clearance_weight * c.gradient
-        A = A + s.damping**2 * np.eye(robot.dof)
-        return np.linalg.solve(A, b), F
-
-    def _metric(self, robot, goal, field: ClearanceField, q: Array) -> Array:
-        """The matrix A (dof, dof) of the quadratic model :meth:`_direction` minimises at q
-        (Gauss-Newton: JᵀJ of the scaled tip residuals, or of the joint residuals towards a
-        goal state, plus the clearance residuals',
-        plus the damping; the identity for ``direction = "gradient"``)."""
-        s = self.settings
-        if s.direction == "gradient":
-            return np.eye(robot.dof)
-        if isinstance(goal, JointGoal):  # the joint residual's Jacobian I / tol_rad
-            A = np.eye(robot.dof) / goal.tol_rad**2
-        else:
-            J_p, J_n = robot.tip_jacobian(q)
-            J = np.vstack([J_p / goal.pos_tol_m, J_n / np.deg2rad(goal.angle_tol_deg)])
-            A = J.T @ J
-        if field(q).close_pairs:
-            dd = self._distance_gradients(field, q)
-            A = A + (s.clearance_weight / s.margin_m) * dd.T @ dd
-        return A + s.damping**2 * np.eye(robot.dof)
-
-    def _joint_direction(
-        self, goal: JointGoal, field: ClearanceField, q: Array, c: Clearance
-    ) -> tuple[Array, float]:
-        """:meth:`_direction` towards a goal state: F = |(q − q_goal) / tol_rad|² + w · cost
-        (continuous joints wrapped), the sum of squares whose Gauss-Newton step is taken:
-        the joint residual (q_goal − q) / tol_rad (its Jacobian I / tol_rad) and the
-        clearance residuals; or −∇F."""
-        s = self.settings
-        dq = joint_difference(q, goal.q_rad, goal.continuous)
-        F = _joint_residual_sq(goal, q) + s.clearance_weight * c.cost
-        if s.direction == "gradient":
-            g = 2.0 * dq / goal.tol_rad**2
-            return -(g + s.clearance_weight * c.gradient), F
-        scale = 1.0 / goal.tol_rad
-        e = -dq * scale
-        # aim only as deep as goal_depth of the tolerance: no pull once well inside
-        if float(np.max(np.abs(dq), initial=0.0)) * scale < s.goal_depth:
-            e[:] = 0.0
-        A = scale**2 * np.eye(len(q))
-        b = scale * e
-        if c.close_pairs:
-            dd = self._distance_gradients(field, q)
-            k2 = s.clearance_weight / s.margin_m
-            A = A + k2 * dd.T @ dd
-            b = b - 0.5 * s.clearance_weight * c.gradient
-        A = A + s.damping**2 * np.eye(len(q))
-        direction: Array = np.asarray(np.linalg.solve(A, b), dtype=float)
-        return direction, F
-
-    @staticmethod
-    def _distance_gradients(field: ClearanceField, q: Array) -> Array:
-        """∇d (c, dof) of the pairs inside the margin."""
-        p, J = field._centres_and_jacobians(q)
-        d, n, a, b = field._pairs(p)
-        close = d < field.margin_m
-        n, a, b = n[close], a[close], b[close]
-        g = np.einsum("ck,ckj->cj", n, J[a])
-        is_self = b >= 0
-        if is_self.any():
-            g[is_self] -= np.einsum("ck,ckj->cj", n[is_self], J[b[is_self]])
-        return g
-
-    def _hold_clearance(
-        self, field: ClearanceField, q: Array, direction: Array, metric: Array | None = None
-    ) -> Array:
-        """The step ``direction`` (dof,) changed as little as possible so that no sphere
-        pair within 1 cm of ``min_clearance_m`` comes closer (to first order: it moves
-        away at a small angle, 0.1 of its gradient's full rate), so the descent slides
-        along the clearance floor instead of stalling against it (a step that would take
-        such a pair closer is refused, and the descent otherwise only shrinks its step).
-        Active-set projection, at most 10 rounds.
-
-        "As little as possible" is measured in ``metric`` (A, the quadratic model's
-        matrix, :meth:`_metric`): ``dq = direction + A⁻¹ Gᵀ λ``, the minimiser of the
-        model under the pairs' constraints, so the held step still lowers the model the
-        direction came from. (The Euclidean projection, ``metric`` None, is not: on a
-        room variant, v14 leg A, it raised F at every radius and the descent stalled with
-        the trust radius collapsing; projected in A it solved the leg.)"""
-        s = self.settings
-        p, J = field._centres_and_jacobians(q)
-        d, n, a, b = field._pairs(p)
-        active = np.flatnonzero(d < s.min_clearance_m + 0.01)
-        if active.size == 0:
-            return direction
-        G = np.einsum("ck,ckj->cj", n[active], J[a[active]])
-        is_self = b[active] >= 0
-        if is_self.any():
-            G[is_self] -= np.einsum("ck,ckj->cj", n[active][is_self], J[b[active][is_self]])
-        norms = np.linalg.norm(G, axis=1)
-        want = 0.1 * norms * float(np.linalg.norm(direction))
-        chosen = np.zeros(len(active), dtype=bool)
-        dq = direction
-        # A⁻¹ Gᵀ (columns: each pair's gradient in the model's metric)
-        AiGt = G.T if metric is None else np.linalg.solve(metric, G.T)
-        for _ in range(10):
-            short = (G @ dq) < want - 1e-12
-            if not short.any():
-                break
-            chosen |= short
-            K = G[chosen] @ AiGt[:, chosen]
-            reg = 1e-9 * max(float(np.trace(K)) / len(K), 1e-12) * np.eye(len(K))
-            lam = np.linalg.solve(K + reg, want[chosen] - G[chosen] @ direction)
-            dq = direction + AiGt[:, chosen] @ lam
-        return dq
-
     def _settle(
         self,
         robot,
         goal,
-        model: _Model,
+        model: Model,
         q: Array,
         checker: CollisionChecker,
         max_step: float,
@@ -385,44 +138,42 @@ class ClearanceDescent:
                 radius *= 0.5
         return used
 
-    def _F(self, robot, goal, field: ClearanceField, q: Array) -> float:
-        return self._f(robot, goal, q) + self.settings.clearance_weight * field(q).cost
-
-    def model(self, problem) -> _Model:
+    def model(self, problem) -> Model:
         """The field and step of ``problem`` on the ``backend`` setting's engine (built
         once per problem and kept: building the field's pair lists takes milliseconds)."""
         cached = self._model_cache
         if cached is not None and cached[0] is problem:
             return cached[1]
         field = ClearanceField(problem.robot, problem.scene, self.settings.margin_m)
-        model: _Model
+        model: Model
         if self.settings.backend == "compiled" and getattr(problem.robot, "kind", "") == "armz":
-            model = _CompiledModel(self, field)
+            model = CompiledModel(self, field)
         else:
-            model = _NumpyModel(self, field)
+            model = NumpyModel(self, field)
         self._model_cache = (problem, model)
         return model
 
     # ------------------------------------------------------------------ solve
     def descend(
         self,
-        problem,
-        leg: int,
+        ctx: PlanningContext,
         q_start: Array,
-        checker: CollisionChecker | None,
-        tracker: BudgetTracker,
         goal=None,
         iterations_before: int = 0,
+        *,
+        checked: bool = True,
     ) -> tuple[Status, str, list[Array], list[float], int]:
-        """Descend from q_start; returns status, reason, path, f per iteration, iterations.
+        """Descend from q_start in the leg's context; returns status, reason, path, f per
+        iteration, iterations.
 
-        ``goal`` overrides the leg's goal region (sub-goals of escapes). ``checker`` None:
+        ``goal`` overrides the leg's goal region (sub-goals of escapes). ``checked`` False:
         the states are not checked (goal selection near q_start). ``iterations_before``:
-        iterations the leg has already used (the budget is the leg's).
+        iterations the leg has already used (the budget is the leg's, ``ctx.tracker``).
         """
         s = self.settings
-        robot = problem.robot
-        goal = goal if goal is not None else problem.goal(leg)
+        problem, robot, tracker = ctx.problem, ctx.robot, ctx.tracker
+        checker = ctx.checker if checked else None
+        goal = goal if goal is not None else ctx.goal
         model = self.model(problem)
         max_step = s.max_step_rad if s.max_step_rad > 0 else problem.joint_step / 2
         q = np.array(q_start, dtype=float)
@@ -509,27 +260,26 @@ class ClearanceDescent:
                 best, best_iter = f_now, iteration
 
     # ------------------------------------------------------------------ goals near q
-    def near_goal_state(
-        self, problem, leg: int, q: Array, checker: CollisionChecker, tracker: BudgetTracker
-    ) -> Array | None:
-        """A collision-free state in leg's goal region found by descending F from q with
-        the path left unchecked (the clearance term still steers): a goal *near* q, the
-        part of the arm that F does not need to move stays where it is. One check."""
-        status, _, path, _, _ = self.leg_descent(problem, leg, q, None, tracker)
+    def near_goal_state(self, ctx: PlanningContext, q: Array) -> Array | None:
+        """A collision-free state in the leg's goal region found by descending F from q
+        with the path left unchecked (the clearance term still steers): a goal *near* q,
+        the part of the arm that F does not need to move stays where it is. One check.
+        The goal finder (:data:`~plannerlab.planners.context.NearGoal`) this descent
+        hands its ``rrtconnect`` escape, with its own settings."""
+        status, _, path, _, _ = self.leg_descent(ctx, q, checked=False)
         q_goal = path[-1]
-        if status is Status.SOLVED and checker.is_valid(q_goal):
+        if status is Status.SOLVED and ctx.checker.is_valid(q_goal):
             return q_goal
         return None
 
     # ------------------------------------------------------------------ the leg's descent
     def leg_descent(
         self,
-        problem,
-        leg: int,
+        ctx: PlanningContext,
         q_start: Array,
-        checker: CollisionChecker | None,
-        tracker: BudgetTracker,
         used: int = 0,
+        *,
+        checked: bool = True,
     ) -> tuple[Status, str, list[Array], list[float], int]:
         """The descent of one leg: with ``approach_m`` > 0, first to the goal's approach
         point (the tip at ``p_d − approach_m · n_d`` with the goal's normal, within the
@@ -537,7 +287,7 @@ class ClearanceDescent:
         goal; if the approach stalls, the descent to the goal continues from there. A goal
         state (:class:`JointGoal`) has no approach point."""
         s = self.settings
-        goal = problem.goal(leg)
+        goal = ctx.goal
         path = [np.array(q_start)]
         trace: list[float] = []
         iterations = 0
@@ -545,7 +295,7 @@ class ClearanceDescent:
         if (
             s.approach_m > 0
             and not isinstance(goal, JointGoal)
-            and not goal.contains(problem.robot, q_start)
+            and not goal.contains(ctx.robot, q_start)
         ):
             sub = GoalRegion(
                 "approach",
@@ -554,16 +304,14 @@ class ClearanceDescent:
                 s.subgoal_pos_tol_m,
                 s.subgoal_angle_tol_deg,
             )
-            st, reason, seg, tr, it = self.descend(
-                problem, leg, path[-1], checker, tracker, sub, used
-            )
+            st, reason, seg, tr, it = self.descend(ctx, path[-1], sub, used, checked=checked)
             iterations += it
             path.extend(seg[1:])
             trace.extend(tr)
             if st not in (Status.SOLVED, Status.LOCAL_MINIMUM):
                 return st, reason, path, trace, iterations
         st, reason, seg, tr, it = self.descend(
-            problem, leg, path[-1], checker, tracker, None, used + iterations
+            ctx, path[-1], None, used + iterations, checked=checked
         )
         path.extend(seg[1:])
         trace.extend(tr)
@@ -572,11 +320,8 @@ class ClearanceDescent:
     # ------------------------------------------------------------------ escapes
     def _detour(
         self,
-        problem,
-        leg: int,
+        ctx: PlanningContext,
         q_stall: Array,
-        checker: CollisionChecker,
-        tracker: BudgetTracker,
         used: int,
         rng: np.random.Generator | None = None,
     ) -> tuple[list[Array], int, str]:
@@ -591,7 +336,7 @@ class ClearanceDescent:
         detour succeeded, else just [q_stall]), the iterations and how far it retracted.
         """
         s = self.settings
-        robot = problem.robot
+        robot, tracker = ctx.robot, ctx.tracker
         iterations = 0
         # retract along the body of the stall state
         F = robot.fk(q_stall)
@@ -612,15 +357,11 @@ class ClearanceDescent:
                 s.subgoal_pos_tol_m,
                 s.subgoal_angle_tol_deg,
             )
-            st, _, seg, _, it = self.descend(
-                problem, leg, q, checker, tracker, sub, used + iterations
-            )
+            st, _, seg, _, it = self.descend(ctx, q, sub, used + iterations)
             iterations += it
             kept.extend(seg[1:])
             q = kept[-1]
-            st2, _, seg2, _, it2 = self.leg_descent(
-                problem, leg, q, checker, tracker, used + iterations
-            )
+            st2, _, seg2, _, it2 = self.leg_descent(ctx, q, used + iterations)
             iterations += it2
             if st2 is Status.SOLVED:
                 return kept + seg2[1:], iterations, f"retract {back} modules"
@@ -641,11 +382,8 @@ class ClearanceDescent:
 
     def _random_detours(
         self,
-        problem,
-        leg: int,
+        ctx: PlanningContext,
         q_stall: Array,
-        checker: CollisionChecker,
-        tracker: BudgetTracker,
         used: int,
         rng: np.random.Generator,
     ) -> tuple[list[Array], int, str]:
@@ -654,141 +392,105 @@ class ClearanceDescent:
         iterations = 0
         how = "none"
         for draw in range(1, self.settings.max_escapes + 1):
-            if tracker.exhausted(used + iterations) is not None:
+            if ctx.tracker.exhausted(used + iterations) is not None:
                 break
-            esc, it, how = self._detour(
-                problem, leg, q_stall, checker, tracker, used + iterations, rng
-            )
+            esc, it, how = self._detour(ctx, q_stall, used + iterations, rng)
             iterations += it
             if len(esc) > 1:
                 return esc, iterations, f"{how} (draw {draw})"
         return [np.array(q_stall)], iterations, how
 
     def _rrtconnect(
-        self,
-        problem,
-        leg: int,
-        q_stall: Array,
-        tracker: BudgetTracker,
-        rng: np.random.Generator,
+        self, ctx: PlanningContext, q_stall: Array, rng: np.random.Generator
     ) -> tuple[list[Array], int, str]:
-        """RRT-Connect from the stall to a goal state found near it (see near_goal_state)
-        or, when the descent from the stall ends in no collision-free goal state, to
+        """RRT-Connect from the stall to a goal state found near it by this descent, with
+        its settings (:meth:`near_goal_state`, the sub-solve's goal finder) or, when the
+        descent from the stall ends in no collision-free goal state, to
         ``escape_goal_samples`` goal states drawn by IK (OMPL's ``near_or_ik`` goal
-        selection), with the checks and time left, at most ``escape_checks`` checks; its
-        iterations count in the leg's afterwards (the caller adds them)."""
+        selection), with the checks and time left, at most ``escape_checks`` checks: a
+        sub-solve in the leg's context (its checks are the leg's); its iterations count
+        in the leg's afterwards (the caller adds them)."""
         if self.escape_planner is None:
             raise PlannerlabError(
                 f"{self.name}: no escape planner given (make it by name, make_planner)"
             )
+        tracker = ctx.tracker
         sub = tracker.remaining(self.settings.escape_checks, limit_iterations=False)
         if sub is None:
             return [np.array(q_stall)], 0, f"not started: {tracker.exhausted() or 'no budget'}"
         rrt = self.escape_planner(
             {"goal_selection": "near_or_ik", "goal_samples": self.settings.escape_goal_samples}
         )
-        r = rrt.solve(problem, leg, sub, rng, q_start=q_stall)
-        tracker.charge_checks(r.collision_checks)  # the sub-planner's checks count here
+        r = plan_in(rrt, ctx.sub(sub, q_stall, near_goal=self.near_goal_state), rng)
         if r.solved:
             return list(r.path), r.iterations, "rrtconnect"
         return [np.array(q_stall)], r.iterations, f"rrtconnect: {r.status.value}"
 
     # ------------------------------------------------------------------ solve
-    def solve(
-        self,
-        problem,
-        leg: int,
-        budget,
-        rng: np.random.Generator,
-        q_start: Array | None = None,
-        stepper=None,
-    ) -> PlanResult:
-        """Descend F from q_start (default: the problem's start) into leg's goal region;
-        at a stall, escape from the stall state (``escape`` setting) and descend again."""
-        del stepper  # kinematic
+    def warm_up(self, problem, leg: int, q_start: Array) -> None:
+        """Build the field (and for the compiled backend, load or compile its core) before
+        the leg's tracker starts, like the checker: a one-off cost outside the limits."""
+        self.model(problem).warm_up(problem.goal(leg), q_start)
+
+    def plan(self, ctx: PlanningContext, rng: np.random.Generator) -> PlanResult:
+        """Descend F from the context's start into its leg's goal region; at a stall,
+        escape from the stall state (``escape`` setting) and descend again."""
         s = self.settings
-        robot = problem.robot
-        goal = problem.goal(leg)
-        checker = problem_checker(problem)
-        q0 = np.array(problem.q_start if q_start is None else q_start, dtype=float)
-        # the field (and for the compiled backend, loading or compiling its core) is built
-        # before the tracker starts, like the checker: a one-off cost outside the limits
-        self.model(problem).warm_up(goal, q0)
-        tracker = BudgetTracker(budget, checker)
-        run = LegRun(self.name, s, problem, leg, tracker)
-        path: list[Array] = [q0]
+        problem, robot, goal, tracker = ctx.problem, ctx.robot, ctx.goal, ctx.tracker
+        q0 = ctx.q_start
+        leg_path = LegPath(ctx.run(self.name, s), q0)
+        path = leg_path.path
         trace: list[float] = []
         escapes_log: list[dict] = []
-        iterations = 0
-        minima = escapes = 0
         descent_rad: list[float] = []
-
-        def note(states: list[Array]) -> None:
-            """Progress after a descent or an escape: the best goal distance it reached."""
-            if states:
-                run.progress.note(float(np.min(goal.distance(robot, np.asarray(states)))))
 
         def dist(a: Array, b: Array) -> float:
             return float(np.linalg.norm(joint_difference(a, b, robot.continuous)))
 
         def done(status: Status, reason: str) -> PlanResult:
             """The leg's result from the state of the loop."""
-            extra: dict = {
-                "descent_rad": descent_rad,
-                "escapes": escapes_log,
-                "path_rad": path_length(np.array(path), robot.continuous),
-                # what ran: "compiled" falls back to numpy for robots other than Arm-Z
-                "descent_backend": self.model(problem).backend,
-            }
-            if status is Status.LOCAL_MINIMUM:
-                extra["q_stall"] = np.asarray(path[-1], dtype=float).tolist()
-            return run.result(
+            return leg_path.result(
                 status,
                 reason,
-                path,
-                iterations=iterations,
                 trace=trace,
-                local_minima=minima,
-                escapes=escapes,
-                extra=extra,
+                extra={
+                    "descent_rad": descent_rad,
+                    "escapes": escapes_log,
+                    # what ran: "compiled" falls back to numpy for robots other than Arm-Z
+                    "descent_backend": self.model(problem).backend,
+                },
             )
 
-        why_not = start_collision(checker, q0)
-        if why_not is not None:
-            return done(Status.INVALID_START, why_not)
-        note([q0])
+        if ctx.start_problem is not None:
+            return done(Status.INVALID_START, ctx.start_problem)
+        leg_path.note([q0])
         q = q0
         while True:
-            st, reason, seg, tr, it = self.leg_descent(
-                problem, leg, q, checker, tracker, iterations
-            )
-            iterations += it
+            st, reason, seg, tr, it = self.leg_descent(ctx, q, leg_path.iterations)
+            leg_path.iterations += it
             trace.extend(tr)
-            note(list(seg))
-            path.extend(seg[1:])
+            leg_path.add(seg)
             descent_rad.append(path_length(np.array(seg), robot.continuous))
-            if st is Status.SOLVED:
+            minima, escapes = leg_path.minima, leg_path.escapes
+            if st is not Status.LOCAL_MINIMUM:  # solved, or out of budget
                 return done(st, f"{reason}; {minima} local minima met, {escapes} escaped")
-            if st is not Status.LOCAL_MINIMUM:
-                return done(st, f"{reason}; {minima} local minima met, {escapes} escaped")
-            minima += 1
+            leg_path.minima = minima = minima + 1
             q_stall = np.array(path[-1])
             if s.escape == "none":
                 return done(st, reason)
             if minima > s.max_escapes:
                 return done(st, f"{reason}; {minima} local minima met, {escapes} escaped; gave up")
             c0 = tracker.checks_used
+            used = leg_path.iterations
             if s.escape == "detour":
-                esc, it, how = self._detour(problem, leg, q_stall, checker, tracker, iterations)
+                esc, it, how = self._detour(ctx, q_stall, used)
             elif s.escape == "random_detour":
-                esc, it, how = self._random_detours(
-                    problem, leg, q_stall, checker, tracker, iterations, rng
-                )
+                esc, it, how = self._random_detours(ctx, q_stall, used, rng)
             else:
-                esc, it, how = self._rrtconnect(problem, leg, q_stall, tracker, rng)
-            iterations += it
+                esc, it, how = self._rrtconnect(ctx, q_stall, rng)
+            leg_path.iterations += it
             left_stall = len(esc) > 1
-            escapes += int(left_stall)
+            leg_path.escapes += int(left_stall)
             escapes_log.append(
                 {
                     "kind": s.escape,
@@ -806,8 +508,7 @@ class ClearanceDescent:
                     Status.LOCAL_MINIMUM,
                     f"{reason}; the {s.escape} escape from stall {minima} failed ({how})",
                 )
-            note(list(esc))
-            path.extend(esc[1:])
+            leg_path.add(esc)
             q = np.array(path[-1])
             if goal.contains(robot, q):
                 return done(
@@ -816,149 +517,67 @@ class ClearanceDescent:
                 )
 
 
-class _NumpyPoint:
-    """The numpy descent's view of one state; each piece is computed when first asked
-    (the direction only at accepted states), as the numpy descent always did."""
+class LegPath:
+    """A leg's path built from segments (descents, escapes, a leader's tracking), the
+    counts the planner keeps on it, and its result: the one home of the result of the
+    clearance family (``gradient.clearance*``, ``gradient.follow_leader*``).
 
-    def __init__(
+    Progress is noted after each segment (the best goal distance it reached); the result
+    adds ``extra["path_rad"]`` (the path's joint-space length) and, at a local minimum,
+    ``extra["q_stall"]`` (the state it stalled at) to the planner's own ``extra``.
+
+    Args:
+        run: the leg's :class:`~plannerlab.planners.base.LegRun`.
+        q0: (dof,) the leg's start, the path's first state.
+    """
+
+    def __init__(self, run: LegRun, q0: Array) -> None:
+        self.run = run
+        self.path: list[Array] = [q0]
+        #: the planner's counts, reported in the result
+        self.iterations = 0
+        self.minima = 0
+        self.escapes = 0
+
+    def note(self, states: Any) -> None:
+        """Progress after a segment: the best goal distance its states reach."""
+        if len(states):
+            run = self.run
+            run.progress.note(float(np.min(run.goal.distance(run.robot, np.asarray(states)))))
+
+    def add(self, segment: Any) -> None:
+        """Append a segment that starts at the path's last state (its first state is
+        dropped) and note its progress."""
+        self.note(list(segment))
+        self.path.extend(list(segment[1:]))
+
+    def result(
         self,
-        descent: ClearanceDescent,
-        field: ClearanceField,
-        goal,
-        q: Array,
-        d_ref: Array | None = None,
-    ):
-        self._descent, self._field, self._goal, self._q = descent, field, goal, q
-        self._d_ref = d_ref
-
-    @cached_property
-    def spacious(self) -> bool:
-        """No pair below ``min_clearance_m`` that came closer than in ``d_ref``."""
-        if self._d_ref is None:
-            return True
-        d_new, floor = self.distances_m, self._descent.settings.min_clearance_m
-        return bool(np.all((d_new >= floor) | (d_new >= self._d_ref - 1e-9)))
-
-    @cached_property
-    def _clearance(self):
-        return self._field(self._q)
-
-    @cached_property
-    def f(self) -> float:
-        return self._descent._f(self._field.robot, self._goal, self._q)
-
-    @property
-    def F(self) -> float:  # noqa: N802 - the module docstring's F
-        w = self._descent.settings.clearance_weight
-        if isinstance(self._goal, JointGoal):
-            return _joint_residual_sq(self._goal, self._q) + w * self._clearance.cost
-        return self.f + w * self._clearance.cost
-
-    @property
-    def cost(self) -> float:
-        return self._clearance.cost
-
-    @property
-    def gradient(self) -> Array:
-        return self._clearance.gradient
-
-    @property
-    def distances_m(self) -> Array:
-        return self._clearance.distances_m
-
-    @cached_property
-    def _errors(self) -> tuple[float, float]:
-        pos_err, ang_err = self._goal.errors(self._field.robot, self._q)
-        return float(pos_err), float(ang_err)
-
-    @property
-    def pos_err_m(self) -> float:
-        return self._errors[0]
-
-    @property
-    def ang_err_deg(self) -> float:
-        return self._errors[1]
-
-    @cached_property
-    def joint_err(self) -> float:
-        """Largest joint difference from a goal state (:class:`JointGoal` only)."""
-        return float(self._goal.joint_error(self._q))
-
-    @cached_property
-    def direction(self) -> Array:
-        return self._descent._direction(self._field.robot, self._goal, self._field, self._q)[0]
-
-
-class _NumpyModel:
-    """The field and the step in numpy (``backend = "numpy"``: the reference)."""
-
-    backend = "numpy"
-
-    def __init__(self, descent: ClearanceDescent, field: ClearanceField) -> None:
-        self._descent, self._field = descent, field
-
-    def point(self, goal, q: Array, d_ref: Array | None = None) -> _NumpyPoint:
-        return _NumpyPoint(self._descent, self._field, goal, q, d_ref)
-
-    def hold(self, goal, q: Array, direction: Array) -> Array:
-        metric = self._descent._metric(self._field.robot, goal, self._field, q)
-        return self._descent._hold_clearance(self._field, q, direction, metric)
-
-    def warm_up(self, goal, q: Array) -> None:
-        """Nothing to load."""
-
-
-class _CompiledModel:
-    """The field and the step compiled (:mod:`plannerlab.planners._descent_core`): one
-    call per state gives F, f, the tip errors, the distances and the step direction."""
-
-    backend = "compiled"
-
-    def __init__(self, descent: ClearanceDescent, field: ClearanceField) -> None:
-        from plannerlab.planners._descent_core import CompiledField
-
-        s = descent.settings
-        self._settings = s
-        # distances beyond both the margin and the hold's floor matter to no test of the
-        # descent (the spacious test looks only below min_clearance_m)
-        self._core = CompiledField(field, far_m=max(s.margin_m, s.min_clearance_m + 0.01))
-
-    def point(self, goal, q: Array, d_ref: Array | None = None):
-        s = self._settings
-        return self._core.evaluate(
-            q,
-            goal,
-            s.r1,
-            s.r2,
-            s.clearance_weight,
-            s.direction == "gauss_newton",
-            s.damping,
-            s.goal_depth,
-            True,
-            d_ref,
-            s.min_clearance_m,
+        status: Status,
+        reason: str,
+        *,
+        trace: Any = None,
+        extra: Mapping[str, Any] | None = None,
+    ) -> PlanResult:
+        """The leg's result: the path, the counts, the planner's ``extra`` with the
+        path's length and, at a local minimum, the stall state."""
+        robot = self.run.robot
+        out: dict[str, Any] = {
+            **(extra or {}),
+            "path_rad": path_length(np.array(self.path), robot.continuous),
+        }
+        if status is Status.LOCAL_MINIMUM:
+            out["q_stall"] = np.asarray(self.path[-1], dtype=float).tolist()
+        return self.run.result(
+            status,
+            reason,
+            self.path,
+            iterations=self.iterations,
+            trace=trace,
+            local_minima=self.minima,
+            escapes=self.escapes,
+            extra=out,
         )
-
-    def hold(self, goal, q: Array, direction: Array) -> Array:
-        """The held step, projected in the metric of the step's quadratic model at q
-        (:meth:`ClearanceDescent._metric`, which the compiled evaluation returns)."""
-        metric = self.point(goal, q).metric
-        floor = self._settings.min_clearance_m + 0.01
-        return self._core.hold_clearance(q, direction, floor, metric)
-
-    def warm_up(self, goal, q: Array) -> None:
-        """Load (or compile) both kernels: one call each."""
-        self.hold(goal, q, self.point(goal, q).direction)
-
-
-_Model = _NumpyModel | _CompiledModel
-
-
-def _joint_residual_sq(goal: JointGoal, q: Array) -> float:
-    """|(q − q_goal) / tol_rad|², continuous joints wrapped: the goal part of F towards a
-    goal state."""
-    e = joint_difference(q, goal.q_rad, goal.continuous) / goal.tol_rad
-    return float(e @ e)
 
 
 def _within(goal: GoalRegion, point, fraction: float) -> bool:

@@ -30,18 +30,16 @@ from typing import Any
 
 import numpy as np
 
-from plannerlab.collision.fcl_checker import CollisionChecker, problem_checker
 from plannerlab.errors import PlannerlabError
 from plannerlab.planners.base import (
     BudgetTracker,
-    LegRun,
     Planner,
     PlanResult,
     Status,
     with_overrides,
 )
+from plannerlab.planners.context import LegPlanner, PlanningContext, plan_in
 from plannerlab.planners.gradient import GradientPlanner, GradientSettings
-from plannerlab.problem.load import Budget
 from plannerlab.robots.base import Array, joint_difference, wrap_to_pi
 from plannerlab.robots.paths import interpolate_edge, path_length
 
@@ -95,8 +93,12 @@ class HybridSettings:
         )
 
 
-class HybridPlanner:
-    """``gradient+rrtconnect`` and ``gradient.multistart`` (see the module docstring)."""
+class HybridPlanner(LegPlanner):
+    """``gradient+rrtconnect`` and ``gradient.multistart`` (see the module docstring).
+
+    Its descents and escapes are sub-solves in the leg's context
+    (:meth:`~plannerlab.planners.context.PlanningContext.sub`): one checker, one tracker.
+    """
 
     def __init__(
         self,
@@ -109,23 +111,13 @@ class HybridPlanner:
         self.escape_planner = escape_planner
         self._descent = GradientPlanner(f"{name}/descent", settings.descent())
 
-    def solve(
-        self,
-        problem: Any,
-        leg: int,
-        budget: Budget,
-        rng: np.random.Generator,
-        q_start: Array | None = None,
-        stepper: Any = None,
-    ) -> PlanResult:
-        del stepper
+    def plan(self, ctx: PlanningContext, rng: np.random.Generator) -> PlanResult:
         s = self.settings
-        robot = problem.robot
-        checker = problem_checker(problem)  # the restarts' edges
-        tracker = BudgetTracker(budget, checker)  # and the sub-solves' results, charged
-        run = LegRun(self.name, s, problem, leg, tracker)
+        robot = ctx.robot
+        tracker = ctx.tracker  # the sub-solves' iterations charged; their checks its own
+        run = ctx.run(self.name, s)
         progress = run.progress
-        q = np.array(problem.q_start if q_start is None else q_start, dtype=float)
+        q = ctx.q_start.copy()
         path: list[Array] = [q]
         trace: list[float] = []
         minima = escapes = 0
@@ -152,20 +144,22 @@ class HybridPlanner:
         def dist(a: Array, b: Array) -> float:
             return float(np.linalg.norm(joint_difference(a, b, robot.continuous)))
 
+        if ctx.start_problem is not None:
+            return done(Status.INVALID_START, ctx.start_problem)
         while True:
             sub = tracker.remaining()
             if sub is None:
                 return done(Status.BUDGET_EXHAUSTED, _used_up(tracker))
             t_sub, c_sub = tracker.elapsed_s, tracker.checks_used
-            r = self._descent.solve(problem, leg, sub, rng, q_start=q)
-            tracker.charge(r)
+            r = self._descent.plan(ctx.sub(sub, q), rng)
+            tracker.charge(r, checks=False)
             progress.extend(r.progress, t_sub, c_sub)
             path.extend(r.path[1:])
             trace.extend(r.trace.tolist())
             descent_rad.append(path_length(r.path, robot.continuous))
             q = r.path[-1]
             notes.append(f"descent: {r.status.value} after {r.iterations} iterations")
-            if r.status in (Status.SOLVED, Status.INVALID_START):
+            if r.status is Status.SOLVED:
                 return done(r.status, f"{r.reason}; {minima} local minima met, {escapes} escaped")
             if r.status is not Status.LOCAL_MINIMUM:
                 return done(r.status, r.reason)
@@ -190,7 +184,7 @@ class HybridPlanner:
             escapes_log.append(record)
             if s.escape == "rrtconnect":
                 t_sub, c_sub = tracker.elapsed_s, tracker.checks_used
-                rrt = self._rrt_escape(problem, leg, tracker, rng, q)
+                rrt = self._rrt_escape(ctx, rng, q)
                 if rrt is None:
                     return done(Status.BUDGET_EXHAUSTED, _used_up(tracker))
                 progress.extend(rrt.progress, t_sub, c_sub)  # an escape: a drop to 0
@@ -206,7 +200,7 @@ class HybridPlanner:
                         f"stall {minima}; {minima} local minima met, {escapes} escaped",
                     )
             # restart near the stall (restart always; rrtconnect after a failed slice)
-            q_new = self._restart(problem, checker, tracker, rng, q, noise)
+            q_new = self._restart(ctx, rng, q, noise)
             noise *= s.restart_noise_growth
             if q_new is None:
                 notes.append(f"no collision-free restart near stall {minima}")
@@ -234,45 +228,35 @@ class HybridPlanner:
         return path[-1]
 
     def _rrt_escape(
-        self,
-        problem: Any,
-        leg: int,
-        tracker: BudgetTracker,
-        rng: np.random.Generator,
-        q: Array,
+        self, ctx: PlanningContext, rng: np.random.Generator, q: Array
     ) -> PlanResult | None:
-        """RRT-Connect from q within an escape's slice of the budget (None: none left)."""
+        """RRT-Connect from q within an escape's slice of the budget (None: none left),
+        a sub-solve in the leg's context."""
         if self.escape_planner is None:
             raise PlannerlabError(
                 f"{self.name}: no escape planner given (make it by name, make_planner)"
             )
-        sub = tracker.remaining(checks_cap=self.settings.escape_checks)
+        sub = ctx.tracker.remaining(checks_cap=self.settings.escape_checks)
         if sub is None:
             return None
         overrides = {"range": self.settings.rrt_range} if self.settings.rrt_range > 0 else {}
-        r = self.escape_planner(overrides).solve(problem, leg, sub, rng, q_start=q)
-        tracker.charge(r)
+        r = plan_in(self.escape_planner(overrides), ctx.sub(sub, q), rng)
+        ctx.tracker.charge(r, checks=False)
         return r
 
     def _restart(
-        self,
-        problem: Any,
-        checker: CollisionChecker,
-        tracker: BudgetTracker,
-        rng: np.random.Generator,
-        q: Array,
-        noise_rad: float,
+        self, ctx: PlanningContext, rng: np.random.Generator, q: Array, noise_rad: float
     ) -> Array | None:
-        """A straight, collision-free edge from q to a random state near it: (m, dof);
-        ``checker`` is the one ``tracker`` counts."""
-        robot = problem.robot
+        """A straight, collision-free edge from q to a random state near it: (m, dof),
+        checked by the leg's checker."""
+        robot, tracker = ctx.robot, ctx.tracker
         for _ in range(self.settings.restart_tries):
             if tracker.remaining() is None:
                 break
             q_try = wrap_to_pi(q + rng.normal(0.0, noise_rad, robot.dof), robot.continuous)
             q_try = np.clip(q_try, robot.lower, robot.upper)
-            edge = interpolate_edge(q, q_try, problem.joint_step, robot.continuous)
-            if checker.first_invalid(edge) is None:
+            edge = interpolate_edge(q, q_try, ctx.joint_step, robot.continuous)
+            if ctx.checker.first_invalid(edge) is None:
                 return wrap_to_pi(edge, robot.continuous)
         return None
 

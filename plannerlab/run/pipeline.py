@@ -29,7 +29,8 @@ import numpy as np
 
 from plannerlab.errors import PlanFileError, PlannerlabError, ProblemError
 from plannerlab.planners import get_entry, make_planner
-from plannerlab.planners.base import LegRun
+from plannerlab.planners.base import LegRun, start_collision
+from plannerlab.planners.context import PlanningContext
 from plannerlab.problem.goals import unreachable_reason
 from plannerlab.problem.load import Budget, Problem
 from plannerlab.record.execution import Execution
@@ -60,10 +61,21 @@ def _unreachable(
     return LegRun(planner_name, None, problem, leg).result(Status.UNREACHABLE, why, [q])
 
 
-def _check_problem_start(problem: Problem) -> None:
-    """Raise a ProblemError naming the colliding pairs if the problem's start collides."""
+#: the problem's start was not checked with the clearance margin (see _refuse_colliding_start)
+_UNCHECKED = "not checked"
+
+
+def _refuse_colliding_start(problem: Problem, with_margin: str | None) -> None:
+    """Raise a ProblemError naming the colliding pairs if the problem's start state
+    collides (without the clearance margin: bad input, not a planning failure).
+
+    ``with_margin`` is the first leg's start-state check (the context's, with the margin):
+    None, a free start, settles it with no other check; a start within the margin, or one
+    not checked (``_UNCHECKED``: a contact-permitting planner's leg, an unreachable one),
+    is checked here without the margin."""
+    if with_margin is None:
+        return
     from plannerlab.collision.fcl_checker import CollisionChecker
-    from plannerlab.planners.base import start_collision
 
     reason = start_collision(CollisionChecker(problem.robot, problem.scene), problem.q_start)
     if reason is not None:
@@ -109,17 +121,23 @@ def solve_legs(
 ) -> Plan:
     """Solve ``legs`` (default: all) in order; each starts where the previous one ended.
 
-    Closed-loop planners get one PyBullet world for the whole task. Every leg's path comes
-    back in its canonical form (:func:`canonical_result`): the plan in memory is the plan
-    its file holds.
+    One collision checker serves the problem (with its clearance margin); each leg gets
+    one :class:`~plannerlab.planners.context.PlanningContext` (its start checked once, its
+    budget tracker) that the planner and its sub-solves plan in. A problem whose own start
+    state collides is refused (ProblemError). Closed-loop planners get one PyBullet world
+    for the whole task. Every leg's path comes back in its canonical form
+    (:func:`canonical_result`): the plan in memory is the plan its file holds.
     """
     entry = get_entry(planner_name)
     planner = make_planner(planner_name, overrides)
     budget = budget or problem.budget
     legs = list(range(problem.legs)) if legs is None else list(legs)
     results: list[PlanResult] = []
-    if legs:  # the first leg starts at the problem's start state
-        _check_problem_start(problem)
+    checker = None
+    if legs and hasattr(planner, "plan") and not getattr(planner, "allows_contact", False):
+        from plannerlab.collision.fcl_checker import problem_checker
+
+        checker = problem_checker(problem)  # one per problem: every leg's context shares it
     with ExitStack() as stack:
         stepper = None
         if entry.needs_stepper:
@@ -135,10 +153,24 @@ def solve_legs(
             )
         q = None  # the first leg starts at the problem's start state
         for leg in legs:
+            first = not results  # it starts at the problem's start state
             why = unreachable_reason(problem.robot, problem.goal(leg))
             if why is not None:
+                if first:
+                    _refuse_colliding_start(problem, _UNCHECKED)
                 r = _unreachable(problem, planner_name, leg, why, q)
-            else:
+            elif hasattr(planner, "plan"):  # a LegPlanner: it plans in the leg's context
+                ctx = PlanningContext.for_planner(
+                    planner, problem, leg, budget, q_start=q, checker=checker, stepper=stepper
+                )
+                if first:
+                    _refuse_colliding_start(
+                        problem, ctx.start_problem if ctx.start_checked else _UNCHECKED
+                    )
+                r = planner.plan(ctx, leg_rng(seed, leg))
+            else:  # a planner of the contract's call only (docs/extending.md)
+                if first:
+                    _refuse_colliding_start(problem, _UNCHECKED)
                 r = planner.solve(
                     problem, leg, budget, leg_rng(seed, leg), q_start=q, stepper=stepper
                 )

@@ -24,8 +24,8 @@ def _models(problem, **overrides):
     compiled = make_planner("gradient.clearance", {"backend": "compiled", **overrides}).model(
         problem
     )
-    assert type(numpy_model).__name__ == "_NumpyModel"
-    assert type(compiled).__name__ == "_CompiledModel"
+    assert type(numpy_model).__name__ == "NumpyModel"
+    assert type(compiled).__name__ == "CompiledModel"
     return numpy_model, compiled
 
 

@@ -119,3 +119,22 @@ def test_progress_rows_a_planner_made_itself_are_kept():
     rows = np.array([[0.5, 10.0, 0.2, np.nan]])
     r = run.result(Status.BUDGET_EXHAUSTED, "used up", [problem.q_start], progress_rows=rows)
     assert np.array_equal(r.progress, rows, equal_nan=True)
+
+
+def test_a_childs_checks_are_its_parents_through_the_shared_checker_and_its_charges_too():
+    problem = toy_problem()
+    checker = CollisionChecker(problem.robot, problem.scene)
+    parent = BudgetTracker(Budget(max_iterations=50, max_collision_checks=100), checker)
+    checker.valid_batch(np.tile(problem.q_start, (3, 1)))
+    sub = parent.remaining(checks_cap=40)
+    assert sub is not None and sub.max_collision_checks == 40
+    child = parent.child(sub)
+    assert (child.checker, child.budget, child.checks_used) == (checker, sub, 0)
+    checker.valid_batch(np.tile(problem.q_start, (5, 1)))  # the sub-solve's checks
+    child.charge_checks(2)  # checked elsewhere: the parent cannot see them, so charged
+    assert (child.checks_used, child.checks_left()) == (5 + 2, 40 - 7)
+    assert parent.checks_used == 3 + 5 + 2
+    # the sub-solve's result: its iterations and FK calls are charged, its checks are not
+    # (the parent counts them already)
+    parent.charge(_sub_result(iterations=6, checks=child.checks_used, fk_calls=9), checks=False)
+    assert (parent.checks_used, parent.iterations, parent.fk_calls) == (10, 6, 9)

@@ -497,6 +497,29 @@ def test_goal_beyond_the_arm_is_unreachable_before_planning(capsys, tmp_path):
     assert leg["collision_checks"] == 0 and "reaches at most" in leg["reason"]
 
 
+@pytest.mark.parametrize("planner", ["gradient", "ompl.rrtconnect"])
+@pytest.mark.parametrize("goal", ["p_m = [0.5, 0.0, 3.0]", "p_m = [100.0, 0.0, 3.0]"])
+def test_a_colliding_start_is_refused_with_the_file_and_the_key(capsys, tmp_path, planner, goal):
+    """The wall through the column: the problem's start collides without the margin, so
+    the problem is bad input, whether the first leg is planned or out of reach."""
+    text = tiny_problem_text("center_m = [3.0, 0.0, 2.0]", "center_m = [0.0, 0.0, 2.0]")
+    path = write_problem(tmp_path, text.replace("p_m = [0.5, 0.0, 3.0]", goal))
+    code, _, err = run(capsys, "solve", str(path), "--planner", planner)
+    assert_clean_error(code, err, str(path), "start", "wall")
+
+
+def test_a_start_within_the_margin_is_the_planners_invalid_start(capsys, tmp_path):
+    """The wall 5 mm from the column: free, but inside the 1-cm clearance margin. Not bad
+    input: the leg's one start check (with the margin) says why it cannot start."""
+    text = tiny_problem_text("center_m = [3.0, 0.0, 2.0]", "center_m = [0.955, 0.0, 2.0]")
+    path = write_problem(tmp_path, text)
+    code, out, err = run(capsys, "solve", str(path), "--planner", "gradient", "--json")
+    assert code == 0, err
+    leg = json.loads(out)["legs"][0]
+    assert leg["status"] == "invalid_start" and "wall" in leg["reason"]
+    assert leg["collision_checks"] == 2  # the start checked once, and its pairs named
+
+
 def test_irb6_goal_off_the_track_is_unreachable(tmp_path):
     from plannerlab.problem.goals import unreachable_reason
 

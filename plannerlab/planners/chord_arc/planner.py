@@ -84,17 +84,15 @@ import math
 import time
 from collections.abc import Sequence
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, ClassVar
 
 import numpy as np
 
 from plannerlab.errors import PlannerlabError
 from plannerlab.planners.base import (
     BudgetTracker,
-    LegRun,
     PlanResult,
     Status,
-    Stepper,
     with_overrides,
 )
 from plannerlab.planners.chord_arc.geometry import (
@@ -120,6 +118,7 @@ from plannerlab.planners.chord_arc.scene import (
     thickness_cuts,
 )
 from plannerlab.planners.chord_arc.settings import ChordArcSettings
+from plannerlab.planners.context import LegPlanner, PlanningContext
 from plannerlab.record.contact_plan import (
     ContactPlan,
     ContactSolution,
@@ -296,12 +295,13 @@ class _Candidate:
 # --------------------------------------------------------------------------- planner
 
 
-class ChordArcPlanner:
+class ChordArcPlanner(LegPlanner):
     """The chord-arc search as a planner (see the module docstring)."""
 
     #: the one contact-permitting planner: its paths touch obstacles at the problem's
-    #: collision points by design, so "every edge collision-free" does not apply.
-    allows_contact: bool = True
+    #: collision points by design, so "every edge collision-free" does not apply (its
+    #: leg's context checks no start state and its tracker counts no checker).
+    allows_contact: ClassVar[bool] = True
 
     def __init__(self, name: str, settings: ChordArcSettings) -> None:
         self.name = name
@@ -516,40 +516,30 @@ class ChordArcPlanner:
         return 0
 
     # ------------------------------------------------------------------ solve
-    def solve(
-        self,
-        problem: Any,
-        leg: int,
-        budget: Any,
-        rng: np.random.Generator,
-        q_start: Array | None = None,
-        stepper: Stepper | None = None,
-    ) -> PlanResult:
-        """Search every chord-arc solution to leg ``leg``'s target; return the chosen one.
+    def plan(self, ctx: PlanningContext, rng: np.random.Generator) -> PlanResult:
+        """Search every chord-arc solution to the leg's target; return the chosen one.
 
         Args:
-            problem: a continuum_chain problem with ``[continuum] collision_points_m``.
-            leg: leg index (its goal position is the target).
-            budget: see the module docstring.
+            ctx: the leg's context: a continuum_chain problem with ``[continuum]
+                collision_points_m``, the leg (its goal position is the target), its
+                budget (see the module docstring) and its start, which must be the
+                retracted straight robot.
             rng: unused (deterministic).
-            q_start: (dof,) must be the retracted straight robot (default: the problem's
-                start).
-            stepper: unused (open-loop).
 
         Raises:
             PlannerlabError: bad input (see :meth:`query`; a collision point off every
                 obstacle boundary).
         """
-        del rng, stepper
+        del rng
         s = self.settings
-        tracker = BudgetTracker(budget)  # checks: the contact classification's states
-        run = LegRun(self.name, s, problem, leg, tracker)
+        problem, leg, budget = ctx.problem, ctx.leg, ctx.tracker.budget
+        tracker = ctx.tracker  # checks: the contact classification's states, charged
+        run = ctx.run(self.name, s)
         robot = problem.robot
-        goal = problem.goal(leg)
+        goal = ctx.goal
         real = self.query(problem, leg)
         query = self.planning_query(problem, real)
-        q0 = np.asarray(problem.q_start if q_start is None else q_start, dtype=float)
-        q0 = q0.reshape(robot.dof)
+        q0 = ctx.q_start.reshape(robot.dof)
         tol = 2.0 * robot.link_radius_m + s.contact_margin_m
         record = _empty_record(problem, real, query, tol, s.inflate_by_radius)
 
