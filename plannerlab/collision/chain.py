@@ -109,16 +109,21 @@ def chain_arrays(robot: Any) -> tuple[np.ndarray, ...]:
 # ``chain_valid`` answers "is this state valid" for a URDF chain in one compiled call with
 # three array arguments (numba's dispatcher pays per argument: the twenty arguments and the
 # tuple of core.chain_first_invalid cost some 4 µs a call before any work is done). Its data
-# are packed once by :class:`ChainValidity` into one float and one int array (``_pack``).
+# are packed once by :class:`ChainValidity` into one float and one int array (``_pack``):
+# the capsules sorted by body and, within a body, by cluster (a few neighbouring capsules
+# under one bounding ball), so that a test goes body ball -> cluster ball -> capsule.
 
-# int header: counts, then the start of each section in the int and the float arrays
-_H_DOF, _H_NB, _H_L, _H_NOBS, _H_NGRP, _H_NPAIR = range(6)
-_H_PARENT, _H_PRISM, _H_BSTART, _H_ORDER, _H_KIND, _H_GROUPS, _H_PAIRS = range(6, 13)
-_H_ISSPH, _H_MOVING = 13, 14
-_F_T0, _F_PRE, _F_CAP_A, _F_CAP_B, _F_RAD, _F_RADS, _F_BC = range(15, 22)
-_F_BR, _F_BRS, _F_R, _F_C, _F_H = range(22, 27)
-_HEADER = 27
+# the int array: a header of counts, then where each section starts (ints, then floats)
+_H_DOF, _H_NB, _H_L, _H_NOBS, _H_NCL = range(5)
+_I_SECTIONS = ("parent", "prism", "body_cl", "cl_start", "order", "kind", "issph", "moving")
+_I_SECTIONS += ("allowed", "any_cl", "groups")
+_F_SECTIONS = ("T0", "pre", "cap_a", "cap_b", "rad", "rads", "bc", "br", "brs")
+_F_SECTIONS += ("cl_c", "cl_r", "cl_rs", "Rs", "cs", "hs", "olo", "ohi")
+_H_I = 5
+_H_F = _H_I + len(_I_SECTIONS) + 1  # + 1: the end of the last int section
+_HEADER = _H_F + len(_F_SECTIONS)
 _SCRATCH = 64  # floats of w (capsule tests)
+_CLUSTER = 6  # capsules per cluster at most
 
 
 @njit(cache=True, nogil=True, inline="always")
@@ -189,7 +194,7 @@ def _bound_apart(kind, R, c, h, x0, x1, x2, rb):
     return qr * qr + qz * qz > rb * rb
 
 
-@njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True, inline="always")
 def _body_frames(q, T0, parent, prism, pre, Bf):
     """Body frames (nb, 3, 4) of one state; each joint turns (or slides) about its frame's
     z axis (the chain's axes are folded into ``pre`` and the capsules by ``_pack``)."""
@@ -224,141 +229,224 @@ def _place(F, p, out, k):
         out[k, a] = F[a, 0] * p[0] + F[a, 1] * p[1] + F[a, 2] * p[2] + F[a, 3]
 
 
+@njit(cache=True, nogil=True, inline="always")
+def _iv(idat, k):
+    """Int section k (see ``_I_SECTIONS``), flat."""
+    return idat[idat[_H_I + k] : idat[_H_I + k + 1]]
+
+
+@njit(cache=True, nogil=True, inline="always")
+def _fv(fd, idat, k):
+    """Float section k (see ``_F_SECTIONS``), flat."""
+    end = idat[_H_F + k + 1] if k + 1 < _HEADER - _H_F else fd.shape[0]
+    return fd[idat[_H_F + k] : end]
+
+
 @njit(cache=True, nogil=True)
 def _unpack(fd, idat):
-    """Views of the packed arrays (see ``_pack``)."""
-    dof, nb, L, n_obs = idat[_H_DOF], idat[_H_NB], idat[_H_L], idat[_H_NOBS]
-    ngrp, npair = idat[_H_NGRP], idat[_H_NPAIR]
-    o = idat[_H_GROUPS]
-    groups = idat[o : o + 4 * ngrp].reshape((ngrp, 4))
-    o = idat[_H_PAIRS]
-    pairs = idat[o : o + 2 * npair].reshape((npair, 2))
-    o = idat[_F_T0]
-    T0 = fd[o : o + 12].reshape((3, 4))
-    o = idat[_F_PRE]
-    pre = fd[o : o + 12 * dof].reshape((dof, 3, 4))
-    o = idat[_F_CAP_A]
-    cap_a = fd[o : o + 3 * L].reshape((L, 3))
-    o = idat[_F_CAP_B]
-    cap_b = fd[o : o + 3 * L].reshape((L, 3))
-    o = idat[_F_BC]
-    bc = fd[o : o + 3 * nb].reshape((nb, 3))
-    o = idat[_F_R]
-    Rs = fd[o : o + 9 * n_obs].reshape((n_obs, 3, 3))
-    o = idat[_F_C]
-    cs = fd[o : o + 3 * n_obs].reshape((n_obs, 3))
-    o = idat[_F_H]
-    hs = fd[o : o + 3 * n_obs].reshape((n_obs, 3))
-    return (
-        idat[idat[_H_PARENT] : idat[_H_PARENT] + dof],
-        idat[idat[_H_PRISM] : idat[_H_PRISM] + dof],
-        idat[idat[_H_BSTART] : idat[_H_BSTART] + nb + 1],
-        idat[idat[_H_ORDER] : idat[_H_ORDER] + nb],
-        idat[idat[_H_KIND] : idat[_H_KIND] + n_obs],
-        groups,
-        pairs,
-        idat[idat[_H_ISSPH] : idat[_H_ISSPH] + L],
-        idat[idat[_H_MOVING] : idat[_H_MOVING] + L],
-        T0,
-        pre,
-        cap_a,
-        cap_b,
-        fd[idat[_F_RAD] : idat[_F_RAD] + L],
-        fd[idat[_F_RADS] : idat[_F_RADS] + L],
-        bc,
-        fd[idat[_F_BR] : idat[_F_BR] + nb],
-        fd[idat[_F_BRS] : idat[_F_BRS] + nb],
-        Rs,
-        cs,
-        hs,
+    """Views of the packed arrays (see ``_pack``), in the order of the sections."""
+    dof, nb, L, n_obs, ncl = idat[_H_DOF], idat[_H_NB], idat[_H_L], idat[_H_NOBS], idat[_H_NCL]
+    ints = (
+        _iv(idat, 0),
+        _iv(idat, 1),
+        _iv(idat, 2),
+        _iv(idat, 3),
+        _iv(idat, 4),
+        _iv(idat, 5),
+        _iv(idat, 6),
+        _iv(idat, 7),
+        _iv(idat, 8).reshape((L, L)),
+        _iv(idat, 9).reshape((ncl, ncl)),
+        _iv(idat, 10).reshape((-1, 2)),
     )
+    floats = (
+        _fv(fd, idat, 0).reshape((3, 4)),
+        _fv(fd, idat, 1).reshape((dof, 3, 4)),
+        _fv(fd, idat, 2).reshape((L, 3)),
+        _fv(fd, idat, 3).reshape((L, 3)),
+        _fv(fd, idat, 4),
+        _fv(fd, idat, 5),
+        _fv(fd, idat, 6).reshape((nb, 3)),
+        _fv(fd, idat, 7),
+        _fv(fd, idat, 8),
+        _fv(fd, idat, 9).reshape((ncl, 3)),
+        _fv(fd, idat, 10),
+        _fv(fd, idat, 11),
+        _fv(fd, idat, 12).reshape((n_obs, 3, 3)),
+        _fv(fd, idat, 13).reshape((n_obs, 3)),
+        _fv(fd, idat, 14).reshape((n_obs, 3)),
+        _fv(fd, idat, 15).reshape((n_obs, 3)),
+        _fv(fd, idat, 16).reshape((n_obs, 3)),
+    )
+    return ints, floats
 
 
-@njit(cache=True, nogil=True)
-def _place_body(Bf, cap_a, cap_b, issph, bstart, b, X, Y):
-    """World end points of body b's capsules into X, Y (a sphere's only into X)."""
-    F = Bf[b]
-    for l in range(bstart[b], bstart[b + 1]):
-        _place(F, cap_a[l], X, l)
+@njit(cache=True, nogil=True, inline="always")
+def _place_body(Bf, cap_a, cap_b, issph, body_cl, cl_start, cl_c, b, X, Y, Kw):
+    """World end points of body b's capsules into X, Y (a sphere's only into X), and the
+    centres of its clusters into Kw."""
+    f00, f01, f02, f03 = Bf[b, 0, 0], Bf[b, 0, 1], Bf[b, 0, 2], Bf[b, 0, 3]
+    f10, f11, f12, f13 = Bf[b, 1, 0], Bf[b, 1, 1], Bf[b, 1, 2], Bf[b, 1, 3]
+    f20, f21, f22, f23 = Bf[b, 2, 0], Bf[b, 2, 1], Bf[b, 2, 2], Bf[b, 2, 3]
+    for K in range(body_cl[b], body_cl[b + 1]):
+        px, py, pz = cl_c[K, 0], cl_c[K, 1], cl_c[K, 2]
+        Kw[K, 0] = f00 * px + f01 * py + f02 * pz + f03
+        Kw[K, 1] = f10 * px + f11 * py + f12 * pz + f13
+        Kw[K, 2] = f20 * px + f21 * py + f22 * pz + f23
+    for l in range(cl_start[body_cl[b]], cl_start[body_cl[b + 1]]):
+        px, py, pz = cap_a[l, 0], cap_a[l, 1], cap_a[l, 2]
+        X[l, 0] = f00 * px + f01 * py + f02 * pz + f03
+        X[l, 1] = f10 * px + f11 * py + f12 * pz + f13
+        X[l, 2] = f20 * px + f21 * py + f22 * pz + f23
         if not issph[l]:
-            _place(F, cap_b[l], Y, l)
+            px, py, pz = cap_b[l, 0], cap_b[l, 1], cap_b[l, 2]
+            Y[l, 0] = f00 * px + f01 * py + f02 * pz + f03
+            Y[l, 1] = f10 * px + f11 * py + f12 * pz + f13
+            Y[l, 2] = f20 * px + f21 * py + f22 * pz + f23
 
 
-@njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True, inline="always")
+def _capsules_hit(o, kind, Rs, cs, hs, l0, l1, issph, moving, rad, X, Y, w):
+    """A moving capsule of l0:l1 touches obstacle o (boxes and spheres inline)."""
+    r00, r01, r02 = Rs[o, 0, 0], Rs[o, 0, 1], Rs[o, 0, 2]
+    r10, r11, r12 = Rs[o, 1, 0], Rs[o, 1, 1], Rs[o, 1, 2]
+    r20, r21, r22 = Rs[o, 2, 0], Rs[o, 2, 1], Rs[o, 2, 2]
+    c0, c1, c2 = cs[o, 0], cs[o, 1], cs[o, 2]
+    h0, h1, h2 = hs[o, 0], hs[o, 1], hs[o, 2]
+    for l in range(l0, l1):
+        if moving[l] == 0:
+            continue
+        r = rad[l]
+        if not issph[l]:
+            if capsule_obstacle_hit(kind, Rs[o], cs[o], hs[o], X[l], Y[l], r, w):
+                return True
+            continue
+        x, y, z = X[l, 0] - c0, X[l, 1] - c1, X[l, 2] - c2
+        if kind == BOX:  # the floats of geometry.seg_box_local for a zero-length segment
+            v = abs(r00 * x + r10 * y + r20 * z) - h0
+            d2 = v * v if v > 0.0 else 0.0
+            v = abs(r01 * x + r11 * y + r21 * z) - h1
+            if v > 0.0:
+                d2 += v * v
+            v = abs(r02 * x + r12 * y + r22 * z) - h2
+            if v > 0.0:
+                d2 += v * v
+            if d2 <= r * r:
+                return True
+        elif kind == SPHERE:
+            rr = r + h0
+            if x * x + y * y + z * z <= rr * rr:
+                return True
+        elif _sphere_hit(kind, Rs[o], cs[o], hs[o], X[l, 0], X[l, 1], X[l, 2], r, w):
+            return True
+    return False
+
+
+@njit(cache=True, nogil=True, inline="always")
+def _apart(P, i, Q, j, r):
+    """Points P[i] and Q[j] are further apart than r."""
+    dx = P[i, 0] - Q[j, 0]
+    dy = P[i, 1] - Q[j, 1]
+    dz = P[i, 2] - Q[j, 2]
+    return dx * dx + dy * dy + dz * dz > r * r
+
+
+@njit(cache=True, nogil=True, inline="always")
+def _pair_hit(i, j, issph, rads, X, Y):
+    """Capsules i < j touch (the floats of geometry.seg_seg, as core.py tests them)."""
+    rr = rads[i] + rads[j]
+    if issph[i] and issph[j]:
+        return not _apart(X, i, X, j, rr)
+    d2, _, _ = seg_seg(X[i], X[i] if issph[i] else Y[i], X[j], X[j] if issph[j] else Y[j])
+    return d2 <= rr * rr
+
+
+@njit(cache=True, nogil=True, inline="always")
 def _state_ok(q, V, S):
     """One state is valid: no moving capsule touches an obstacle, no checked pair of
-    capsules touches. ``V``: ``_unpack``'s views; ``S``: ``_scratch``'s. Bodies are tested
-    through a bounding ball first (in ``order``, against each obstacle; per group of pairs
-    between two bodies), their capsules placed only when a ball is not clear; the first
-    hit ends the test."""
-    (parent, prism, bstart, order, kinds, groups, pairs, issph, moving) = V[:9]
-    (T0, pre, cap_a, cap_b, rad, rads, bc, br, brs, Rs, cs, hs) = V[9:]
-    Bf, Cw, X, Y, done, w = S
+    capsules touches. ``V``: ``_unpack``'s views; ``S``: ``_scratch``'s.
+
+    Against the scene, body by body (in ``order``) and obstacle by obstacle: the body's
+    ball, then each cluster's ball, then its capsules. Between links, per pair of bodies
+    holding a checked pair: the bodies' balls, then per pair of clusters holding one their
+    balls, then the pairs. A body's capsules are placed only when one of its balls is not
+    clear; the first hit ends the test."""
+    (parent, prism, body_cl, cl_start, order, kinds, issph, moving, allowed, any_cl, groups) = V[0]
+    (T0, pre, cap_a, cap_b, rad, rads, bc, br, brs, cl_c, cl_r, cl_rs, Rs, cs, hs) = V[1][:15]
+    olo, ohi = V[1][15], V[1][16]
+    Bf, Cw, Kw, X, Y, done, w = S
     _body_frames(q, T0, parent, prism, pre, Bf)
     nb = bc.shape[0]
     for b in range(nb):
-        _place(Bf[b], bc[b], Cw, b)
+        x, y, z = bc[b, 0], bc[b, 1], bc[b, 2]
+        for a in range(3):
+            Cw[b, a] = Bf[b, a, 0] * x + Bf[b, a, 1] * y + Bf[b, a, 2] * z + Bf[b, a, 3]
         done[b] = 0.0
     n_obs = kinds.shape[0]
     for k in range(nb):
         b = order[k]
-        rb = br[b]
-        if rb < 0.0:
+        if br[b] < 0.0:
             continue  # no moving capsule
-        x0, x1, x2 = Cw[b, 0], Cw[b, 1], Cw[b, 2]
+        x, y, z, rb = Cw[b, 0], Cw[b, 1], Cw[b, 2], br[b]
         for o in range(n_obs):
+            if (
+                (x + rb < olo[o, 0])
+                | (x - rb > ohi[o, 0])
+                | (y + rb < olo[o, 1])
+                | (y - rb > ohi[o, 1])
+                | (z + rb < olo[o, 2])
+                | (z - rb > ohi[o, 2])
+            ):
+                continue  # the body's ball is clear of the obstacle's box in the world
             kind = kinds[o]
-            if _bound_apart(kind, Rs[o], cs[o], hs[o], x0, x1, x2, rb):
+            if _bound_apart(kind, Rs[o], cs[o], hs[o], x, y, z, rb):
                 continue
             if done[b] == 0.0:
-                _place_body(Bf, cap_a, cap_b, issph, bstart, b, X, Y)
+                _place_body(Bf, cap_a, cap_b, issph, body_cl, cl_start, cl_c, b, X, Y, Kw)
                 done[b] = 1.0
-            for l in range(bstart[b], bstart[b + 1]):
-                if moving[l] == 0:
+            for K in range(body_cl[b], body_cl[b + 1]):
+                rk = cl_r[K]
+                if rk < 0.0 or _bound_apart(kind, Rs[o], cs[o], hs[o], Kw[K, 0], Kw[K, 1], Kw[K, 2], rk):
                     continue
-                if issph[l]:
-                    hit = _sphere_hit(kind, Rs[o], cs[o], hs[o], X[l, 0], X[l, 1], X[l, 2], rad[l], w)
-                else:
-                    hit = capsule_obstacle_hit(kind, Rs[o], cs[o], hs[o], X[l], Y[l], rad[l], w)
-                if hit:
+                if _capsules_hit(o, kind, Rs, cs, hs, cl_start[K], cl_start[K + 1], issph, moving, rad, X, Y, w):
                     return False
     for g in range(groups.shape[0]):
         bu, bv = groups[g, 0], groups[g, 1]
-        if bu != bv:
-            dx = Cw[bu, 0] - Cw[bv, 0]
-            dy = Cw[bu, 1] - Cw[bv, 1]
-            dz = Cw[bu, 2] - Cw[bv, 2]
-            rr = brs[bu] + brs[bv]
-            if dx * dx + dy * dy + dz * dz > rr * rr:
-                continue
+        if bu != bv and _apart(Cw, bu, Cw, bv, brs[bu] + brs[bv]):
+            continue
         for b in (bu, bv):
             if done[b] == 0.0:
-                _place_body(Bf, cap_a, cap_b, issph, bstart, b, X, Y)
+                _place_body(Bf, cap_a, cap_b, issph, body_cl, cl_start, cl_c, b, X, Y, Kw)
                 done[b] = 1.0
-        for k in range(groups[g, 2], groups[g, 3]):
-            i, j = pairs[k, 0], pairs[k, 1]
-            if issph[i] and issph[j]:
-                dx = X[i, 0] - X[j, 0]
-                dy = X[i, 1] - X[j, 1]
-                dz = X[i, 2] - X[j, 2]
-                d2 = dx * dx + dy * dy + dz * dz
-            else:
-                d2, _, _ = seg_seg(X[i], X[i] if issph[i] else Y[i], X[j], X[j] if issph[j] else Y[j])
-            rr = rads[i] + rads[j]
-            if d2 <= rr * rr:
-                return False
+        for Ku in range(body_cl[bu], body_cl[bu + 1]):
+            if bu != bv and _apart(Kw, Ku, Cw, bv, cl_rs[Ku] + brs[bv]):
+                continue
+            for Kv in range(Ku if bu == bv else body_cl[bv], body_cl[bv + 1]):
+                if any_cl[Ku, Kv] == 0:
+                    continue
+                if Ku != Kv and _apart(Kw, Ku, Kw, Kv, cl_rs[Ku] + cl_rs[Kv]):
+                    continue
+                for i in range(cl_start[Ku], cl_start[Ku + 1]):
+                    if Ku != Kv and issph[i] and _apart(X, i, Kw, Kv, rads[i] + cl_rs[Kv]):
+                        continue
+                    j0 = i + 1 if Ku == Kv else cl_start[Kv]
+                    for j in range(j0, cl_start[Kv + 1]):
+                        if allowed[i, j] and _pair_hit(i, j, issph, rads, X, Y):
+                            return False
     return True
 
 
 @njit(cache=True, nogil=True)
 def _scratch(idat):
     """Per-call scratch of :func:`_state_ok`, in one allocation."""
-    nb, L = idat[_H_NB], idat[_H_L]
-    S = np.empty(16 * nb + 6 * L + _SCRATCH)
+    nb, L, ncl = idat[_H_NB], idat[_H_L], idat[_H_NCL]
+    S = np.empty(16 * nb + 3 * ncl + 6 * L + _SCRATCH)
     Bf = S[: 12 * nb].reshape((nb, 3, 4))
     o = 12 * nb
     Cw = S[o : o + 3 * nb].reshape((nb, 3))
     o += 3 * nb
+    Kw = S[o : o + 3 * ncl].reshape((ncl, 3))
+    o += 3 * ncl
     X = S[o : o + 3 * L].reshape((L, 3))
     o += 3 * L
     Y = S[o : o + 3 * L].reshape((L, 3))
@@ -367,7 +455,7 @@ def _scratch(idat):
     o += nb
     w = S[o : o + _SCRATCH]
     w[:] = 0.0
-    return Bf, Cw, X, Y, done, w
+    return Bf, Cw, Kw, X, Y, done, w
 
 
 @njit(cache=True, nogil=True)
@@ -420,6 +508,18 @@ def _ball(centres: np.ndarray, reach: np.ndarray) -> tuple[np.ndarray, float]:
     return c, float(np.max(np.linalg.norm(centres - c, axis=1) + reach)) + _BOUND_PAD_M
 
 
+def _clusters(points: np.ndarray, idx: np.ndarray, size: int) -> list[np.ndarray]:
+    """idx cut into groups of at most ``size`` neighbours (halved along the widest axis of
+    their points, recursively)."""
+    if len(idx) <= size:
+        return [idx]
+    p = points[idx]
+    axis = int(np.argmax(p.max(axis=0) - p.min(axis=0)))
+    by = idx[np.argsort(p[:, axis], kind="stable")]
+    half = len(by) // 2
+    return _clusters(points, by[:half], size) + _clusters(points, by[half:], size)
+
+
 def _pack(
     robot: Any,
     radii: np.ndarray,
@@ -433,7 +533,7 @@ def _pack(
     order: np.ndarray | None,
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """The chain, its capsules, the checked pairs and the scene in one float and one int
-    array for :func:`chain_valid`, and the permutation of the capsules (sorted by body).
+    array for :func:`chain_valid`, and the capsules' new order (by body, then cluster).
 
     Each joint's axis u is turned onto its frame's z axis: with A e_z = u, a turn about u
     is A Rz(q) Aᵀ, so the body frames are kept as B·A and A is folded into the fixed
@@ -447,60 +547,85 @@ def _pack(
         Ap, Ai = np.eye(4), np.eye(4)
         Ap[:3, :3], Ai[:3, :3] = A[int(parent[i])], A[i + 1]
         pre_f[i] = (Ap.T @ np.asarray(pre[i], dtype=float) @ Ai)[:3]
-    perm = np.argsort(np.asarray(cap_body), kind="stable")
-    body = np.asarray(cap_body)[perm]
+    cap_body = np.asarray(cap_body, dtype=np.int64)
+    mid = (np.asarray(cap_a, dtype=float) + np.asarray(cap_b, dtype=float)) / 2.0
+    perm_l: list[int] = []
+    cl_start, body_cl = [0], [0]
+    for b in range(nb):
+        for members in _clusters(mid, np.flatnonzero(cap_body == b), _CLUSTER):
+            perm_l.extend(int(m) for m in members)
+            cl_start.append(len(perm_l))
+        body_cl.append(len(cl_start) - 1)
+    perm = np.array(perm_l, dtype=np.int64)
+    body = cap_body[perm]
     ca = np.array([A[int(b)].T @ p for b, p in zip(body, np.asarray(cap_a)[perm])]).reshape(-1, 3)
     cb = np.array([A[int(b)].T @ p for b, p in zip(body, np.asarray(cap_b)[perm])]).reshape(-1, 3)
     issph = np.all(np.asarray(cap_a)[perm] == np.asarray(cap_b)[perm], axis=1)
-    rad, rads, mov = radii[perm], radii_self[perm], moving[perm]
-    bstart = np.searchsorted(body, np.arange(nb + 1))
-    bc = np.zeros((nb, 3))
-    br, brs = np.full(nb, -1.0), np.full(nb, -1.0)
-    for b in range(nb):
-        sl = slice(bstart[b], bstart[b + 1])
-        pts = np.concatenate([ca[sl], cb[sl]])
-        both = np.concatenate([rad[sl], rad[sl]])
-        m = np.concatenate([mov[sl], mov[sl]])
-        bc[b], brs[b] = _ball(pts, np.concatenate([rads[sl], rads[sl]]))
-        if m.any():  # the scene's ball: the moving capsules only, about the same centre
-            br[b] = float(np.max(np.linalg.norm(pts[m] - bc[b], axis=1) + both[m])) + _BOUND_PAD_M
-    # the checked pairs (i < j in the capsules' new order), grouped by their two bodies
-    inv = np.argsort(perm)
+    rad, rads, mov = radii[perm], radii_self[perm], np.asarray(moving, dtype=bool)[perm]
+
+    def balls(ranges: list[tuple[int, int]]) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Per range of capsules: centre, radius against the scene (moving capsules only;
+        -1: none) and between links."""
+        c, r, rs = np.zeros((len(ranges), 3)), np.full(len(ranges), -1.0), np.zeros(len(ranges))
+        for k, (l0, l1) in enumerate(ranges):
+            pts = np.concatenate([ca[l0:l1], cb[l0:l1]])
+            c[k], rs[k] = _ball(pts, np.tile(rads[l0:l1], 2))
+            m = np.tile(mov[l0:l1], 2)
+            if m.any():
+                reach = np.tile(rad[l0:l1], 2)[m]
+                r[k] = float(np.max(np.linalg.norm(pts[m] - c[k], axis=1) + reach)) + _BOUND_PAD_M
+        return c, r, rs
+
+    ncl = len(cl_start) - 1
+    cl_c, cl_r, cl_rs = balls([(cl_start[k], cl_start[k + 1]) for k in range(ncl)])
+    bc, br, brs = balls([(cl_start[body_cl[b]], cl_start[body_cl[b + 1]]) for b in range(nb)])
+    # the checked pairs in the new order (i < j), and which clusters and bodies hold one
     sym = np.asarray(allowed, dtype=bool) | np.asarray(allowed, dtype=bool).T
-    by_bodies: dict[tuple[int, int], list[tuple[int, int]]] = {}
-    for i0, j0 in zip(*np.nonzero(np.triu(sym, 1))):
-        i, j = sorted((int(inv[i0]), int(inv[j0])))
-        key = (int(body[i]), int(body[j]))
-        by_bodies.setdefault((min(key), max(key)), []).append((i, j))
-    groups, pairs = [], []
-    for (bu, bv), members in sorted(by_bodies.items()):
-        groups.append((bu, bv, len(pairs), len(pairs) + len(members)))
-        pairs.extend(members)
+    al = np.triu(sym[np.ix_(perm, perm)], 1)
+    cl_of = np.repeat(np.arange(ncl), np.diff(cl_start))
+    any_cl = np.zeros((ncl, ncl), dtype=np.int64)
+    for i, j in zip(*np.nonzero(al)):
+        any_cl[cl_of[i], cl_of[j]] = 1
+    cl_body = np.repeat(np.arange(nb), np.diff(body_cl))
+    groups = sorted({(int(cl_body[u]), int(cl_body[v])) for u, v in zip(*np.nonzero(any_cl))})
     body_order = np.arange(nb)[::-1] if order is None else np.asarray(order)
     ints = [
-        np.asarray(parent, dtype=np.int64),
-        np.asarray(prismatic, dtype=np.int64),
-        bstart.astype(np.int64),
-        body_order.astype(np.int64),
-        np.asarray(kinds, dtype=np.int64),
-        np.asarray(groups, dtype=np.int64).reshape(-1),
-        np.asarray(pairs, dtype=np.int64).reshape(-1),
-        issph.astype(np.int64),
-        mov.astype(np.int64),
+        np.asarray(parent),
+        np.asarray(prismatic),
+        np.asarray(body_cl),
+        np.asarray(cl_start),
+        body_order,
+        np.asarray(kinds),
+        issph,
+        mov,
+        al,
+        any_cl,
+        np.asarray(groups).reshape(-1, 2),
     ]
-    T0 = np.asarray(robot.T_world_base, dtype=float)[:3]
-    floats = [T0, pre_f, ca, cb, rad, rads, bc, br, brs, Rs, cs, hs]
-    idat = np.zeros(_HEADER, dtype=np.int64)
-    idat[:_H_PARENT] = (dof, nb, len(body), len(kinds), len(groups), len(pairs))
+    floats = [np.asarray(robot.T_world_base, dtype=float)[:3], pre_f, ca, cb, rad, rads]
+    # world boxes around the obstacles (a first, cheaper cull), grown beyond rounding
+    Rs, cs, hs = (np.asarray(a, dtype=float) for a in (Rs, cs, hs))
+    kinds = np.asarray(kinds)
+    ext = np.where(
+        (kinds == BOX)[:, None],
+        hs,
+        np.where((kinds == SPHERE)[:, None], hs[:, :1], np.stack([hs[:, 0], hs[:, 0], hs[:, 1]], 1)),
+    )
+    half = np.abs(Rs) @ ext[:, :, None] if len(kinds) else np.zeros((0, 3, 1))
+    half = np.where((kinds == SPHERE)[:, None], ext, half[..., 0]) + _BOUND_PAD_M
+    floats += [bc, br, brs, cl_c, cl_r, cl_rs, Rs, cs, hs, cs - half, cs + half]
+    head = np.zeros(_HEADER, dtype=np.int64)
+    head[:_H_I] = (dof, nb, len(body), len(kinds), ncl)
     at = _HEADER
-    for h, a in zip(range(_H_PARENT, _F_T0), ints):
-        idat[h] = at
-        at += a.size
-    fat = 0
-    for h, a in zip(range(_F_T0, _HEADER), floats):
-        idat[h] = fat
-        fat += np.asarray(a).size
-    idat = np.concatenate([idat] + ints)
+    for k, a in enumerate(ints):
+        head[_H_I + k] = at
+        at += np.asarray(a).size
+    head[_H_I + len(ints)] = at
+    at = 0
+    for k, a in enumerate(floats):
+        head[_H_F + k] = at
+        at += np.asarray(a).size
+    idat = np.concatenate([head] + [np.asarray(a, dtype=np.int64).reshape(-1) for a in ints])
     fd = np.concatenate([np.asarray(a, dtype=float).reshape(-1) for a in floats])
     return np.ascontiguousarray(fd), np.ascontiguousarray(idat), perm
 
