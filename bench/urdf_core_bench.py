@@ -57,9 +57,7 @@ def _agreement(files: list[Path], n_states: int) -> None:
                 f"{f.stem:24s} margin {margin:4.2f} m  valid {b.mean():.3f}  differ from FCL: "
                 f"core {np.sum(a != b)}, ChainValidity {np.sum(c != b)}"
             )
-    print(
-        f"{total} states: core {old_differ}, ChainValidity {new_differ} verdicts differ from FCL"
-    )
+    print(f"{total} states: core {old_differ}, ChainValidity {new_differ} verdicts differ from FCL")
 
 
 def _wired(checker: CollisionChecker, fused: ChainValidity) -> CollisionChecker:
@@ -131,20 +129,38 @@ def main() -> None:
         timed("kinematics (core.segments)", lambda: old._core.segments(Q), len(Q))  # type: ignore[union-attr]
         timed("batched validity, old (Core.valid)", lambda: old.valid_batch(Q), len(Q))
         timed("batched validity, new (ChainValidity.valid)", lambda: fused.valid(Q), len(Q))
-        timed("one state, new kernel method (ChainValidity.is_valid)",
-              lambda: [fused.is_valid(q) for q in one], len(one))
-        timed("one state, old (CollisionChecker.is_valid)",
-              lambda: [old.is_valid(q) for q in one], len(one))
-        timed("one state, new, wired (CollisionChecker.is_valid)",
-              lambda: [new.is_valid(q) for q in one], len(one))
-        for name, r in roads.items():
-            si, states, space, guard = r["si"], r["states"], r["space"], r["guard"]
-            timed(f"one state, {name}: OMPL isValid -> callback",
-                  lambda: [si.isValid(s) for s in states], len(states))
-        r = roads["new"]
-        timed("  of which space.to_q(state)", lambda: [r["space"].to_q(s) for s in r["states"]], 500)
-        qs = [r["space"].to_q(s) for s in r["states"]]
-        timed("  of which guard.is_valid(q), new", lambda: [r["guard"].is_valid(q) for q in qs], 500)
+        timed(
+            "one state, new kernel method (ChainValidity.is_valid)",
+            lambda: [fused.is_valid(q) for q in one],
+            len(one),
+        )
+        timed(
+            "one state, old (CollisionChecker.is_valid)",
+            lambda: [old.is_valid(q) for q in one],
+            len(one),
+        )
+        timed(
+            "one state, new, wired (CollisionChecker.is_valid)",
+            lambda: [new.is_valid(q) for q in one],
+            len(one),
+        )
+        for name, road in roads.items():
+            timed(
+                f"one state, {name}: OMPL isValid -> callback",
+                lambda road=road: [road["si"].isValid(s) for s in road["states"]],
+                len(one),
+            )
+        road = roads["new"]
+        timed(
+            "  of which space.to_q(state)",
+            lambda road=road: [road["space"].to_q(s) for s in road["states"]],
+            len(one),
+        )
+        timed(
+            "  of which guard.is_valid(q), new",
+            lambda road=road: [road["guard"].is_valid(q) for q in one],
+            len(one),
+        )
     for name, vals in rows.items():
         print(f"{name:58s} {min(vals):7.2f} µs/state (median {np.median(vals):.2f})")
     b_old = min(rows["batched validity, old (Core.valid)"])

@@ -11,9 +11,8 @@ numpy detour per state.
 
 from __future__ import annotations
 
-from typing import Any
-
 import math
+from typing import Any
 
 import numpy as np
 from numba import njit
@@ -103,7 +102,6 @@ def chain_arrays(robot: Any) -> tuple[np.ndarray, ...]:
     )
 
 
-
 # ---------------------------------------------------------------------- fused validity
 #
 # ``chain_valid`` answers "is this state valid" for a URDF chain in one compiled call with
@@ -115,10 +113,14 @@ def chain_arrays(robot: Any) -> tuple[np.ndarray, ...]:
 
 # the int array: a header of counts, then where each section starts (ints, then floats)
 _H_DOF, _H_NB, _H_L, _H_NOBS, _H_NCL = range(5)
-_I_SECTIONS = ("parent", "prism", "body_cl", "cl_start", "order", "kind", "issph", "moving")
-_I_SECTIONS += ("allowed", "any_cl", "groups")
-_F_SECTIONS = ("T0", "pre", "cap_a", "cap_b", "rad", "rads", "bc", "br", "brs")
-_F_SECTIONS += ("cl_c", "cl_r", "cl_rs", "Rs", "cs", "hs", "olo", "ohi")
+_I_SECTIONS = (
+    *("parent", "prism", "body_cl", "cl_start", "order", "kind", "issph", "moving"),
+    *("allowed", "any_cl", "groups"),
+)
+_F_SECTIONS = (
+    *("T0", "pre", "cap_a", "cap_b", "rad", "rads", "bc", "br", "brs"),
+    *("cl_c", "cl_r", "cl_rs", "Rs", "cs", "hs", "olo", "ohi"),
+)
 _H_I = 5
 _H_F = _H_I + len(_I_SECTIONS) + 1  # + 1: the end of the last int section
 _HEADER = _H_F + len(_F_SECTIONS)
@@ -406,9 +408,13 @@ def _state_ok(q, V, S):
                 done[b] = 1.0
             for K in range(body_cl[b], body_cl[b + 1]):
                 rk = cl_r[K]
-                if rk < 0.0 or _bound_apart(kind, Rs[o], cs[o], hs[o], Kw[K, 0], Kw[K, 1], Kw[K, 2], rk):
+                if rk < 0.0 or _bound_apart(
+                    kind, Rs[o], cs[o], hs[o], Kw[K, 0], Kw[K, 1], Kw[K, 2], rk
+                ):
                     continue
-                if _capsules_hit(o, kind, Rs, cs, hs, cl_start[K], cl_start[K + 1], issph, moving, rad, X, Y, w):
+                if _capsules_hit(
+                    o, kind, Rs, cs, hs, cl_start[K], cl_start[K + 1], issph, moving, rad, X, Y, w
+                ):
                     return False
     for g in range(groups.shape[0]):
         bu, bv = groups[g, 0], groups[g, 1]
@@ -477,6 +483,26 @@ def chain_first_bad(Q, fd, idat):
         if not _state_ok(Q[s], V, S):
             return s
     return -1
+
+
+@njit(cache=True, nogil=True)
+def chain_points(Q, fd, idat, out):
+    """Capsule axes of a batch, the kinematics of :func:`chain_valid`: Q (k, dof) -> out
+    (k, L, 2, 3), the capsules in the packed order."""
+    V = _unpack(fd, idat)
+    (parent, prism, body_cl, cl_start, _, _, issph) = V[0][:7]
+    (T0, pre, cap_a, cap_b) = V[1][:4]
+    cl_c = V[1][9]
+    Bf, _, Kw, X, Y, _, _ = _scratch(idat)
+    for s in range(Q.shape[0]):
+        _body_frames(Q[s], T0, parent, prism, pre, Bf)
+        for b in range(Bf.shape[0]):
+            _place_body(Bf, cap_a, cap_b, issph, body_cl, cl_start, cl_c, b, X, Y, Kw)
+        for l in range(X.shape[0]):
+            for a in range(3):
+                out[s, l, 0, a] = X[l, a]
+                out[s, l, 1, a] = X[l, a] if issph[l] else Y[l, a]
+    return out
 
 
 @njit(cache=True, nogil=True)
@@ -558,8 +584,12 @@ def _pack(
         body_cl.append(len(cl_start) - 1)
     perm = np.array(perm_l, dtype=np.int64)
     body = cap_body[perm]
-    ca = np.array([A[int(b)].T @ p for b, p in zip(body, np.asarray(cap_a)[perm])]).reshape(-1, 3)
-    cb = np.array([A[int(b)].T @ p for b, p in zip(body, np.asarray(cap_b)[perm])]).reshape(-1, 3)
+    ca = np.array(
+        [A[int(b)].T @ p for b, p in zip(body, np.asarray(cap_a)[perm], strict=True)]
+    ).reshape(-1, 3)
+    cb = np.array(
+        [A[int(b)].T @ p for b, p in zip(body, np.asarray(cap_b)[perm], strict=True)]
+    ).reshape(-1, 3)
     issph = np.all(np.asarray(cap_a)[perm] == np.asarray(cap_b)[perm], axis=1)
     rad, rads, mov = radii[perm], radii_self[perm], np.asarray(moving, dtype=bool)[perm]
 
@@ -584,10 +614,12 @@ def _pack(
     al = np.triu(sym[np.ix_(perm, perm)], 1)
     cl_of = np.repeat(np.arange(ncl), np.diff(cl_start))
     any_cl = np.zeros((ncl, ncl), dtype=np.int64)
-    for i, j in zip(*np.nonzero(al)):
+    for i, j in zip(*np.nonzero(al), strict=True):
         any_cl[cl_of[i], cl_of[j]] = 1
     cl_body = np.repeat(np.arange(nb), np.diff(body_cl))
-    groups = sorted({(int(cl_body[u]), int(cl_body[v])) for u, v in zip(*np.nonzero(any_cl))})
+    groups = sorted(
+        {(int(cl_body[u]), int(cl_body[v])) for u, v in zip(*np.nonzero(any_cl), strict=True)}
+    )
     body_order = np.arange(nb)[::-1] if order is None else np.asarray(order)
     ints = [
         np.asarray(parent),
@@ -609,7 +641,9 @@ def _pack(
     ext = np.where(
         (kinds == BOX)[:, None],
         hs,
-        np.where((kinds == SPHERE)[:, None], hs[:, :1], np.stack([hs[:, 0], hs[:, 0], hs[:, 1]], 1)),
+        np.where(
+            (kinds == SPHERE)[:, None], hs[:, :1], np.stack([hs[:, 0], hs[:, 0], hs[:, 1]], 1)
+        ),
     )
     half = np.abs(Rs) @ ext[:, :, None] if len(kinds) else np.zeros((0, 3, 1))
     half = np.where((kinds == SPHERE)[:, None], ext, half[..., 0]) + _BOUND_PAD_M
@@ -664,7 +698,15 @@ class ChainValidity:
         """From a built :class:`~plannerlab.collision.core.Core` of a URDF chain."""
         c = core
         return cls(
-            c.robot, c.radii, c.radii_self, c.moving, c.allowed, c.kinds, c.Rs, c.cs, c.hs,
+            c.robot,
+            c.radii,
+            c.radii_self,
+            c.moving,
+            c.allowed,
+            c.kinds,
+            c.Rs,
+            c.cs,
+            c.hs,
             body_order,
         )
 
@@ -673,6 +715,15 @@ class ChainValidity:
         if Qc.ndim != 2 or Qc.shape[1] != self.dof:
             raise ValueError(f"q must have {self.dof} joints, got shape {np.shape(Q)}")
         return Qc
+
+    def segments(self, Q: Any) -> np.ndarray:
+        """Capsule axes (k, L, 2, 3) of Q (k, dof) from this kinematics (axes folded onto
+        z), in the robot's capsule order: ``link_segments``' numbers to rounding."""
+        Qc = self._Q(Q)
+        kernel: Any = chain_points
+        out = np.empty((len(Qc), len(self.perm), 2, 3))
+        kernel(Qc, self._fd, self._idat, out)
+        return out[:, np.argsort(self.perm)]
 
     def valid(self, Q: Any) -> np.ndarray:
         """(k,) bool validity of Q (k, dof)."""
@@ -705,6 +756,7 @@ __all__ = [
     "ChainValidity",
     "chain_arrays",
     "chain_first_bad",
+    "chain_points",
     "chain_segments",
     "chain_state_valid",
     "chain_valid",
