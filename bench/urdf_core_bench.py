@@ -34,7 +34,7 @@ from typing import Any
 
 import numpy as np
 
-from plannerlab.collision.chain import ChainValidity
+from plannerlab.collision.chain_valid import ChainValidity
 from plannerlab.collision.fcl_checker import CollisionChecker
 from plannerlab.problem.load import Budget, parse_problem
 
