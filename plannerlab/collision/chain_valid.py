@@ -40,21 +40,17 @@ from plannerlab.collision.geometry import (
     seg_seg,
 )
 
-# the int array: a header of counts, then where each section starts (ints, then floats)
+# the int array: a header of counts, then the sections (see _pack), flat
 _H_DOF, _H_NB, _H_L, _H_NOBS, _H_NCL = range(5)
 _I_SECTIONS = (
     *("parent", "prism", "body_cl", "cl_start", "order", "kind", "issph", "moving"),
     *("allowed", "any_cl", "groups"),
 )
-_F_SECTIONS = (
-    *("T0", "pre", "cap_a", "cap_b", "rad", "rads", "bc", "br", "brs"),
-    *("cl_c", "cl_r", "cl_rs", "Rs", "cs", "hs", "olo", "ohi"),
-)
 _H_I = 5
-_H_F = _H_I + len(_I_SECTIONS) + 1  # + 1: the end of the last int section
-_HEADER = _H_F + len(_F_SECTIONS)
+_HEADER = _H_I + len(_I_SECTIONS) + 1  # + 1: the end of the last section
 _SCRATCH = 64  # floats of w (capsule tests)
 _CLUSTER = 6  # capsules per cluster at most
+_F64 = np.dtype(np.float64)
 
 
 @njit(cache=True, nogil=True, inline="always")
@@ -166,17 +162,11 @@ def _iv(idat, k):
     return idat[idat[_H_I + k] : idat[_H_I + k + 1]]
 
 
-@njit(cache=True, nogil=True, inline="always")
-def _fv(fd, idat, k):
-    """Float section k (see ``_F_SECTIONS``), flat."""
-    end = idat[_H_F + k + 1] if k + 1 < _HEADER - _H_F else fd.shape[0]
-    return fd[idat[_H_F + k] : end]
-
-
 @njit(cache=True, nogil=True)
-def _unpack(fd, idat):
-    """Views of the packed arrays (see ``_pack``), in the order of the sections."""
-    dof, nb, L, n_obs, ncl = idat[_H_DOF], idat[_H_NB], idat[_H_L], idat[_H_NOBS], idat[_H_NCL]
+def _unpack(P, M, idat):
+    """Views of the packed arrays (see ``_pack``): slices only (a reshape costs some 30 ns
+    in numba, a slice about one)."""
+    dof, nb, L, n, ncl = idat[_H_DOF], idat[_H_NB], idat[_H_L], idat[_H_NOBS], idat[_H_NCL]
     ints = (
         _iv(idat, 0),
         _iv(idat, 1),
@@ -186,28 +176,29 @@ def _unpack(fd, idat):
         _iv(idat, 5),
         _iv(idat, 6),
         _iv(idat, 7),
-        _iv(idat, 8).reshape((L, L)),
-        _iv(idat, 9).reshape((ncl, ncl)),
-        _iv(idat, 10).reshape((-1, 2)),
+        _iv(idat, 8),
+        _iv(idat, 9),
+        _iv(idat, 10),
     )
+    o = 3 * L + 2 * nb + 2 * ncl  # the obstacles' rows of P
     floats = (
-        _fv(fd, idat, 0).reshape((3, 4)),
-        _fv(fd, idat, 1).reshape((dof, 3, 4)),
-        _fv(fd, idat, 2).reshape((L, 3)),
-        _fv(fd, idat, 3).reshape((L, 3)),
-        _fv(fd, idat, 4),
-        _fv(fd, idat, 5),
-        _fv(fd, idat, 6).reshape((nb, 3)),
-        _fv(fd, idat, 7),
-        _fv(fd, idat, 8),
-        _fv(fd, idat, 9).reshape((ncl, 3)),
-        _fv(fd, idat, 10),
-        _fv(fd, idat, 11),
-        _fv(fd, idat, 12).reshape((n_obs, 3, 3)),
-        _fv(fd, idat, 13).reshape((n_obs, 3)),
-        _fv(fd, idat, 14).reshape((n_obs, 3)),
-        _fv(fd, idat, 15).reshape((n_obs, 3)),
-        _fv(fd, idat, 16).reshape((n_obs, 3)),
+        M[0],
+        M[1 : 1 + dof],
+        P[0:L],
+        P[L : 2 * L],
+        P[2 * L : 3 * L, 0],
+        P[2 * L : 3 * L, 1],
+        P[3 * L : 3 * L + nb],
+        P[3 * L + nb : 3 * L + 2 * nb, 0],
+        P[3 * L + nb : 3 * L + 2 * nb, 1],
+        P[3 * L + 2 * nb : 3 * L + 2 * nb + ncl],
+        P[3 * L + 2 * nb + ncl : o, 0],
+        P[3 * L + 2 * nb + ncl : o, 1],
+        M[1 + dof : 1 + dof + n, :, :3],
+        P[o : o + n],
+        P[o + n : o + 2 * n],
+        P[o + 2 * n : o + 3 * n],
+        P[o + 3 * n : o + 4 * n],
     )
     return ints, floats
 
@@ -345,8 +336,10 @@ def _state_ok(q, V, S):
                     o, kind, Rs, cs, hs, cl_start[K], cl_start[K + 1], issph, moving, rad, X, Y, w
                 ):
                     return False
-    for g in range(groups.shape[0]):
-        bu, bv = groups[g, 0], groups[g, 1]
+    ncl = Kw.shape[0]
+    L = X.shape[0]
+    for g in range(groups.shape[0] // 2):
+        bu, bv = groups[2 * g], groups[2 * g + 1]
         if bu != bv and _apart(Cw, bu, Cw, bv, brs[bu] + brs[bv]):
             continue
         for b in (bu, bv):
@@ -357,7 +350,7 @@ def _state_ok(q, V, S):
             if bu != bv and _apart(Kw, Ku, Cw, bv, cl_rs[Ku] + brs[bv]):
                 continue
             for Kv in range(Ku if bu == bv else body_cl[bv], body_cl[bv + 1]):
-                if any_cl[Ku, Kv] == 0:
+                if any_cl[Ku * ncl + Kv] == 0:
                     continue
                 if Ku != Kv and _apart(Kw, Ku, Kw, Kv, cl_rs[Ku] + cl_rs[Kv]):
                     continue
@@ -366,37 +359,34 @@ def _state_ok(q, V, S):
                         continue
                     j0 = i + 1 if Ku == Kv else cl_start[Kv]
                     for j in range(j0, cl_start[Kv + 1]):
-                        if allowed[i, j] and _pair_hit(i, j, issph, rads, X, Y):
+                        if allowed[i * L + j] and _pair_hit(i, j, issph, rads, X, Y):
                             return False
     return True
 
 
 @njit(cache=True, nogil=True)
 def _scratch(idat):
-    """Per-call scratch of :func:`_state_ok`, in one allocation."""
+    """Per-call scratch of :func:`_state_ok`: (body frames, body ball centres, cluster ball
+    centres, capsule ends a and b, placed flags, capsule-test scratch)."""
     nb, L, ncl = idat[_H_NB], idat[_H_L], idat[_H_NCL]
-    S = np.empty(16 * nb + 3 * ncl + 6 * L + _SCRATCH)
-    Bf = S[: 12 * nb].reshape((nb, 3, 4))
-    o = 12 * nb
-    Cw = S[o : o + 3 * nb].reshape((nb, 3))
-    o += 3 * nb
-    Kw = S[o : o + 3 * ncl].reshape((ncl, 3))
-    o += 3 * ncl
-    X = S[o : o + 3 * L].reshape((L, 3))
-    o += 3 * L
-    Y = S[o : o + 3 * L].reshape((L, 3))
-    o += 3 * L
-    done = S[o : o + nb]
-    o += nb
-    w = S[o : o + _SCRATCH]
-    w[:] = 0.0
-    return Bf, Cw, Kw, X, Y, done, w
+    Bf = np.empty((nb, 3, 4))
+    W = np.empty((nb + ncl + 2 * L, 3))
+    aux = np.zeros(nb + _SCRATCH)
+    return (
+        Bf,
+        W[:nb],
+        W[nb : nb + ncl],
+        W[nb + ncl : nb + ncl + L],
+        W[nb + ncl + L :],
+        aux[:nb],
+        aux[nb:],
+    )
 
 
 @njit(cache=True, nogil=True)
-def chain_valid(Q, fd, idat, out):
+def chain_valid(Q, P, M, idat, out):
     """Validity of a batch Q (k, dof) -> out (k,) bool, kinematics included."""
-    V = _unpack(fd, idat)
+    V = _unpack(P, M, idat)
     S = _scratch(idat)
     for s in range(Q.shape[0]):
         out[s] = _state_ok(Q[s], V, S)
@@ -404,9 +394,9 @@ def chain_valid(Q, fd, idat, out):
 
 
 @njit(cache=True, nogil=True)
-def chain_first_bad(Q, fd, idat):
+def chain_first_bad(Q, P, M, idat):
     """Index of the first invalid state of Q (k, dof) in order, or -1."""
-    V = _unpack(fd, idat)
+    V = _unpack(P, M, idat)
     S = _scratch(idat)
     for s in range(Q.shape[0]):
         if not _state_ok(Q[s], V, S):
@@ -415,10 +405,10 @@ def chain_first_bad(Q, fd, idat):
 
 
 @njit(cache=True, nogil=True)
-def chain_points(Q, fd, idat, out):
+def chain_points(Q, P, M, idat, out):
     """Capsule axes of a batch, the kinematics of :func:`chain_valid`: Q (k, dof) -> out
     (k, L, 2, 3), the capsules in the packed order."""
-    V = _unpack(fd, idat)
+    V = _unpack(P, M, idat)
     (parent, prism, body_cl, cl_start, _, _, issph) = V[0][:7]
     (T0, pre, cap_a, cap_b) = V[1][:4]
     cl_c = V[1][9]
@@ -435,9 +425,9 @@ def chain_points(Q, fd, idat, out):
 
 
 @njit(cache=True, nogil=True)
-def chain_state_valid(q, fd, idat):
+def chain_state_valid(q, P, M, idat):
     """Validity of one state q (dof,)."""
-    return _state_ok(q, _unpack(fd, idat), _scratch(idat))
+    return _state_ok(q, _unpack(P, M, idat), _scratch(idat))
 
 
 # ---------------------------------------------------------------------- packing (once)
@@ -486,9 +476,11 @@ def _pack(
     cs: np.ndarray,
     hs: np.ndarray,
     order: np.ndarray | None,
-) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """The chain, its capsules, the checked pairs and the scene in one float and one int
-    array for :func:`chain_valid`, and the capsules' new order (by body, then cluster).
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """The chain, its capsules, the checked pairs and the scene for :func:`chain_valid`:
+    points, centres and per-capsule, -body, -cluster radii as rows of three (P), frames
+    as 3 x 4 matrices (M), counts and indices (idat); and the capsules' new order (by body,
+    then cluster).
 
     Each joint's axis u is turned onto its frame's z axis: with A e_z = u, a turn about u
     is A Rz(q) Aᵀ, so the body frames are kept as B·A and A is folded into the fixed
@@ -550,33 +542,30 @@ def _pack(
         {(int(cl_body[u]), int(cl_body[v])) for u, v in zip(*np.nonzero(any_cl), strict=True)}
     )
     body_order = np.arange(nb)[::-1] if order is None else np.asarray(order)
+    # world boxes around the obstacles (a first, cheaper cull), grown beyond rounding
+    Rs, cs, hs = (np.asarray(a, dtype=float) for a in (Rs, cs, hs))
+    kinds = np.asarray(kinds)
+    sph = (kinds == SPHERE)[:, None]
+    ext = np.where(
+        (kinds == BOX)[:, None],
+        hs,
+        np.where(sph, hs[:, :1], np.stack([hs[:, 0], hs[:, 0], hs[:, 1]], 1)),
+    )
+    half = (np.abs(Rs) @ ext[:, :, None])[..., 0] if len(kinds) else np.zeros((0, 3))
+    half = np.where(sph, ext, half) + _BOUND_PAD_M
     ints = [
         np.asarray(parent),
         np.asarray(prismatic),
         np.asarray(body_cl),
         np.asarray(cl_start),
         body_order,
-        np.asarray(kinds),
+        kinds,
         issph,
         mov,
         al,
         any_cl,
         np.asarray(groups).reshape(-1, 2),
     ]
-    floats = [np.asarray(robot.T_world_base, dtype=float)[:3], pre_f, ca, cb, rad, rads]
-    # world boxes around the obstacles (a first, cheaper cull), grown beyond rounding
-    Rs, cs, hs = (np.asarray(a, dtype=float) for a in (Rs, cs, hs))
-    kinds = np.asarray(kinds)
-    ext = np.where(
-        (kinds == BOX)[:, None],
-        hs,
-        np.where(
-            (kinds == SPHERE)[:, None], hs[:, :1], np.stack([hs[:, 0], hs[:, 0], hs[:, 1]], 1)
-        ),
-    )
-    half = np.abs(Rs) @ ext[:, :, None] if len(kinds) else np.zeros((0, 3, 1))
-    half = np.where((kinds == SPHERE)[:, None], ext, half[..., 0]) + _BOUND_PAD_M
-    floats += [bc, br, brs, cl_c, cl_r, cl_rs, Rs, cs, hs, cs - half, cs + half]
     head = np.zeros(_HEADER, dtype=np.int64)
     head[:_H_I] = (dof, nb, len(body), len(kinds), ncl)
     at = _HEADER
@@ -584,13 +573,19 @@ def _pack(
         head[_H_I + k] = at
         at += np.asarray(a).size
     head[_H_I + len(ints)] = at
-    at = 0
-    for k, a in enumerate(floats):
-        head[_H_F + k] = at
-        at += np.asarray(a).size
     idat = np.concatenate([head] + [np.asarray(a, dtype=np.int64).reshape(-1) for a in ints])
-    fd = np.concatenate([np.asarray(a, dtype=float).reshape(-1) for a in floats])
-    return np.ascontiguousarray(fd), np.ascontiguousarray(idat), perm
+    zeros = np.zeros
+    P = np.concatenate(
+        [ca, cb, np.column_stack([rad, rads, zeros(len(rad))]), bc]
+        + [np.column_stack([br, brs, zeros(nb)]), cl_c, np.column_stack([cl_r, cl_rs, zeros(ncl)])]
+        + [cs.reshape(-1, 3), hs.reshape(-1, 3), (cs - half).reshape(-1, 3)]
+        + [(cs + half).reshape(-1, 3)]
+    )
+    R34 = zeros((len(kinds), 3, 4))
+    R34[:, :, :3] = Rs.reshape(-1, 3, 3)
+    T0 = np.asarray(robot.T_world_base, dtype=float)[None, :3]
+    M = np.concatenate([T0, pre_f, R34])
+    return np.ascontiguousarray(P), np.ascontiguousarray(M), idat, perm
 
 
 class ChainValidity:
@@ -618,9 +613,19 @@ class ChainValidity:
         body_order: np.ndarray | None = None,
     ) -> None:
         self.dof = int(robot.dof)
-        self._fd, self._idat, self.perm = _pack(
+        self._one = (self.dof,)
+        self._state_valid: Any = chain_state_valid  # a numba dispatcher
+        self._P, self._M, self._idat, self.perm = _pack(
             robot, radii, radii_self, moving, allowed, kinds, Rs, cs, hs, body_order
         )
+        #: the kernels' arguments after the states: ``chain_state_valid(q, *args)``
+        self.args = (self._P, self._M, self._idat)
+        kernels: tuple[Any, ...] = (chain_valid, chain_first_bad, chain_state_valid)
+        if not all(k.signatures for k in kernels):  # compile or load them here, not later
+            q = np.clip(np.zeros(self.dof), robot.lower, robot.upper)
+            self.valid(np.vstack([q, q]))
+            self.first_invalid(np.vstack([q, q]))
+            self.is_valid(q)
 
     @classmethod
     def of(cls, core: Any, body_order: np.ndarray | None = None) -> ChainValidity:
@@ -651,34 +656,29 @@ class ChainValidity:
         Qc = self._Q(Q)
         kernel: Any = chain_points
         out = np.empty((len(Qc), len(self.perm), 2, 3))
-        kernel(Qc, self._fd, self._idat, out)
+        kernel(Qc, self._P, self._M, self._idat, out)
         return out[:, np.argsort(self.perm)]
 
     def valid(self, Q: Any) -> np.ndarray:
         """(k,) bool validity of Q (k, dof)."""
         Qc = self._Q(Q)
         kernel: Any = chain_valid  # a numba dispatcher
-        return kernel(Qc, self._fd, self._idat, np.empty(len(Qc), dtype=np.bool_))
+        return kernel(Qc, self._P, self._M, self._idat, np.empty(len(Qc), dtype=np.bool_))
 
     def first_invalid(self, Q: Any) -> int:
         """Index of the first invalid state of Q (k, dof) in order, -1 if all are valid."""
         kernel: Any = chain_first_bad
-        return int(kernel(self._Q(Q), self._fd, self._idat))
+        return int(kernel(self._Q(Q), self._P, self._M, self._idat))
 
     def is_valid(self, q: Any) -> bool:
-        """Validity of one state q (dof,)."""
-        if not (
-            type(q) is np.ndarray
-            and q.shape == (self.dof,)
-            and q.dtype == np.float64
-            and q.flags.c_contiguous
-        ):
+        """Validity of one state q (dof,): a float64 array of that shape goes straight to
+        the kernel (numba takes any memory layout), anything else through ``_Q``."""
+        if type(q) is not np.ndarray or q.shape != self._one or q.dtype is not _F64:
             q = self._Q(q)
             if len(q) != 1:
                 raise ValueError(f"q must be one state ({self.dof},), got shape {q.shape}")
             q = q[0]
-        kernel: Any = chain_state_valid
-        return bool(kernel(q, self._fd, self._idat))
+        return self._state_valid(q, *self.args)
 
 
 __all__ = [
