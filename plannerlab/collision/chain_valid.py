@@ -2,10 +2,11 @@
 kinematics and the capsule tests of :mod:`plannerlab.collision.core` (moving capsules
 against every obstacle, the checked link pairs) with the same verdicts, built for speed.
 
-* **Few arguments.** numba's dispatcher pays per argument (the twenty arguments and the
-  tuple of ``core.chain_first_invalid`` cost some 4 µs a call before any work is done):
-  the chain, its capsules, the pairs and the scene are packed once into one float and one
-  int array (:func:`_pack`), so a call passes three.
+* **Few arguments.** numba's dispatcher pays per argument, most for a tuple (a call of
+  ``core.chain_first_invalid``, twenty arguments and a tuple, costs ~2.7 µs before any work;
+  ``bench/urdf_core_bench.py``): the chain, its capsules, the pairs and the scene are
+  packed once (:func:`_pack`) into rows of three floats, 3 x 4 matrices and one int array,
+  sliced in the kernel without a reshape, so a call passes the states and three arrays.
 * **Kinematics about z.** Each joint's axis is turned onto its frame's z axis once (the
   turn folded into the fixed transforms and the capsules' points), so a joint costs one
   affine product and a turn of two columns; body frames are 3 x 4.
