@@ -6,7 +6,8 @@ the unit axis and whether it slides; per capsule its body and its two end points
 body's frame. :func:`chain_segments` turns a batch of states into capsule axes in the world
 in one numba call (``cache=True``), the same numbers as ``UrdfChain.link_segments`` (to
 rounding), so that :class:`~plannerlab.collision.core.Core` checks a URDF robot without a
-numpy detour per state.
+numpy detour per state. Validity in one fused call per query:
+:mod:`plannerlab.collision.chain_valid`.
 """
 
 from __future__ import annotations

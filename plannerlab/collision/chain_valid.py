@@ -1,0 +1,684 @@
+"""Validity of a URDF chain's states in one fused compiled call (:class:`ChainValidity`):
+kinematics and the capsule tests of :mod:`plannerlab.collision.core` (moving capsules
+against every obstacle, the checked link pairs) with the same verdicts, built for speed.
+
+* **Few arguments.** numba's dispatcher pays per argument, most for a tuple (a call of
+  ``core.chain_first_invalid``, twenty arguments and a tuple, costs ~2.7 µs before any work;
+  ``bench/urdf_core_bench.py``): the chain, its capsules, the pairs and the scene are
+  packed once (:func:`_pack`) into rows of three floats, 3 x 4 matrices and one int array,
+  sliced in the kernel without a reshape, so a call passes the states and three arrays.
+* **Kinematics about z.** Each joint's axis is turned onto its frame's z axis once (the
+  turn folded into the fixed transforms and the capsules' points), so a joint costs one
+  affine product and a turn of two columns; body frames are 3 x 4.
+* **Bounding balls.** The capsules are sorted by body and, within a body, into clusters of
+  a few neighbours; a body ball, then cluster balls (grown by ``_BOUND_PAD_M`` beyond
+  rounding) are tested before the capsules under them, against the scene (after the
+  obstacle's world box) and between bodies; a body's capsules are placed in the world only
+  when one of its balls is not clear.
+* **Spheres in closed form.** A zero-length capsule (a spherized URDF's spheres) against a
+  box, a sphere or another sphere is tested inline with the very floats of
+  :mod:`plannerlab.collision.geometry`; against a cylinder by geometry's own reject and
+  the signed distance at the point (what its golden-section search returns for a
+  zero-length segment); real capsules go through geometry's tests.
+* **Early exit.** The first hit ends a state's test; bodies meet the scene in
+  ``body_order`` (default: the last body first).
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+import numpy as np
+from numba import njit
+
+from plannerlab.collision.geometry import (
+    BOX,
+    SPHERE,
+    _sd_cyl,
+    _to_local,
+    capsule_obstacle_hit,
+    seg_seg,
+)
+
+# the int array: a header of counts, then the sections (see _pack), flat
+_H_DOF, _H_NB, _H_L, _H_NOBS, _H_NCL = range(5)
+_I_SECTIONS = (
+    *("parent", "prism", "body_cl", "cl_start", "order", "kind", "issph", "moving"),
+    *("allowed", "any_cl", "groups"),
+)
+_H_I = 5
+_HEADER = _H_I + len(_I_SECTIONS) + 1  # + 1: the end of the last section
+_SCRATCH = 64  # floats of w (capsule tests)
+_CLUSTER = 6  # capsules per cluster at most
+_F64 = np.dtype(np.float64)
+
+
+@njit(cache=True, nogil=True, inline="always")
+def _box_d2(R, c, h, x0, x1, x2):
+    """Squared distance from a world point to a box (frame R, c; half sizes h): the floats
+    of ``geometry.seg_box_local`` for a zero-length segment."""
+    x, y, z = x0 - c[0], x1 - c[1], x2 - c[2]
+    p0 = R[0, 0] * x + R[1, 0] * y + R[2, 0] * z
+    p1 = R[0, 1] * x + R[1, 1] * y + R[2, 1] * z
+    p2 = R[0, 2] * x + R[1, 2] * y + R[2, 2] * z
+    s = 0.0
+    v = abs(p0) - h[0]
+    if v > 0.0:
+        s += v * v
+    v = abs(p1) - h[1]
+    if v > 0.0:
+        s += v * v
+    v = abs(p2) - h[2]
+    if v > 0.0:
+        s += v * v
+    return s
+
+
+@njit(cache=True, nogil=True)
+def _sphere_hit(kind, R, c, h, x0, x1, x2, r, w):
+    """A sphere (centre x, radius r) touches the obstacle: the verdict of
+    ``geometry.capsule_obstacle_hit`` for a zero-length capsule, in closed form."""
+    if kind == SPHERE:
+        ex, ey, ez = x0 - c[0], x1 - c[1], x2 - c[2]
+        rr = r + h[0]
+        return ex * ex + ey * ey + ez * ez <= rr * rr
+    if kind == BOX:
+        return _box_d2(R, c, h, x0, x1, x2) <= r * r
+    # cylinder: geometry's reject by the capsule around its axis, then the signed distance
+    # at the point (its golden-section search over a zero-length segment sees only that)
+    p = w[0:3]
+    w[3] = x0
+    w[4] = x1
+    w[5] = x2
+    _to_local(R, c, w[3:6], p)
+    ax0 = w[20:23]
+    ax1 = w[23:26]
+    ax0[0], ax0[1], ax1[0], ax1[1] = 0.0, 0.0, 0.0, 0.0
+    ax0[2] = -h[1]
+    ax1[2] = h[1]
+    d2, _, _ = seg_seg(p, p, ax0, ax1)
+    lim = r + h[0]
+    if d2 > lim * lim:
+        return False
+    return _sd_cyl(p[0], p[1], p[2], h) <= r
+
+
+@njit(cache=True, nogil=True, inline="always")
+def _bound_apart(kind, R, c, h, x0, x1, x2, rb):
+    """A ball (centre x, radius rb) is certainly clear of the obstacle (cheap, conservative)."""
+    if kind == SPHERE:
+        ex, ey, ez = x0 - c[0], x1 - c[1], x2 - c[2]
+        rr = rb + h[0]
+        return ex * ex + ey * ey + ez * ez > rr * rr
+    if kind == BOX:
+        return _box_d2(R, c, h, x0, x1, x2) > rb * rb
+    x, y, z = x0 - c[0], x1 - c[1], x2 - c[2]
+    p0 = R[0, 0] * x + R[1, 0] * y + R[2, 0] * z
+    p1 = R[0, 1] * x + R[1, 1] * y + R[2, 1] * z
+    p2 = R[0, 2] * x + R[1, 2] * y + R[2, 2] * z
+    qr = max(math.sqrt(p0 * p0 + p1 * p1) - h[0], 0.0)
+    qz = max(abs(p2) - h[1], 0.0)
+    return qr * qr + qz * qz > rb * rb
+
+
+@njit(cache=True, nogil=True, inline="always")
+def _body_frames(q, T0, parent, prism, pre, Bf):
+    """Body frames (nb, 3, 4) of one state; each joint turns (or slides) about its frame's
+    z axis (the chain's axes are folded into ``pre`` and the capsules by ``_pack``)."""
+    for a in range(3):
+        for b in range(4):
+            Bf[0, a, b] = T0[a, b]
+    for i in range(q.shape[0]):
+        F = Bf[parent[i]]
+        P = pre[i]
+        G = Bf[i + 1]
+        for a in range(3):
+            f0, f1, f2 = F[a, 0], F[a, 1], F[a, 2]
+            for b in range(4):
+                G[a, b] = f0 * P[0, b] + f1 * P[1, b] + f2 * P[2, b]
+            G[a, 3] += F[a, 3]
+        if prism[i]:
+            for a in range(3):
+                G[a, 3] += q[i] * G[a, 2]
+        else:
+            cq = math.cos(q[i])
+            sq = math.sin(q[i])
+            for a in range(3):
+                g0, g1 = G[a, 0], G[a, 1]
+                G[a, 0] = cq * g0 + sq * g1
+                G[a, 1] = cq * g1 - sq * g0
+
+
+@njit(cache=True, nogil=True, inline="always")
+def _iv(idat, k):
+    """Int section k (see ``_I_SECTIONS``), flat."""
+    return idat[idat[_H_I + k] : idat[_H_I + k + 1]]
+
+
+@njit(cache=True, nogil=True)
+def _unpack(P, M, idat):
+    """Views of the packed arrays (see ``_pack``): slices only (a reshape costs some 30 ns
+    in numba, a slice about one)."""
+    dof, nb, L, n, ncl = idat[_H_DOF], idat[_H_NB], idat[_H_L], idat[_H_NOBS], idat[_H_NCL]
+    ints = (
+        _iv(idat, 0),
+        _iv(idat, 1),
+        _iv(idat, 2),
+        _iv(idat, 3),
+        _iv(idat, 4),
+        _iv(idat, 5),
+        _iv(idat, 6),
+        _iv(idat, 7),
+        _iv(idat, 8),
+        _iv(idat, 9),
+        _iv(idat, 10),
+    )
+    o = 3 * L + 2 * nb + 2 * ncl  # the obstacles' rows of P
+    floats = (
+        M[0],
+        M[1 : 1 + dof],
+        P[0:L],
+        P[L : 2 * L],
+        P[2 * L : 3 * L, 0],
+        P[2 * L : 3 * L, 1],
+        P[3 * L : 3 * L + nb],
+        P[3 * L + nb : 3 * L + 2 * nb, 0],
+        P[3 * L + nb : 3 * L + 2 * nb, 1],
+        P[3 * L + 2 * nb : 3 * L + 2 * nb + ncl],
+        P[3 * L + 2 * nb + ncl : o, 0],
+        P[3 * L + 2 * nb + ncl : o, 1],
+        M[1 + dof : 1 + dof + n, :, :3],
+        P[o : o + n],
+        P[o + n : o + 2 * n],
+        P[o + 2 * n : o + 3 * n],
+        P[o + 3 * n : o + 4 * n],
+    )
+    return ints, floats
+
+
+@njit(cache=True, nogil=True, inline="always")
+def _place_body(Bf, cap_a, cap_b, issph, body_cl, cl_start, cl_c, b, X, Y, Kw):
+    """World end points of body b's capsules into X, Y (a sphere's only into X), and the
+    centres of its clusters into Kw."""
+    f00, f01, f02, f03 = Bf[b, 0, 0], Bf[b, 0, 1], Bf[b, 0, 2], Bf[b, 0, 3]
+    f10, f11, f12, f13 = Bf[b, 1, 0], Bf[b, 1, 1], Bf[b, 1, 2], Bf[b, 1, 3]
+    f20, f21, f22, f23 = Bf[b, 2, 0], Bf[b, 2, 1], Bf[b, 2, 2], Bf[b, 2, 3]
+    for K in range(body_cl[b], body_cl[b + 1]):
+        px, py, pz = cl_c[K, 0], cl_c[K, 1], cl_c[K, 2]
+        Kw[K, 0] = f00 * px + f01 * py + f02 * pz + f03
+        Kw[K, 1] = f10 * px + f11 * py + f12 * pz + f13
+        Kw[K, 2] = f20 * px + f21 * py + f22 * pz + f23
+    for l in range(cl_start[body_cl[b]], cl_start[body_cl[b + 1]]):
+        px, py, pz = cap_a[l, 0], cap_a[l, 1], cap_a[l, 2]
+        X[l, 0] = f00 * px + f01 * py + f02 * pz + f03
+        X[l, 1] = f10 * px + f11 * py + f12 * pz + f13
+        X[l, 2] = f20 * px + f21 * py + f22 * pz + f23
+        if not issph[l]:
+            px, py, pz = cap_b[l, 0], cap_b[l, 1], cap_b[l, 2]
+            Y[l, 0] = f00 * px + f01 * py + f02 * pz + f03
+            Y[l, 1] = f10 * px + f11 * py + f12 * pz + f13
+            Y[l, 2] = f20 * px + f21 * py + f22 * pz + f23
+
+
+@njit(cache=True, nogil=True, inline="always")
+def _capsules_hit(o, kind, Rs, cs, hs, l0, l1, issph, moving, rad, X, Y, w):
+    """A moving capsule of l0:l1 touches obstacle o (boxes and spheres inline)."""
+    r00, r01, r02 = Rs[o, 0, 0], Rs[o, 0, 1], Rs[o, 0, 2]
+    r10, r11, r12 = Rs[o, 1, 0], Rs[o, 1, 1], Rs[o, 1, 2]
+    r20, r21, r22 = Rs[o, 2, 0], Rs[o, 2, 1], Rs[o, 2, 2]
+    c0, c1, c2 = cs[o, 0], cs[o, 1], cs[o, 2]
+    h0, h1, h2 = hs[o, 0], hs[o, 1], hs[o, 2]
+    for l in range(l0, l1):
+        if moving[l] == 0:
+            continue
+        r = rad[l]
+        if not issph[l]:
+            if capsule_obstacle_hit(kind, Rs[o], cs[o], hs[o], X[l], Y[l], r, w):
+                return True
+            continue
+        x, y, z = X[l, 0] - c0, X[l, 1] - c1, X[l, 2] - c2
+        if kind == BOX:  # the floats of geometry.seg_box_local for a zero-length segment
+            v = abs(r00 * x + r10 * y + r20 * z) - h0
+            d2 = v * v if v > 0.0 else 0.0
+            v = abs(r01 * x + r11 * y + r21 * z) - h1
+            if v > 0.0:
+                d2 += v * v
+            v = abs(r02 * x + r12 * y + r22 * z) - h2
+            if v > 0.0:
+                d2 += v * v
+            if d2 <= r * r:
+                return True
+        elif kind == SPHERE:
+            rr = r + h0
+            if x * x + y * y + z * z <= rr * rr:
+                return True
+        elif _sphere_hit(kind, Rs[o], cs[o], hs[o], X[l, 0], X[l, 1], X[l, 2], r, w):
+            return True
+    return False
+
+
+@njit(cache=True, nogil=True, inline="always")
+def _apart(P, i, Q, j, r):
+    """Points P[i] and Q[j] are further apart than r."""
+    dx = P[i, 0] - Q[j, 0]
+    dy = P[i, 1] - Q[j, 1]
+    dz = P[i, 2] - Q[j, 2]
+    return dx * dx + dy * dy + dz * dz > r * r
+
+
+@njit(cache=True, nogil=True, inline="always")
+def _pair_hit(i, j, issph, rads, X, Y):
+    """Capsules i < j touch (the floats of geometry.seg_seg, as core.py tests them)."""
+    rr = rads[i] + rads[j]
+    if issph[i] and issph[j]:
+        return not _apart(X, i, X, j, rr)
+    d2, _, _ = seg_seg(X[i], X[i] if issph[i] else Y[i], X[j], X[j] if issph[j] else Y[j])
+    return d2 <= rr * rr
+
+
+# not inlined into _run at numba's level: ~7 % slower, but compiled in ~13 s instead of ~25
+@njit(cache=True, nogil=True)
+def _state_ok(q, V, S):
+    """One state is valid: no moving capsule touches an obstacle, no checked pair of
+    capsules touches. ``V``: ``_unpack``'s views; ``S``: ``_scratch``'s.
+
+    Against the scene, body by body (in ``order``) and obstacle by obstacle: the body's
+    ball, then each cluster's ball, then its capsules. Between links, per pair of bodies
+    holding a checked pair: the bodies' balls, then per pair of clusters holding one their
+    balls, then the pairs. A body's capsules are placed only when one of its balls is not
+    clear; the first hit ends the test."""
+    (parent, prism, body_cl, cl_start, order, kinds, issph, moving, allowed, any_cl, groups) = V[0]
+    (T0, pre, cap_a, cap_b, rad, rads, bc, br, brs, cl_c, cl_r, cl_rs, Rs, cs, hs) = V[1][:15]
+    olo, ohi = V[1][15], V[1][16]
+    Bf, Cw, Kw, X, Y, done, w = S
+    _body_frames(q, T0, parent, prism, pre, Bf)
+    nb = bc.shape[0]
+    for b in range(nb):
+        x, y, z = bc[b, 0], bc[b, 1], bc[b, 2]
+        for a in range(3):
+            Cw[b, a] = Bf[b, a, 0] * x + Bf[b, a, 1] * y + Bf[b, a, 2] * z + Bf[b, a, 3]
+        done[b] = 0.0
+    n_obs = kinds.shape[0]
+    for k in range(nb):
+        b = order[k]
+        if br[b] < 0.0:
+            continue  # no moving capsule
+        x, y, z, rb = Cw[b, 0], Cw[b, 1], Cw[b, 2], br[b]
+        for o in range(n_obs):
+            if (
+                (x + rb < olo[o, 0])
+                | (x - rb > ohi[o, 0])
+                | (y + rb < olo[o, 1])
+                | (y - rb > ohi[o, 1])
+                | (z + rb < olo[o, 2])
+                | (z - rb > ohi[o, 2])
+            ):
+                continue  # the body's ball is clear of the obstacle's box in the world
+            kind = kinds[o]
+            if _bound_apart(kind, Rs[o], cs[o], hs[o], x, y, z, rb):
+                continue
+            if done[b] == 0.0:
+                _place_body(Bf, cap_a, cap_b, issph, body_cl, cl_start, cl_c, b, X, Y, Kw)
+                done[b] = 1.0
+            for K in range(body_cl[b], body_cl[b + 1]):
+                rk = cl_r[K]
+                if rk < 0.0 or _bound_apart(
+                    kind, Rs[o], cs[o], hs[o], Kw[K, 0], Kw[K, 1], Kw[K, 2], rk
+                ):
+                    continue
+                if _capsules_hit(
+                    o, kind, Rs, cs, hs, cl_start[K], cl_start[K + 1], issph, moving, rad, X, Y, w
+                ):
+                    return False
+    ncl = Kw.shape[0]
+    L = X.shape[0]
+    for g in range(groups.shape[0] // 2):
+        bu, bv = groups[2 * g], groups[2 * g + 1]
+        if bu != bv and _apart(Cw, bu, Cw, bv, brs[bu] + brs[bv]):
+            continue
+        for b in (bu, bv):
+            if done[b] == 0.0:
+                _place_body(Bf, cap_a, cap_b, issph, body_cl, cl_start, cl_c, b, X, Y, Kw)
+                done[b] = 1.0
+        for Ku in range(body_cl[bu], body_cl[bu + 1]):
+            if bu != bv and _apart(Kw, Ku, Cw, bv, cl_rs[Ku] + brs[bv]):
+                continue
+            for Kv in range(Ku if bu == bv else body_cl[bv], body_cl[bv + 1]):
+                if any_cl[Ku * ncl + Kv] == 0:
+                    continue
+                if Ku != Kv and _apart(Kw, Ku, Kw, Kv, cl_rs[Ku] + cl_rs[Kv]):
+                    continue
+                for i in range(cl_start[Ku], cl_start[Ku + 1]):
+                    if Ku != Kv and issph[i] and _apart(X, i, Kw, Kv, rads[i] + cl_rs[Kv]):
+                        continue
+                    j0 = i + 1 if Ku == Kv else cl_start[Kv]
+                    for j in range(j0, cl_start[Kv + 1]):
+                        if allowed[i * L + j] and _pair_hit(i, j, issph, rads, X, Y):
+                            return False
+    return True
+
+
+@njit(cache=True, nogil=True)
+def _scratch(idat):
+    """Per-call scratch of :func:`_state_ok`: (body frames, body ball centres, cluster ball
+    centres, capsule ends a and b, placed flags, capsule-test scratch)."""
+    nb, L, ncl = idat[_H_NB], idat[_H_L], idat[_H_NCL]
+    Bf = np.empty((nb, 3, 4))
+    W = np.empty((nb + ncl + 2 * L, 3))
+    aux = np.zeros(nb + _SCRATCH)
+    return (
+        Bf,
+        W[:nb],
+        W[nb : nb + ncl],
+        W[nb + ncl : nb + ncl + L],
+        W[nb + ncl + L :],
+        aux[:nb],
+        aux[nb:],
+    )
+
+
+@njit(cache=True, nogil=True)
+def _run(Q, P, M, idat, out, first_only):
+    """The states of Q (k, dof) in order: validity into out (k,); with ``first_only``
+    stops at the first invalid one. Returns its index, or -1. (The one copy of the
+    inlined test: the kernels below call it.)"""
+    V = _unpack(P, M, idat)
+    S = _scratch(idat)
+    for s in range(Q.shape[0]):
+        ok = _state_ok(Q[s], V, S)
+        out[s] = ok
+        if first_only and not ok:
+            return s
+    return -1
+
+
+@njit(cache=True, nogil=True)
+def chain_valid(Q, P, M, idat, out):
+    """Validity of a batch Q (k, dof) -> out (k,) bool, kinematics included."""
+    _run(Q, P, M, idat, out, False)
+    return out
+
+
+@njit(cache=True, nogil=True)
+def chain_first_bad(Q, P, M, idat):
+    """Index of the first invalid state of Q (k, dof) in order, or -1."""
+    return _run(Q, P, M, idat, np.empty(Q.shape[0], dtype=np.bool_), True)
+
+
+@njit(cache=True, nogil=True)
+def chain_state_valid(q, P, M, idat):
+    """Validity of one state q (dof,)."""
+    out = np.empty(1, dtype=np.bool_)
+    _run(q.reshape((1, q.shape[0])), P, M, idat, out, True)
+    return out[0]
+
+
+@njit(cache=True, nogil=True)
+def chain_points(Q, P, M, idat, out):
+    """Capsule axes of a batch, the kinematics of :func:`chain_valid`: Q (k, dof) -> out
+    (k, L, 2, 3), the capsules in the packed order."""
+    V = _unpack(P, M, idat)
+    (parent, prism, body_cl, cl_start, _, _, issph) = V[0][:7]
+    (T0, pre, cap_a, cap_b) = V[1][:4]
+    cl_c = V[1][9]
+    Bf, _, Kw, X, Y, _, _ = _scratch(idat)
+    for s in range(Q.shape[0]):
+        _body_frames(Q[s], T0, parent, prism, pre, Bf)
+        for b in range(Bf.shape[0]):
+            _place_body(Bf, cap_a, cap_b, issph, body_cl, cl_start, cl_c, b, X, Y, Kw)
+        for l in range(X.shape[0]):
+            for a in range(3):
+                out[s, l, 0, a] = X[l, a]
+                out[s, l, 1, a] = X[l, a] if issph[l] else Y[l, a]
+    return out
+
+
+# ---------------------------------------------------------------------- packing (once)
+_BOUND_PAD_M = 1e-9  # grows every bounding ball beyond rounding: a ball clear is clear
+
+
+def _align(u: np.ndarray) -> np.ndarray:
+    """A rotation A (3, 3) with A e_z = u (the identity for u = e_z)."""
+    z = np.asarray(u, dtype=float)
+    if np.array_equal(z, [0.0, 0.0, 1.0]):
+        return np.eye(3)
+    e = np.eye(3)[int(np.argmin(np.abs(z)))]
+    x = np.cross(e, z)
+    x /= np.linalg.norm(x)
+    return np.column_stack([x, np.cross(z, x), z])
+
+
+def _ball(centres: np.ndarray, reach: np.ndarray) -> tuple[np.ndarray, float]:
+    """A ball around points each grown by its own reach: (centre, radius), radius -1 for none."""
+    if len(centres) == 0:
+        return np.zeros(3), -1.0
+    c = (centres.min(axis=0) + centres.max(axis=0)) / 2.0
+    return c, float(np.max(np.linalg.norm(centres - c, axis=1) + reach)) + _BOUND_PAD_M
+
+
+def _clusters(points: np.ndarray, idx: np.ndarray, size: int) -> list[np.ndarray]:
+    """idx cut into groups of at most ``size`` neighbours (halved along the widest axis of
+    their points, recursively)."""
+    if len(idx) <= size:
+        return [idx]
+    p = points[idx]
+    axis = int(np.argmax(p.max(axis=0) - p.min(axis=0)))
+    by = idx[np.argsort(p[:, axis], kind="stable")]
+    half = len(by) // 2
+    return _clusters(points, by[:half], size) + _clusters(points, by[half:], size)
+
+
+def _pack(
+    robot: Any,
+    radii: np.ndarray,
+    radii_self: np.ndarray,
+    moving: np.ndarray,
+    allowed: np.ndarray,
+    kinds: np.ndarray,
+    Rs: np.ndarray,
+    cs: np.ndarray,
+    hs: np.ndarray,
+    order: np.ndarray | None,
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """The chain, its capsules, the checked pairs and the scene for :func:`chain_valid`:
+    points, centres and per-capsule, -body, -cluster radii as rows of three (P), frames
+    as 3 x 4 matrices (M), counts and indices (idat); and the capsules' new order (by body,
+    then cluster).
+
+    Each joint's axis u is turned onto its frame's z axis: with A e_z = u, a turn about u
+    is A Rz(q) Aᵀ, so the body frames are kept as B·A and A is folded into the fixed
+    transforms and the capsules' points (the kinematics then turn about z only)."""
+    parent, pre, axes, prismatic, cap_body, cap_a, cap_b = robot.chain_data()
+    dof = len(parent)
+    nb = dof + 1
+    A = [np.eye(3)] + [_align(axes[i]) for i in range(dof)]
+    pre_f = np.empty((dof, 3, 4))
+    for i in range(dof):
+        Ap, Ai = np.eye(4), np.eye(4)
+        Ap[:3, :3], Ai[:3, :3] = A[int(parent[i])], A[i + 1]
+        pre_f[i] = (Ap.T @ np.asarray(pre[i], dtype=float) @ Ai)[:3]
+    cap_body = np.asarray(cap_body, dtype=np.int64)
+    mid = (np.asarray(cap_a, dtype=float) + np.asarray(cap_b, dtype=float)) / 2.0
+    perm_l: list[int] = []
+    cl_start, body_cl = [0], [0]
+    for b in range(nb):
+        for members in _clusters(mid, np.flatnonzero(cap_body == b), _CLUSTER):
+            perm_l.extend(int(m) for m in members)
+            cl_start.append(len(perm_l))
+        body_cl.append(len(cl_start) - 1)
+    perm = np.array(perm_l, dtype=np.int64)
+    body = cap_body[perm]
+    ca = np.array(
+        [A[int(b)].T @ p for b, p in zip(body, np.asarray(cap_a)[perm], strict=True)]
+    ).reshape(-1, 3)
+    cb = np.array(
+        [A[int(b)].T @ p for b, p in zip(body, np.asarray(cap_b)[perm], strict=True)]
+    ).reshape(-1, 3)
+    issph = np.all(np.asarray(cap_a)[perm] == np.asarray(cap_b)[perm], axis=1)
+    rad, rads, mov = radii[perm], radii_self[perm], np.asarray(moving, dtype=bool)[perm]
+
+    def balls(ranges: list[tuple[int, int]]) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Per range of capsules: centre, radius against the scene (moving capsules only;
+        -1: none) and between links."""
+        c, r, rs = np.zeros((len(ranges), 3)), np.full(len(ranges), -1.0), np.zeros(len(ranges))
+        for k, (l0, l1) in enumerate(ranges):
+            pts = np.concatenate([ca[l0:l1], cb[l0:l1]])
+            c[k], rs[k] = _ball(pts, np.tile(rads[l0:l1], 2))
+            m = np.tile(mov[l0:l1], 2)
+            if m.any():
+                reach = np.tile(rad[l0:l1], 2)[m]
+                r[k] = float(np.max(np.linalg.norm(pts[m] - c[k], axis=1) + reach)) + _BOUND_PAD_M
+        return c, r, rs
+
+    ncl = len(cl_start) - 1
+    cl_c, cl_r, cl_rs = balls([(cl_start[k], cl_start[k + 1]) for k in range(ncl)])
+    bc, br, brs = balls([(cl_start[body_cl[b]], cl_start[body_cl[b + 1]]) for b in range(nb)])
+    # the checked pairs in the new order (i < j), and which clusters and bodies hold one
+    sym = np.asarray(allowed, dtype=bool) | np.asarray(allowed, dtype=bool).T
+    al = np.triu(sym[np.ix_(perm, perm)], 1)
+    cl_of = np.repeat(np.arange(ncl), np.diff(cl_start))
+    any_cl = np.zeros((ncl, ncl), dtype=np.int64)
+    for i, j in zip(*np.nonzero(al), strict=True):
+        any_cl[cl_of[i], cl_of[j]] = 1
+    cl_body = np.repeat(np.arange(nb), np.diff(body_cl))
+    groups = sorted(
+        {(int(cl_body[u]), int(cl_body[v])) for u, v in zip(*np.nonzero(any_cl), strict=True)}
+    )
+    body_order = np.arange(nb)[::-1] if order is None else np.asarray(order)
+    # world boxes around the obstacles (a first, cheaper cull), grown beyond rounding
+    Rs, cs, hs = (np.asarray(a, dtype=float) for a in (Rs, cs, hs))
+    kinds = np.asarray(kinds)
+    sph = (kinds == SPHERE)[:, None]
+    ext = np.where(
+        (kinds == BOX)[:, None],
+        hs,
+        np.where(sph, hs[:, :1], np.stack([hs[:, 0], hs[:, 0], hs[:, 1]], 1)),
+    )
+    half = (np.abs(Rs) @ ext[:, :, None])[..., 0] if len(kinds) else np.zeros((0, 3))
+    half = np.where(sph, ext, half) + _BOUND_PAD_M
+    ints = [
+        np.asarray(parent),
+        np.asarray(prismatic),
+        np.asarray(body_cl),
+        np.asarray(cl_start),
+        body_order,
+        kinds,
+        issph,
+        mov,
+        al,
+        any_cl,
+        np.asarray(groups).reshape(-1, 2),
+    ]
+    head = np.zeros(_HEADER, dtype=np.int64)
+    head[:_H_I] = (dof, nb, len(body), len(kinds), ncl)
+    at = _HEADER
+    for k, a in enumerate(ints):
+        head[_H_I + k] = at
+        at += np.asarray(a).size
+    head[_H_I + len(ints)] = at
+    idat = np.concatenate([head] + [np.asarray(a, dtype=np.int64).reshape(-1) for a in ints])
+    zeros = np.zeros
+    P = np.concatenate(
+        [ca, cb, np.column_stack([rad, rads, zeros(len(rad))]), bc]
+        + [np.column_stack([br, brs, zeros(nb)]), cl_c, np.column_stack([cl_r, cl_rs, zeros(ncl)])]
+        + [cs.reshape(-1, 3), hs.reshape(-1, 3), (cs - half).reshape(-1, 3)]
+        + [(cs + half).reshape(-1, 3)]
+    )
+    R34 = zeros((len(kinds), 3, 4))
+    R34[:, :, :3] = Rs.reshape(-1, 3, 3)
+    T0 = np.asarray(robot.T_world_base, dtype=float)[None, :3]
+    M = np.concatenate([T0, pre_f, R34])
+    return np.ascontiguousarray(P), np.ascontiguousarray(M), idat, perm
+
+
+class ChainValidity:
+    """Validity of a URDF chain's states in one compiled call each (:func:`chain_valid`,
+    :func:`chain_first_bad`, :func:`chain_state_valid`): the same pairs and tests as the
+    core's (``core.py``: moving capsules against every obstacle, the ``allowed`` link
+    pairs), with the core's arrays (:class:`~plannerlab.collision.core.Core` ``radii``,
+    ``radii_self``, ``moving``, ``allowed``, ``kinds``, ``Rs``, ``cs``, ``hs``).
+
+    ``body_order``: the order in which bodies are tested against the scene (the first hit
+    ends a test, so bodies that collide most often go first); default the last body first.
+    """
+
+    def __init__(
+        self,
+        robot: Any,
+        radii: np.ndarray,
+        radii_self: np.ndarray,
+        moving: np.ndarray,
+        allowed: np.ndarray,
+        kinds: np.ndarray,
+        Rs: np.ndarray,
+        cs: np.ndarray,
+        hs: np.ndarray,
+        body_order: np.ndarray | None = None,
+    ) -> None:
+        self.dof = int(robot.dof)
+        self._one = (self.dof,)
+        self._state_valid: Any = chain_state_valid  # a numba dispatcher
+        self._P, self._M, self._idat, self.perm = _pack(
+            robot, radii, radii_self, moving, allowed, kinds, Rs, cs, hs, body_order
+        )
+        #: the kernels' arguments after the states: ``chain_state_valid(q, *args)``
+        self.args = (self._P, self._M, self._idat)
+        kernels: tuple[Any, ...] = (chain_valid, chain_first_bad, chain_state_valid)
+        if not all(k.signatures for k in kernels):  # compile or load them here, not later
+            q = np.clip(np.zeros(self.dof), robot.lower, robot.upper)
+            self.valid(np.vstack([q, q]))
+            self.first_invalid(np.vstack([q, q]))
+            self.is_valid(q)
+
+    @classmethod
+    def of(cls, core: Any, body_order: np.ndarray | None = None) -> ChainValidity:
+        """From a built :class:`~plannerlab.collision.core.Core` of a URDF chain."""
+        c = core
+        geo = (c.radii, c.radii_self, c.moving, c.allowed, c.kinds, c.Rs, c.cs, c.hs)
+        return cls(c.robot, *geo, body_order)
+
+    def _Q(self, Q: Any) -> np.ndarray:
+        Qc = np.ascontiguousarray(np.atleast_2d(np.asarray(Q, dtype=np.float64)))
+        if Qc.ndim != 2 or Qc.shape[1] != self.dof:
+            raise ValueError(f"q must have {self.dof} joints, got shape {np.shape(Q)}")
+        return Qc
+
+    def segments(self, Q: Any) -> np.ndarray:
+        """Capsule axes (k, L, 2, 3) of Q (k, dof) from this kinematics (axes folded onto
+        z), in the robot's capsule order: ``link_segments``' numbers to rounding."""
+        Qc = self._Q(Q)
+        kernel: Any = chain_points
+        out = np.empty((len(Qc), len(self.perm), 2, 3))
+        kernel(Qc, self._P, self._M, self._idat, out)
+        return out[:, np.argsort(self.perm)]
+
+    def valid(self, Q: Any) -> np.ndarray:
+        """(k,) bool validity of Q (k, dof)."""
+        Qc = self._Q(Q)
+        kernel: Any = chain_valid  # a numba dispatcher
+        return kernel(Qc, self._P, self._M, self._idat, np.empty(len(Qc), dtype=np.bool_))
+
+    def first_invalid(self, Q: Any) -> int:
+        """Index of the first invalid state of Q (k, dof) in order, -1 if all are valid."""
+        kernel: Any = chain_first_bad
+        return int(kernel(self._Q(Q), self._P, self._M, self._idat))
+
+    def is_valid(self, q: Any) -> bool:
+        """Validity of one state q (dof,): a float64 array of that shape goes straight to
+        the kernel (numba takes any memory layout), anything else through ``_Q``."""
+        if type(q) is not np.ndarray or q.shape != self._one or q.dtype is not _F64:
+            q = self._Q(q)
+            if len(q) != 1:
+                raise ValueError(f"q must be one state ({self.dof},), got shape {q.shape}")
+            q = q[0]
+        return self._state_valid(q, *self.args)
+
+
+__all__ = [
+    "ChainValidity",
+    "chain_first_bad",
+    "chain_points",
+    "chain_state_valid",
+    "chain_valid",
+]
