@@ -104,6 +104,7 @@ from plannerlab.collision.armz import (
     armz_segments,
 )
 from plannerlab.collision.chain import chain_arrays, chain_segments
+from plannerlab.collision.chain_valid import ChainValidity, chain_state_valid
 from plannerlab.collision.geometry import BOX, CYLINDER, SPHERE
 from plannerlab.collision.kernels import (
     advance_dt,
@@ -247,8 +248,11 @@ class Core:
         self._armz = getattr(robot, "kind", "") == "armz"
         #: a URDF chain: its capsules from compiled kinematics (collision/chain.py)
         self._chain: Any = None
+        #: its validity in one fused call per query (collision/chain_valid.py)
+        self._fused: ChainValidity | None = None
         if callable(getattr(robot, "chain_data", None)):
             self._chain = chain_arrays(robot)
+            self._fused = ChainValidity.of(self)
         if self._armz:
             armz: Any = robot  # an ArmZ: its fixed transforms feed the compiled kinematics
             T0 = np.ascontiguousarray(armz.T_world_base, dtype=np.float64)
@@ -341,6 +345,8 @@ class Core:
     # ------------------------------------------------------------------ queries
     def valid(self, Q: Array) -> np.ndarray:
         """(k,) bool validity of Q (k, dof)."""
+        if self._fused is not None:
+            return self._fused.valid(Q)
         segs = self.segments(Q)
         out = np.empty(len(segs), dtype=bool)
         return valid_batch(segs, *self._geo, out)
@@ -360,9 +366,9 @@ class Core:
             raise ValueError(f"q must be one state ({self.robot.dof},), got shape {np.shape(q)}")
         if self._armz:
             return armz_first_invalid(Qc, self._T0, self._T1, self._M, *self._geo) < 0
-        if self._chain is not None:
-            kernel: Any = chain_first_invalid  # a numba dispatcher
-            return bool(kernel(Qc, *self._chain, *self._geo) < 0)
+        if self._fused is not None:
+            kernel: Any = chain_state_valid  # a numba dispatcher
+            return bool(kernel(Qc[0], *self._fused.args))
         return bool(self.valid(Qc)[0])
 
     def first_invalid(self, Q: Array) -> int:
@@ -370,9 +376,8 @@ class Core:
         Qc = self._Q(Q)
         if self._armz:
             return int(armz_first_invalid(Qc, self._T0, self._T1, self._M, *self._geo))
-        if self._chain is not None:
-            kernel: Any = chain_first_invalid  # a numba dispatcher
-            return int(kernel(Qc, *self._chain, *self._geo))
+        if self._fused is not None:
+            return self._fused.first_invalid(Qc)
         return int(first_invalid(self.segments(Qc), *self._geo))
 
     def edge_first_invalid(
@@ -413,6 +418,8 @@ class Core:
             bad = (
                 -1
                 if n > MAX_EDGE_STATES or len(Q) == 0
+                else self._fused.first_invalid(Q)
+                if self._fused is not None
                 else first_invalid(self.segments(Q), *self._geo)
             )
         if n > MAX_EDGE_STATES:
