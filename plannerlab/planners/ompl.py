@@ -675,6 +675,18 @@ class _Guard:
             return False
         return bad is None
 
+    def path_valid(self, Q: Array, joint_step: float) -> bool:
+        """Every state ``checker.check_path(Q, joint_step)`` checks is valid (the re-check's
+        own states of a motion, for the repair); refused without checking when they do not
+        all fit the checks left."""
+        if self._out_of_time():
+            return False
+        left = self.checks_left()
+        if left is not None and self.checker.grid_states(Q, joint_step) > left:
+            self.refused += 1
+            return False
+        return self.checker.check_path(Q, joint_step).valid
+
 
 def _goal_class() -> type:
     """The goal type (created per solve so no OMPL-derived type outlives a solve)."""
@@ -749,6 +761,24 @@ def _near_goal(
     return make_clearance("gradient.clearance", {}).near_goal_state(
         problem, leg, q0, checker, tracker
     )
+
+
+@dataclass(frozen=True)
+class _RepairKit:
+    """What :meth:`OMPLPlanner._repair` works with: one solve's OMPL objects, its guard,
+    how a path becomes the states re-checked (``rows_of``), the clock of the steps after
+    planning (``past_time``), the re-check's step and the leg's ``extra``."""
+
+    si: Any
+    space: _Space
+    guard: _Guard
+    planner: Any
+    pdef: Any
+    goal_obj: Any
+    rows_of: Callable[[Any], Array]
+    past_time: Callable[[], bool]
+    recheck_step: float
+    extra: dict[str, Any]
 
 
 # ---------------------------------------------------------------------------- planner
@@ -1172,6 +1202,7 @@ class OMPLPlanner:
             if held[0] is not None:
                 ompl_path = ompl_path_of(held[0])
         simplified = og.PathGeometric(ompl_path)
+        unsimplified = og.PathGeometric(ompl_path)  # for the repair (below)
 
         def simplify_done() -> bool:
             """Stop simplifying at any limit, or once only the held path's reserve is left;
@@ -1273,14 +1304,24 @@ class OMPLPlanner:
         if not check.complete:
             return self._out_of_time(result, status_text, path, iterations, time_limit)
         if not check.valid:
-            return result(
-                Status.INVALID_PATH,
+            failed = (
                 f"{self.ompl_class} path fails the re-check at joint_step/4 on "
                 f"edge {check.first_invalid_edge}: "
-                + ", ".join(f"{a} x {b}" for a, b in check.pairs),
-                path,
-                iterations,
+                + ", ".join(f"{a} x {b}" for a, b in check.pairs)
             )
+            extra["recheck_failed"] = failed
+            kit = _RepairKit(
+                si, space, guard, planner, pdef, goal_obj, rows_of, past_time, recheck_step, extra
+            )
+            c0 = checker.checks
+            fixed = self._repair(kit, unsimplified, replan=exact)
+            extra["repair_checks"] = checker.checks - c0
+            if fixed is None:
+                return result(
+                    Status.INVALID_PATH, f"{failed}; repair: {extra['repair']}", path, iterations
+                )
+            path = fixed
+            extra["path_length_rad"] = path_length(path, robot.continuous)
         if exact and bool(goal.contains(robot, path[-1])):
             return result(Status.SOLVED, f"{self.ompl_class}: {status_text}", path, iterations)
         return result(
@@ -1290,6 +1331,109 @@ class OMPLPlanner:
             path,
             iterations,
         )
+
+    def _repair(self, kit: _RepairKit, raw: Any, replan: bool) -> Array | None:
+        """A path that passes the re-check, after the simplified one failed it, or None
+        (``extra["repair"]`` says how it went).
+
+        The planner's motions are checked at ``joint_step``, the re-check looks at the
+        states of the interpolated path at ``joint_step / 4``: a path that OMPL's
+        simplifier pulled taut against an obstacle passes the first and can graze the
+        obstacle between its checked states. From here on every motion is checked as the
+        re-check will see it (OMPL's interpolation of the motion), on a grid twice as fine
+        as the re-check's (a repaired path is one that runs close to an obstacle):
+
+        1. the path as planned, before simplification, is re-checked; if it passes, it
+           is simplified again with the strict motion checks (if that one fails the
+           re-check, the path as planned is the result);
+        2. else (``replan``: the planner found an exact solution) the planner is cleared
+           and solves again, with the strict motion checks, within the budget left, and
+           its path is simplified with them.
+
+        Whatever comes out is re-checked as the first path was: the re-check stays the
+        judge. The checks and time of the repair are the leg's.
+        """
+        si, space, guard = kit.si, kit.space, kit.guard
+        interpolate, step = self.settings.interpolate, kit.recheck_step
+        state_space, between = space.space, space.space.allocState()
+
+        def edge_rows(a: Any, b: Any) -> Array:
+            """The motion a -> b as the re-check gets it: OMPL's ``PathGeometric.interpolate``
+            of it (``validSegmentCount`` pieces, states at j / n), if set."""
+            n = max(int(state_space.validSegmentCount(a, b)), 1) if interpolate else 1
+            Q = np.empty((n + 1, space.dof))
+            Q[0], Q[n] = space.to_q(a), space.to_q(b)
+            for j in range(1, n):
+                state_space.interpolate(a, b, j / n, between)
+                Q[j] = space.to_q(between)
+            return wrap_to_pi(Q, space.robot.continuous)
+
+        class StrictValidator(ob.MotionValidator):
+            def checkMotion(self, a: Any, b: Any) -> bool:  # noqa: N802
+                return guard.path_valid(edge_rows(a, b), step / 2.0)
+
+        previous, strict = si.getMotionValidator(), StrictValidator(si)
+        si.setMotionValidator(strict)
+        guard.reserve = 0  # the held path was re-checked: nothing left to hold back
+        try:
+            return self._repair_steps(kit, raw, replan)
+        finally:
+            si.setMotionValidator(previous)  # no OMPL object outlives the solve
+
+    def _repair_steps(self, kit: _RepairKit, raw: Any, replan: bool) -> Array | None:
+        """:meth:`_repair`'s steps, on the strict motion checks."""
+        si, guard, extra = kit.si, kit.guard, kit.extra
+
+        def recheck(ompl_path: Any) -> Array | None:
+            """The rows of the path if they pass the re-check within the budget."""
+            rows = kit.rows_of(ompl_path)
+            left = guard.checks_left()
+            if left is not None and _recheck_cost(rows, kit.recheck_step, guard.checker) > left:
+                return None
+            check = guard.checker.check_path(
+                rows, kit.recheck_step, stop=kit.past_time, chunk=_CHUNK_STATES
+            )
+            return rows if check.valid else None
+
+        def simplified(ompl_path: Any) -> Array | None:
+            """The path simplified with the strict motion checks, if it passes."""
+            if ompl_path.getStateCount() > _SIMPLIFY_MAX_STATES or guard.exhausted():
+                return None
+            short = og.PathGeometric(ompl_path)
+            og.PathSimplifier(si, kit.goal_obj).simplify(
+                short, ob.PlannerTerminationCondition(guard.poll)
+            )
+            return recheck(short)
+
+        rows = recheck(raw)
+        if rows is not None:
+            better = simplified(raw) if self.settings.simplify else None
+            extra["repair"] = (
+                "the path as planned, simplified again with strict motion checks"
+                if better is not None
+                else "the path as planned (before simplification)"
+            )
+            return better if better is not None else rows
+        if not replan or self.ompl_class in _ROADMAP or guard.exhausted():
+            extra["repair"] = "the path as planned fails the re-check too"
+            return None
+        # resume with the budget left, on strict motion checks
+        kit.planner.clear()
+        kit.pdef.clearSolutionPaths()
+        status = kit.planner.solve(ob.PlannerTerminationCondition(guard.poll))
+        if status.getStatus() != ob.PlannerStatus.PlannerStatusType.EXACT_SOLUTION:
+            extra["repair"] = f"solved again with strict motion checks: {status.asString()}"
+            return None
+        again = og.PathGeometric(kit.pdef.getSolutionPath())
+        rows = simplified(again) if self.settings.simplify else None
+        if rows is None:
+            rows = recheck(again)
+        extra["repair"] = (
+            "solved again with strict motion checks"
+            if rows is not None
+            else "solved again with strict motion checks, and that path fails the re-check"
+        )
+        return rows
 
     def _out_of_time(
         self,
