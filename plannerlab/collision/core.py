@@ -537,12 +537,33 @@ def chain_first_invalid(
     ohi,
 ):
     """:func:`first_invalid` of a URDF chain's states Q (k, dof), kinematics included
-    (:func:`~plannerlab.collision.chain.chain_segments`): one compiled call per query."""
-    segs = np.empty((Q.shape[0], cap_body.shape[0], 2, 3))
-    chain_segments(Q, T0, parent, pre, axes, prismatic, cap_body, cap_a, cap_b, segs)
-    return first_invalid(
-        segs, radii, radii_self, moving, allowed, tree, kinds, Rs, cs, hs, olo, ohi
-    )
+    (:func:`~plannerlab.collision.chain.chain_segments`): one compiled call per query,
+    state by state (no state after the first invalid one is placed)."""
+    L = cap_body.shape[0]
+    seg = np.empty((1, L, 2, 3))
+    buf = _scratch(L)
+    pairs = np.empty((1, 3), dtype=np.int64)
+    for s in range(Q.shape[0]):
+        chain_segments(Q[s : s + 1], T0, parent, pre, axes, prismatic, cap_body, cap_a, cap_b, seg)
+        if _state_hits(
+            seg[0],
+            radii,
+            radii_self,
+            moving,
+            allowed,
+            tree,
+            kinds,
+            Rs,
+            cs,
+            hs,
+            olo,
+            ohi,
+            buf,
+            True,
+            pairs,
+        ):
+            return s
+    return -1
 
 
 @njit(cache=True, nogil=True)
@@ -1438,7 +1459,7 @@ class Core:
             bad = (
                 -1
                 if n > MAX_EDGE_STATES or len(Q) == 0
-                else first_invalid(self.segments(Q), *self._geo)
+                else self.first_invalid(Q)  # a chain's: kinematics state by state
             )
         if n > MAX_EDGE_STATES:
             span = float(np.max(np.abs(joint_difference(qb, qa, self._continuous))))
