@@ -1316,6 +1316,8 @@ class OMPLPlanner:
             c0 = checker.checks
             fixed = self._repair(kit, unsimplified, replan=exact)
             extra["repair_checks"] = checker.checks - c0
+            if fixed is None and past_time():
+                return self._out_of_time(result, status_text, path, iterations, time_limit)
             if fixed is None:
                 return result(
                     Status.INVALID_PATH, f"{failed}; repair: {extra['repair']}", path, iterations
