@@ -1348,9 +1348,10 @@ class OMPLPlanner:
         1. the path as planned, before simplification, is re-checked; if it passes, it
            is simplified again with the strict motion checks (if that one fails the
            re-check, the path as planned is the result);
-        2. else (``replan``: the planner found an exact solution) the planner is cleared
-           and solves again, with the strict motion checks, within the budget left, and
-           its path is simplified with them.
+        2. else (``replan``: the planner found an exact solution; not for the roadmap
+           planners, nor for the optimizing ones, which would spend all that is left) the
+           planner is cleared and solves again, with the strict motion checks, within the
+           budget left, and its path is simplified with them.
 
         Whatever comes out is re-checked as the first path was: the re-check stays the
         judge. The checks and time of the repair are the leg's.
@@ -1416,7 +1417,12 @@ class OMPLPlanner:
                 else "the path as planned (before simplification)"
             )
             return better if better is not None else rows
-        if not replan or self.ompl_class in _ROADMAP or guard.exhausted():
+        if (
+            not replan
+            or self.ompl_class in _ROADMAP
+            or hasattr(kit.planner, "bestCost")  # an optimizing one would spend all that is left
+            or guard.exhausted()
+        ):
             extra["repair"] = "the path as planned fails the re-check too"
             return None
         # resume with the budget left, on strict motion checks
