@@ -13,8 +13,8 @@ then::
         [--mplib-python PATH]
 
 What is timed: for plannerlab the whole ``solve`` call of one leg (goal state handed over,
-RRT-Connect, simplification, interpolation and plannerlab's own re-check at
-``joint_step / 4``), after one untimed warm-up solve that loads the compiled core; for
+RRT-Connect, simplification, interpolation, plannerlab's own re-check at
+``joint_step / 4`` and, when it refuses the path, the repair), after one untimed warm-up solve that loads the compiled core; for
 MPlib its OMPL ``planner.plan`` call (RRT-Connect and simplification in C++; the TOPP-RA
 retiming of ``plan_qpos`` is left out, as plannerlab's solve does not retime), on a
 planner built before the clock starts. Both get the same RRT-Connect range (OMPL's
@@ -213,6 +213,8 @@ def plannerlab_runs(problems: list[Any], planner_name: str, time_limit_s: float,
                 "checks": r.collision_checks,
                 "plan_s": r.time_s,
                 "path": np.asarray(r.path),
+                "reason": r.reason,
+                "repair": r.extra.get("repair", ""),
             }
         )
     return runs
@@ -262,6 +264,13 @@ def summary(label: str, runs: list[dict[str, Any]], problems: dict[str, Any], st
         else None,
         "statuses": {k: sum(r["status"] == k for r in runs) for k in {r["status"] for r in runs}},
         "recheck_failures": failures,
+        "not_solved": [
+            f"{r['name']}: {r['status']}: {r.get('reason', '')}" for r in runs if not r["solved"]
+        ],
+        "repairs": {
+            k: sum(r.get("repair") == k for r in runs)
+            for k in {r.get("repair", "") for r in runs} - {""}
+        },
     }
 
 
@@ -370,8 +379,12 @@ def main() -> None:
             else f", median collision checks {r['median_checks']:.0f}"
         )
         print(f"{r['label']}: statuses {r['statuses']}{checks}")
+        for how, count in sorted(r["repairs"].items()):
+            print(f"  repaired after the re-check refused the first path ({count}): {how}")
         for f in r["recheck_failures"]:
             print(f"  re-check failed: {f}")
+        for f in r["not_solved"]:
+            print(f"  not solved: {f[:300]}")
     if args.json:
         args.json.write_text(json.dumps(rows, indent=1))
 

@@ -44,6 +44,7 @@ if TYPE_CHECKING:
 _EXPORTS: dict[str, str] = {
     "load_problem": "plannerlab.problem.catalog:load_problem",
     "list_problems": "plannerlab.problem.catalog:list_problems",
+    "problems_dir": "plannerlab.problem.catalog:problems_dir",
     "Problem": "plannerlab.problem.load:Problem",
     "Budget": "plannerlab.problem.load:Budget",
     "planner_names": "plannerlab.planners:planner_names",
@@ -85,6 +86,7 @@ __all__ = [
     "make_planner",
     "markdown_report",
     "planner_names",
+    "problems_dir",
     "snapshot_figure",
     "solve",
     "summarise",

@@ -578,14 +578,58 @@ def min_clearance_kernel(
     segs, radii, radii_self, moving, allowed, tree, kinds, Rs, cs, hs, olo, ohi, include_self
 ):
     """Smallest signed distance [m] over every checked pair of every state (k, L, 2, 3)
-    (link pairs only with ``include_self``; inf when none): :func:`pair_distances_kernel`
-    state by state."""
+    (link pairs only with ``include_self``; inf when none): the minimum of
+    :func:`pair_distances_kernel`'s distances over the states, the same distance functions
+    on the same pairs, without measuring every pair. A pair whose bounding boxes (the
+    capsule's, grown by its radius, and the obstacle's or the other capsule's) are apart
+    by a gap ``g > 0`` is at least ``g`` apart, so once ``g`` is no smaller than the
+    smallest distance found so far the pair cannot lower it and is not measured (boxes
+    that touch bound nothing: a penetration may hide inside)."""
+    L = segs.shape[1]
+    n_obs = kinds.shape[0]
+    lo = np.empty((L, 3))
+    hi = np.empty((L, 3))
+    lo2 = np.empty((L, 3))
+    hi2 = np.empty((L, 3))
+    nv = np.empty(3)
+    w = np.zeros(32)
     best = np.inf
     for s in range(segs.shape[0]):
-        idx, d, _, _, _ = pair_distances_kernel(
-            segs[s], radii, radii_self, moving, allowed, tree, kinds, Rs, cs, hs, olo, ohi, np.inf
-        )
-        for m in range(d.shape[0]):
-            if (include_self or idx[m, 2] == 0) and d[m] < best:
-                best = d[m]
+        seg = segs[s]
+        link_boxes(seg, radii, lo, hi)
+        for li in range(L):
+            if not moving[li]:
+                continue
+            for oi in range(n_obs):
+                g = box_gap(lo, hi, li, olo, ohi, oi)
+                if g > 0.0 and g >= best:
+                    continue
+                dist, _ = capsule_obstacle(
+                    kinds[oi],
+                    Rs[oi],
+                    cs[oi],
+                    hs[oi],
+                    seg[li, 0],
+                    seg[li, 1],
+                    radii[li],
+                    False,
+                    nv,
+                    w,
+                )
+                if dist < best:
+                    best = dist
+        if not include_self:
+            continue
+        link_boxes(seg, radii_self, lo2, hi2)
+        for i in range(L):
+            for j in range(i + 1, L):
+                if not allowed[i, j]:
+                    continue
+                g = box_gap(lo2, hi2, i, lo2, hi2, j)
+                if g > 0.0 and g >= best:
+                    continue
+                d2, _, _ = seg_seg(seg[i, 0], seg[i, 1], seg[j, 0], seg[j, 1])
+                dist = math.sqrt(d2) - radii_self[i] - radii_self[j]
+                if dist < best:
+                    best = dist
     return best

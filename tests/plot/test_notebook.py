@@ -24,4 +24,9 @@ def test_compare_notebook_runs_headless(tmp_path, monkeypatch):
     images = [o for c in nb.cells for o in c.get("outputs", []) if "image/png" in o.get("data", {})]
     assert len(images) >= 2  # the arm snapshot and the progress plot
     gifs = [o for c in nb.cells for o in c.get("outputs", []) if "image/gif" in o.get("data", {})]
-    assert len(gifs) == 1  # the motion, planned and executed, inline
+    assert len(gifs) == 2  # the motions, planned and executed, inline: Arm-Z's and the Panda's
+    # the Panda on the bookshelf, from the files in problems/urdf/panda (no network)
+    panda = outputs.split("bookshelf_small_0001 - MotionBenchMaker")[1]
+    assert panda.startswith(" bookshelf_small_panda/scene0001")
+    assert "solved - RRTConnect: Exact solution" in panda
+    assert "without contact" in panda

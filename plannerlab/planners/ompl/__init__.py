@@ -89,8 +89,11 @@ Design (measured on ``armz_inspection``, 23 continuous joints):
 * **After solving.** OMPL's ``PathSimplifier`` (within the remaining budget; path length
   before and after in ``extra``), ``interpolate``, conversion to ``(m, dof)`` with
   continuous joints wrapped into ``[-pi, pi)``, then ``checker.check_path(path,
-  problem.joint_step / 4)``: only a path that passes is SOLVED (else INVALID_PATH); an
-  approximate solution is APPROXIMATE.
+  problem.joint_step / 4)``: only a path that passes is SOLVED; an approximate solution is
+  APPROXIMATE. A path the re-check refuses (one the simplifier pulled taut against an
+  obstacle grazes it between the states checked at ``joint_step``) is repaired within the
+  budget left, on motions checked as the re-check sees them (``repair.py``), and re-checked
+  again; INVALID_PATH when that fails too.
 * **Logging.** The wheel's ``OutputHandler`` cannot be subclassed from Python (no
   constructor is bound), so during a solve OMPL writes to an ``OutputHandlerFile`` in a
   temporary file; afterwards each message is re-emitted on the ``plannerlab.ompl``

@@ -22,6 +22,7 @@ from plannerlab.planners.base import PlanResult, Status
 from plannerlab.planners.context import PlanningContext
 from plannerlab.planners.ompl.goal import fill_goal_pool, goal_class
 from plannerlab.planners.ompl.guard import Guard, TimeUp
+from plannerlab.planners.ompl.repair import repair
 from plannerlab.planners.ompl.roadmap import roadmap_solve
 from plannerlab.planners.ompl.settings import (
     CHUNK_STATES,
@@ -96,6 +97,8 @@ class Solve:
         self.goal_obj: Any = None
         self.planner: Any = None
         self.motion_validator: Any = None
+        #: the found path before simplification (the repair's first step)
+        self.unsimplified: Any = None
 
     # ------------------------------------------------------------------ the solve
     def result(self, status: Status, reason: str, path: Array, iterations: int) -> PlanResult:
@@ -144,7 +147,7 @@ class Solve:
         this solve: break the cycle so that they are freed with it)."""
         self.guard.iteration_source = None
         self.planner = self.pdef = self.goal_obj = self.si = None
-        self.motion_validator = self.space = None
+        self.motion_validator = self.space = self.unsimplified = None
 
     # ------------------------------------------------------------------ building
     def _build(self) -> None:
@@ -459,6 +462,7 @@ class Solve:
             if self.held is not None:
                 ompl_path = self.ompl_path_of(self.held)
         simplified = og.PathGeometric(ompl_path)
+        self.unsimplified = og.PathGeometric(ompl_path)  # for the repair (repair.py)
         if self.s.simplify and self.guard.exhausted() is None:
             self._simplify(simplified)
         left = self.tracker.checks_left()
@@ -535,14 +539,23 @@ class Solve:
         if not check.complete:
             return self._out_of_time(status_text, path, iterations)
         if not check.valid:
-            return self.result(
-                Status.INVALID_PATH,
+            failed = (
                 f"{self.ompl_class} path fails the re-check at joint_step/4 on "
                 f"edge {check.first_invalid_edge}: "
-                + ", ".join(f"{a} x {b}" for a, b in check.pairs),
-                path,
-                iterations,
+                + ", ".join(f"{a} x {b}" for a, b in check.pairs)
             )
+            extra["recheck_failed"] = failed
+            c0 = checker.checks
+            fixed = repair(self, self.unsimplified, replan=exact)
+            extra["repair_checks"] = checker.checks - c0
+            if fixed is None and self.past_time():
+                return self._out_of_time(status_text, path, iterations)
+            if fixed is None:
+                return self.result(
+                    Status.INVALID_PATH, f"{failed}; repair: {extra['repair']}", path, iterations
+                )
+            path = fixed
+            extra["path_length_rad"] = path_length(path, self.robot.continuous)
         if exact and bool(self.goal.contains(self.robot, path[-1])):
             return self.result(Status.SOLVED, f"{self.ompl_class}: {status_text}", path, iterations)
         return self.result(

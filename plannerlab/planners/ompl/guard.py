@@ -90,3 +90,15 @@ class Guard:
             self.refused += 1
             return False
         return bad is None
+
+    def path_valid(self, Q: Array, joint_step: float) -> bool:
+        """Every state ``checker.check_path(Q, joint_step)`` checks is valid (the re-check's
+        own states of a motion, for the repair); refused without checking when they do not
+        all fit the checks left."""
+        if self._out_of_time():
+            return False
+        left = self.checks_left()
+        if left is not None and self.checker.grid_states(Q, joint_step) > left:
+            self.refused += 1
+            return False
+        return bool(self.checker.check_path(Q, joint_step).valid)
