@@ -130,20 +130,43 @@ class GradientPlanner(LegPlanner):
     ) -> tuple[Array, bool]:
         """Move along q → q_target up to the last collision-free state (blocked by contact).
 
-        At most ``max_states`` states are checked (the rest of the check budget); an edge
-        longer than that ends where checking had to stop, as if blocked.
+        The step is cut into states ``joint_step`` apart; the move goes through them up to
+        the last one before the first invalid state. With a margin, the checker checks
+        edges in metres (conservative advancement: no point of the robot moves further
+        than the margin between two checked states): then the stretch kept is confirmed
+        as one such edge, and, if it is not clear, cut back to the states whose edges from
+        their predecessor are (a joint-space grid alone misses an obstacle a long arm's
+        tip sweeps through between two states: the paper's 0.02 rad grid moves the
+        Arm-Z's tip up to 0.3 m). At most ``max_states`` states are checked (the rest of
+        the check budget); an edge longer than that ends where checking had to stop, as
+        if blocked.
         """
         states = interpolate_edge(q, q_target, problem.joint_step, problem.robot.continuous)[1:]
-        if max_states is not None and len(states) > max_states:
+        cut = max_states is not None and len(states) > max_states
+        if cut:
             states = states[:max_states]
-            bad = checker.first_invalid(states)
-            if bad is None:
-                return states[-1], True
-        else:
-            bad = checker.first_invalid(states)
+        bad = checker.first_invalid(states)
+        end = len(states) if bad is None else bad  # states[:end] are valid
+        if end and checker.edge_check == "advance":
+            end = self._clear_prefix(checker, q, states[:end], problem.joint_step)
+        blocked = cut or bad is not None or end < len(states)
+        return (states[end - 1] if end > 0 else q), blocked
+
+    @staticmethod
+    def _clear_prefix(checker: CollisionChecker, q: Array, states: Array, joint_step: float) -> int:
+        """How many of ``states`` (valid, in order from q) are reached by edges clear in
+        metres: the whole stretch in one check, else edge by edge up to the first that is
+        not."""
+        _, bad = checker.check_edge(q, states[-1], joint_step)
         if bad is None:
-            return states[-1], False
-        return (states[bad - 1] if bad > 0 else q), True
+            return len(states)
+        prev = q
+        for k, qk in enumerate(states):
+            _, bad = checker.check_edge(prev, qk, joint_step)
+            if bad is not None:
+                return k
+            prev = qk
+        return len(states)
 
     # ------------------------------------------------------------------ solve
     def plan(self, ctx: PlanningContext, rng: np.random.Generator) -> PlanResult:

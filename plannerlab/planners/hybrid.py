@@ -255,8 +255,11 @@ class HybridPlanner(LegPlanner):
                 break
             q_try = wrap_to_pi(q + rng.normal(0.0, noise_rad, robot.dof), robot.continuous)
             q_try = np.clip(q_try, robot.lower, robot.upper)
-            edge = interpolate_edge(q, q_try, ctx.joint_step, robot.continuous)
-            if ctx.checker.first_invalid(edge) is None:
+            # checked as every planner's edges are: in metres with a margin (the
+            # checker's conservative advancement), on the joint_step grid without
+            _, bad = ctx.checker.check_edge(q, q_try, ctx.joint_step)
+            if bad is None:
+                edge = interpolate_edge(q, q_try, ctx.joint_step, robot.continuous)
                 return wrap_to_pi(edge, robot.continuous)
         return None
 

@@ -28,19 +28,20 @@ GOLDEN = {
     ("gradient.follow_leader", "toy", 20_000, 5): ("solved", 564, 587, 0, 0, "61d72f1330090571"),
     ("gradient+rrtconnect", "armz_pocket", 30_000, 3): (
         "solved",
-        14375,
+        14414,  # the descent's steps confirmed in metres (+39 checks, same path)
         131,
         2,
         2,
         "dea25a25e2abb420",
     ),
     ("gradient.multistart", "armz_pocket", 30_000, 3): (
-        "local_minimum",
-        24684,
-        1738,
-        11,
-        10,
-        "e60635e471242d86",
+        # restarts checked in metres: fewer of them are clear, the budget runs out first
+        "budget_exhausted",
+        30013,
+        1074,
+        7,
+        7,
+        "1d8fdcf342e3f1cd",
     ),
 }
 
