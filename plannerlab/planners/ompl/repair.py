@@ -22,17 +22,40 @@ The checks and time of the repair are the leg's.
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING, Any
+from typing import Any, Protocol
 
 import numpy as np
 import ompl.base as ob
 import ompl.geometric as og
 
-from plannerlab.planners.ompl.settings import CHUNK_STATES, ROADMAP, SIMPLIFY_MAX_STATES
+from plannerlab.planners.ompl.guard import Guard
+from plannerlab.planners.ompl.settings import (
+    CHUNK_STATES,
+    ROADMAP,
+    SIMPLIFY_MAX_STATES,
+    OMPLSettings,
+)
 from plannerlab.robots.base import Array, wrap_to_pi
 
-if TYPE_CHECKING:
-    from plannerlab.planners.ompl.driver import Solve
+
+class Solve(Protocol):
+    """What the repair reads of one solve (:class:`plannerlab.planners.ompl.driver.Solve`,
+    which calls it): a protocol, so that this module does not import the driver back."""
+
+    ompl_class: str
+    s: OMPLSettings
+    guard: Guard
+    recheck_step: float
+    extra: dict[str, Any]
+    si: Any
+    space: Any
+    pdef: Any
+    goal_obj: Any
+    planner: Any
+
+    def rows_of(self, ompl_path: Any) -> Array: ...
+
+    def past_time(self) -> bool: ...
 
 
 def repair(solve: Solve, raw: Any, replan: bool) -> Array | None:
