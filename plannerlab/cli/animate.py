@@ -15,15 +15,13 @@ from plannerlab.errors import PlannerlabError
 
 def cmd_animate(args: argparse.Namespace, console: Console) -> int:
     from plannerlab.plot.animate import animate_plan
-    from plannerlab.run.plan_check import check_plan, read_plan
+    from plannerlab.run.plan_check import read_checked_plan
 
     if args.frames < 2:
         raise PlannerlabError(f"--frames: expected >= 2, got {args.frames}")
     if args.fps < 1:
         raise PlannerlabError(f"--fps: expected >= 1, got {args.fps}")
-    plan = read_plan(args.plan)
-    problem = plan.load_problem()
-    check_plan(plan, problem, args.plan)
+    plan, problem = read_checked_plan(args.plan)
     out = Path(args.out) if args.out else Path(args.plan).with_suffix(f".{args.format}")
     executions = plan_executions(args.plan)
     note = "with its execution record (PLAN.exec.json)"

@@ -14,7 +14,8 @@ target) is written per case to ``--figures`` (default ``results/``). ``--execute
 runs the chosen solution in PyBullet (:func:`plannerlab.sim.continuum.execute_chord_arc`)
 and shows the tip error and the expected / unexpected contacts.
 
-The data behind each row are the house's records: the first run is planned by
+The data behind each row are the house's records, made by
+:func:`plannerlab.comparison.continuum.run_case`: the first run is planned by
 :func:`plannerlab.run.pipeline.solve_legs` (seed 0) into a :class:`~plannerlab.record.plan.Plan`
 whose one :class:`~plannerlab.record.leg.PlanResult` gives the row, and the execution is
 an :class:`~plannerlab.record.execution.Execution`. ``--out DIR`` writes them as any
@@ -25,16 +26,15 @@ run's and the zero-thickness run's, so a case costs ``--runs`` + 2 searches. ``-
 document (``planner``, ``runs``, ``overrides``, ``cases``: per case the timing summary,
 the files written, and the ``plan`` and ``execution`` records through the one codec).
 
-Argument parsing and printing only; the work is done by the library.
+Argument parsing, drawing and printing only: the runs are
+:func:`plannerlab.comparison.continuum.run_case`'s.
 """
 
 from __future__ import annotations
 
 import argparse
 import contextlib
-import dataclasses
 import os
-import statistics
 import sys
 from collections.abc import Iterator
 from pathlib import Path
@@ -103,10 +103,6 @@ def _stdout_to_stderr(active: bool) -> Iterator[None]:
         os.close(saved)
 
 
-def _case_name(case: str) -> str:
-    return f"continuum_case{case}" if case.isdigit() else case
-
-
 def _thickness_figure(thin: Any, thick: Any, problem: Any, out: Path) -> Path:
     """Where the paper's zero-thickness curves and the robot of the problem's radius part,
     from the two legs' contact plans."""
@@ -137,108 +133,33 @@ def _figure(problem: Any, result: Any, out: Path) -> Path:
     return draw_case(plan, out / f"{problem.name}.png", title=title)
 
 
-@dataclasses.dataclass(frozen=True)
-class CaseRun:
-    """One case of the table: the records behind its row and the timing summary.
-
-    Attributes:
-        plan: the first (warm-up) run as a plan (:func:`plannerlab.run.pipeline.solve_legs`,
-            seed 0): its one leg's :class:`~plannerlab.record.leg.PlanResult` is the row.
-        execution: the chosen solution executed in PyBullet (``--execute``), or None.
-        timing: ``runs``, ``search_median_s``, ``solve_median_s``, ``same_every_run``,
-            ``solutions_zero_thickness`` and the paper's row (``paper``, or None).
-        files: what was written: ``figure``, ``thickness_figure``, ``plan_file``,
-            ``execution_file``.
-    """
-
-    plan: Any
-    execution: Any
-    timing: dict[str, Any]
-    files: dict[str, str]
-
-    @property
-    def result(self) -> Any:
-        return self.plan.legs[0]
-
-    def to_dict(self) -> dict[str, Any]:
-        """The case as data: the records through their own ``to_dict`` (the codec's)."""
-        return {
-            "problem": self.plan.problem,
-            **self.timing,
-            "files": self.files,
-            "plan": self.plan.to_dict(),
-            "execution": None if self.execution is None else self.execution.to_dict(),
-        }
-
-
-def run_case(
-    case: str,
-    runs: int,
-    overrides: dict[str, Any],
-    figures: Path | None,
-    do_execute: bool,
-    out: Path | None = None,
-) -> CaseRun:
-    """One row of the table: the plan record, the timed runs, the execution record."""
-    from plannerlab.planners import make_planner
-    from plannerlab.planners.chord_arc.planner import PAPER_TABLE
-    from plannerlab.planners.chord_arc.scene import guide_obstacles
-    from plannerlab.problem.catalog import load_problem
+def _write(row: Any, figures: Path | None, out: Path | None) -> dict[str, str]:
+    """The case's figures (from its records' contact plans) and, with ``out``, its plan
+    and execution files: what was written, by kind."""
     from plannerlab.record.files import versions
     from plannerlab.record.plan import ExecutionFile, execution_path
-    from plannerlab.run.pipeline import execute_results, leg_rng, solve_legs
 
-    problem = load_problem(_case_name(case))
-    planner = make_planner("chord_arc", overrides)
-    budget = problem.budget
-    plan = solve_legs(problem, "chord_arc", 0, legs=[0], overrides=overrides)  # warm-up
-    first = plan.legs[0]
-    solve_s, search_s, counts = [], [], set()
-    for i in range(runs):
-        r = planner.solve(problem, 0, budget, leg_rng(i, 0))
-        solve_s.append(r.time_s)
-        cp = r.contact_plan
-        search_s.append(float(cp.search.get("time_s", float("nan"))) if cp else float("nan"))
-        counts.add((r.status.value, *((len(cp.solutions), len(cp.dropped)) if cp else ())))
-    paper = PAPER_TABLE.get(problem.name)
-    thin = make_planner("chord_arc", {**overrides, "inflate_by_radius": False})
-    thin_r = thin.solve(problem, 0, budget, leg_rng(0, 0))
-    timing: dict[str, Any] = {
-        "runs": runs,
-        "search_median_s": statistics.median(search_s),
-        "solve_median_s": statistics.median(solve_s),
-        "same_every_run": len(counts) <= 1,
-        "solutions_zero_thickness": (
-            len(thin_r.contact_plan.solutions) if thin_r.contact_plan else 0
-        ),
-        "paper": None if paper is None else dataclasses.asdict(paper),
-    }
+    problem, first = row.problem, row.result
     files: dict[str, str] = {}
-    first_plan = first.contact_plan
-    if figures is not None and first_plan is not None and first_plan.solutions:
+    if figures is not None and first.contact_plan is not None and first.contact_plan.solutions:
         files["figure"] = str(_figure(problem, first, figures))
-        thick = first
-        if not first.settings.get("inflate_by_radius", True):
-            thick_planner = make_planner("chord_arc", {**overrides, "inflate_by_radius": True})
-            thick = thick_planner.solve(problem, 0, budget, leg_rng(0, 0))
-        if thin_r.contact_plan is not None and thick.contact_plan is not None:
-            files["thickness_figure"] = str(_thickness_figure(thin_r, thick, problem, figures))
-    execution = None
-    if do_execute and first_plan is not None and first_plan.chosen is not None:
-        guide_obstacles(problem)  # validated (the plan's extra carries the names)
-        (execution,) = execute_results(problem, plan.legs)
+        if row.thin.contact_plan is not None and row.thick.contact_plan is not None:
+            files["thickness_figure"] = str(
+                _thickness_figure(row.thin, row.thick, problem, figures)
+            )
     if out is not None:
-        plan_file = plan.save(out / f"{problem.name}.plan.json")
+        plan_file = row.plan.save(out / f"{problem.name}.plan.json")
         files["plan_file"] = str(plan_file)
-        if execution is not None:
-            record = ExecutionFile.of(plan, plan_file, [execution], versions())
+        if row.execution is not None:
+            record = ExecutionFile.of(row.plan, plan_file, [row.execution], versions())
             files["execution_file"] = str(record.save(execution_path(plan_file)))
-    return CaseRun(plan, execution, timing, files)
+    return files
 
 
 def cmd_continuum(args: argparse.Namespace, console: Console) -> int:
     """``plannerlab continuum``: print the table (or JSON); write the figures and plans."""
     from plannerlab.cli.common import parse_overrides
+    from plannerlab.comparison.continuum import case_name, run_case
     from plannerlab.errors import PlannerlabError
     from plannerlab.record.codec import dumps
 
@@ -250,20 +171,22 @@ def cmd_continuum(args: argparse.Namespace, console: Console) -> int:
     for folder in (out, figures):  # a folder that cannot exist fails now, not after the runs
         if folder is not None:
             folder.mkdir(parents=True, exist_ok=True)
-    rows: list[CaseRun] = []
+    rows: list[Any] = []
+    written: list[dict[str, str]] = []
     with console.status("chord_arc") as status, _stdout_to_stderr(args.json):
         for case in args.cases:
             status.update(
-                f"chord_arc on {_case_name(case)}: {args.runs} runs"
+                f"chord_arc on {case_name(case)}: {args.runs} runs"
                 + (" and PyBullet" if args.execute else "")
             )
-            rows.append(run_case(case, args.runs, overrides, figures, args.execute, out))
+            rows.append(run_case(case, args.runs, overrides, execute=args.execute))
+            written.append(_write(rows[-1], figures, out))
     if args.json:
         doc = {
             "planner": "chord_arc",
             "runs": args.runs,
             "overrides": overrides,
-            "cases": [row.to_dict() for row in rows],
+            "cases": [row.to_dict(files) for row, files in zip(rows, written, strict=True)],
         }
         print(dumps(doc))
         return 0
@@ -290,7 +213,7 @@ def cmd_continuum(args: argparse.Namespace, console: Console) -> int:
     for col in cols:
         t.add_column(escape(col), justify="right", no_wrap=(col == "case"))
     notes = []
-    for row in rows:
+    for row, files in zip(rows, written, strict=True):
         r, timing = row.result, row.timing
         paper = timing["paper"]
         cp = r.contact_plan
@@ -328,15 +251,16 @@ def cmd_continuum(args: argparse.Namespace, console: Console) -> int:
         t.add_row(*cells)
         for d in cp.dropped if cp else ():
             notes.append(f"{r.problem} dropped: {d.reason}")
-        if "figure" in row.files:
+        if "figure" in files:
             notes.append(
-                f"{r.problem} figures: {row.files['figure']}, {row.files['thickness_figure']}"
+                f"{r.problem} figures: "
+                + ", ".join(files[k] for k in ("figure", "thickness_figure") if k in files)
             )
-        if "plan_file" in row.files:
-            written = row.files["plan_file"]
-            if "execution_file" in row.files:
-                written += f", {row.files['execution_file']}"
-            notes.append(f"{r.problem} written: {written}")
+        if "plan_file" in files:
+            notes.append(
+                f"{r.problem} written: "
+                + ", ".join(files[k] for k in ("plan_file", "execution_file") if k in files)
+            )
     t.caption = escape(
         "\n".join(
             [
@@ -353,4 +277,4 @@ def cmd_continuum(args: argparse.Namespace, console: Console) -> int:
     return 0
 
 
-__all__ = ["CaseRun", "add_continuum_parser", "cmd_continuum", "run_case"]
+__all__ = ["add_continuum_parser", "cmd_continuum"]

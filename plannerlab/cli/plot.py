@@ -21,11 +21,9 @@ def plan_executions(plan_file: str | Path) -> list[Any]:
 
 def cmd_plot(args: argparse.Namespace, console: Console) -> int:
     from plannerlab.plot.plans import plot_plan
-    from plannerlab.run.plan_check import check_plan, read_plan
+    from plannerlab.run.plan_check import read_checked_plan
 
-    plan = read_plan(args.plan)
-    problem = plan.load_problem()
-    check_plan(plan, problem, args.plan)
+    plan, problem = read_checked_plan(args.plan)
     out_dir = Path(args.out) if args.out else Path(args.plan).with_suffix("")
     files = plot_plan(plan, problem, out_dir, plan_executions(args.plan))
     if args.json:

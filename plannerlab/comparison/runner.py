@@ -28,10 +28,9 @@ Decisions:
   writer, and the store, resuming and ``on_done`` are the same whatever the backend.
 * **Seeding.** numpy generators come from :func:`plannerlab.run.pipeline.leg_rng`. The
   child calls ``seed_ompl(seed)`` before anything else whenever
-  :mod:`plannerlab.planners.ompl` imports; the trial's first OMPL solve then seeds OMPL
-  from its leg's generator (no OMPL generator exists before it), once for the process,
-  and every leg records the seed in effect (``extra["ompl_seed"]``; see
-  :mod:`plannerlab.planners.ompl`).
+  :mod:`plannerlab.planners.ompl` imports; every OMPL solve then reseeds OMPL from its
+  leg's generator before it builds any OMPL object, and every leg records that seed,
+  the one in effect (``extra["ompl_seed"]``; see :mod:`plannerlab.planners.ompl`).
 * **Trial key.** ``problem/planner/s<seed>/<hash>`` where the hash (sha256, 10 hex) covers
   the budget and settings overrides, the legs and the execute flag, so one store can hold
   runs of the same grid under different budgets without mixing them.

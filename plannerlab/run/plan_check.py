@@ -57,3 +57,16 @@ def check_plan(plan: Any, problem: Any, path: str | Path) -> None:
         if not np.all(np.isfinite(q)):
             row = int(np.flatnonzero(~np.all(np.isfinite(q), axis=1))[0])
             raise PlanFileError(f"{path}: [{key}.path[{row}]] finite joint values, got NaN or inf")
+
+
+def read_checked_plan(path: str | Path) -> tuple[Any, Any]:
+    """A user's plan file and its problem, ready to draw or animate: :func:`read_plan`,
+    the problem it was planned on (:meth:`Plan.load_problem`), :func:`check_plan`.
+
+    Raises:
+        PlanFileError: a plan file that cannot be read or does not fit its problem.
+    """
+    plan = read_plan(path)
+    problem = plan.load_problem()
+    check_plan(plan, problem, path)
+    return plan, problem

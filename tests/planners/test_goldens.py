@@ -1,8 +1,11 @@
 """Golden values of every planner family on fixed seeds and check budgets: the OMPL
-adapter, the hybrids' escapes (RRT-Connect from the stall, random restarts) and
-follow-the-leader (the clearance descent's own goldens are in test_descent_core and
-test_gradient_clearance, the paper's gradient's in test_gradient and test_traps, the
-chord-arc search's in test_continuum_planning).
+adapter (a tree planner, KPIECE, the roadmap planners PRM and PRM* of ompl/roadmap.py),
+the hybrids' escapes (RRT-Connect from the stall, random restarts), the clearance family
+(the plain descent, its detour, random detour and RRT-Connect escapes),
+follow-the-leader (and its seeded variant), the chord-arc search, and a goal state
+(JointGoal) for OMPL and the clearance descent. The paper's gradient's are in
+test_gradient and test_traps; test_descent_core holds the compiled descent to the numpy
+one's path, test_joint_goal_descent the Panda's goal-state checks.
 
 Each solve runs in a fresh spawned process: OMPL's seed takes effect only before its first
 generator exists. Pinned: status, collision checks, iterations, local minima met and
@@ -12,6 +15,10 @@ moves one of them changes what the planner does: re-pin only with the reason in 
 The hybrids' checks were 14 378 and 24 694 before each leg got one planning context: their
 sub-solves (each descent after the first, each RRT-Connect escape) checked their start,
 a state of the path checked already, again; 3 and 10 checks fewer, the paths the same.
+
+Problems: ``toy`` (conftest.toy_problem), ``toy_joint`` (the toy with the goal state whose
+tip pose its goal region is), ``armz_behind_plate`` (test_escape_goals: the clearance
+descent stalls at a plate and escapes with RRT-Connect), the rest bundled.
 """
 
 from __future__ import annotations
@@ -43,20 +50,92 @@ GOLDEN = {
         7,
         "1d8fdcf342e3f1cd",
     ),
+    ("ompl.prm", "toy", 20_000, 5): ("solved", 17612, 72, 0, 0, "429e64a7746baed4"),
+    ("ompl.prmstar", "toy", 20_000, 5): ("solved", 19925, 76, 0, 0, "c0daa7e1398b7050"),
+    ("ompl.rrtconnect", "toy_joint", 20_000, 5): ("solved", 600, 1, 0, 0, "5e54a2caaa73d393"),
+    ("gradient.clearance", "armz_pocket", 20_000, 0): (
+        "solved",
+        323,
+        341,
+        0,
+        0,
+        "b9ba13985f6b9eab",
+    ),
+    ("gradient.clearance", "toy_joint", 20_000, 5): ("solved", 39, 39, 0, 0, "d7e910ea840010e6"),
+    ("gradient.clearance+detour", "armz_thin_wall", 20_000, 0): (
+        "solved",
+        487,
+        574,
+        1,
+        1,
+        "a422fbc4367b408b",
+    ),
+    ("gradient.clearance+random_detour", "armz_thin_wall", 20_000, 0): (
+        "solved",
+        550,
+        607,
+        1,
+        1,
+        "e490ba083476c424",
+    ),
+    ("gradient.clearance+rrtconnect", "armz_behind_plate", 60_000, 0): (
+        "solved",
+        3151,
+        244,
+        1,
+        1,
+        "30c5d4df45629854",
+    ),
+    ("gradient.follow_leader+random", "armz_thin_wall", 20_000, 0): (
+        "solved",
+        409,
+        427,
+        0,
+        0,
+        "7fd21662fad47124",
+    ),
+    ("chord_arc", "continuum_case1", 20_000, 0): ("solved", 576, 18, 0, 0, "72a33f66dc3b20ff"),
 }
+
+
+def _problem(name: str):
+    """A golden case's problem (see the module docstring)."""
+    import dataclasses
+    import tempfile
+    from pathlib import Path
+
+    import numpy as np
+    from conftest import toy_problem
+
+    from plannerlab.problem.catalog import load_problem
+    from plannerlab.problem.goals import JointGoal
+
+    if name == "toy":
+        return toy_problem()
+    if name == "toy_joint":
+        toy = toy_problem()
+        q_goal = np.array([np.pi, 2.2, np.pi, 2.5, np.pi])  # the toy goal region's state
+        return dataclasses.replace(toy, goals=(JointGoal.at(toy.robot, "state", q_goal, 0.05),))
+    if name == "armz_behind_plate":
+        from test_escape_goals import BEHIND_PLATE_TOML
+
+        with tempfile.TemporaryDirectory() as tmp:
+            path = Path(tmp) / "armz_behind_plate.toml"
+            path.write_text(BEHIND_PLATE_TOML, encoding="utf-8")
+            return load_problem(path)
+    return load_problem(name)
 
 
 def _solve(case: tuple[str, str, int, int]) -> tuple:
     """Spawned worker: one leg-0 solve, OMPL seeded by it (a fresh process)."""
-    from conftest import path_digest, toy_problem
+    from conftest import path_digest
 
     from plannerlab.planners import make_planner
-    from plannerlab.problem.catalog import load_problem
     from plannerlab.problem.load import Budget
     from plannerlab.run.pipeline import leg_rng
 
     name, problem_name, checks, seed = case
-    problem = toy_problem() if problem_name == "toy" else load_problem(problem_name)
+    problem = _problem(problem_name)
     r = make_planner(name).solve(problem, 0, Budget(max_collision_checks=checks), leg_rng(seed, 0))
     return (
         r.status.value,

@@ -15,7 +15,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from conftest import toy_problem
+from conftest import path_digest, toy_problem
 
 from plannerlab.collision.fcl_checker import CollisionChecker
 from plannerlab.errors import UnknownNameError
@@ -195,28 +195,31 @@ def test_a_held_path_is_always_rechecked_within_the_budget(suffix: str) -> None:
     assert outcomes.count(Status.SOLVED) == len(outcomes), outcomes
 
 
-def _seeds_in_effect(seed: int) -> list[int]:
-    """Spawned worker: three solves in one process, each from its own generator."""
-    del seed
+def _legs_in_one_process(rng_seeds: tuple[int, ...]) -> list[tuple[int, str]]:
+    """Spawned worker: solves in one fresh process, each from its own generator: (the
+    OMPL seed each records, its path's digest)."""
     planner = make_planner("ompl.rrtconnect")
-    return [
-        int(
-            planner.solve(
-                toy_problem(), 0, Budget(max_collision_checks=2_000), np.random.default_rng(s)
-            ).extra["ompl_seed"]
+    out = []
+    for s in rng_seeds:
+        r = planner.solve(
+            toy_problem(), 0, Budget(max_collision_checks=2_000), np.random.default_rng(s)
         )
-        for s in (1, 2, 3)
-    ]
+        out.append((int(r.extra["ompl_seed"]), path_digest(r.path)))
+    return out
 
 
 def test_every_leg_records_the_ompl_seed_in_effect() -> None:
-    """OMPL is seeded once per process, by the first solve: every later solve records
-    that seed (the one in effect), not the one it asked for (which OMPL ignores)."""
+    """Every solve reseeds OMPL with a seed drawn from its generator, and that seed is in
+    effect whether or not an OMPL solve ran before in the process (OMPL's RNG.getSeed()
+    would keep saying the first one): a solve after others gives the path it gives alone
+    in a fresh process, and records the seed it drew."""
     ctx = mp.get_context("spawn")
-    with ctx.Pool(1, maxtasksperchild=1) as pool:
-        (seeds,) = pool.map(_seeds_in_effect, [0])
-    first_request = int(np.random.default_rng(1).integers(1, 2**31 - 1))
-    assert seeds == [first_request] * 3
+    with ctx.Pool(2, maxtasksperchild=1) as pool:
+        after_others, alone = pool.map(_legs_in_one_process, [(1, 2, 3), (3,)])
+    drawn = [int(np.random.default_rng(s).integers(1, 2**31 - 1)) for s in (1, 2, 3)]
+    assert [seed for seed, _ in after_others] == drawn
+    assert after_others[2] == alone[0]
+    assert len({digest for _, digest in after_others}) == 3  # the seeds matter here
 
 
 def test_rrtconnect_regression_fresh_processes() -> None:

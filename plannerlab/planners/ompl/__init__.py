@@ -99,14 +99,15 @@ Design (measured on ``armz_inspection``, 23 continuous joints):
   temporary file; afterwards each message is re-emitted on the ``plannerlab.ompl``
   logger at its level, and the previous handler and log level are restored. OMPL's log
   level follows that logger's effective level.
-* **Seeding.** OMPL's seed is process-global and only takes effect before OMPL's first
-  random generator exists. Each solve (``plan``) asks for a seed derived from ``rng``
-  (``ompl.util.RNG.setSeed``): in a fresh process the first solve's request takes
-  effect (before it, no OMPL generator exists, whatever :func:`seed_ompl` set), so a
-  seeded trial, which runs in its own process, is reproducible; every later request in
-  that process has no effect (OMPL logs an error, re-emitted here at DEBUG level). OMPL
-  is thus seeded once per process, and every leg records the seed **in effect**
-  (``extra["ompl_seed"]``, ``ompl.util.RNG.getSeed()``), not the one it asked for.
+* **Seeding.** OMPL's seed is process-global. Each solve (``plan``) draws a seed from
+  ``rng`` and calls ``ompl.util.RNG.setSeed`` with it before it builds any OMPL object:
+  that reseeds OMPL's seed generator, which seeds every generator the solve builds, so
+  the solve is determined by its own seed (and ``rng``) whether it is the first of its
+  process or a later one (for a later one OMPL logs that "random number generation
+  already started", re-emitted here at DEBUG level, and ``RNG.getSeed()`` keeps
+  returning the process's first seed: measured, a leg solved after another gives the
+  path it gives alone in a fresh process with the same seed). Every leg records that
+  seed, the one in effect (``extra["ompl_seed"]``), so any leg can be re-run alone.
 """
 
 from __future__ import annotations

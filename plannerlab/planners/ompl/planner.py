@@ -75,12 +75,13 @@ class OMPLPlanner(LegPlanner):
                 f"{', '.join(map(repr, GOAL_SELECTIONS))}, got "
                 f"{self.settings.goal_selection!r}"
             )
-        requested = int(rng.integers(1, SEED_MAX))
+        ompl_seed = int(rng.integers(1, SEED_MAX))
         with ompl_logging(LOGGER):
-            # effective only before OMPL's first generator exists (the first solve of a
-            # process); every leg records the seed in effect, whether or not this took
-            ou.RNG.setSeed(requested)
-            ompl_seed = int(ou.RNG.getSeed())
+            # reseeds OMPL's seed generator, which seeds every generator this solve builds:
+            # the solve is determined by this seed whether or not it is the process's first
+            # (OMPL then logs that generation has started, and RNG.getSeed() keeps saying
+            # the first seed: not the one in effect here, so it is not what is recorded)
+            ou.RNG.setSeed(ompl_seed)
             solve = Solve(
                 self.name,
                 self.ompl_class,

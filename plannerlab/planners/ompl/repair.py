@@ -22,21 +22,46 @@ The checks and time of the repair are the leg's.
 
 from __future__ import annotations
 
-from typing import Any
+from typing import Any, Protocol
 
 import numpy as np
 import ompl.base as ob
 import ompl.geometric as og
 
-from plannerlab.planners.ompl.settings import CHUNK_STATES, ROADMAP, SIMPLIFY_MAX_STATES
+from plannerlab.planners.ompl.guard import Guard
+from plannerlab.planners.ompl.settings import (
+    CHUNK_STATES,
+    ROADMAP,
+    SIMPLIFY_MAX_STATES,
+    OMPLSettings,
+)
 from plannerlab.robots.base import Array, wrap_to_pi
 
 
-def repair(solve: Any, raw: Any, replan: bool) -> Array | None:
+class Solve(Protocol):
+    """What the repair reads of one solve (:class:`plannerlab.planners.ompl.driver.Solve`,
+    which calls it): a protocol, so that this module does not import the driver back."""
+
+    ompl_class: str
+    s: OMPLSettings
+    guard: Guard
+    recheck_step: float
+    extra: dict[str, Any]
+    si: Any
+    space: Any
+    pdef: Any
+    goal_obj: Any
+    planner: Any
+
+    def rows_of(self, ompl_path: Any) -> Array: ...
+
+    def past_time(self) -> bool: ...
+
+
+def repair(solve: Solve, raw: Any, replan: bool) -> Array | None:
     """A path that passes the re-check, after the simplified one failed it, or None
-    (``solve.extra["repair"]`` says how it went); ``solve`` is the driver's
-    :class:`~plannerlab.planners.ompl.driver.Solve` (typed loosely: the driver imports
-    this module), ``raw`` the OMPL path before simplification (see the module docstring)."""
+    (``solve.extra["repair"]`` says how it went); ``raw`` is the OMPL path before
+    simplification (see the module docstring)."""
     si, space, guard = solve.si, solve.space, solve.guard
     interpolate, step = solve.s.interpolate, solve.recheck_step
     state_space, between = space.space, space.space.allocState()
@@ -65,7 +90,7 @@ def repair(solve: Any, raw: Any, replan: bool) -> Array | None:
         si.setMotionValidator(previous)  # no OMPL object outlives the solve
 
 
-def _repair_steps(solve: Any, raw: Any, replan: bool) -> Array | None:
+def _repair_steps(solve: Solve, raw: Any, replan: bool) -> Array | None:
     """:func:`repair`'s steps, on the strict motion checks."""
     si, guard, extra = solve.si, solve.guard, solve.extra
 
