@@ -101,7 +101,10 @@ def evaluate(
     sphere centres and pairs (:func:`_centres`, :func:`_pairs`), the clearance cost and its
     gradient (:func:`_clearance_cost`), the spacious test (:func:`_spacious`), and the step
     direction: towards a goal state :func:`_joint_direction`, else the tip's Jacobians
-    (:func:`_tip_jacobians`) and :func:`_tip_steepest` or :func:`_tip_gauss_newton`."""
+    (:func:`_tip_jacobians`) and :func:`_tip_steepest` or :func:`_tip_gauss_newton`. The
+    steps of this module are inlined into it (``inline="always"``: numba's IR), the
+    geometry's are called; each is the fused kernel's former code, the same expressions in
+    the same order, so the descent takes the same iterates, to the last bit."""
     dof = q.shape[0]
     Fr = _frames(q, F1, T0, M)
     p, n, diff, dist, cn, ang_err_deg = _tip_errors(Fr, dof + 1, p_goal, n_goal)
@@ -174,7 +177,7 @@ def evaluate(
 
 
 # ---------------------------------------------------------------------- its steps
-@njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True, inline="always")
 def _tip_errors(Fr, tip, p_goal, n_goal):
     """The tip (frame ``tip`` of the frames ``Fr``) against the tip target (p_goal,
     n_goal): its position p (3,), axis n (3,), p − p_goal (3,), |p − p_goal| [m],
@@ -189,7 +192,7 @@ def _tip_errors(Fr, tip, p_goal, n_goal):
     return p, n, diff, dist, cn, ang_err_deg
 
 
-@njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True, inline="always")
 def _joint_errors(q, q_goal, continuous, tol_rad):
     """q (dof,) against the goal state q_goal (dof,) (``continuous`` joints wrapped to
     [−π, π)): dq = q − q_goal (dof,), |dq|², |dq / tol_rad|² and the largest |dq_j| [rad]."""
@@ -209,7 +212,7 @@ def _joint_errors(q, q_goal, continuous, tol_rad):
     return dq, sq, e_sq, joint_err
 
 
-@njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True, inline="always")
 def _clearance_cost(Fr, P, link, nrm, A_idx, B_idx, d, margin):
     """The clearance cost Σ (margin − d)² / margin over the pairs closer than ``margin``,
     its gradient (dof,), how many pairs are that close and their rows (n_close,)."""
@@ -237,7 +240,7 @@ def _clearance_cost(Fr, P, link, nrm, A_idx, B_idx, d, margin):
     return cost, grad, n_close, close
 
 
-@njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True, inline="always")
 def _spacious(d, d_ref, floor_m):
     """No pair closer than ``floor_m`` that came closer than in ``d_ref`` (empty: True)."""
     if d_ref.shape[0] == d.shape[0]:
@@ -247,7 +250,7 @@ def _spacious(d, d_ref, floor_m):
     return True
 
 
-@njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True, inline="always")
 def _tip_steepest(diff, dist, cn, n_goal, Jp, Jn, grad, r1, r2, weight):
     """Steepest descent on F = r1 |p − p_goal| + r2 (1 − n · n_goal)² + w · cost (dof,)."""
     dof = Jp.shape[1]
@@ -261,7 +264,7 @@ def _tip_steepest(diff, dist, cn, n_goal, Jp, Jn, grad, r1, r2, weight):
     return direction
 
 
-@njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True, inline="always")
 def _tip_gauss_newton(
     p,
     n,
@@ -304,7 +307,7 @@ def _tip_gauss_newton(
     return _damped_solve(_with_close_pairs(A, b, pairs, grad, weight), b, damping)
 
 
-@njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True, inline="always")
 def _with_close_pairs(A, b, pairs, grad, weight):
     """The Gauss-Newton system (A, b) with one residual per close pair added:
     A + (w / margin) D^T D (a new matrix; D (n_close, dof): the close pairs' distance
@@ -327,7 +330,7 @@ def _with_close_pairs(A, b, pairs, grad, weight):
     return A
 
 
-@njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True, inline="always")
 def _damped_solve(A, b, damping):
     """A + damping² I (A changed in place) and the solution of (A + damping² I) x = b:
     (x, A)."""
@@ -336,7 +339,7 @@ def _damped_solve(A, b, damping):
     return np.linalg.solve(A, b), A
 
 
-@njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True, inline="always")
 def _joint_direction(
     dq, joint_err, pairs, grad, weight, gauss_newton, damping, goal_depth, tol_rad
 ):
