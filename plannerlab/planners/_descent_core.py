@@ -36,6 +36,7 @@ from plannerlab.planners._descent_geometry import (
     _frames,
     _pair_gradient,
     _pairs,
+    _tip_jacobians,
     pair_spheres,
 )
 from plannerlab.planners.clearance import ClearanceField
@@ -93,31 +94,26 @@ def evaluate(
     is the state ``q_goal`` (dof,) (``continuous`` joints wrapped) with tolerance
     ``tol_rad``: f = r1 |q − q_goal|, F = |(q − q_goal) / tol_rad|² + w · cost, the
     Gauss-Newton residual (q_goal − q) / tol_rad, and joint_err the largest joint
-    difference (else 0)."""
+    difference (else 0).
+
+    The steps, each its own compiled function: the chain's frames (:func:`_frames`), the
+    tip's errors (:func:`_tip_errors`) or the joint errors (:func:`_joint_errors`), the
+    sphere centres and pairs (:func:`_centres`, :func:`_pairs`), the clearance cost and its
+    gradient (:func:`_clearance_cost`), the spacious test (:func:`_spacious`), and the step
+    direction: towards a goal state :func:`_joint_direction`, else the tip's Jacobians
+    (:func:`_tip_jacobians`) and :func:`_tip_steepest` or :func:`_tip_gauss_newton`. The
+    steps of this module are inlined into it (``inline="always"``: numba's IR), the
+    geometry's are called; each is the fused kernel's former code, the same expressions in
+    the same order, so the descent takes the same iterates, to the last bit."""
     dof = q.shape[0]
     Fr = _frames(q, F1, T0, M)
-    tip = dof + 1
-    p = Fr[tip, :3, 3].copy()
-    n = Fr[tip, :3, 2].copy()
-    diff = p - p_goal
-    dist = math.sqrt(diff[0] ** 2 + diff[1] ** 2 + diff[2] ** 2)
-    dot = n[0] * n_goal[0] + n[1] * n_goal[1] + n[2] * n_goal[2]
-    cn = 1.0 - dot
+    p, n, diff, dist, cn, ang_err_deg = _tip_errors(Fr, dof + 1, p_goal, n_goal)
     f = r1 * dist + r2 * cn**2
-    ang_err_deg = math.degrees(math.acos(min(max(dot, -1.0), 1.0)))
     dq = np.zeros(dof)
     joint_err = 0.0
     e_sq = 0.0  # |dq / tol_rad|²
     if joint_goal:
-        sq = 0.0
-        for j in range(dof):
-            dj = q[j] - q_goal[j]
-            if continuous[j]:
-                dj = (dj + math.pi) % (2.0 * math.pi) - math.pi
-            dq[j] = dj
-            sq += dj * dj
-            e_sq += (dj / tol_rad) ** 2
-            joint_err = max(joint_err, abs(dj))
+        dq, sq, e_sq, joint_err = _joint_errors(q, q_goal, continuous, tol_rad)
         f = r1 * math.sqrt(sq)
 
     P = _centres(Fr, link, t)
@@ -139,6 +135,88 @@ def evaluate(
         lp_links,
         link_ends,
     )
+    cost, grad, n_close, close = _clearance_cost(Fr, P, link, nrm, A_idx, B_idx, d, margin)
+    if joint_goal:
+        F = e_sq + weight * cost
+    else:
+        F = r1 * dist + r2 * cn**2 + weight * cost
+    spacious = _spacious(d, d_ref, floor_m)
+    direction = np.zeros(dof)
+    metric = np.eye(dof)  # the step's quadratic model (the identity for plain gradients)
+    if not want_direction:
+        return F, f, dist, ang_err_deg, cost, grad, d, direction, spacious, metric, joint_err
+    pairs = (Fr, P, link, nrm, A_idx, B_idx, n_close, close, margin)  # the close pairs
+    if joint_goal:
+        direction, metric = _joint_direction(
+            dq, joint_err, pairs, grad, weight, gauss_newton, damping, goal_depth, tol_rad
+        )
+        return F, f, dist, ang_err_deg, cost, grad, d, direction, spacious, metric, joint_err
+
+    Jp, Jn = _tip_jacobians(Fr, p, n)
+    if not gauss_newton:
+        direction = _tip_steepest(diff, dist, cn, n_goal, Jp, Jn, grad, r1, r2, weight)
+        return F, f, dist, ang_err_deg, cost, grad, d, direction, spacious, metric, joint_err
+    direction, A = _tip_gauss_newton(
+        p,
+        n,
+        p_goal,
+        n_goal,
+        dist,
+        cn,
+        Jp,
+        Jn,
+        pos_tol,
+        angle_tol_deg,
+        goal_depth,
+        pairs,
+        grad,
+        weight,
+        damping,
+    )
+    return F, f, dist, ang_err_deg, cost, grad, d, direction, spacious, A, joint_err
+
+
+# ---------------------------------------------------------------------- its steps
+@njit(cache=True, nogil=True, inline="always")
+def _tip_errors(Fr, tip, p_goal, n_goal):
+    """The tip (frame ``tip`` of the frames ``Fr``) against the tip target (p_goal,
+    n_goal): its position p (3,), axis n (3,), p − p_goal (3,), |p − p_goal| [m],
+    1 − n · n_goal and the angle between n and n_goal [deg]."""
+    p = Fr[tip, :3, 3].copy()
+    n = Fr[tip, :3, 2].copy()
+    diff = p - p_goal
+    dist = math.sqrt(diff[0] ** 2 + diff[1] ** 2 + diff[2] ** 2)
+    dot = n[0] * n_goal[0] + n[1] * n_goal[1] + n[2] * n_goal[2]
+    cn = 1.0 - dot
+    ang_err_deg = math.degrees(math.acos(min(max(dot, -1.0), 1.0)))
+    return p, n, diff, dist, cn, ang_err_deg
+
+
+@njit(cache=True, nogil=True, inline="always")
+def _joint_errors(q, q_goal, continuous, tol_rad):
+    """q (dof,) against the goal state q_goal (dof,) (``continuous`` joints wrapped to
+    [−π, π)): dq = q − q_goal (dof,), |dq|², |dq / tol_rad|² and the largest |dq_j| [rad]."""
+    dof = q.shape[0]
+    dq = np.zeros(dof)
+    joint_err = 0.0
+    e_sq = 0.0
+    sq = 0.0
+    for j in range(dof):
+        dj = q[j] - q_goal[j]
+        if continuous[j]:
+            dj = (dj + math.pi) % (2.0 * math.pi) - math.pi
+        dq[j] = dj
+        sq += dj * dj
+        e_sq += (dj / tol_rad) ** 2
+        joint_err = max(joint_err, abs(dj))
+    return dq, sq, e_sq, joint_err
+
+
+@njit(cache=True, nogil=True, inline="always")
+def _clearance_cost(Fr, P, link, nrm, A_idx, B_idx, d, margin):
+    """The clearance cost Σ (margin − d)² / margin over the pairs closer than ``margin``,
+    its gradient (dof,), how many pairs are that close and their rows (n_close,)."""
+    dof = Fr.shape[0] - 2
     cost = 0.0
     grad = np.zeros(dof)
     n_close = 0
@@ -159,66 +237,56 @@ def evaluate(
             _pair_gradient(Fr, P, link, nrm, A_idx[i], B_idx[i], i, gi)
             for j in range(dof):
                 grad[j] += wgt * gi[j]
-    if joint_goal:
-        F = e_sq + weight * cost
-    else:
-        F = r1 * dist + r2 * cn**2 + weight * cost
-    spacious = True
+    return cost, grad, n_close, close
+
+
+@njit(cache=True, nogil=True, inline="always")
+def _spacious(d, d_ref, floor_m):
+    """No pair closer than ``floor_m`` that came closer than in ``d_ref`` (empty: True)."""
     if d_ref.shape[0] == d.shape[0]:
         for i in range(d.shape[0]):
             if d[i] < floor_m and d[i] < d_ref[i] - 1e-9:
-                spacious = False
-                break
+                return False
+    return True
+
+
+@njit(cache=True, nogil=True, inline="always")
+def _tip_steepest(diff, dist, cn, n_goal, Jp, Jn, grad, r1, r2, weight):
+    """Steepest descent on F = r1 |p − p_goal| + r2 (1 − n · n_goal)² + w · cost (dof,)."""
+    dof = Jp.shape[1]
     direction = np.zeros(dof)
-    metric = np.eye(dof)  # the step's quadratic model (the identity for plain gradients)
-    if not want_direction:
-        return F, f, dist, ang_err_deg, cost, grad, d, direction, spacious, metric, joint_err
-    if joint_goal:
-        direction, metric = _joint_direction(
-            dq,
-            joint_err,
-            Fr,
-            P,
-            link,
-            nrm,
-            A_idx,
-            B_idx,
-            d,
-            margin,
-            grad,
-            n_close,
-            close,
-            weight,
-            gauss_newton,
-            damping,
-            goal_depth,
-            tol_rad,
-        )
-        return F, f, dist, ang_err_deg, cost, grad, d, direction, spacious, metric, joint_err
-
-    # tip Jacobians: dp/dθ_j = z_j × (p − o_j), dn/dθ_j = z_j × n
-    Jp = np.empty((3, dof))
-    Jn = np.empty((3, dof))
     for j in range(dof):
-        zx, zy, zz = Fr[j + 1, 0, 2], Fr[j + 1, 1, 2], Fr[j + 1, 2, 2]
-        dx = p[0] - Fr[j + 1, 0, 3]
-        dy = p[1] - Fr[j + 1, 1, 3]
-        dz = p[2] - Fr[j + 1, 2, 3]
-        Jp[0, j] = zy * dz - zz * dy
-        Jp[1, j] = zz * dx - zx * dz
-        Jp[2, j] = zx * dy - zy * dx
-        Jn[0, j] = zy * n[2] - zz * n[1]
-        Jn[1, j] = zz * n[0] - zx * n[2]
-        Jn[2, j] = zx * n[1] - zy * n[0]
-    if not gauss_newton:
-        for j in range(dof):
-            g = 0.0
-            if dist > 1e-12:
-                g = (diff[0] * Jp[0, j] + diff[1] * Jp[1, j] + diff[2] * Jp[2, j]) / dist
-            gn = n_goal[0] * Jn[0, j] + n_goal[1] * Jn[1, j] + n_goal[2] * Jn[2, j]
-            direction[j] = -(r1 * g - 2.0 * r2 * cn * gn + weight * grad[j])
-        return F, f, dist, ang_err_deg, cost, grad, d, direction, spacious, metric, joint_err
+        g = 0.0
+        if dist > 1e-12:
+            g = (diff[0] * Jp[0, j] + diff[1] * Jp[1, j] + diff[2] * Jp[2, j]) / dist
+        gn = n_goal[0] * Jn[0, j] + n_goal[1] * Jn[1, j] + n_goal[2] * Jn[2, j]
+        direction[j] = -(r1 * g - 2.0 * r2 * cn * gn + weight * grad[j])
+    return direction
 
+
+@njit(cache=True, nogil=True, inline="always")
+def _tip_gauss_newton(
+    p,
+    n,
+    p_goal,
+    n_goal,
+    dist,
+    cn,
+    Jp,
+    Jn,
+    pos_tol,
+    angle_tol_deg,
+    goal_depth,
+    pairs,
+    grad,
+    weight,
+    damping,
+):
+    """Damped Gauss-Newton on the tip residuals (p_goal − p) / pos_tol and
+    (n_goal − n) / angle_tol (each zero once deeper than ``goal_depth`` tolerances in the
+    goal) plus one residual per close pair (``pairs``, see :func:`_with_close_pairs`):
+    the step (dof,) and the matrix of its quadratic model (dof, dof)."""
+    dof = Jp.shape[1]
     pos_scale = 1.0 / pos_tol
     ang_scale = 1.0 / math.radians(angle_tol_deg)
     e = np.empty(6)
@@ -236,7 +304,20 @@ def evaluate(
             Jt[3 + k, j] = Jn[k, j] * ang_scale
     A = Jt.T @ Jt
     b = Jt.T @ e
+    return _damped_solve(_with_close_pairs(A, b, pairs, grad, weight), b, damping)
+
+
+@njit(cache=True, nogil=True, inline="always")
+def _with_close_pairs(A, b, pairs, grad, weight):
+    """The Gauss-Newton system (A, b) with one residual per close pair added:
+    A + (w / margin) D^T D (a new matrix; D (n_close, dof): the close pairs' distance
+    gradients) and b − w/2 · gradient (in place). ``pairs``: the frames, the centres,
+    each sphere's link, the pairs' directions, spheres a and b, how many pairs are close,
+    their rows and the margin."""
+    Fr, P, link, nrm, A_idx, B_idx, n_close, close, margin = pairs
+    dof = b.shape[0]
     if n_close > 0:
+        gi = np.empty(dof)
         dd = np.empty((n_close, dof))
         for c in range(n_close):
             i = close[c]
@@ -246,37 +327,27 @@ def evaluate(
         A = A + k2 * (dd.T @ dd)
         for j in range(dof):
             b[j] = b[j] - 0.5 * weight * grad[j]
-    for j in range(dof):
+    return A
+
+
+@njit(cache=True, nogil=True, inline="always")
+def _damped_solve(A, b, damping):
+    """A + damping² I (A changed in place) and the solution of (A + damping² I) x = b:
+    (x, A)."""
+    for j in range(b.shape[0]):
         A[j, j] += damping**2
-    direction = np.linalg.solve(A, b)
-    return F, f, dist, ang_err_deg, cost, grad, d, direction, spacious, A, joint_err
+    return np.linalg.solve(A, b), A
 
 
-@njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True, inline="always")
 def _joint_direction(
-    dq,
-    joint_err,
-    Fr,
-    P,
-    link,
-    nrm,
-    A_idx,
-    B_idx,
-    d,
-    margin,
-    grad,
-    n_close,
-    close,
-    weight,
-    gauss_newton,
-    damping,
-    goal_depth,
-    tol_rad,
+    dq, joint_err, pairs, grad, weight, gauss_newton, damping, goal_depth, tol_rad
 ):
     """The step towards a goal state (``ClearanceDescent._joint_direction``): steepest
     descent on F = |dq / tol|² + w · cost, or damped Gauss-Newton on the joint residual
-    −dq / tol (Jacobian I / tol) plus one residual per close pair; dq = q − q_goal.
-    Returns the step and the matrix of its quadratic model (the hold's metric)."""
+    −dq / tol (Jacobian I / tol) plus one residual per close pair (``pairs``, see
+    :func:`_with_close_pairs`); dq = q − q_goal. Returns the step and the matrix of its
+    quadratic model (the hold's metric)."""
     dof = dq.shape[0]
     direction = np.zeros(dof)
     if not gauss_newton:
@@ -290,20 +361,7 @@ def _joint_direction(
     for j in range(dof):
         A[j, j] = scale * scale
         b[j] = 0.0 if deep else scale * (-dq[j] * scale)
-    if n_close > 0:
-        gi = np.empty(dof)
-        dd = np.empty((n_close, dof))
-        for c in range(n_close):
-            i = close[c]
-            _pair_gradient(Fr, P, link, nrm, A_idx[i], B_idx[i], i, gi)
-            dd[c] = gi
-        k2 = weight / margin
-        A = A + k2 * (dd.T @ dd)
-        for j in range(dof):
-            b[j] = b[j] - 0.5 * weight * grad[j]
-    for j in range(dof):
-        A[j, j] += damping**2
-    return np.linalg.solve(A, b), A
+    return _damped_solve(_with_close_pairs(A, b, pairs, grad, weight), b, damping)
 
 
 @njit(cache=True, nogil=True)

@@ -1,7 +1,7 @@
 """The geometry of the compiled clearance descent (:mod:`plannerlab.planners._descent_core`,
-numba, cached): an Arm-Z chain's face frames and sphere centres, every sphere pair's
-distance and direction (sphere against box, cylinder or sphere; sphere against sphere),
-and one pair's distance gradient through the chain. The arithmetic of
+numba, cached): an Arm-Z chain's face frames, sphere centres and tip Jacobians, every
+sphere pair's distance and direction (sphere against box, cylinder or sphere; sphere
+against sphere), and one pair's distance gradient through the chain. The arithmetic of
 :class:`~plannerlab.planners.clearance.ClearanceField` written as loops (same spheres,
 same pairs in the same order)."""
 
@@ -53,6 +53,26 @@ def _centres(F, link, t):
             b = F[li + 1, k, 3]
             P[s, k] = a + t[s] * (b - a)
     return P
+
+
+@njit(cache=True, nogil=True)
+def _tip_jacobians(Fr, p, n):
+    """The tip's Jacobians (3, dof) each: dp/dθ_j = z_j × (p − o_j), dn/dθ_j = z_j × n."""
+    dof = Fr.shape[0] - 2
+    Jp = np.empty((3, dof))
+    Jn = np.empty((3, dof))
+    for j in range(dof):
+        zx, zy, zz = Fr[j + 1, 0, 2], Fr[j + 1, 1, 2], Fr[j + 1, 2, 2]
+        dx = p[0] - Fr[j + 1, 0, 3]
+        dy = p[1] - Fr[j + 1, 1, 3]
+        dz = p[2] - Fr[j + 1, 2, 3]
+        Jp[0, j] = zy * dz - zz * dy
+        Jp[1, j] = zz * dx - zx * dz
+        Jp[2, j] = zx * dy - zy * dx
+        Jn[0, j] = zy * n[2] - zz * n[1]
+        Jn[1, j] = zz * n[0] - zx * n[2]
+        Jn[2, j] = zx * n[1] - zy * n[0]
+    return Jp, Jn
 
 
 # ---------------------------------------------------------------------- pairs
