@@ -3,8 +3,9 @@
     python results/escapes/report.py [STORE_DIR]     (default: results/escapes)
 
 Reads ``STORE_DIR/<problem>/trials.jsonl`` (written by ``results/escapes/run.sh``), prints
-the Markdown tables that ``results/escapes.md`` holds between its ``<!-- table -->`` marks
-(and rewrites them there), and draws ``STORE_DIR/progress_traps.png`` and
+the Markdown tables that ``results/escapes.md`` holds between its ``<!-- headline -->`` and
+``<!-- /table -->`` marks (and rewrites them there, and the headline table in the README
+between ``<!-- escapes -->`` marks), and draws ``STORE_DIR/progress_traps.png`` and
 ``STORE_DIR/progress_tasks.png``. Only trials that ran (not killed, no error) count
 as runs; a trial killed past its wall-clock limit counts as run and failed.
 
@@ -270,6 +271,12 @@ def main() -> None:
         old = md.read_text()
         new = re.sub(r"<!-- headline -->.*<!-- /table -->\n", lambda _: text, old, flags=re.S)
         md.write_text(new)
+    readme = ROOT / "README.md"  # the headline table there too, between its own marks
+    old = readme.read_text()
+    head = "<!-- escapes -->\n" + headline(rs, TRAPS + TASKS) + "<!-- /escapes -->"
+    readme.write_text(
+        re.sub(r"<!-- escapes -->.*?<!-- /escapes -->", lambda _: head, old, flags=re.S)
+    )
     figures(data, store_dir)
 
 
