@@ -78,13 +78,16 @@ def _wired(checker: CollisionChecker, fused: ChainValidity) -> CollisionChecker:
 
 def _ompl_road(checker: CollisionChecker, problem: Any, Q: np.ndarray) -> dict[str, Any]:
     """The OMPL adapter's validity callback on OMPL states: (isValid, to_q, guard, states)."""
-    from plannerlab.planners import ompl as adapter  # the only user of ompl
-    from plannerlab.planners.base import BudgetTracker
+    import ompl.base as ob  # through the adapter's own modules below, as the planner does
 
-    space = adapter._Space(problem.robot)
+    from plannerlab.planners.base import BudgetTracker
+    from plannerlab.planners.ompl.guard import Guard
+    from plannerlab.planners.ompl.space import Space
+
+    space = Space(problem.robot)
     tracker = BudgetTracker(Budget(time_limit_s=1e9), checker)
-    guard = adapter._Guard(checker, tracker)
-    si = adapter.ob.SpaceInformation(space.space)
+    guard = Guard(checker, tracker)
+    si = ob.SpaceInformation(space.space)
 
     def state_valid(state: Any) -> bool:  # as in OmplPlanner's solve
         return guard.is_valid(space.to_q(state))
@@ -139,6 +142,7 @@ def main() -> None:
     old = CollisionChecker(p.robot, p.scene, backend="core")
     new = CollisionChecker(p.robot, p.scene, backend="core")
     core: Any = old._core
+    core._fused = None  # "old": the core's own kernels, as before ChainValidity was wired in
     assert core is not None and new._core is not None
     fused = ChainValidity.of(new._core)
     base_first = ChainValidity.of(new._core, body_order=np.arange(p.robot.dof + 1))
