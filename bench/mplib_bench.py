@@ -176,7 +176,7 @@ def plannerlab_runs(
 ):
     import numpy as np
 
-    import plannerlab.planners.ompl as pl_ompl
+    import plannerlab.planners.ompl.goal as pl_ompl  # where the goal pool calls IK
     from plannerlab.planners import make_planner
     from plannerlab.problem.goals import GoalRegion
     from plannerlab.problem.load import Budget, Problem
