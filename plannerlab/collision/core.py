@@ -250,7 +250,7 @@ class Core:
         self._chain: Any = None
         #: its validity in one fused call per query (collision/chain_valid.py)
         self._fused: ChainValidity | None = None
-        if callable(getattr(robot, "chain_data", None)):
+        if not self._armz and callable(getattr(robot, "chain_data", None)):
             self._chain = chain_arrays(robot)
             self._fused = ChainValidity.of(self)
         if self._armz:
@@ -273,6 +273,8 @@ class Core:
                 self._M,
                 *self._geo,
             )
+        #: the compiled robot–scene model (:attr:`model`), built on first use
+        self._model: Any = None
         self._warm_up()
 
     def _warm_up(self) -> None:
@@ -304,6 +306,20 @@ class Core:
             q1 = q.copy()
             q1[0] += 0.5 if q[0] + 0.5 <= self.robot.upper[0] else -0.5
             self.path_advance(np.vstack([q, q1]), 1, 0.05, None)
+
+    @property
+    def model(self) -> Any:
+        """The compiled robot–scene model of this core
+        (:class:`~plannerlab.collision.model.CompiledModel`), built on first use and kept.
+
+        Raises:
+            ValueError: the robot gives no serial chain (``chain_data``) to compile.
+        """
+        if self._model is None:
+            from plannerlab.collision.model import model_of_core
+
+            self._model = model_of_core(self)
+        return self._model
 
     # ------------------------------------------------------------------ kinematics
     def _Q(self, Q: Array) -> np.ndarray:

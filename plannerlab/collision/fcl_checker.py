@@ -448,12 +448,28 @@ class CollisionChecker:
         assert self.edge_weights is not None
         return edge_counts(path, joint_step, self.robot.continuous, self.edge_weights)
 
+    @property
+    def model(self) -> Any:
+        """The compiled robot–scene model (:class:`~plannerlab.collision.model.
+        CompiledModel`) of this checker's robot, scene and margin, built once.
+
+        Raises:
+            ValueError: the checker has no compiled core (an FCL-only scene) or the robot
+                gives no serial chain.
+        """
+        if self._core is None:
+            raise ValueError(
+                "the compiled model needs the core backend (boxes, cylinders, spheres)"
+            )
+        return self._core.model
+
     def check_path(
         self,
         path: Array,
         joint_step: float,
         stop: Callable[[], bool] | None = None,
         chunk: int = 4096,
+        mode: str | None = None,
     ) -> PathCheck:
         """Check every state of a path densified to at most ``joint_step`` per joint.
 
@@ -464,8 +480,14 @@ class CollisionChecker:
         With ``edge_check == "advance"`` the states are those of conservative advancement
         (:meth:`~plannerlab.collision.core.Core.path_advance`), at most as many as
         :meth:`densify` gives (the reserve planners keep for this check stays sound).
+        ``mode`` "grid" checks the grid's states whatever ``edge_check`` says (the states a
+        compiled planner checked its edges on: its path passes by construction).
         """
-        if self.edge_check == "advance":
+        if mode not in (None, "grid", "advance"):
+            raise ValueError(f"mode must be None, 'grid' or 'advance', got {mode!r}")
+        if (mode or self.edge_check) == "advance":
+            if self.edge_check != "advance":
+                raise ValueError("mode 'advance' needs a checker with edge_check 'advance'")
             return self._check_path_advance(path, joint_step, stop, chunk)
         states, owners = self.densify(path, joint_step)
         step = len(states) if stop is None else max(int(chunk), 1)

@@ -28,6 +28,7 @@ overlap geometrically and are excluded from self-collision.
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 
@@ -170,6 +171,30 @@ class ArmZ:
         J_p = np.cross(z, p - o).T
         J_n = np.cross(z, n).T
         return J_p, J_n
+
+    def chain_data(self) -> tuple[Any, ...]:
+        """The chain as plain arrays for the compiled robot-scene model
+        (:mod:`plannerlab.collision.model`), in the form of a URDF chain's ``chain_data``:
+        per joint its parent body (dof,), the fixed transform parent body -> joint frame
+        (dof, 4, 4), its unit axis (dof, 3), whether it slides (dof,); per capsule its body
+        (L,) and its two end points in that body's frame (L, 3) each.
+
+        Body 0 is the base (``T_world_base``); body ``i + 1`` is face frame ``i + 1`` turned
+        by ``q_i`` about its z axis, so face ``i + 2 = body i+1 · M``. Module 0 runs from
+        the base to face 1, module ``l ≥ 1`` from body ``l``'s origin to ``M``'s."""
+        dof = self.dof
+        parent = np.arange(dof, dtype=np.int64)
+        pre = np.empty((dof, 4, 4))
+        pre[0] = self._T_base_j1
+        pre[1:] = self._M
+        axes = np.tile([0.0, 0.0, 1.0], (dof, 1))
+        prismatic = np.zeros(dof, dtype=bool)
+        L = self.n_modules
+        cap_body = np.arange(L, dtype=np.int64)
+        cap_a = np.zeros((L, 3))
+        cap_b = np.tile(self._M[:3, 3], (L, 1))
+        cap_b[0] = self._T_base_j1[:3, 3]
+        return parent, pre, axes, prismatic, cap_body, cap_a, cap_b
 
     def link_segments(self, q: Array) -> Array:
         """Capsule axes (L, 2, 3) or (k, L, 2, 3): chord between consecutive face centres."""
