@@ -11,7 +11,7 @@ against every obstacle, the checked link pairs) with the same verdicts, built fo
   turn folded into the fixed transforms and the capsules' points), so a joint costs one
   affine product and a turn of two columns; body frames are 3 x 4.
 * **Bounding balls.** The capsules are sorted by body and, within a body, into clusters of
-  a few neighbours; a body ball, then cluster balls (grown by ``_BOUND_PAD_M`` beyond
+  a few neighbours; a body ball, then cluster balls (grown by ``chain_pack._BOUND_PAD_M`` beyond
   rounding) are tested before the capsules under them, against the scene (after the
   obstacle's world box) and between bodies; a body's capsules are placed in the world only
   when one of its balls is not clear.
@@ -32,6 +32,16 @@ from typing import Any
 import numpy as np
 from numba import njit
 
+from plannerlab.collision.chain_pack import (  # the packing, and its layout
+    _H_DOF,
+    _H_I,
+    _H_L,
+    _H_NB,
+    _H_NCL,
+    _H_NCPL,
+    _H_NOBS,
+    _pack,
+)
 from plannerlab.collision.geometry import (
     BOX,
     SPHERE,
@@ -41,16 +51,7 @@ from plannerlab.collision.geometry import (
     seg_seg,
 )
 
-# the int array: a header of counts, then the sections (see _pack), flat
-_H_DOF, _H_NB, _H_L, _H_NOBS, _H_NCL = range(5)
-_I_SECTIONS = (
-    *("parent", "prism", "body_cl", "cl_start", "order", "kind", "issph", "moving"),
-    *("allowed", "any_cl", "groups"),
-)
-_H_I = 5
-_HEADER = _H_I + len(_I_SECTIONS) + 1  # + 1: the end of the last section
 _SCRATCH = 64  # floats of w (capsule tests)
-_CLUSTER = 6  # capsules per cluster at most
 _F64 = np.dtype(np.float64)
 
 
@@ -123,13 +124,28 @@ def _bound_apart(kind, R, c, h, x0, x1, x2, rb):
 
 
 @njit(cache=True, nogil=True, inline="always")
-def _body_frames(q, T0, parent, prism, pre, Bf):
+def _joint_value(q, i, cpl_start, cpl_idx, cpl_val):
+    """The chain's joint i's value at state q: ``q[i]``, or with a coupling (``cpl_start``
+    not empty) ``Σ_k cpl_val[k] q[cpl_idx[k]]`` over its entries (``chain.py``)."""
+    if cpl_start.shape[0] == 0:
+        return q[i]
+    v = 0.0
+    for k in range(cpl_start[i], cpl_start[i + 1]):
+        v += cpl_val[k // 3, k % 3] * q[cpl_idx[k]]
+    return v
+
+
+@njit(cache=True, nogil=True, inline="always")
+def _body_frames(q, T0, parent, prism, pre, Bf, cpl):
     """Body frames (nb, 3, 4) of one state; each joint turns (or slides) about its frame's
-    z axis (the chain's axes are folded into ``pre`` and the capsules by ``_pack``)."""
+    z axis (the chain's axes are folded into ``pre`` and the capsules by ``_pack``).
+    ``cpl``: the coupling's (starts, indices, coefficients), empty without one."""
+    cpl_start, cpl_idx, cpl_val = cpl
     for a in range(3):
         for b in range(4):
             Bf[0, a, b] = T0[a, b]
-    for i in range(q.shape[0]):
+    for i in range(parent.shape[0]):
+        qi = _joint_value(q, i, cpl_start, cpl_idx, cpl_val)
         F = Bf[parent[i]]
         P = pre[i]
         G = Bf[i + 1]
@@ -140,10 +156,10 @@ def _body_frames(q, T0, parent, prism, pre, Bf):
             G[a, 3] += F[a, 3]
         if prism[i]:
             for a in range(3):
-                G[a, 3] += q[i] * G[a, 2]
+                G[a, 3] += qi * G[a, 2]
         else:
-            cq = math.cos(q[i])
-            sq = math.sin(q[i])
+            cq = math.cos(qi)
+            sq = math.sin(qi)
             for a in range(3):
                 g0, g1 = G[a, 0], G[a, 1]
                 G[a, 0] = cq * g0 + sq * g1
@@ -152,7 +168,7 @@ def _body_frames(q, T0, parent, prism, pre, Bf):
 
 @njit(cache=True, nogil=True, inline="always")
 def _iv(idat, k):
-    """Int section k (see ``_I_SECTIONS``), flat."""
+    """Int section k (see ``chain_pack._I_SECTIONS``), flat."""
     return idat[idat[_H_I + k] : idat[_H_I + k + 1]]
 
 
@@ -161,6 +177,7 @@ def _unpack(P, M, idat):
     """Views of the packed arrays (see ``_pack``): slices only (a reshape costs some 30 ns
     in numba, a slice about one)."""
     dof, nb, L, n, ncl = idat[_H_DOF], idat[_H_NB], idat[_H_L], idat[_H_NOBS], idat[_H_NCL]
+    ncpl = idat[_H_NCPL]
     ints = (
         _iv(idat, 0),
         _iv(idat, 1),
@@ -175,6 +192,8 @@ def _unpack(P, M, idat):
         _iv(idat, 10),
     )
     o = 3 * L + 2 * nb + 2 * ncl  # the obstacles' rows of P
+    e = o + 4 * n  # the coupling's coefficients, three a row, after the obstacles
+    cpl = (_iv(idat, 11), _iv(idat, 12), P[e : e + (ncpl + 2) // 3])
     floats = (
         M[0],
         M[1 : 1 + dof],
@@ -194,7 +213,7 @@ def _unpack(P, M, idat):
         P[o + 2 * n : o + 3 * n],
         P[o + 3 * n : o + 4 * n],
     )
-    return ints, floats
+    return ints, floats, cpl
 
 
 @njit(cache=True, nogil=True, inline="always")
@@ -292,7 +311,7 @@ def _state_ok(q, V, S):
     (T0, pre, cap_a, cap_b, rad, rads, bc, br, brs, cl_c, cl_r, cl_rs, Rs, cs, hs) = V[1][:15]
     olo, ohi = V[1][15], V[1][16]
     Bf, Cw, Kw, X, Y, done, w = S
-    _body_frames(q, T0, parent, prism, pre, Bf)
+    _body_frames(q, T0, parent, prism, pre, Bf, V[2])
     nb = bc.shape[0]
     for b in range(nb):
         x, y, z = bc[b, 0], bc[b, 1], bc[b, 2]
@@ -424,7 +443,7 @@ def chain_points(Q, P, M, idat, out):
     cl_c = V[1][9]
     Bf, _, Kw, X, Y, _, _ = _scratch(idat)
     for s in range(Q.shape[0]):
-        _body_frames(Q[s], T0, parent, prism, pre, Bf)
+        _body_frames(Q[s], T0, parent, prism, pre, Bf, V[2])
         for b in range(Bf.shape[0]):
             _place_body(Bf, cap_a, cap_b, issph, body_cl, cl_start, cl_c, b, X, Y, Kw)
         for l in range(X.shape[0]):
@@ -432,164 +451,6 @@ def chain_points(Q, P, M, idat, out):
                 out[s, l, 0, a] = X[l, a]
                 out[s, l, 1, a] = X[l, a] if issph[l] else Y[l, a]
     return out
-
-
-# ---------------------------------------------------------------------- packing (once)
-_BOUND_PAD_M = 1e-9  # grows every bounding ball beyond rounding: a ball clear is clear
-
-
-def _align(u: np.ndarray) -> np.ndarray:
-    """A rotation A (3, 3) with A e_z = u (the identity for u = e_z)."""
-    z = np.asarray(u, dtype=float)
-    if np.array_equal(z, [0.0, 0.0, 1.0]):
-        return np.eye(3)
-    e = np.eye(3)[int(np.argmin(np.abs(z)))]
-    x = np.cross(e, z)
-    x /= np.linalg.norm(x)
-    return np.column_stack([x, np.cross(z, x), z])
-
-
-def _ball(centres: np.ndarray, reach: np.ndarray) -> tuple[np.ndarray, float]:
-    """A ball around points each grown by its own reach: (centre, radius), radius -1 for none."""
-    if len(centres) == 0:
-        return np.zeros(3), -1.0
-    c = (centres.min(axis=0) + centres.max(axis=0)) / 2.0
-    return c, float(np.max(np.linalg.norm(centres - c, axis=1) + reach)) + _BOUND_PAD_M
-
-
-def _clusters(points: np.ndarray, idx: np.ndarray, size: int) -> list[np.ndarray]:
-    """idx cut into groups of at most ``size`` neighbours (halved along the widest axis of
-    their points, recursively)."""
-    if len(idx) <= size:
-        return [idx]
-    p = points[idx]
-    axis = int(np.argmax(p.max(axis=0) - p.min(axis=0)))
-    by = idx[np.argsort(p[:, axis], kind="stable")]
-    half = len(by) // 2
-    return _clusters(points, by[:half], size) + _clusters(points, by[half:], size)
-
-
-def _pack(
-    robot: Any,
-    radii: np.ndarray,
-    radii_self: np.ndarray,
-    moving: np.ndarray,
-    allowed: np.ndarray,
-    kinds: np.ndarray,
-    Rs: np.ndarray,
-    cs: np.ndarray,
-    hs: np.ndarray,
-    order: np.ndarray | None,
-) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-    """The chain, its capsules, the checked pairs and the scene for :func:`chain_valid`:
-    points, centres and per-capsule, -body, -cluster radii as rows of three (P), frames
-    as 3 x 4 matrices (M), counts and indices (idat); and the capsules' new order (by body,
-    then cluster).
-
-    Each joint's axis u is turned onto its frame's z axis: with A e_z = u, a turn about u
-    is A Rz(q) Aᵀ, so the body frames are kept as B·A and A is folded into the fixed
-    transforms and the capsules' points (the kinematics then turn about z only)."""
-    parent, pre, axes, prismatic, cap_body, cap_a, cap_b = robot.chain_data()
-    dof = len(parent)
-    nb = dof + 1
-    A = [np.eye(3)] + [_align(axes[i]) for i in range(dof)]
-    pre_f = np.empty((dof, 3, 4))
-    for i in range(dof):
-        Ap, Ai = np.eye(4), np.eye(4)
-        Ap[:3, :3], Ai[:3, :3] = A[int(parent[i])], A[i + 1]
-        pre_f[i] = (Ap.T @ np.asarray(pre[i], dtype=float) @ Ai)[:3]
-    cap_body = np.asarray(cap_body, dtype=np.int64)
-    mid = (np.asarray(cap_a, dtype=float) + np.asarray(cap_b, dtype=float)) / 2.0
-    perm_l: list[int] = []
-    cl_start, body_cl = [0], [0]
-    for b in range(nb):
-        for members in _clusters(mid, np.flatnonzero(cap_body == b), _CLUSTER):
-            perm_l.extend(int(m) for m in members)
-            cl_start.append(len(perm_l))
-        body_cl.append(len(cl_start) - 1)
-    perm = np.array(perm_l, dtype=np.int64)
-    body = cap_body[perm]
-    ca = np.array(
-        [A[int(b)].T @ p for b, p in zip(body, np.asarray(cap_a)[perm], strict=True)]
-    ).reshape(-1, 3)
-    cb = np.array(
-        [A[int(b)].T @ p for b, p in zip(body, np.asarray(cap_b)[perm], strict=True)]
-    ).reshape(-1, 3)
-    issph = np.all(np.asarray(cap_a)[perm] == np.asarray(cap_b)[perm], axis=1)
-    rad, rads, mov = radii[perm], radii_self[perm], np.asarray(moving, dtype=bool)[perm]
-
-    def balls(ranges: list[tuple[int, int]]) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """Per range of capsules: centre, radius against the scene (moving capsules only;
-        -1: none) and between links."""
-        c, r, rs = np.zeros((len(ranges), 3)), np.full(len(ranges), -1.0), np.zeros(len(ranges))
-        for k, (l0, l1) in enumerate(ranges):
-            pts = np.concatenate([ca[l0:l1], cb[l0:l1]])
-            c[k], rs[k] = _ball(pts, np.tile(rads[l0:l1], 2))
-            m = np.tile(mov[l0:l1], 2)
-            if m.any():
-                reach = np.tile(rad[l0:l1], 2)[m]
-                r[k] = float(np.max(np.linalg.norm(pts[m] - c[k], axis=1) + reach)) + _BOUND_PAD_M
-        return c, r, rs
-
-    ncl = len(cl_start) - 1
-    cl_c, cl_r, cl_rs = balls([(cl_start[k], cl_start[k + 1]) for k in range(ncl)])
-    bc, br, brs = balls([(cl_start[body_cl[b]], cl_start[body_cl[b + 1]]) for b in range(nb)])
-    # the checked pairs in the new order (i < j), and which clusters and bodies hold one
-    sym = np.asarray(allowed, dtype=bool) | np.asarray(allowed, dtype=bool).T
-    al = np.triu(sym[np.ix_(perm, perm)], 1)
-    cl_of = np.repeat(np.arange(ncl), np.diff(cl_start))
-    any_cl = np.zeros((ncl, ncl), dtype=np.int64)
-    for i, j in zip(*np.nonzero(al), strict=True):
-        any_cl[cl_of[i], cl_of[j]] = 1
-    cl_body = np.repeat(np.arange(nb), np.diff(body_cl))
-    groups = sorted(
-        {(int(cl_body[u]), int(cl_body[v])) for u, v in zip(*np.nonzero(any_cl), strict=True)}
-    )
-    body_order = np.arange(nb)[::-1] if order is None else np.asarray(order)
-    # world boxes around the obstacles (a first, cheaper cull), grown beyond rounding
-    Rs, cs, hs = (np.asarray(a, dtype=float) for a in (Rs, cs, hs))
-    kinds = np.asarray(kinds)
-    sph = (kinds == SPHERE)[:, None]
-    ext = np.where(
-        (kinds == BOX)[:, None],
-        hs,
-        np.where(sph, hs[:, :1], np.stack([hs[:, 0], hs[:, 0], hs[:, 1]], 1)),
-    )
-    half = (np.abs(Rs) @ ext[:, :, None])[..., 0] if len(kinds) else np.zeros((0, 3))
-    half = np.where(sph, ext, half) + _BOUND_PAD_M
-    ints = [
-        np.asarray(parent),
-        np.asarray(prismatic),
-        np.asarray(body_cl),
-        np.asarray(cl_start),
-        body_order,
-        kinds,
-        issph,
-        mov,
-        al,
-        any_cl,
-        np.asarray(groups).reshape(-1, 2),
-    ]
-    head = np.zeros(_HEADER, dtype=np.int64)
-    head[:_H_I] = (dof, nb, len(body), len(kinds), ncl)
-    at = _HEADER
-    for k, a in enumerate(ints):
-        head[_H_I + k] = at
-        at += np.asarray(a).size
-    head[_H_I + len(ints)] = at
-    idat = np.concatenate([head] + [np.asarray(a, dtype=np.int64).reshape(-1) for a in ints])
-    zeros = np.zeros
-    P = np.concatenate(
-        [ca, cb, np.column_stack([rad, rads, zeros(len(rad))]), bc]
-        + [np.column_stack([br, brs, zeros(nb)]), cl_c, np.column_stack([cl_r, cl_rs, zeros(ncl)])]
-        + [cs.reshape(-1, 3), hs.reshape(-1, 3), (cs - half).reshape(-1, 3)]
-        + [(cs + half).reshape(-1, 3)]
-    )
-    R34 = zeros((len(kinds), 3, 4))
-    R34[:, :, :3] = Rs.reshape(-1, 3, 3)
-    T0 = np.asarray(robot.T_world_base, dtype=float)[None, :3]
-    M = np.concatenate([T0, pre_f, R34])
-    return np.ascontiguousarray(P), np.ascontiguousarray(M), idat, perm
 
 
 class ChainValidity:

@@ -313,12 +313,13 @@ class Core:
         (:class:`~plannerlab.collision.model.CompiledModel`), built on first use and kept.
 
         Raises:
-            ValueError: the robot gives no serial chain (``chain_data``) to compile.
+            ModelError: the robot gives no serial chain (``chain_data``) to compile and
+                its family registers no builder of its own.
         """
         if self._model is None:
-            from plannerlab.collision.model import model_of_core
+            from plannerlab.collision.model import build_model
 
-            self._model = model_of_core(self)
+            self._model = build_model(self)
         return self._model
 
     # ------------------------------------------------------------------ kinematics

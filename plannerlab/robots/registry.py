@@ -19,6 +19,9 @@ from typing import Any
 from plannerlab.errors import UnknownNameError
 from plannerlab.robots.schema import RobotTable
 
+#: the generic serial-chain builder of the compiled model (from ``robot.chain_data()``)
+DEFAULT_MODEL = "plannerlab.collision.model:model_of_core"
+
 
 @dataclass(frozen=True)
 class RobotFamily:
@@ -39,6 +42,11 @@ class RobotFamily:
             every link's length, the last link to the tip).
         gravity_off: why the family's problems default to no gravity when their file has
             no ``[simulation]`` table, or None for the usual -9.81 m/s² along -z.
+        model: ``"module:function"`` building the family's compiled robot–scene model
+            (:class:`~plannerlab.collision.model.CompiledModel`) from a built collision core,
+            called as ``function(core)``; the default is the generic serial-chain builder,
+            which reads the robot's ``chain_data()`` (so a new family with a chain is on the
+            compiled road with no entry of its own).
         summary: one line for the documentation.
     """
 
@@ -47,6 +55,7 @@ class RobotFamily:
     goal_sampler: str | None = None
     reach: str | None = None
     gravity_off: str | None = None
+    model: str = DEFAULT_MODEL
     summary: str = ""
 
 
@@ -120,6 +129,13 @@ def reach_function(kind: str) -> Any:
     return None if entry is None or entry.reach is None else _target(entry.reach)
 
 
+def model_builder(kind: str) -> Any:
+    """The family's builder of its compiled model (see :attr:`RobotFamily.model`); the
+    generic serial-chain builder for a kind that is not registered (a robot built in code)."""
+    entry = FAMILIES.get(kind)
+    return _target(DEFAULT_MODEL if entry is None else entry.model)
+
+
 def gravity_off_reason(kind: str) -> str | None:
     """Why the family's problems default to no gravity (None: they do not)."""
     entry = FAMILIES.get(kind)
@@ -127,11 +143,13 @@ def gravity_off_reason(kind: str) -> str | None:
 
 
 __all__ = [
+    "DEFAULT_MODEL",
     "FAMILIES",
     "RobotFamily",
     "family",
     "goal_sampler",
     "gravity_off_reason",
+    "model_builder",
     "reach_function",
     "robot_table",
 ]
