@@ -47,6 +47,11 @@ class RobotFamily:
             called as ``function(core)``; the default is the generic serial-chain builder,
             which reads the robot's ``chain_data()`` (so a new family with a chain is on the
             compiled road with no entry of its own).
+        ik_descent: ``"module:function"`` giving a robot's compiled IK descent
+            (``function(robot)`` -> ``descent(goal, q_seed, max_iterations, damping,
+            max_step_rad, target_fraction) -> (q, steps)``) that the numeric goal sampling
+            of :mod:`plannerlab.problem.ik` restarts instead of its numpy descent; None:
+            the numpy descent (on the robot's ``tip_jacobian``).
         summary: one line for the documentation.
     """
 
@@ -56,6 +61,7 @@ class RobotFamily:
     reach: str | None = None
     gravity_off: str | None = None
     model: str = DEFAULT_MODEL
+    ik_descent: str | None = None
     summary: str = ""
 
 
@@ -85,6 +91,7 @@ FAMILIES: dict[str, RobotFamily] = {
     "urdf": RobotFamily(
         "urdf",
         "plannerlab.robots.urdf.schema:TABLE",
+        ik_descent="plannerlab.collision.chain_ik:descent_for",
         summary="any serial chain read from a URDF (yourdfpy), with its collision spheres",
     ),
 }
@@ -136,6 +143,13 @@ def model_builder(kind: str) -> Any:
     return _target(DEFAULT_MODEL if entry is None else entry.model)
 
 
+def ik_descent(kind: str) -> Any:
+    """The family's compiled IK descent factory (see :attr:`RobotFamily.ik_descent`), or
+    None (also for a kind that is not registered)."""
+    entry = FAMILIES.get(kind)
+    return None if entry is None or entry.ik_descent is None else _target(entry.ik_descent)
+
+
 def gravity_off_reason(kind: str) -> str | None:
     """Why the family's problems default to no gravity (None: they do not)."""
     entry = FAMILIES.get(kind)
@@ -149,6 +163,7 @@ __all__ = [
     "family",
     "goal_sampler",
     "gravity_off_reason",
+    "ik_descent",
     "model_builder",
     "reach_function",
     "robot_table",
