@@ -146,9 +146,9 @@ def segments(Q, m, out):
     (parent, prism, body_cl, cl_start, _, _, issph) = V[0][:7]
     (T0, pre, cap_a, cap_b) = V[1][:4]
     cl_c = V[1][9]
-    Bf, _, Kw, X, Y, _, _ = S
+    Bf, _, Kw, X, Y, v, _ = S
     for s in range(Q.shape[0]):
-        _body_frames(Q[s], T0, parent, prism, pre, Bf, V[2])
+        _body_frames(Q[s], T0, parent, prism, pre, Bf, V[2], v)
         for b in range(Bf.shape[0]):
             _place_body(Bf, cap_a, cap_b, issph, body_cl, cl_start, cl_c, b, X, Y, Kw)
         for k in range(X.shape[0]):
