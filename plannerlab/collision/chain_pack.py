@@ -17,11 +17,12 @@ from plannerlab.collision.geometry import BOX, SPHERE
 _H_DOF, _H_NB, _H_L, _H_NOBS, _H_NCL, _H_NCPL = range(6)  # _H_DOF: the chain's joints
 _I_SECTIONS = (
     *("parent", "prism", "body_cl", "cl_start", "order", "kind", "issph", "moving"),
-    *("allowed", "any_cl", "groups", "cpl_start", "cpl_idx"),
+    *("allowed", "any_cl", "groups", "cpl_start", "cpl_idx", "cgroups"),
 )
 _H_I = 6
 _HEADER = _H_I + len(_I_SECTIONS) + 1  # + 1: the end of the last section
 _CLUSTER = 6  # capsules per cluster at most
+_CHUNK = 4  # consecutive bodies per chunk (the self-check's first cull)
 
 
 _BOUND_PAD_M = 1e-9  # grows every bounding ball beyond rounding: a ball clear is clear
@@ -142,9 +143,19 @@ def _pack(
     for i, j in zip(*np.nonzero(al), strict=True):
         any_cl[cl_of[i], cl_of[j]] = 1
     cl_body = np.repeat(np.arange(nb), np.diff(body_cl))
+    # the body pairs holding a checked pair, by chunk pair (chunks of _CHUNK consecutive
+    # bodies: a pair of chunks whose balls are apart skips all its body pairs at once)
     groups = sorted(
-        {(int(cl_body[u]), int(cl_body[v])) for u, v in zip(*np.nonzero(any_cl), strict=True)}
+        {(int(cl_body[u]), int(cl_body[v])) for u, v in zip(*np.nonzero(any_cl), strict=True)},
+        key=lambda g: (g[0] // _CHUNK, g[1] // _CHUNK, g[0], g[1]),
     )
+    cgroups: list[int] = []  # rows (chunk u, chunk v, first group, end)
+    for k, (bu, bv) in enumerate(groups):
+        cu, cv = bu // _CHUNK, bv // _CHUNK
+        if cgroups and cgroups[-4] == cu and cgroups[-3] == cv:
+            cgroups[-1] = k + 1
+        else:
+            cgroups.extend((cu, cv, k, k + 1))
     body_order = np.arange(nb)[::-1] if order is None else np.asarray(order)
     # world boxes around the obstacles (a first, cheaper cull), grown beyond rounding
     Rs, cs, hs = (np.asarray(a, dtype=float) for a in (Rs, cs, hs))
@@ -171,6 +182,7 @@ def _pack(
         np.asarray(groups).reshape(-1, 2),
         np.asarray(cpl_start, dtype=np.int64),
         np.asarray(cpl_idx, dtype=np.int64),
+        np.asarray(cgroups, dtype=np.int64),
     ]
     head = np.zeros(_HEADER, dtype=np.int64)
     head[:_H_I] = (dof, nb, len(body), len(kinds), ncl, len(cpl_val))

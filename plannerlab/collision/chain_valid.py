@@ -33,6 +33,8 @@ import numpy as np
 from numba import njit
 
 from plannerlab.collision.chain_pack import (  # the packing, and its layout
+    _BOUND_PAD_M,
+    _CHUNK,
     _H_DOF,
     _H_I,
     _H_L,
@@ -204,6 +206,7 @@ def _unpack(P, M, idat):
         _iv(idat, 8),
         _iv(idat, 9),
         _iv(idat, 10),
+        _iv(idat, 13),
     )
     o = 3 * L + 2 * nb + 2 * ncl  # the obstacles' rows of P
     e = o + 4 * n  # the coupling's coefficients, three a row, after the obstacles
@@ -321,7 +324,8 @@ def _state_ok(q, V, S):
     holding a checked pair: the bodies' balls, then per pair of clusters holding one their
     balls, then the pairs. A body's capsules are placed only when one of its balls is not
     clear; the first hit ends the test."""
-    (parent, prism, body_cl, cl_start, order, kinds, issph, moving, allowed, any_cl, groups) = V[0]
+    (parent, prism, body_cl, cl_start, order, kinds, issph, moving, allowed, any_cl) = V[0][:10]
+    groups, cgroups = V[0][10], V[0][11]
     (T0, pre, cap_a, cap_b, rad, rads, bc, br, brs, cl_c, cl_r, cl_rs, Rs, cs, hs) = V[1][:15]
     olo, ohi = V[1][15], V[1][16]
     Bf, Cw, Kw, X, Y, done, w = S
@@ -366,29 +370,56 @@ def _state_ok(q, V, S):
                     return False
     ncl = Kw.shape[0]
     L = X.shape[0]
-    for g in range(groups.shape[0] // 2):
-        bu, bv = groups[2 * g], groups[2 * g + 1]
-        if bu != bv and _apart(Cw, bu, Cw, bv, brs[bu] + brs[bv]):
-            continue
-        for b in (bu, bv):
-            if done[b] == 0.0:
-                _place_body(Bf, cap_a, cap_b, issph, body_cl, cl_start, cl_c, b, X, Y, Kw)
-                done[b] = 1.0
-        for Ku in range(body_cl[bu], body_cl[bu + 1]):
-            if bu != bv and _apart(Kw, Ku, Cw, bv, cl_rs[Ku] + brs[bv]):
+    # balls around chunks of _CHUNK consecutive bodies (around their body balls), rows
+    # (x, y, z, r) after the capsule tests' scratch
+    cb = w[_SCRATCH:]
+    if cgroups.shape[0] > 0:
+        for c in range((nb + _CHUNK - 1) // _CHUNK):
+            b0, b1 = c * _CHUNK, min(nb, (c + 1) * _CHUNK)
+            x, y, z = 0.0, 0.0, 0.0
+            for b in range(b0, b1):
+                x += Cw[b, 0]
+                y += Cw[b, 1]
+                z += Cw[b, 2]
+            k = 1.0 / (b1 - b0)
+            x, y, z = x * k, y * k, z * k
+            r = 0.0
+            for b in range(b0, b1):
+                dx, dy, dz = Cw[b, 0] - x, Cw[b, 1] - y, Cw[b, 2] - z
+                r = max(r, math.sqrt(dx * dx + dy * dy + dz * dz) + brs[b])
+            cb[4 * c], cb[4 * c + 1], cb[4 * c + 2], cb[4 * c + 3] = x, y, z, r + _BOUND_PAD_M
+    for t in range(cgroups.shape[0] // 4):
+        cu, cv = cgroups[4 * t], cgroups[4 * t + 1]
+        if cu != cv:
+            dx = cb[4 * cu] - cb[4 * cv]
+            dy = cb[4 * cu + 1] - cb[4 * cv + 1]
+            dz = cb[4 * cu + 2] - cb[4 * cv + 2]
+            rr = cb[4 * cu + 3] + cb[4 * cv + 3]
+            if dx * dx + dy * dy + dz * dz > rr * rr:
+                continue  # the chunks' balls are apart: none of their body pairs touch
+        for g in range(cgroups[4 * t + 2], cgroups[4 * t + 3]):
+            bu, bv = groups[2 * g], groups[2 * g + 1]
+            if bu != bv and _apart(Cw, bu, Cw, bv, brs[bu] + brs[bv]):
                 continue
-            for Kv in range(Ku if bu == bv else body_cl[bv], body_cl[bv + 1]):
-                if any_cl[Ku * ncl + Kv] == 0:
+            for b in (bu, bv):
+                if done[b] == 0.0:
+                    _place_body(Bf, cap_a, cap_b, issph, body_cl, cl_start, cl_c, b, X, Y, Kw)
+                    done[b] = 1.0
+            for Ku in range(body_cl[bu], body_cl[bu + 1]):
+                if bu != bv and _apart(Kw, Ku, Cw, bv, cl_rs[Ku] + brs[bv]):
                     continue
-                if Ku != Kv and _apart(Kw, Ku, Kw, Kv, cl_rs[Ku] + cl_rs[Kv]):
-                    continue
-                for i in range(cl_start[Ku], cl_start[Ku + 1]):
-                    if Ku != Kv and issph[i] and _apart(X, i, Kw, Kv, rads[i] + cl_rs[Kv]):
+                for Kv in range(Ku if bu == bv else body_cl[bv], body_cl[bv + 1]):
+                    if any_cl[Ku * ncl + Kv] == 0:
                         continue
-                    j0 = i + 1 if Ku == Kv else cl_start[Kv]
-                    for j in range(j0, cl_start[Kv + 1]):
-                        if allowed[i * L + j] and _pair_hit(i, j, issph, rads, X, Y):
-                            return False
+                    if Ku != Kv and _apart(Kw, Ku, Kw, Kv, cl_rs[Ku] + cl_rs[Kv]):
+                        continue
+                    for i in range(cl_start[Ku], cl_start[Ku + 1]):
+                        if Ku != Kv and issph[i] and _apart(X, i, Kw, Kv, rads[i] + cl_rs[Kv]):
+                            continue
+                        j0 = i + 1 if Ku == Kv else cl_start[Kv]
+                        for j in range(j0, cl_start[Kv + 1]):
+                            if allowed[i * L + j] and _pair_hit(i, j, issph, rads, X, Y):
+                                return False
     return True
 
 
@@ -396,11 +427,11 @@ def _state_ok(q, V, S):
 def _scratch(idat):
     """Per-call scratch of :func:`_state_ok`: (body frames, body ball centres, cluster ball
     centres, capsule ends a and b, placed flags (nb: also the coupled joint values while
-    the frames are made), capsule-test scratch)."""
+    the frames are made), capsule-test scratch (then the chunk balls))."""
     nb, L, ncl = idat[_H_NB], idat[_H_L], idat[_H_NCL]
     Bf = np.empty((nb, 3, 4))
     W = np.empty((nb + ncl + 2 * L, 3))
-    aux = np.zeros(nb + _SCRATCH)
+    aux = np.zeros(nb + _SCRATCH + 4 * ((nb + _CHUNK - 1) // _CHUNK))
     return (
         Bf,
         W[:nb],
