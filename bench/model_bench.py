@@ -15,6 +15,9 @@ roads interleaved in each repetition so that other load counts alike):
 * ``core road, batched`` / ``one state``: ``CollisionChecker.valid_batch`` /
   ``is_valid`` (the checker every planner uses: Arm-Z on its own compiled kinematics,
   URDF chains on the fused chain check);
+* ``numpy kinematics + core kernels``: the robot's own ``link_segments`` and the core's
+  generic kernels, the road IRb-6 and the continuum chain took before they gave their
+  chain (``--all`` adds them);
 * ``FCL, batched`` / ``one state``: the independent reference (fewer states: it is slow).
 
 The ratio column is the model's batched figure over each row's. ``--ik`` adds the compiled
@@ -34,6 +37,7 @@ from numba import njit
 
 from plannerlab.collision.chain_valid import chain_state_valid
 from plannerlab.collision.fcl_checker import CollisionChecker, problem_checker
+from plannerlab.collision.kernels import valid_batch
 from plannerlab.collision.model import state_ok, valid_states, views
 from plannerlab.problem.catalog import load_problem
 from plannerlab.problem.load import parse_problem
@@ -76,6 +80,7 @@ def _bench(name: str, problem: Any, n_states: int, repeats: int) -> None:
     assert np.array_equal(v_model, checker.valid_batch(Q)), "model and core differ"
     differ = int(np.sum(v_model[: len(Qf)] != v_fcl))
     args = (m.P, m.M, m.idat)
+    geo = checker._core._geo  # the core's arrays for its generic kernels
     roads: dict[str, tuple[Callable[[], Any], int]] = {
         "model, batched": (lambda: valid_states(Q, m, out), n_states),
         "model, one state in compiled code": (lambda: _one_by_one(Q, m), n_states),
@@ -84,6 +89,12 @@ def _bench(name: str, problem: Any, n_states: int, repeats: int) -> None:
             n_states,
         ),
         "core road, batched": (lambda: checker.valid_batch(Q), n_states),
+        "numpy kinematics + core kernels, batched": (
+            lambda: valid_batch(
+                np.ascontiguousarray(robot.link_segments(Q)), *geo, np.empty(n_states, bool)
+            ),
+            n_states,
+        ),
         "core road, one state": (lambda: [checker.is_valid(q) for q in Q], n_states),
         "FCL, batched": (lambda: fcl.valid_batch(Qf), len(Qf)),
         "FCL, one state": (lambda: [fcl.is_valid(q) for q in Qf], len(Qf)),
@@ -98,9 +109,9 @@ def _bench(name: str, problem: Any, n_states: int, repeats: int) -> None:
         f"states, {v_model.mean():.3f} valid; {differ} of {len(Qf)} verdicts differ from FCL"
     )
     base = min(times["model, batched"])
-    print(f"  {'road':38s} {'min us':>9s} {'median':>9s} {'model/road':>11s}")
+    print(f"  {'road':42s} {'min us':>9s} {'median':>9s} {'model/road':>11s}")
     for k, t in times.items():
-        print(f"  {k:38s} {min(t):9.3f} {float(np.median(t)):9.3f} {base / min(t):11.3f}")
+        print(f"  {k:42s} {min(t):9.3f} {float(np.median(t)):9.3f} {base / min(t):11.3f}")
 
 
 def _bench_ik(repeats: int) -> None:
@@ -138,11 +149,15 @@ def main() -> None:
     ap.add_argument("--states", type=int, default=4000)
     ap.add_argument("--repeats", type=int, default=7)
     ap.add_argument("--ik", action="store_true", help="also the Panda's goal-state IK")
+    ap.add_argument("--all", action="store_true", help="also irb6_case1, continuum_case1")
     a = ap.parse_args()
     print(f"load average at start: {os.getloadavg()}")
     panda = parse_problem(PANDA)
     _bench("Panda, MotionBenchMaker bookshelf_small_0001", panda, a.states, a.repeats)
     _bench("Arm-Z, armz_inspection", load_problem("armz_inspection"), a.states, a.repeats)
+    if a.all:
+        for name in ("irb6_case1", "continuum_case1"):
+            _bench(name, load_problem(name), a.states, a.repeats)
     if a.ik:
         _bench_ik(20)
     print(f"\nload average at end: {os.getloadavg()}")
