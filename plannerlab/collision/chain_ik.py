@@ -279,7 +279,8 @@ def ik_arrays(robot: Any) -> tuple[Any, ...]:
 
 
 class ChainDescent:
-    """The compiled descent of one robot (its arrays made once), called as
+    """The compiled descent of one robot (its arrays made once; the kernel compiled or
+    loaded from numba's cache when this is built, not inside a search), called as
     ``descent(goal, q_seed, max_iterations, damping, max_step_rad, target_fraction)`` ->
     (q (dof,), steps) for a :class:`~plannerlab.problem.goals.GoalRegion` ``goal``: the
     signature :func:`plannerlab.problem.ik.solve_ik` runs a family's descent with."""
@@ -293,6 +294,20 @@ class ChainDescent:
             f(robot.upper, dtype=np.float64),
             f(robot.continuous, dtype=np.bool_),
         )
+        kernel: Any = descend_kernel  # a numba dispatcher
+        if not kernel.signatures:  # compile (first run on the machine) or load it here
+            q = np.clip(np.zeros(self.dof), robot.lower, robot.upper)
+            kernel(
+                q,
+                *self._arrays,
+                *((np.zeros(3), np.ones(3) / 3**0.5, 1.0, 1.0)),
+                *self._bounds,
+                0,
+                0.05,
+                0.25,
+                0.3,
+                np.empty(self.dof),
+            )
 
     def __call__(
         self,
