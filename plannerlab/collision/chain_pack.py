@@ -88,9 +88,9 @@ def _pack(
     if coupling is not None:
         cpl_start.append(0)
         for i in range(dof):
-            for k in np.flatnonzero(coupling[i]):
-                cpl_idx.append(int(k))
-                cpl_val.append(float(coupling[i, k]))
+            for col in np.flatnonzero(coupling[i]):
+                cpl_idx.append(int(col))
+                cpl_val.append(float(coupling[i, col]))
             cpl_start.append(len(cpl_idx))
     nb = dof + 1
     A = [np.eye(3)] + [_align(axes[i]) for i in range(dof)]
@@ -150,12 +150,12 @@ def _pack(
         key=lambda g: (g[0] // _CHUNK, g[1] // _CHUNK, g[0], g[1]),
     )
     cgroups: list[int] = []  # rows (chunk u, chunk v, first group, end)
-    for k, (bu, bv) in enumerate(groups):
+    for gi, (bu, bv) in enumerate(groups):
         cu, cv = bu // _CHUNK, bv // _CHUNK
         if cgroups and cgroups[-4] == cu and cgroups[-3] == cv:
-            cgroups[-1] = k + 1
+            cgroups[-1] = gi + 1
         else:
-            cgroups.extend((cu, cv, k, k + 1))
+            cgroups.extend((cu, cv, gi, gi + 1))
     body_order = np.arange(nb)[::-1] if order is None else np.asarray(order)
     # world boxes around the obstacles (a first, cheaper cull), grown beyond rounding
     Rs, cs, hs = (np.asarray(a, dtype=float) for a in (Rs, cs, hs))
