@@ -12,18 +12,9 @@ from plannerlab.cli.tables import table
 
 
 def cmd_planners(args: argparse.Namespace, console: Console) -> int:
-    from plannerlab.planners import REGISTRY
+    import plannerlab as pl
 
-    rows: list[dict[str, Any]] = [
-        {
-            "name": e.name,
-            "summary": e.summary,
-            "needs_simulator": e.needs_stepper,
-            "uses_rng": e.uses_rng,
-            "robots": list(e.robots) if e.robots else "any",
-        }
-        for e in REGISTRY.values()
-    ]
+    rows = pl.planner_catalog()
     if args.json:
         print(json.dumps(rows, indent=1))
         return 0
