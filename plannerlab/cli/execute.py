@@ -13,7 +13,7 @@ from rich.table import Table
 
 from plannerlab.cli.common import require_display
 from plannerlab.cli.solve import add_plan_arguments, leg_table, solve_and_save
-from plannerlab.cli.tables import natural_width, table
+from plannerlab.cli.tables import Kind, natural_width, table
 from plannerlab.errors import PlanFileError, PlannerlabError
 from plannerlab.record.cells import fmt
 from plannerlab.record.codec import dumps
@@ -56,6 +56,7 @@ def execution_table(legs: Any, executions: Any, why: bool = True) -> Table:
     the joint tracking error, informational since the verdict is in metres, and the
     trajectory's duration are in ``--json``; which pairs collided or touched goes in the
     caption (names never cut)."""
+    why_column: list[tuple[str, Kind]] = [("why not", "text")] if why else []
     t = table(
         "execution in PyBullet",
         [
@@ -69,7 +70,7 @@ def execution_table(legs: Any, executions: Any, why: bool = True) -> Table:
             ("con-\ntacts", "num"),
             ("wall s", "num"),
             ("ok", "name"),
-            *([("why not", "text")] if why else []),
+            *why_column,
         ],
         compact=True,
     )
