@@ -16,6 +16,15 @@ The data flow is one way: problem file → :func:`load_problem` → planner
 :func:`execute` (:class:`Execution`) → table (:func:`compare`, :func:`summarise`,
 :func:`markdown_report`); figures with :func:`snapshot_figure` and :func:`trace_figure`,
 animations with :func:`animate_plan`.
+
+The command line is this API's first client (``plannerlab/cli/`` imports nothing else of
+the package but its records), so whatever a command does is here too: plan files
+(:func:`read_checked_plan`, :func:`execute_results`, :func:`plot_plan`), the catalogues
+(:func:`problem_catalog`, :func:`planner_catalog`, :func:`planner_info`), comparisons
+(:class:`ComparisonSpec`, :func:`run_spec`, :class:`TrialStore`, :func:`write_reports`),
+the continuum paper's cases (:func:`run_continuum_case`), room variants
+(:func:`generate_variants`), the IRb-6's analytic IK (:func:`irb6_ik`) and
+MotionBenchMaker's importer (``pl.mbm``).
 """
 
 from __future__ import annotations
