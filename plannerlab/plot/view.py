@@ -273,13 +273,16 @@ class Viewer:
         legend = [f"<span style='color:{hex_colour(PLANNED_RGB)}'>&#9632;</span> {planned}"]
         if executed:
             legend.append(
+                f"<span style='color:{hex_colour(CONTACT_RGB)}'>&#9679;</span> contact "
+                "(where the execution recorded one)"
+            )
+            legend.append(
                 f"<span style='color:{hex_colour(EXECUTED_RGB)}'>&#9632;</span> "
                 "executed in PyBullet"
             )
         legend += [
             f"<span style='color:{hex_colour(GOAL_RGB)}'>&#9632;</span> goal: ball = position "
             "tolerance, cone = normal's angle tolerance",
-            f"<span style='color:{hex_colour(CONTACT_RGB)}'>&#9679;</span> contact (execution)",
             f"nearest link: red touching &rarr; green &ge; {CLEAR_AT_M * 1000:.0f} mm clearance",
         ]
         s.gui.add_html("<div style='font-size:0.8em'>" + "<br>".join(legend) + "</div>")
