@@ -130,21 +130,25 @@ def view(
     """
     from pathlib import Path
 
+    from plannerlab.errors import PlanFileError
     from plannerlab.plot.view import serve
     from plannerlab.record.plan import ExecutionFile, execution_path
     from plannerlab.run.clearance import link_clearance
-    from plannerlab.run.plan_check import check_plan, read_checked_plan
+    from plannerlab.run.plan_check import check_plan, read_plan
 
     executions: Any = ()
     if isinstance(plan, str | Path):
         plan_file = Path(plan)
+        plan = read_plan(plan_file)
         if problem is None:
-            plan, problem = read_checked_plan(plan_file)
-        else:
-            from plannerlab.run.plan_check import read_plan
-
-            plan = read_plan(plan_file)
-            check_plan(plan, problem, plan_file)
+            if not Path(plan.problem_file).is_file():
+                raise PlanFileError(
+                    f"{plan_file}: [problem_file] names {plan.problem_file}, which no longer "
+                    "exists: restore it (the plan is drawn in its problem's scene), or give "
+                    "the problem (plannerlab.view(plan, problem=...))"
+                )
+            problem = plan.load_problem()
+        check_plan(plan, problem, plan_file)
         beside = execution_path(plan_file)
         if execution is None and beside.is_file():
             execution = beside

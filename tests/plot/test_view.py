@@ -136,4 +136,4 @@ def test_a_plan_whose_problem_file_is_gone_is_an_error(tmp_path, capsys):
     rc = main(["view", str(plan_file), "--port", "0", "--no-browser"])
     assert rc == 2
     err = capsys.readouterr().err
-    assert "pocket_copy.toml" in err
+    assert "pocket_copy.toml" in err and "no longer exists" in err
