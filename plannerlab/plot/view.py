@@ -227,7 +227,8 @@ class Viewer:
                     position=T[:3, 3],
                     wxyz=matrix_to_wxyz(T[:3, :3]),
                 )
-                color = (*(c / 255 for c in rgb), 1.0 if opacity is None else opacity)
+                alpha = 1.0 if opacity is None else opacity
+                color = (rgb[0] / 255, rgb[1] / 255, rgb[2] / 255, alpha)
                 nodes["urdf"] = ViserUrdf(
                     s, model, root_node_name=f"/{kind}/meshes", mesh_color_override=color
                 )
@@ -404,9 +405,9 @@ class Viewer:
             if self.slider.max != max(m.frames - 1, 1):
                 self.slider.max = max(m.frames - 1, 1)
             if self.leg_dropdown.value != _leg_label(m):
-                self.leg_dropdown.value = _leg_label(m)
+                self.leg_dropdown.value = _leg_label(m)  # type: ignore[misc]
             if self.slider.value != 0:
-                self.slider.value = 0  # calls _show_frame
+                self.slider.value = 0  # type: ignore[misc]  # calls _show_frame
             else:
                 self._show_frame(0)
             self._apply_visibility()
@@ -480,7 +481,7 @@ class Viewer:
                 k = int(self.slider.value)
                 m = self.legs[self._leg]
                 if k + 1 < m.frames:
-                    self.slider.value = k + 1
+                    self.slider.value = k + 1  # type: ignore[misc]
                 elif self._leg + 1 < len(self.legs):
                     self._show_leg(self._leg + 1)
                 else:

@@ -194,7 +194,7 @@ def capsule_batch(segments: Array, radii_m: Array) -> CapsuleBatch:
     )
 
 
-def obstacle_mesh(o: Any) -> tuple[Array, Array]:
+def obstacle_mesh(o: Any) -> tuple[Array, np.ndarray]:
     """An obstacle's surface as triangles in the world: vertices (V, 3) [m], faces (F, 3).
 
     Boxes, cylinders and spheres are made exactly (cylinders and spheres finely
@@ -230,7 +230,7 @@ def obstacle_mesh(o: Any) -> tuple[Array, Array]:
 
 def cone_mesh(
     apex: Array, axis: Array, half_angle_deg: float, length_m: float
-) -> tuple[Array, Array]:
+) -> tuple[Array, np.ndarray]:
     """An open cone (the tip normals a goal accepts): apex, unit axis, half angle, slant
     height. Vertices (V, 3) [m] and faces (F, 3)."""
     import trimesh
@@ -362,7 +362,7 @@ def motion_span(problem: Problem, legs: Sequence[LegMotion]) -> float:
     pts = [m.tips_planned for m in legs] + [np.array([g.p_world_m for g in problem.goals])]
     pts += [np.asarray(problem.robot.link_segments(legs[0].q_planned[0])).reshape(-1, 3)]
     p = np.concatenate(pts)
-    return float(max(np.linalg.norm(p.max(axis=0) - p.min(axis=0)), 0.1))
+    return max(float(np.linalg.norm(p.max(axis=0) - p.min(axis=0))), 0.1)
 
 
 def unit_cylinder() -> tuple[Array, Array]:
@@ -386,7 +386,7 @@ def camera_pose(problem: Problem, legs: Sequence[LegMotion]) -> tuple[Array, Arr
     p = np.concatenate(pts)
     lo, hi = p.min(axis=0), p.max(axis=0)
     centre = (lo + hi) / 2.0
-    span = float(max(np.linalg.norm(hi - lo), 0.2))
+    span = max(float(np.linalg.norm(hi - lo)), 0.2)
     return centre + span * np.array([0.8, -1.0, 0.6]), centre
 
 

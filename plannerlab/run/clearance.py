@@ -30,7 +30,7 @@ def link_clearance(problem: Problem) -> Callable[[Array], tuple[Array, Sequence[
         d_m = np.full(n_links, np.inf)
         other = [""] * n_links
         if len(links):
-            d = checker.fcl_pair_distances(np.asarray(q, dtype=float), links, others, is_link)
+            d = checker.fcl_pair_distances(np.asarray(q, dtype=float), links, others, is_link)  # type: ignore[arg-type]
             d = d.reshape(len(moving), len(names))
             j = np.argmin(d, axis=1)
             d_m[moving] = d[np.arange(len(moving)), j]
