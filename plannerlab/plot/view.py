@@ -274,12 +274,12 @@ class Viewer:
         legend = [f"<span style='color:{hex_colour(PLANNED_RGB)}'>&#9632;</span> {planned}"]
         if executed:
             legend.append(
-                f"<span style='color:{hex_colour(CONTACT_RGB)}'>&#9679;</span> contact "
-                "(where the execution recorded one)"
-            )
-            legend.append(
                 f"<span style='color:{hex_colour(EXECUTED_RGB)}'>&#9632;</span> "
                 "executed in PyBullet"
+            )
+            legend.append(
+                f"<span style='color:{hex_colour(CONTACT_RGB)}'>&#9679;</span> contact "
+                "(where the execution recorded one)"
             )
         legend += [
             f"<span style='color:{hex_colour(GOAL_RGB)}'>&#9632;</span> goal: ball = position "

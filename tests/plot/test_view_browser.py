@@ -2,10 +2,11 @@
 ``chromium-driver``, which ``.ci/run`` installs) driven by selenium loads the page, and
 the tests look at what it drew.
 
-What they assert: the server lists the scene nodes it sends (robot, scene, goals, traces)
-and reports the browser that connected; the screenshot's 3-D area is not blank (the
-robot's blue is there); moving the timeline (from the browser's slider, and from the
-server's slider handle) changes the picture; Ctrl-C ends the command with exit code 0
+What they assert: the server lists the scene nodes it sends (planned and executed robot,
+scene, goals, traces) and reports the browser that connected; the screenshot's 3-D area
+is not blank (the executed robot's orange and the plan's blue are there); moving the
+timeline (from the browser's slider, and from the server's slider handle) changes the
+picture; Ctrl-C ends the command with exit code 0
 and no traceback. Every wait is bounded; no assertion depends on how fast the machine is.
 """
 
@@ -55,6 +56,19 @@ def plan_file(tmp_path_factory) -> Path:
     return plan.save(tmp_path_factory.mktemp("view") / "pocket.json")
 
 
+@pytest.fixture(scope="module")
+def executed_plan_file(plan_file, tmp_path_factory) -> Path:
+    """The same plan executed in PyBullet, ``PLAN.exec.json`` beside it."""
+    from plannerlab.record.files import versions
+    from plannerlab.record.plan import ExecutionFile, execution_path
+
+    plan = pl.Plan.load(plan_file)
+    path = plan.save(tmp_path_factory.mktemp("view_exec") / "pocket.json")
+    executions = pl.execute(plan, plan.load_problem())
+    ExecutionFile.of(plan, path, executions, versions()).save(execution_path(path))
+    return path
+
+
 @pytest.fixture
 def browser(tmp_path):
     from selenium import webdriver
@@ -97,6 +111,12 @@ def blue_pixels(img: np.ndarray) -> int:
     return int(np.sum((v[..., 2] > v[..., 0] + 60) & (v[..., 2] > 90)))
 
 
+def orange_pixels(img: np.ndarray) -> int:
+    """Pixels of the 3-D area in the executed robot's orange (red well above blue)."""
+    v = img[VIEW_BOX].astype(int)
+    return int(np.sum((v[..., 0] > v[..., 2] + 80) & (v[..., 1] > 60)))
+
+
 def wait_for_picture(driver, ok, timeout_s: float, what: str) -> np.ndarray:
     """Screenshots every half second until ``ok(picture)`` (at most ``timeout_s``)."""
     end = time.monotonic() + timeout_s
@@ -119,7 +139,9 @@ def _lines(stream, out: queue.Queue) -> None:
         out.put(line)
 
 
-def test_the_command_serves_a_page_chromium_draws_and_ctrl_c_ends_it(plan_file, browser, tmp_path):
+def test_the_command_serves_a_page_chromium_draws_and_ctrl_c_ends_it(
+    executed_plan_file, browser, tmp_path
+):
     import json
 
     from selenium.webdriver.common.by import By
@@ -127,7 +149,7 @@ def test_the_command_serves_a_page_chromium_draws_and_ctrl_c_ends_it(plan_file, 
 
     env = {**os.environ, "PYTHONPATH": str(ROOT)}
     proc = subprocess.Popen(
-        [sys.executable, "-m", "plannerlab", "view", str(plan_file), "--port", "0"]
+        [sys.executable, "-m", "plannerlab", "view", str(executed_plan_file), "--port", "0"]
         + ["--no-browser", "--json"],
         stdout=subprocess.PIPE,
         stderr=subprocess.PIPE,
@@ -140,16 +162,27 @@ def test_the_command_serves_a_page_chromium_draws_and_ctrl_c_ends_it(plan_file, 
         serving = json.loads(events.get(timeout=120))
         assert serving["event"] == "serving"
         nodes = serving["scene_nodes"]
-        for node in ("/planned/links", "/planned/joints", "/scene/boulder", "/goals/0/ball"):
+        for node in (
+            "/planned/links",
+            "/planned/joints",
+            "/executed/links",
+            "/traces/executed",
+            "/scene/boulder",
+            "/goals/0/ball",
+        ):
             assert node in nodes
-        assert serving["legs"] == 1 and serving["executed_legs"] == 0
+        assert serving["legs"] == 1 and serving["executed_legs"] == 1
 
         browser.get(serving["url"])
         connected = json.loads(events.get(timeout=60))
         assert connected == {"event": "clients", "clients": 1, "scene_nodes": len(nodes)}
 
+        # PyBullet's robot solid orange, the plan's blue wireframe over it
         first = wait_for_picture(
-            browser, lambda img: blue_pixels(img) > 300, 90, "the robot drawn in blue"
+            browser,
+            lambda img: orange_pixels(img) > 300 and blue_pixels(img) > 30,
+            90,
+            "the executed robot in orange and the planned one in blue",
         )
         (tmp_path / "start.png").write_bytes(browser.get_screenshot_as_png())
         # the timeline to its end, from the page: the slider's thumb and the End key
@@ -162,7 +195,7 @@ def test_the_command_serves_a_page_chromium_draws_and_ctrl_c_ends_it(plan_file, 
             "the picture to change after the slider moved",
         )
         (tmp_path / "end.png").write_bytes(browser.get_screenshot_as_png())
-        assert blue_pixels(last) > 300
+        assert orange_pixels(last) > 300
     finally:
         proc.send_signal(signal.SIGINT)
         try:
