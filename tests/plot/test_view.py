@@ -12,7 +12,10 @@ import pytest
 import plannerlab as pl
 from plannerlab.cli.main import main
 from plannerlab.plot.view_scene import (
+    EXECUTED_RGB,
+    PLANNED_RGB,
     capsule_batch,
+    clearance_rgb,
     cone_mesh,
     leg_motions,
     obstacle_mesh,
@@ -137,3 +140,53 @@ def test_a_plan_whose_problem_file_is_gone_is_an_error(tmp_path, capsys):
     assert rc == 2
     err = capsys.readouterr().err
     assert "pocket_copy.toml" in err and "no longer exists" in err
+
+
+def test_the_leg_selector_switches_the_timeline():
+    problem = pl.load_problem("armz_inspection")
+    q0 = np.asarray(problem.q_start, dtype=float)
+    q1 = np.where(q0 + 0.1 <= problem.robot.upper, q0 + 0.1, q0 - 0.1)
+    legs = (
+        pl.PlanResult("test", problem.name, 0, problem.goals[0].name, "approximate", "", [q0, q1]),
+        pl.PlanResult("test", problem.name, 1, problem.goals[1].name, "approximate", "", [q1, q0]),
+    )
+    plan = pl.Plan(problem.name, problem.source, "test", 0, {}, legs)
+    with pl.view(plan, problem=problem, port=0, max_frames=7) as viewer:
+        assert len(viewer.leg_dropdown.options) == 2
+        viewer.slider.value = 3
+        viewer.leg_dropdown.value = viewer.leg_dropdown.options[1]
+        assert viewer.slider.value == 0  # a new leg starts at its first frame
+        assert viewer.slider.max == viewer.legs[1].frames - 1
+        assert f"leg 1 '{problem.goals[1].name}'" in viewer.info.content
+        # the goal of the selected leg stands out
+        assert viewer._nodes["/goals/1/ball"].opacity > viewer._nodes["/goals/0/ball"].opacity
+
+
+def test_the_nearest_link_is_coloured_and_contacts_are_marked():
+    import dataclasses
+
+    from plannerlab.record.execution import ContactRecord
+
+    problem = pl.load_problem("armz_pocket")
+    plan = _still_plan(problem, 0.05)
+    (e,) = pl.execute(plan, problem)
+    hit = ContactRecord("module_23", "boulder", False, 0.02, 0.5, (3.0, -0.1, 16.0))
+    e = dataclasses.replace(e, contacts=(hit,))
+    with pl.view(plan, [e], problem=problem, port=0) as viewer:
+        assert {"/executed/links", "/traces/executed", "/contacts/0"} <= set(viewer.scene_nodes)
+        np.testing.assert_allclose(viewer._nodes["/contacts/0"].position, hit.p_world_m)
+        m = viewer.legs[0]
+        for kind, q, rgb in (
+            ("planned", m.q_planned[0], PLANNED_RGB),
+            ("executed", m.q_executed[0], EXECUTED_RGB),
+        ):
+            d, other = viewer.clearance(q)
+            j = int(np.argmin(d))
+            expected = np.tile(rgb, (len(d), 1))
+            expected[j] = clearance_rgb(float(d[j]))
+            # every link in its motion's colour but the one nearest the scene
+            colors = np.asarray(viewer._nodes[f"/{kind}/links"].batched_colors)
+            np.testing.assert_array_equal(colors, expected)
+            assert f"{kind}: nearest link {problem.robot.link_names[j]} to {other[j]}" in (
+                viewer.info.content
+            )
