@@ -42,6 +42,7 @@ from plannerlab.plot.view_scene import (
     CONTACT_RGB,
     EXECUTED_RGB,
     GOAL_RGB,
+    MIN_LINK_SPAN,
     MIN_MARK_M,
     PLANNED_OPACITY,
     PLANNED_RGB,
@@ -147,6 +148,8 @@ class Viewer:
         s = self.server
         robot = self.problem.robot
         s.scene.set_up_direction("+z")
+        # less of viser's ambient environment light: the colours stay saturated
+        s.scene.configure_environment_map("warehouse", environment_intensity=0.4)
         span = motion_span(self.problem, self.legs)
         cell = 10.0 ** math.floor(math.log10(span / 4.0))
         self._add(
@@ -160,12 +163,19 @@ class Viewer:
                 v,
                 f,
                 color=SCENE_RGB,
-                opacity=0.85,
+                opacity=0.6,  # a robot inside a guide or sleeve shows through
                 side="double",
             )
         self._draw_goals()
         # the robots: capsules always (the clearance colours live there), meshes on top
         radii = np.asarray(robot.link_radii_m, dtype=float)
+        thinnest = MIN_LINK_SPAN * span
+        if np.any(radii < thinnest):
+            self.notes.append(
+                f"links thinner than {thinnest * 1000:.1f} mm (radius) are drawn that thick "
+                f"to be seen (true radii from {radii.min() * 1000:.1f} mm)"
+            )
+        radii = np.maximum(radii, thinnest)
         self._radii = radii
         cyl = unit_cylinder()
         sph = unit_sphere()

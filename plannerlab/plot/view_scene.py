@@ -32,6 +32,8 @@ PLANNED_OPACITY = 0.45
 CLEAR_AT_M = 0.05
 #: a goal ball or contact marker is drawn at least this big, to be seen [m]
 MIN_MARK_M = 0.006
+#: a link is drawn at least this thick (radius), as a fraction of the motion's size
+MIN_LINK_SPAN = 0.006
 
 #: ``clearance(q)``: per link, the smallest signed distance to the scene [m] (inf for a
 #: link that is never checked) and the obstacle it is measured to
@@ -379,15 +381,44 @@ def unit_sphere() -> tuple[Array, Array]:
     return np.asarray(m.vertices, dtype=np.float32), np.asarray(m.faces, dtype=np.uint32)
 
 
+def _segment_hits_boxes(p0: Array, p1: Array, lo: Array, hi: Array) -> np.ndarray:
+    """Which axis-aligned boxes (n, 3) the segment p0-p1 passes through (slab test)."""
+    d = p1 - p0
+    with np.errstate(divide="ignore", invalid="ignore"):
+        t0 = (lo - p0) / d
+        t1 = (hi - p0) / d
+    t_near = np.nanmax(np.where(np.isfinite(t0), np.minimum(t0, t1), -np.inf), axis=1)
+    t_far = np.nanmin(np.where(np.isfinite(t1), np.maximum(t0, t1), np.inf), axis=1)
+    inside = np.all((p0 >= lo) & (p0 <= hi) | (d != 0), axis=1)  # parallel slabs
+    return inside & (t_near <= t_far) & (t_far >= 0.0) & (t_near <= 1.0)
+
+
 def camera_pose(problem: Problem, legs: Sequence[LegMotion]) -> tuple[Array, Array]:
-    """A camera position and look-at point [m] that frame the motion and the goals."""
+    """A camera position and look-at point [m] that frame the motion and the goals, from
+    the side (of eight, 35 degrees up) whose line of sight crosses the fewest obstacles
+    (those around the look-at point left out: every side crosses them)."""
     pts = [m.tips_planned for m in legs] + [np.array([g.p_world_m for g in problem.goals])]
     pts += [np.asarray(problem.robot.link_segments(legs[0].q_planned[0])).reshape(-1, 3)]
     p = np.concatenate(pts)
     lo, hi = p.min(axis=0), p.max(axis=0)
     centre = (lo + hi) / 2.0
     span = max(float(np.linalg.norm(hi - lo)), 0.2)
-    return centre + span * np.array([0.8, -1.0, 0.6]), centre
+    olo, ohi = problem.scene.aabbs()
+    keep = ~np.all((centre >= olo) & (centre <= ohi), axis=1)
+    olo, ohi = olo[keep], ohi[keep]
+    best, best_hits = None, None
+    for k in range(8):  # from the default side (-51 degrees) round
+        az = math.radians(-51.0 + 45.0 * k)
+        el = math.radians(35.0)
+        direction = np.array(
+            [math.cos(el) * math.cos(az), math.cos(el) * math.sin(az), math.sin(el)]
+        )
+        eye = centre + 1.45 * span * direction
+        hits = int(np.sum(_segment_hits_boxes(eye, centre, olo, ohi))) if len(olo) else 0
+        if best_hits is None or hits < best_hits:
+            best, best_hits = eye, hits
+    assert best is not None
+    return best, centre
 
 
 __all__ = [

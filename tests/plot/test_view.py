@@ -13,11 +13,13 @@ import plannerlab as pl
 from plannerlab.cli.main import main
 from plannerlab.plot.view_scene import (
     EXECUTED_RGB,
+    MIN_LINK_SPAN,
     PLANNED_RGB,
     capsule_batch,
     clearance_rgb,
     cone_mesh,
     leg_motions,
+    motion_span,
     obstacle_mesh,
     port_free,
     z_to_wxyz,
@@ -107,9 +109,13 @@ def test_a_viewer_draws_every_robot_family(name):
         L = len(problem.robot.link_radii_m)
         links = viewer._nodes["/planned/links"]
         assert links.batched_positions.shape == (L, 3)
-        np.testing.assert_allclose(
-            links.batched_scales[:, 0], problem.robot.link_radii_m, rtol=1e-6
+        # true radii; a link too thin to be seen drawn at MIN_LINK_SPAN of the motion's size
+        shown = np.maximum(
+            problem.robot.link_radii_m, MIN_LINK_SPAN * motion_span(problem, viewer.legs)
         )
+        np.testing.assert_allclose(links.batched_scales[:, 0], shown, rtol=1e-6)
+        thin = bool(np.any(shown > problem.robot.link_radii_m))
+        assert thin == any("drawn that thick" in n for n in viewer.notes)
         before = np.array(links.batched_positions)
         viewer.slider.value = viewer.legs[0].frames - 1
         assert not np.allclose(before, links.batched_positions)
