@@ -75,11 +75,12 @@ def add_parser(sub: Any) -> None:
     p = sub.add_parser(
         "view",
         help="interactive 3-D view of a plan and its execution in the browser",
-        description="Serve an interactive 3-D view of PLAN.json (viser): the scene, the robot "
-        "with its true capsules (or a URDF's meshes), the planned motion (translucent blue) "
-        "and, when PLAN.exec.json is beside it, PyBullet's motion (orange) on one timeline "
-        "with play/pause, tip traces, goal regions, a leg selector, the link nearest the "
-        "scene coloured by clearance, contacts where they happened. Runs until Ctrl-C.",
+        description="Serve an interactive 3-D view of PLAN.json (viser) until Ctrl-C:\n"
+        "the scene, the robot's true capsules (or a URDF's visual meshes), the planned\n"
+        "motion in blue and, when PLAN.exec.json is beside it, PyBullet's motion in orange\n"
+        "(the plan a wireframe over it) on one timeline with play/pause; tip traces, goal\n"
+        "regions (ball: position tolerance, cone: normal's angle tolerance), a leg selector,\n"
+        "the link nearest the scene coloured by its clearance, contacts where they happened.",
     )
     p.add_argument("plan", help="PLAN.json written by solve (PLAN.exec.json beside it is shown)")
     p.add_argument("--port", type=int, default=8080, help="port to serve on (0: any free port)")
