@@ -89,6 +89,41 @@ def motion_frames(
     return frames
 
 
+def capsule_collections(
+    panels: Sequence[tuple[Any, tuple[int, int] | None]], has_exec: bool
+) -> tuple[list[Any], list[Any]]:
+    """Per panel, the (empty) collections the planned and the executed links' capsules are
+    drawn in: lines as wide as the links in 3-D, the capsules' outlines in the 2-D views;
+    PyBullet's filled orange, the plan's blue outline on top (filled when there is no
+    execution)."""
+    caps_p, caps_e = [], []
+    for ax, dims in panels:
+        if dims is None:
+            cp: Any = Line3DCollection(
+                [], colors=[PLANNED], alpha=0.25 if has_exec else 0.6, capstyle="round", zorder=4
+            )
+            ce: Any = Line3DCollection(
+                [], colors=[EXECUTED], alpha=0.55, capstyle="round", zorder=3
+            )
+        else:
+            cp = PolyCollection(
+                [],
+                facecolors="none" if has_exec else PLANNED,
+                edgecolors=PLANNED,
+                linewidths=0.9,
+                alpha=0.9 if has_exec else 0.45,
+                zorder=5,
+            )
+            ce = PolyCollection(
+                [], facecolors=EXECUTED, edgecolors=EXECUTED, linewidths=0.5, alpha=0.45, zorder=4
+            )
+        ax.add_collection(cp)
+        ax.add_collection(ce)
+        caps_p.append(cp)
+        caps_e.append(ce)
+    return caps_p, caps_e
+
+
 def animation_figure(
     problem: Problem,
     frames: Sequence[Frame],
@@ -163,29 +198,7 @@ def animation_figure(
     # outline on top (filled when there is no execution), so both show where they agree
     radii = np.asarray(problem.robot.link_radii_m, dtype=float)
     has_exec = executed_all is not None
-    caps_p, caps_e = [], []
-    for ax, dims in panels:
-        if dims is None:
-            cp = Line3DCollection(
-                [], colors=[PLANNED], alpha=0.25 if has_exec else 0.6, capstyle="round", zorder=4
-            )
-            ce = Line3DCollection([], colors=[EXECUTED], alpha=0.55, capstyle="round", zorder=3)
-        else:
-            cp = PolyCollection(
-                [],
-                facecolors="none" if has_exec else PLANNED,
-                edgecolors=PLANNED,
-                linewidths=0.9,
-                alpha=0.9 if has_exec else 0.45,
-                zorder=5,
-            )
-            ce = PolyCollection(
-                [], facecolors=EXECUTED, edgecolors=EXECUTED, linewidths=0.5, alpha=0.45, zorder=4
-            )
-        ax.add_collection(cp)
-        ax.add_collection(ce)
-        caps_p.append(cp)
-        caps_e.append(ce)
+    caps_p, caps_e = capsule_collections(panels, has_exec)
     handles, labels = views[0][0].get_legend_handles_labels()
     handles += [
         Patch(
