@@ -327,14 +327,22 @@ def urdf_with_meshes(robot: Any, mesh_dirs: Sequence[Path]) -> tuple[Any | None,
         p = find(fname)
         return str(p) if p is not None else fname
 
-    model = yourdfpy.URDF.load(
-        str(path),
-        build_scene_graph=True,
-        load_meshes=True,
-        build_collision_scene_graph=False,
-        load_collision_meshes=False,
-        filename_handler=handler,
-    )
+    import logging
+
+    log = logging.getLogger("yourdfpy")
+    level = log.level
+    log.setLevel(logging.ERROR)  # not a warning per mimic joint off the chain
+    try:
+        model = yourdfpy.URDF.load(
+            str(path),
+            build_scene_graph=True,
+            load_meshes=True,
+            build_collision_scene_graph=False,
+            load_collision_meshes=False,
+            filename_handler=handler,
+        )
+    finally:
+        log.setLevel(level)
     return model, ""
 
 
