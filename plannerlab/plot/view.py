@@ -27,6 +27,7 @@ from __future__ import annotations
 
 import contextlib
 import io
+import logging
 import math
 import threading
 import time
@@ -131,6 +132,7 @@ class Viewer:
         self._cache: dict[tuple[int, int, str], tuple[Array, Sequence[str]]] = {}
         self._leg = 0
         self._nodes: dict[str, Any] = {}
+        self._quiet = _QuietMimic()
         self._trace_nodes: list[Any] = []
         with contextlib.redirect_stdout(io.StringIO()):  # viser's banner
             self.server = viser.ViserServer(host=host, port=int(port), verbose=False)
@@ -191,6 +193,10 @@ class Viewer:
         model, why = urdf_with_meshes(robot, [Path(d) for d in mesh_dirs])
         if why:
             self.notes.append(why)
+        if model is not None:
+            # yourdfpy warns on every pose of a mimic joint whose joint is fixed (the
+            # Panda's second finger): once per frame, so not at all while this view runs
+            logging.getLogger("yourdfpy.urdf").addFilter(self._quiet)
         for kind, rgb, opacity in kinds:
             nodes: dict[str, Any] = {}
             nodes["links"] = self._add(
@@ -522,6 +528,7 @@ class Viewer:
         """Stop playing and the server (idempotent)."""
         self._stop.set()
         self._playing.clear()
+        logging.getLogger("yourdfpy.urdf").removeFilter(self._quiet)
         with contextlib.redirect_stdout(io.StringIO()):  # viser says "Server stopped"
             self.server.stop()
 
@@ -537,6 +544,13 @@ class Viewer:
 
     def __exit__(self, *exc: Any) -> None:
         self.close()
+
+
+class _QuietMimic(logging.Filter):
+    """Drops yourdfpy's per-pose warning about a mimic joint whose joint is not actuated."""
+
+    def filter(self, record: logging.LogRecord) -> bool:
+        return "is supposed to mimic" not in record.getMessage()
 
 
 def _node(name: str) -> str:
