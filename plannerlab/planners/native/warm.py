@@ -14,6 +14,9 @@ def warm_up(model: Any | None = None) -> None:
     from plannerlab.collision.model import views
     from plannerlab.planners.native import kernels as K
 
+    entries = (views, K.rrtc_run, K.tree_path, K.shortcut_run)
+    if model is None and all(f.signatures for f in entries):
+        return  # loaded in this process already
     if model is None:
         model = _tiny_model()
     V, S = views(model)
