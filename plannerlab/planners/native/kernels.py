@@ -11,11 +11,13 @@ edges child → parent (the path runs from a goal tree's leaf to its root), shor
 the path. The re-check ``checker.check_path(path, step, mode="grid")`` thus checks states
 the search checked, bit for bit, and a returned path passes it by construction.
 
-Budgets: a kernel call runs until a *soft* limit on its checks (the chunk: the caller
-looks at the clock between chunks) or iterations is passed at the end of an iteration, or
-a *hard* limit on checks (the budget) would be crossed inside one (the edge is then left
-unproved and the search stops). Chunks end between iterations, so the search does not
-depend on how it is cut into chunks: the same seed gives the same path.
+Budgets: a kernel call runs until a *soft* limit on its checks is passed (the chunk:
+the caller looks at the clock between chunks; given only with a time limit), checked
+between two edges (an edge is never cut short by it, so every chunk makes progress), or
+until a *hard* one (the budget) is reached, if need be inside an edge, which is then left
+unproved, or the iteration budget is used up. Without a time limit there is one chunk,
+so the search does not depend on the machine: the same seed gives the same path, checks
+and iterations.
 
 Generator: xoshiro256+ (state: 4 uint64, seeded by :func:`seed_state`); doubles from
 its upper 53 bits; Gaussian noise by Box–Muller.
@@ -307,8 +309,9 @@ def rrtc_run(
     RRT-Connect); the trees then swap roles.
 
     Limits: ``max_iterations`` (total), ``soft_checks`` (total checks after which this
-    call returns :data:`CHUNK` at the end of an iteration), ``hard_checks`` (total checks
-    never crossed: :data:`HARD`), ``need_free`` (free rows each tree needs before an
+    call returns :data:`CHUNK` between two edges: a connection stops where it got to, its
+    nodes checked), ``hard_checks`` (total checks never crossed, inside an edge if need
+    be: :data:`HARD`), ``need_free`` (free rows each tree needs before an
     iteration starts, else :data:`FULL`). ``buf`` (4, dof) scratch.
 
     Returns a code (:data:`CHUNK`, :data:`DONE`, :data:`HARD`, :data:`ITERATIONS`,
@@ -317,6 +320,8 @@ def rrtc_run(
     while True:
         if counters[0] >= max_iterations:
             return ITERATIONS
+        if counters[1] >= hard_checks:
+            return HARD
         if counters[1] >= soft_checks:
             return CHUNK
         if QA.shape[0] - sizes[0] < need_free or QB.shape[0] - sizes[1] < need_free:
@@ -383,6 +388,8 @@ def rrtc_run(
                 counters[3] = new_t if t == 0 else near
                 counters[4] = near if t == 0 else new_t
                 return DONE
+            if counters[1] >= soft_checks:  # the connection so far stays (checked nodes)
+                return CHUNK
 
 
 @njit(cache=True, nogil=True)
@@ -448,6 +455,8 @@ def shortcut_run(P, k, m, V, S, joint_step, rng, tries, counters, soft_checks, h
         if k < 3:
             counters[0] = tries
             break
+        if counters[1] >= hard_checks:
+            return k, HARD
         if counters[1] >= soft_checks:
             return k, CHUNK
         counters[0] += 1
@@ -460,6 +469,8 @@ def shortcut_run(P, k, m, V, S, joint_step, rng, tries, counters, soft_checks, h
     if counters[2] == 0:
         counters[2] = 1
     while counters[2] < k - 1:
+        if counters[1] >= hard_checks:
+            return k, HARD
         if counters[1] >= soft_checks:
             return k, CHUNK
         i = counters[2]

@@ -2,12 +2,12 @@
 :class:`NativeSolve` per leg (the goal pool, the compiled search in chunks, the compiled
 shortcuts, the re-check), :class:`NativePlanner` and :func:`make`, the registry's factory.
 
-The search runs in :mod:`~plannerlab.planners.native.kernels`, a chunk of iterations per
-call; between chunks this module charges the chunk's checks to the leg's tracker, looks at
-the clock and sizes the next chunk by counting work: a chunk gets the checks the last
-chunks made in about ``CHUNK_TIME_FRACTION`` of the time limit, so a search stops within
-about that fraction of its limit. The chunks do not change the search (they end between
-iterations): the same seed gives the same path.
+The search runs in :mod:`~plannerlab.planners.native.kernels`, a chunk of work per call;
+between chunks this module charges the chunk's checks to the leg's tracker, looks at the
+clock and sizes the next chunk by counting work: a chunk gets the checks the last chunks
+made in about ``CHUNK_TIME_FRACTION`` of the time limit, so a search stops within about
+that fraction of its limit. Without a time limit the search is one chunk: the same seed
+gives the same path, checks and iterations on any machine.
 
 Checks are counted as every planner counts them: every state the kernels check is one
 collision check, charged to the leg's tracker (:meth:`~plannerlab.planners.base.
@@ -39,8 +39,8 @@ from plannerlab.robots.paths import path_length
 CHUNK_TIME_FRACTION = 0.004
 #: the first chunk's guess of the time per check [s] (the next chunks measure it)
 FIRST_RATE_S = 1e-6
-#: checks per chunk at least / at most (with a time limit); without one, every chunk
-CHUNK_MIN, CHUNK_MAX, CHUNK_NO_CLOCK = 64, 1 << 22, 1 << 18
+#: checks per chunk at least / at most (with a time limit; without one, one chunk)
+CHUNK_MIN, CHUNK_MAX = 64, 1 << 22
 #: the re-check may run this fraction past the time limit (as the OMPL planners')
 TIME_SLACK = 0.01
 #: the time kept for the re-check is this many times its checks at the search's rate
@@ -138,9 +138,9 @@ class NativeSolve:
 
     def chunk_checks(self) -> int:
         """Checks of the next chunk: about ``CHUNK_TIME_FRACTION`` of the time limit at
-        the measured rate (all of them without a time limit)."""
+        the measured rate (all of them without a time limit: one chunk)."""
         if self.time_limit is None:
-            return CHUNK_NO_CLOCK
+            return UNLIMITED
         n = CHUNK_TIME_FRACTION * self.time_limit / max(self.rate_s, 1e-9)
         return int(min(max(n, CHUNK_MIN), CHUNK_MAX))
 

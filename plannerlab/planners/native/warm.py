@@ -13,9 +13,10 @@ def warm_up(model: Any | None = None) -> None:
     model to run them on; default: a two-joint chain in an empty room)."""
     from plannerlab.collision.model import views
     from plannerlab.planners.native import kernels as K
+    from plannerlab.planners.native import rrtstar as R
 
-    entries = (views, K.rrtc_run, K.tree_path, K.shortcut_run)
-    if model is None and all(f.signatures for f in entries):
+    entries = (views, K.rrtc_run, K.tree_path, K.shortcut_run, R.rrtstar_run, R.chain)
+    if model is None and all(getattr(f, "signatures", True) for f in entries):
         return  # loaded in this process already
     if model is None:
         model = _tiny_model()
@@ -33,6 +34,14 @@ def warm_up(model: Any | None = None) -> None:
     )
     K.tree_path(Q, P, 0, Q, P, 0, Q.copy())
     K.shortcut_run(Q, 1, model, V, S, 0.1, rng, 0, np.zeros(3, dtype=np.int64), 0, 0, buf)
+    cost = np.zeros(4)
+    R.rrtstar_run(
+        model, V, S, Q, P, cost, P.copy(), P.copy(), P.copy(), P.copy(),
+        np.array([1, 0], dtype=np.int64),
+        np.array([0, 0, -1, 0], dtype=np.int64), rng, guides, 0.0, guides, 0.0, 0.1, 1.0, 0.1,
+        1.0, 0, 0, 0, buf, np.empty(4, dtype=np.int64), np.empty(4), np.empty(4, dtype=np.int64),
+    )  # fmt: skip
+    R.chain(Q, P, 0, Q.copy())
 
 
 def _tiny_model() -> Any:
