@@ -18,6 +18,17 @@ Modules: ``settings`` (frozen settings), ``kernels`` (the compiled search),
 from __future__ import annotations
 
 from plannerlab.planners.native.planner import NativePlanner, NativeSolve, make
-from plannerlab.planners.native.settings import NativeSettings, RRTstarSettings
+from plannerlab.planners.native.settings import (
+    NativeSettings,
+    RRTConnectSettings,
+    RRTstarSettings,
+)
 
-__all__ = ["NativePlanner", "NativeSettings", "NativeSolve", "RRTstarSettings", "make"]
+__all__ = [
+    "NativePlanner",
+    "NativeSettings",
+    "NativeSolve",
+    "RRTConnectSettings",
+    "RRTstarSettings",
+    "make",
+]

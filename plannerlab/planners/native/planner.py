@@ -31,7 +31,12 @@ from plannerlab.planners.base import BudgetTracker, PlanResult, Status, with_ove
 from plannerlab.planners.context import LegPlanner, PlanningContext
 from plannerlab.planners.goal_pool import fill_goal_pool
 from plannerlab.planners.native import kernels as K
-from plannerlab.planners.native.settings import GOAL_SELECTIONS, NativeSettings, RRTstarSettings
+from plannerlab.planners.native.settings import (
+    GOAL_SELECTIONS,
+    NativeSettings,
+    RRTConnectSettings,
+    RRTstarSettings,
+)
 from plannerlab.robots.base import Array, wrap_to_pi
 from plannerlab.robots.paths import path_length
 
@@ -197,7 +202,7 @@ class NativeSolve:
         k = len(P)
         cost = int(self.checker.grid_states(P, self.step))
         tries = self.s.shortcut_tries or max(32, 4 * k)
-        counters = np.zeros(3, dtype=np.int64)
+        counters = np.zeros(4, dtype=np.int64)
         self._charged = 0
         buf = np.empty((4, P.shape[1]))
         left = self.tracker.checks_left()
@@ -313,15 +318,17 @@ class NativeSolve:
         cap = max(self.tree_rows(hard0, len(G), dof), need_free + len(G) + 1)
         self.extra["tree_rows"] = cap
         rows = min(cap, max(FIRST_ROWS, need_free + len(G) + 1))
-        QA, PA = np.empty((rows, dof)), np.full(rows, -1, dtype=np.int64)
-        QB, PB = np.empty((rows, dof)), np.full(rows, -1, dtype=np.int64)
-        QA[0] = q0
-        QB[: len(G)] = G
+        trees = []
+        for roots in (q0[None], G):
+            Q, P = np.empty((rows, dof)), np.full(rows, -1, dtype=np.int64)
+            F = np.full(rows, K.CHECKED, dtype=np.int8)
+            Q[: len(roots)] = roots
+            trees += [Q, P, F]
         sizes = np.array([1, len(G)], dtype=np.int64)
-        counters = np.zeros(5, dtype=np.int64)
+        counters = np.zeros(6, dtype=np.int64)
+        every = int(getattr(self.s, "lazy_every", 1))
         buf = np.empty((4, dof))
         max_it = UNLIMITED if self.budget.max_iterations is None else self.budget.max_iterations
-        trees = [QA, PA, QB, PB]
         self._charged = 0
 
         def call(soft: int, hard: int) -> int:
@@ -330,10 +337,7 @@ class NativeSolve:
                     model,
                     V,
                     S,
-                    trees[0],
-                    trees[1],
-                    trees[2],
-                    trees[3],
+                    *trees,
                     sizes,
                     counters,
                     rng_state,
@@ -342,6 +346,7 @@ class NativeSolve:
                     self.s.guide_sigma_rad,
                     range_rad,
                     self.step,
+                    every,
                     max_it,
                     soft,
                     hard,
@@ -355,20 +360,19 @@ class NativeSolve:
             self.iterations = int(counters[0])
             if code == K.FULL and len(trees[0]) < cap:
                 grown = min(cap, 4 * len(trees[0]))
-                for t in (0, 2):
-                    Q = np.empty((grown, dof))
-                    Q[: len(trees[t])] = trees[t]
-                    P = np.full(grown, -1, dtype=np.int64)
-                    P[: len(trees[t + 1])] = trees[t + 1]
-                    trees[t], trees[t + 1] = Q, P
+                for i, a in enumerate(trees):
+                    bigger = np.full((grown,) + a.shape[1:], -1, dtype=a.dtype)
+                    bigger[: len(a)] = a
+                    trees[i] = bigger
                 continue
             break
         self.extra["planning_checks"] = int(counters[1])
         self.extra["nodes"] = [int(sizes[0]), int(sizes[1])]
+        self.extra["paths_failing_fine_check"] = int(counters[5])
         if code != K.DONE:
             return self.stopped(code, f"{int(sizes[0])} + {int(sizes[1])} tree nodes")
         out = np.empty((int(sizes.sum()), dof))
-        k = K.tree_path(trees[0], trees[1], counters[3], trees[2], trees[3], counters[4], out)
+        k = K.tree_path(trees[0], trees[1], counters[3], trees[3], trees[4], counters[4], out)
         path = out[:k].copy()
         self.extra["waypoints_raw"] = k
         self.extra["length_raw"] = path_length(path, self.robot.continuous)
@@ -410,6 +414,9 @@ def _check_settings(name: str, s: NativeSettings) -> None:
             raise PlannerlabError(f"{name}: {key} must be a finite number >= 0, got {v!r}")
     if not (math.isfinite(s.max_tree_mb) and s.max_tree_mb > 0.0):
         raise PlannerlabError(f"{name}: max_tree_mb must be > 0, got {s.max_tree_mb!r}")
+    every = getattr(s, "lazy_every", 1)
+    if every < 1 or every & (every - 1):
+        raise PlannerlabError(f"{name}: lazy_every must be a power of two >= 1, got {every!r}")
     if s.goal_samples < 1 or s.max_goal_attempts < 1 or s.shortcut_tries < 0:
         raise PlannerlabError(
             f"{name}: goal_samples and max_goal_attempts must be >= 1 and shortcut_tries "
@@ -433,6 +440,30 @@ class NativePlanner(LegPlanner):
         from plannerlab.planners.native.warm import warm_up
 
         warm_up()
+
+    def solve(
+        self,
+        problem: Any,
+        leg: int,
+        budget: Any,
+        rng: np.random.Generator,
+        q_start: Array | None = None,
+        stepper: Any = None,
+    ) -> PlanResult:
+        """:meth:`LegPlanner.solve` with the problem's checker and its compiled model
+        built before the leg's clock starts (as the checker is), not in the search's
+        time."""
+        from plannerlab.collision.fcl_checker import problem_checker
+
+        checker = problem_checker(problem)
+        try:
+            checker.model  # noqa: B018 - built and kept by the checker
+        except ValueError:
+            pass  # plan() says why there is none
+        ctx = PlanningContext.for_planner(
+            self, problem, leg, budget, q_start=q_start, checker=checker, stepper=stepper
+        )
+        return self.plan(ctx, rng)
 
     def guide_states(self, ctx: PlanningContext, rng: np.random.Generator) -> Array:
         """The sampler's guide states (k, dof), drawn with probability ``guide_bias``:
@@ -463,7 +494,7 @@ class NativePlanner(LegPlanner):
 
 #: algorithm -> its settings
 SETTINGS: Mapping[str, type[NativeSettings]] = {
-    "rrtconnect": NativeSettings,
+    "rrtconnect": RRTConnectSettings,
     "rrtstar": RRTstarSettings,
 }
 

@@ -151,6 +151,7 @@ def rrtstar_run(
     sibling,
     goal_nodes,
     goal_node_of,
+    flags,
     sizes,
     counters,
     rng,
@@ -176,7 +177,8 @@ def rrtstar_run(
     (joint-space length from the root), children lists (``child`` first child,
     ``sibling`` next sibling, -1 ends), ``goal_nodes`` the nodes that are goal states
     (``sizes`` (2,): nodes, goal nodes), ``goal_node_of`` (g,) the node of each goal
-    state (-1: not in the tree). A new node within ``range_rad`` of a goal state not in
+    state (-1: not in the tree), ``flags`` (cap,) int8 zeros (the nearest-node search's
+    flags; RRT* checks its edges in full). A new node within ``range_rad`` of a goal state not in
     the tree tries the edge to it (the start too, first). ``counters`` (4,) int64:
     iterations, checks, the best goal node (-1: none yet), the held re-check checks of
     its path (never spent: the hard limit of an edge is ``hard_checks`` less them).
@@ -212,7 +214,7 @@ def rrtstar_run(
                 rng, m.lower, m.upper, m.continuous, guides, guide_bias, guide_sigma_rad, q_rand
             )
         n = sizes[0]
-        near = K.nearest(Q, n, q_rand, m.continuous, m.continuous.any())
+        near = K.nearest(Q, n, q_rand, m.continuous, m.continuous.any(), flags)
         if K.distance2(Q[near], q_rand, m.continuous) == 0.0:
             continue
         reached = K.steer(Q[near], q_rand, range_rad, m.continuous, buf[2], target)
@@ -367,6 +369,7 @@ def rrtstar(solve: NativeSolve) -> PlanResult:
         "sibling": np.full(rows, -1, dtype=np.int64),
         "goal_nodes": np.full(rows, -1, dtype=np.int64),
         "stack": np.empty(rows, dtype=np.int64),
+        "flags": np.zeros(rows, dtype=np.int8),  # no node is ever dead here
     }
     tree["Q"][0] = q0
     sizes = np.array([1, 0], dtype=np.int64)
@@ -385,8 +388,8 @@ def rrtstar(solve: NativeSolve) -> PlanResult:
         t = tree
         code = rrtstar_run(
             model, V, S, t["Q"], t["parent"], t["cost"], t["child"], t["sibling"],
-            t["goal_nodes"], goal_node_of, sizes, counters, rng_state, G, goal_bias, solve.guides,
-            s.guide_bias, s.guide_sigma_rad, range_rad, solve.step, k_factor, max_it,
+            t["goal_nodes"], goal_node_of, t["flags"], sizes, counters, rng_state, G, goal_bias,
+            solve.guides, s.guide_bias, s.guide_sigma_rad, range_rad, solve.step, k_factor, max_it,
             soft, hard, buf, nb_idx, nb_d2, t["stack"],
         )  # fmt: skip
         best = int(counters[2])

@@ -47,6 +47,22 @@ class NativeSettings:
 
 
 @dataclass(frozen=True)
+class RRTConnectSettings(NativeSettings):
+    """RRT-Connect.
+
+    Attributes:
+        lazy_every: a tree edge is checked, when it is added, on its coarse states only:
+            its ends and every ``lazy_every``-th state of its grid (a power of two); the
+            others only when a path through it is found (a failure there drops the
+            edge's subtree and the search goes on). Most tree edges are never on a path,
+            so most of their states are never checked; the returned path's are all. 1:
+            every edge in full at once.
+    """
+
+    lazy_every: int = 8
+
+
+@dataclass(frozen=True)
 class RRTstarSettings(NativeSettings):
     """RRT* (one tree from the start, goal-biased, rewired in a ball of ``k`` nearest).
 

@@ -25,18 +25,20 @@ def warm_up(model: Any | None = None) -> None:
     Q = np.zeros((4, dof))
     P = np.full(4, -1, dtype=np.int64)
     sizes = np.array([1, 1], dtype=np.int64)
-    counters = np.zeros(5, dtype=np.int64)
+    counters = np.zeros(6, dtype=np.int64)
     rng = np.array([1, 2, 3, 4], dtype=np.uint64)
     buf = np.empty((4, dof))
     guides = np.zeros((0, dof))
+    F = np.ones(4, dtype=np.int8)
     K.rrtc_run(
-        model, V, S, Q, P, Q, P, sizes, counters, rng, guides, 0.0, 0.1, 1.0, 0.1, 0, 0, 0, 1, buf
-    )
+        model, V, S, Q, P, F, Q, P, F, sizes, counters, rng, guides, 0.0, 0.1, 1.0, 0.1, 8, 0,
+        0, 0, 1, buf,
+    )  # fmt: skip
     K.tree_path(Q, P, 0, Q, P, 0, Q.copy())
-    K.shortcut_run(Q, 1, model, V, S, 0.1, rng, 0, np.zeros(3, dtype=np.int64), 0, 0, buf)
+    K.shortcut_run(Q, 1, model, V, S, 0.1, rng, 0, np.zeros(4, dtype=np.int64), 0, 0, buf)
     cost = np.zeros(4)
     R.rrtstar_run(
-        model, V, S, Q, P, cost, P.copy(), P.copy(), P.copy(), P.copy(),
+        model, V, S, Q, P, cost, P.copy(), P.copy(), P.copy(), P.copy(), F,
         np.array([1, 0], dtype=np.int64),
         np.array([0, 0, -1, 0], dtype=np.int64), rng, guides, 0.0, guides, 0.0, 0.1, 1.0, 0.1,
         1.0, 0, 0, 0, buf, np.empty(4, dtype=np.int64), np.empty(4), np.empty(4, dtype=np.int64),
