@@ -111,7 +111,11 @@ def test_goal_kinds_joint_and_tip():
 
 #: (planner, problem, seed) -> (iterations, collision checks, path length [rad]) on the
 #: budget of ``solve``; regenerate by printing them when the search changes on purpose
-GOLDEN: dict[tuple[str, str, int], tuple[int, int, float]] = {}
+GOLDEN: dict[tuple[str, str, int], tuple[int, int, float]] = {
+    ("native.rrtconnect", "panda", 0): (13, 3699, 7.104709325307024),
+    ("native.rrtconnect", "armz_pocket", 0): (1, 30943, 1.0791939382379752),
+    ("native.rrtstar", "armz_pocket", 0): (13, 300000, 0.904686558899481),
+}
 
 
 @pytest.mark.parametrize("key", sorted(GOLDEN))
@@ -154,6 +158,26 @@ def test_a_time_limit_cuts_the_search_into_chunks(monkeypatch: pytest.MonkeyPatc
     assert sum(calls) == r.extra["planning_checks"]
     assert len(calls) >= 10
     assert sorted(calls)[len(calls) // 2] < 64 + 1000  # a chunk: 64 checks and one edge
+
+
+def test_lazy_fine_checks_fewer_checks_and_paths_that_fail_them_are_dropped():
+    """Tree edges checked on their coarse states first: over seeds 0-5 on the Panda some
+    found path fails its fine states (its subtree is dropped, the search goes on), every
+    returned path passes the re-check, and the searches use fewer checks than checking
+    every edge in full at once (``lazy_every`` = 1, which never drops a path)."""
+    lazy = [
+        solve("native.rrtconnect", "panda", s, Budget(max_collision_checks=CHECKS))
+        for s in range(6)
+    ]
+    eager = [
+        solve("native.rrtconnect", "panda", s, Budget(max_collision_checks=CHECKS), lazy_every=1)
+        for s in range(6)
+    ]
+    for r in lazy + eager:
+        assert_path_checked("panda", r)
+    assert max(r.extra["paths_failing_fine_check"] for r in lazy) >= 1
+    assert all(r.extra["paths_failing_fine_check"] == 0 for r in eager)
+    assert sum(r.collision_checks for r in lazy) < sum(r.collision_checks for r in eager)
 
 
 # ---------------------------------------------------------------------- budgets
@@ -246,7 +270,13 @@ def test_guides_steer_the_samples():
 
 @pytest.mark.parametrize(
     "overrides",
-    [{"guide_bias": 1.5}, {"range_rad": -1.0}, {"goal_selection": "nope"}, {"max_tree_mb": 0}],
+    [
+        {"guide_bias": 1.5},
+        {"range_rad": -1.0},
+        {"goal_selection": "nope"},
+        {"max_tree_mb": 0},
+        {"lazy_every": 12},
+    ],
 )
 def test_bad_settings_are_refused(overrides: dict[str, Any]):
     with pytest.raises(PlannerlabError, match=next(iter(overrides))):

@@ -59,7 +59,7 @@ class RRTConnectSettings(NativeSettings):
             every edge in full at once.
     """
 
-    lazy_every: int = 8
+    lazy_every: int = 16
 
 
 @dataclass(frozen=True)
