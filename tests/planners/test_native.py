@@ -20,6 +20,7 @@ from plannerlab.errors import PlannerlabError, UnknownNameError
 from plannerlab.planners import PlanResult, Status, make_planner
 from plannerlab.planners.base import start_collision
 from plannerlab.planners.native import planner as native_planner
+from plannerlab.planners.native import solve as native_solve
 from plannerlab.problem.catalog import load_problem
 from plannerlab.problem.goals import GoalRegion, JointGoal
 from plannerlab.problem.load import Budget, Problem
@@ -141,7 +142,7 @@ def test_a_time_limit_cuts_the_search_into_chunks(monkeypatch: pytest.MonkeyPatc
     ``CHUNK_MAX`` checks (here 64), between two edges (an edge is never cut short, so the
     search goes on; the limit itself is never reached); the path passes the re-check."""
     calls: list[int] = []
-    kernel = native_planner.K.rrtc_run
+    kernel = native_solve.K.rrtc_run
 
     def counted(*args: Any) -> int:
         before = int(args[10][1])  # counters: iterations, checks, ...
@@ -149,8 +150,8 @@ def test_a_time_limit_cuts_the_search_into_chunks(monkeypatch: pytest.MonkeyPatc
         calls.append(int(args[10][1]) - before)
         return int(code)
 
-    monkeypatch.setattr(native_planner, "CHUNK_MAX", 64)
-    monkeypatch.setattr(native_planner.K, "rrtc_run", counted)
+    monkeypatch.setattr(native_solve, "CHUNK_MAX", 64)
+    monkeypatch.setattr(native_solve.K, "rrtc_run", counted)
     r = solve(
         "native.rrtconnect", "panda", 1, Budget(max_collision_checks=CHECKS, time_limit_s=1e6)
     )

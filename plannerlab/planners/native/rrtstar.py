@@ -23,7 +23,7 @@ from numba import njit
 
 from plannerlab.planners.base import PlanResult, Status
 from plannerlab.planners.native import kernels as K
-from plannerlab.planners.native.planner import (
+from plannerlab.planners.native.solve import (
     FIRST_ROWS,
     RESERVE_FACTOR,
     UNLIMITED,
