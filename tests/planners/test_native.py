@@ -145,9 +145,9 @@ def test_a_time_limit_cuts_the_search_into_chunks(monkeypatch: pytest.MonkeyPatc
     kernel = native_solve.K.rrtc_run
 
     def counted(*args: Any) -> int:
-        before = int(args[10][1])  # counters: iterations, checks, ...
+        before = int(args[12][1])  # counters: iterations, checks, ...
         code = kernel(*args)
-        calls.append(int(args[10][1]) - before)
+        calls.append(int(args[12][1]) - before)
         return int(code)
 
     monkeypatch.setattr(native_solve, "CHUNK_MAX", 64)
@@ -179,6 +179,16 @@ def test_lazy_fine_checks_fewer_checks_and_paths_that_fail_them_are_dropped():
     assert max(r.extra["paths_failing_fine_check"] for r in lazy) >= 1
     assert all(r.extra["paths_failing_fine_check"] == 0 for r in eager)
     assert sum(r.collision_checks for r in lazy) < sum(r.collision_checks for r in eager)
+
+
+@pytest.mark.parametrize("seed", [0, 1, 2])
+def test_dynamic_domain_paths_pass_the_recheck(seed: int):
+    """The dynamic domain (VAMP's default) drops far samples of failing nodes; its paths
+    pass the re-check like the others (it once let a dropped connection step through)."""
+    r = solve(
+        "native.rrtconnect", "panda", seed, Budget(max_collision_checks=CHECKS), dynamic_domain=True
+    )
+    assert_path_checked("panda", r)
 
 
 # ---------------------------------------------------------------------- budgets

@@ -274,16 +274,25 @@ def _tree_edge(Qt, Pt, c, goal_tree, joint_step, m, V, S, buf, limit, every, fin
 
 
 @njit(cache=True, nogil=True)
-def _grow(Qt, Pt, Ft, nt, goal_tree, near, q_to, range_rad, joint_step, m, V, S, buf, limit,
-          every):  # fmt: skip
-    """Grow tree (Qt, Pt, Ft) of nt nodes from node ``near`` (-1: the nearest live one)
+def _grow(Qt, Pt, Ft, Rt, nt, goal_tree, near, q_to, range_rad, joint_step, m, V, S, buf,
+          limit, every, dd):  # fmt: skip
+    """Grow tree (Qt, Pt, Ft, Rt) of nt nodes from node ``near`` (-1: the nearest live one)
     towards q_to: a node at most ``range_rad`` on, added at index nt when the coarse
     states of its edge are free (all of them with ``every`` = 1).
 
+    Dynamic domain (``dd`` = (radius, min_radius, alpha) [rad, rad, 1], radius > 0; only
+    for the nearest-node step): a sample farther from its nearest node than the node's
+    radius ``Rt`` is dropped unchecked; a node's first failed extension sets its radius
+    to ``radius``, later ones shrink it by (1 - alpha) down to ``min_radius``, successes
+    grow it by (1 + alpha) (Yershova et al. 2005, as VAMP's RRT-Connect).
+
     Returns (code, checks, near): code 0 trapped, 1 advanced, 2 reached q_to, 3 the
-    hard limit came first."""
+    hard limit came first, 4 dropped by the dynamic domain."""
+    domain = near < 0 and dd[0] > 0.0
     if near < 0:
         near = nearest(Qt, nt, q_to, m.continuous, m.continuous.any(), Ft)
+        if domain and distance2(Qt[near], q_to, m.continuous) > Rt[near] * Rt[near]:
+            return 4, 0, near
     Qt[nt] = Qt[near]  # the new row's parent edge, from near to the target
     Pt[nt] = near
     reached = steer(Qt[near], q_to, range_rad, m.continuous, buf[2], Qt[nt])
@@ -292,8 +301,13 @@ def _grow(Qt, Pt, Ft, nt, goal_tree, near, q_to, range_rad, joint_step, m, V, S,
     if status == 2:
         return 3, checks, near
     if status == 1:
+        if domain:
+            Rt[near] = dd[0] if Rt[near] == np.inf else max(Rt[near] * (1.0 - dd[2]), dd[1])
         return 0, checks, near
+    if domain and Rt[near] != np.inf:
+        Rt[near] *= 1.0 + dd[2]
     Ft[nt] = CHECKED if every == 1 else COARSE
+    Rt[nt] = np.inf
     return (2 if reached else 1), checks, near
 
 
@@ -338,9 +352,11 @@ def rrtc_run(
     QA,
     PA,
     FA,
+    RA,
     QB,
     PB,
     FB,
+    RB,
     sizes,
     counters,
     rng,
@@ -350,6 +366,7 @@ def rrtc_run(
     range_rad,
     joint_step,
     every,
+    dd,
     max_iterations,
     soft_checks,
     hard_checks,
@@ -358,8 +375,9 @@ def rrtc_run(
 ):
     """RRT-Connect iterations until a path, a limit, or a full tree.
 
-    Trees: A (QA (cap_a, dof) states, PA parents, -1 at the root: the start, FA flags)
-    and B (the goal tree, a root per goal state); ``sizes`` (2,) their node counts.
+    Trees: A (QA (cap_a, dof) states, PA parents, -1 at the root: the start, FA flags,
+    RA dynamic-domain radii, inf: none) and B (the goal tree, a root per goal state);
+    ``sizes`` (2,) their node counts.
     ``counters`` (6,) int64 carries the search across calls: iterations, checks, the tree
     to grow next (0 A, 1 B), on a path the meeting node in A and in B (equal states), and
     the found paths whose fine check failed.
@@ -368,6 +386,7 @@ def rrtc_run(
     states (its ends and every ``every``-th grid state) when it is added; the others only
     when a path through it is found (:func:`_certify`); a failure kills the subtree below
     it and the search goes on. With ``every`` = 1 every edge is checked in full at once.
+    ``dd``: the dynamic domain of the extension (:func:`_grow`; radius 0: none).
 
     Each iteration draws a sample (:func:`sample`: uniform, or a guide state perturbed,
     with probability ``guide_bias``; ``guides`` (k, dof), k = 0 for none), extends the
@@ -384,6 +403,7 @@ def rrtc_run(
     Returns a code (:data:`CHUNK`, :data:`DONE`, :data:`HARD`, :data:`ITERATIONS`,
     :data:`FULL`)."""
     q_rand = buf[0]
+    no_domain = np.zeros(3)  # the connection steps have none
     while True:
         if counters[0] >= max_iterations:
             return ITERATIONS
@@ -398,13 +418,14 @@ def rrtc_run(
         t = counters[2]
         counters[2] = 1 - t
         if t == 0:
-            Qt, Pt, Ft, Qo, Po, Fo = QA, PA, FA, QB, PB, FB
+            Qt, Pt, Ft, Rt, Qo, Po, Fo, Ro = QA, PA, FA, RA, QB, PB, FB, RB
         else:
-            Qt, Pt, Ft, Qo, Po, Fo = QB, PB, FB, QA, PA, FA
+            Qt, Pt, Ft, Rt, Qo, Po, Fo, Ro = QB, PB, FB, RB, QA, PA, FA, RA
         code, c, _ = _grow(
             Qt,
             Pt,
             Ft,
+            Rt,
             sizes[t],
             t == 1,
             -1,
@@ -417,11 +438,12 @@ def rrtc_run(
             buf,
             hard_checks - counters[1],
             every,
+            dd,
         )
         counters[1] += c
         if code == 3:
             return HARD
-        if code == 0:
+        if code == 0 or code == 4:
             continue
         new_t = sizes[t]
         sizes[t] += 1
@@ -435,6 +457,7 @@ def rrtc_run(
                 Qo,
                 Po,
                 Fo,
+                Ro,
                 sizes[o],
                 o == 1,
                 near,
@@ -447,6 +470,7 @@ def rrtc_run(
                 buf,
                 hard_checks - counters[1],
                 every,
+                no_domain,
             )
             counters[1] += c
             if code == 3:

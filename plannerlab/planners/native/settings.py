@@ -57,9 +57,15 @@ class RRTConnectSettings(NativeSettings):
             edge's subtree and the search goes on). Most tree edges are never on a path,
             so most of their states are never checked; the returned path's are all. 1:
             every edge in full at once.
+        dynamic_domain: the dynamic domain of the extension step (Yershova et al. 2005;
+            VAMP's RRT-Connect has it on): a sample farther from its nearest node than
+            that node's radius is dropped unchecked; a failed extension gives its node a
+            radius of 2 ``range_rad`` and shrinks it slowly to ``range_rad`` / 2. Off:
+            OMPL's RRT-Connect (``ompl.rrtconnect``'s algorithm).
     """
 
     lazy_every: int = 16
+    dynamic_domain: bool = False
 
 
 @dataclass(frozen=True)

@@ -313,8 +313,12 @@ class NativeSolve:
         for roots in (q0[None], G):
             Q, P = np.empty((rows, dof)), np.full(rows, -1, dtype=np.int64)
             F = np.full(rows, K.CHECKED, dtype=np.int8)
+            R = np.full(rows, np.inf)
             Q[: len(roots)] = roots
-            trees += [Q, P, F]
+            trees += [Q, P, F, R]
+        dd = np.zeros(3)
+        if getattr(self.s, "dynamic_domain", False):
+            dd[:] = (2.0 * range_rad, 0.5 * range_rad, 1e-4)  # VAMP's 4, 1 for its range 2
         sizes = np.array([1, len(G)], dtype=np.int64)
         counters = np.zeros(6, dtype=np.int64)
         every = int(getattr(self.s, "lazy_every", 1))
@@ -338,6 +342,7 @@ class NativeSolve:
                     range_rad,
                     self.step,
                     every,
+                    dd,
                     max_it,
                     soft,
                     hard,
@@ -352,7 +357,7 @@ class NativeSolve:
             if code == K.FULL and len(trees[0]) < cap:
                 grown = min(cap, 4 * len(trees[0]))
                 for i, a in enumerate(trees):
-                    bigger = np.full((grown,) + a.shape[1:], -1, dtype=a.dtype)
+                    bigger = np.full((grown,) + a.shape[1:], -1, dtype=a.dtype)  # rows unused
                     bigger[: len(a)] = a
                     trees[i] = bigger
                 continue
@@ -363,7 +368,7 @@ class NativeSolve:
         if code != K.DONE:
             return self.stopped(code, f"{int(sizes[0])} + {int(sizes[1])} tree nodes")
         out = np.empty((int(sizes.sum()), dof))
-        k = K.tree_path(trees[0], trees[1], counters[3], trees[3], trees[4], counters[4], out)
+        k = K.tree_path(trees[0], trees[1], counters[3], trees[4], trees[5], counters[4], out)
         path = out[:k].copy()
         self.extra["waypoints_raw"] = k
         self.extra["length_raw"] = path_length(path, self.robot.continuous)

@@ -30,9 +30,10 @@ def warm_up(model: Any | None = None) -> None:
     buf = np.empty((4, dof))
     guides = np.zeros((0, dof))
     F = np.ones(4, dtype=np.int8)
+    radii = np.full(4, np.inf)
     K.rrtc_run(
-        model, V, S, Q, P, F, Q, P, F, sizes, counters, rng, guides, 0.0, 0.1, 1.0, 0.1, 8, 0,
-        0, 0, 1, buf,
+        model, V, S, Q, P, F, radii, Q, P, F, radii, sizes, counters, rng, guides, 0.0, 0.1,
+        1.0, 0.1, 8, np.zeros(3), 0, 0, 0, 1, buf,
     )  # fmt: skip
     K.tree_path(Q, P, 0, Q, P, 0, Q.copy())
     K.shortcut_run(Q, 1, model, V, S, 0.1, rng, 0, np.zeros(4, dtype=np.int64), 0, 0, buf)
