@@ -140,6 +140,72 @@ def _connect_goal(Q, parent, cost, child, sibling, goal_nodes, goal_node_of, siz
 
 
 @njit(cache=True, nogil=True)
+def _by_cost(cost, nb_idx, nb_d2, cnt):
+    """The neighbours nb_idx[:cnt] (squared distances nb_d2) sorted by the cost through
+    them (cost + distance), which nb_d2 then holds."""
+    for a in range(cnt):
+        nb_d2[a] = cost[nb_idx[a]] + math.sqrt(nb_d2[a])
+    for a in range(1, cnt):
+        j = a
+        while j > 0 and nb_d2[j - 1] > nb_d2[j]:
+            nb_d2[j - 1], nb_d2[j] = nb_d2[j], nb_d2[j - 1]
+            nb_idx[j - 1], nb_idx[j] = nb_idx[j], nb_idx[j - 1]
+            j -= 1
+
+
+@njit(cache=True, nogil=True)
+def _rewire(Q, parent, cost, child, sibling, stack, new, best_p, best_c, nb_idx, cnt,
+            joint_step, m, V, S, buf, limit, soft):  # fmt: skip
+    """Rewire the neighbours nb_idx[:cnt] through node ``new`` (of cost best_c) when that
+    is shorter and the edge new -> neighbour is free; their subtrees' costs follow.
+    Returns (status, checks): 0 done, 2 a limit (``limit`` hard, ``soft`` the chunk's,
+    both counted from here) ended it."""
+    checks = 0
+    for a in range(cnt):
+        v = nb_idx[a]
+        if v == best_p or parent[v] < 0:
+            continue
+        through = best_c + math.sqrt(K.distance2(Q[new], Q[v], m.continuous))
+        if through >= cost[v]:
+            continue
+        if checks >= soft:
+            return 2, checks
+        status, c = K.edge_free(
+            Q[new], Q[v], joint_step, m, V, S, buf[2], buf[3], limit - checks, False
+        )
+        checks += c
+        if status == 2:
+            return 2, checks
+        if status == 0:
+            _unlink(child, sibling, parent[v], v)
+            parent[v] = new
+            sibling[v] = child[new]
+            child[new] = v
+            _shift_costs(cost, child, sibling, v, through - cost[v], stack)
+            cost[v] = through
+    return 0, checks
+
+
+@njit(cache=True, nogil=True)
+def _update_best(Q, parent, cost, goal_nodes, sizes, counters, hard_checks, joint_step, m, buf):
+    """The best path to a goal state whose re-check fits the checks left: its goal node
+    into counters[2], its re-check's checks into counters[3]."""
+    if sizes[1] == 0:
+        return
+    b = counters[2]
+    for g in range(sizes[1]):
+        v = goal_nodes[g]
+        if v != b and (b < 0 or cost[v] < cost[b]):
+            held = _recheck_states(Q, parent, v, joint_step, m, buf[2])
+            if counters[1] + held <= hard_checks:
+                b = v
+                counters[3] = held
+    if b >= 0 and b == counters[2]:
+        counters[3] = _recheck_states(Q, parent, b, joint_step, m, buf[2])
+    counters[2] = b
+
+
+@njit(cache=True, nogil=True)
 def rrtstar_run(
     m,
     V,
@@ -231,15 +297,7 @@ def rrtstar_run(
         cnt = _k_nearest(Q, n, target, m.continuous, k, nb_idx, nb_d2)
         best_p = near
         best_c = cost[near] + math.sqrt(K.distance2(Q[near], target, m.continuous))
-        # candidates cheaper than the nearest, cheapest first (insertion order by cost)
-        for a in range(cnt):
-            nb_d2[a] = cost[nb_idx[a]] + math.sqrt(nb_d2[a])  # now: the cost through it
-        for a in range(1, cnt):
-            j = a
-            while j > 0 and nb_d2[j - 1] > nb_d2[j]:
-                nb_d2[j - 1], nb_d2[j] = nb_d2[j], nb_d2[j - 1]
-                nb_idx[j - 1], nb_idx[j] = nb_idx[j], nb_idx[j - 1]
-                j -= 1
+        _by_cost(cost, nb_idx, nb_d2, cnt)  # nb_d2 now: the cost through each, cheapest first
         for a in range(cnt):
             p = nb_idx[a]
             if nb_d2[a] >= best_c:
@@ -282,45 +340,13 @@ def rrtstar_run(
             if status == 2:
                 return K.HARD
         # rewire the neighbours through the new node (a limit ends the rewiring)
-        limited = False
-        for a in range(cnt):
-            v = nb_idx[a]
-            if v == best_p or parent[v] < 0:
-                continue
-            through = best_c + math.sqrt(K.distance2(target, Q[v], m.continuous))
-            if through >= cost[v]:
-                continue
-            if counters[1] >= soft_checks:
-                limited = True
-                break
-            status, c = K.edge_free(
-                Q[new], Q[v], joint_step, m, V, S, buf[2], buf[3], hard - counters[1], False,
-            )  # fmt: skip
-            counters[1] += c
-            if status == 2:
-                limited = True
-                break
-            if status == 0:
-                _unlink(child, sibling, parent[v], v)
-                parent[v] = new
-                sibling[v] = child[new]
-                child[new] = v
-                _shift_costs(cost, child, sibling, v, through - cost[v], stack)
-                cost[v] = through
-        # the best path to a goal state whose re-check fits the checks left
-        if sizes[1] > 0:
-            b = counters[2]
-            for g in range(sizes[1]):
-                v = goal_nodes[g]
-                if v != b and (b < 0 or cost[v] < cost[b]):
-                    held = _recheck_states(Q, parent, v, joint_step, m, buf[2])
-                    if counters[1] + held <= hard_checks:
-                        b = v
-                        counters[3] = held
-            if b >= 0 and b == counters[2]:
-                counters[3] = _recheck_states(Q, parent, b, joint_step, m, buf[2])
-            counters[2] = b
-        if limited:
+        status, c = _rewire(Q, parent, cost, child, sibling, stack, new, best_p, best_c, nb_idx,
+                            cnt, joint_step, m, V, S, buf, hard - counters[1],
+                            soft_checks - counters[1])  # fmt: skip
+        counters[1] += c
+        _update_best(Q, parent, cost, goal_nodes, sizes, counters, hard_checks, joint_step, m,
+                     buf)  # fmt: skip
+        if status == 2:
             return K.HARD if counters[1] >= hard_checks - counters[3] else K.CHUNK
     return K.CHUNK
 
@@ -361,7 +387,7 @@ def rrtstar(solve: NativeSolve) -> PlanResult:
     cap = max(solve.tree_rows(solve.hard_checks(), 1, dof) * 2, 4)  # one tree: both halves
     solve.extra["tree_rows"] = cap
     rows = min(cap, FIRST_ROWS)
-    tree = {
+    tree: dict[str, np.ndarray] = {
         "Q": np.empty((rows, dof)),
         "parent": np.full(rows, -1, dtype=np.int64),
         "cost": np.zeros(rows),

@@ -309,7 +309,7 @@ class NativeSolve:
         cap = max(self.tree_rows(hard0, len(G), dof), need_free + len(G) + 1)
         self.extra["tree_rows"] = cap
         rows = min(cap, max(FIRST_ROWS, need_free + len(G) + 1))
-        trees = []
+        trees: list[np.ndarray] = []
         for roots in (q0[None], G):
             Q, P = np.empty((rows, dof)), np.full(rows, -1, dtype=np.int64)
             F = np.full(rows, K.CHECKED, dtype=np.int8)
@@ -332,7 +332,14 @@ class NativeSolve:
                     model,
                     V,
                     S,
-                    *trees,
+                    trees[0],
+                    trees[1],
+                    trees[2],
+                    trees[3],
+                    trees[4],
+                    trees[5],
+                    trees[6],
+                    trees[7],
                     sizes,
                     counters,
                     rng_state,

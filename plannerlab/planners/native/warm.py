@@ -55,4 +55,5 @@ def _tiny_model() -> Any:
     from plannerlab.robots.base import trans
 
     scene = Scene((Sphere("far", trans(5.0, 0.0, 0.0), 0.1),))
-    return CollisionChecker(ArmZ(n_modules=3), scene, margin_m=0.01).model
+    robot: Any = ArmZ(n_modules=3)
+    return CollisionChecker(robot, scene, margin_m=0.01).model
