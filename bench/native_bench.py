@@ -115,10 +115,13 @@ def recheck(problem: Any, path: Any) -> str:
 def solve_once(planner: Any, problem: Any, budget: Any, seed: int) -> dict[str, Any]:
     import numpy as np
 
+    from plannerlab.robots.paths import path_length
+
     t0 = time.perf_counter()
     r = planner.solve(problem, 0, budget, np.random.default_rng(seed))
     wall = time.perf_counter() - t0
     row = {
+        "length_rad": path_length(r.path, problem.robot.continuous),
         "status": r.status.value,
         "plan_s": r.time_s,
         "wall_s": wall,
@@ -183,8 +186,8 @@ def mbm(args: argparse.Namespace) -> list[str]:
         "collision: " + (", ".join(sorted(invalid)) or "none") + ")",
         "",
         "| planner | solved and re-checked | median planning time | p95 | median checks |"
-        " median whole call |",
-        "|---|---|---|---|---|---|",
+        " median whole call | median path length |",
+        "|---|---|---|---|---|---|---|",
     ]
     med = {}
     for n in names:
@@ -197,7 +200,8 @@ def mbm(args: argparse.Namespace) -> list[str]:
             f"| `{n}` | {len(ok)}/{len(problems) - len(invalid)}"
             + (f" ({bad} refused by the re-check)" if bad else "")
             + f" | {ms(m)} | {ms(p95)} | {statistics.median([r['checks'] for r in ok] or [0]):.0f}"
-            f" | {ms(stats([r['wall_s'] for r in ok])[0])} |"
+            f" | {ms(stats([r['wall_s'] for r in ok])[0])}"
+            f" | {stats([r['length_rad'] for r in ok])[0]:.2f} rad |"
         )
     # the ratio on the problems both solved
     both = [
