@@ -1,6 +1,7 @@
 """The compiled sampling planners' kernels: a generator, sampling (uniform or guided),
-nearest neighbours, edges on the checker's grid, RRT-Connect and RRT* in chunks of
-iterations, and the path's shortcuts. Every kernel takes the robot–scene model
+nearest neighbours, edges on the checker's grid, RRT-Connect in chunks of work (RRT*'s
+kernel, on these, is in :mod:`~plannerlab.planners.native.rrtstar`), and the path's
+shortcuts. Every kernel takes the robot–scene model
 (:class:`~plannerlab.collision.model.CompiledModel`, with its views ``V, S``) and works
 for any robot that gives one.
 
