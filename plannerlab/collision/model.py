@@ -99,7 +99,13 @@ def model_of_core(core: Any) -> CompiledModel:
         core.hs,
         None,
     )
-    f = np.ascontiguousarray
+
+    def f(a: Any, dtype: Any) -> np.ndarray:
+        # a writable C-ordered copy: numba types read-only arrays (a robot's bounds may
+        # be read-only views) apart, and every kernel taking the model would be compiled
+        # and cached twice
+        return np.array(a, dtype=dtype, order="C", copy=True)
+
     return CompiledModel(
         P=P,
         M=M,

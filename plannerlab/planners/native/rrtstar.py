@@ -30,7 +30,6 @@ from plannerlab.planners.native.solve import (
     K_views,
     NativeSolve,
     space_extent,
-    writable_model,
 )
 from plannerlab.robots.paths import path_length
 
@@ -372,7 +371,7 @@ def rrtstar(solve: NativeSolve) -> PlanResult:
     s, robot, q0 = solve.s, solve.robot, solve.q0
     if solve.ctx.start_problem is not None:
         return solve.result(Status.INVALID_START, solve.ctx.start_problem, q0[None])
-    model = writable_model(solve.checker.model)
+    model = solve.checker.model
     solve.run.progress.note(float(solve.goal.distance(robot, q0)))
     G, failed = solve.goal_pool()
     if failed is not None:

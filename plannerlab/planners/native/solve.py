@@ -294,7 +294,7 @@ class NativeSolve:
         q0 = self.q0
         if self.ctx.start_problem is not None:
             return self.result(Status.INVALID_START, self.ctx.start_problem, q0[None])
-        model = writable_model(self.checker.model)
+        model = self.checker.model
         self.run.progress.note(float(self.goal.distance(self.robot, q0)))
         G, failed = self.goal_pool()
         if failed is not None:
@@ -389,15 +389,3 @@ def K_views(model: Any) -> tuple[Any, Any]:  # noqa: N802
     from plannerlab.collision.model import views
 
     return views(model)
-
-
-def writable_model(model: Any) -> Any:
-    """The model with its read-only arrays copied (a robot's bounds may be read-only
-    views): numba types read-only arrays apart, so every kernel would be compiled, and
-    cached, twice."""
-    changes = {
-        k: np.array(v)
-        for k, v in model._asdict().items()
-        if isinstance(v, np.ndarray) and not v.flags.writeable
-    }
-    return model._replace(**changes) if changes else model
