@@ -53,8 +53,6 @@ def test_every_link_of_the_readme_and_docs_resolves():
         for target in re.findall(r"\]\(([^)#\s]+)(?:#[^)]*)?\)", page.read_text("utf-8")):
             if target.startswith(("http://", "https://")):
                 continue
-            if target == "docs/img/viewer.png":  # the viewer's screenshot, made by `view`
-                continue
             if not (page.parent / target).exists():
                 broken.append(f"{page.relative_to(ROOT)}: {target}")
     assert broken == []
