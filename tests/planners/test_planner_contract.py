@@ -283,7 +283,9 @@ LOOP_CHECKS = 3_000
 TIME_SLACK_S = TIME_LIMIT_S * 0.01 + LOOP_READS * READ_S + LOOP_CHECKS * CHECK_S
 
 
-def timed_solve(name: str, problem: Problem, limit_s: float, seed: int = SEED) -> Any:
+def timed_solve(
+    name: str, problem: Problem, limit_s: float, seed: int = SEED, read_s: float = READ_S
+) -> Any:
     """Solve leg 0 of ``problem`` with only a time limit, on a :class:`StepClock` counting
     the checks of the problem's checker; returns the result, the clock's time when the
     solve returned (from 0 before the context is built: set-up included) and the clock."""
@@ -293,7 +295,7 @@ def timed_solve(name: str, problem: Problem, limit_s: float, seed: int = SEED) -
 
     planner = make_planner(name, OVERRIDES.get(name, {}))
     checker = problem_checker(problem) if not getattr(planner, "allows_contact", False) else None
-    clock = StepClock(READ_S, CHECK_S, (lambda: checker.checks) if checker is not None else None)
+    clock = StepClock(read_s, CHECK_S, (lambda: checker.checks) if checker is not None else None)
     budget = Budget(time_limit_s=limit_s, clock=clock)
     rng = np.random.default_rng(seed)
     if REGISTRY[name].needs_stepper:
