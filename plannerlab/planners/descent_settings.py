@@ -17,7 +17,7 @@ from __future__ import annotations
 
 import dataclasses
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, cast
 
 import numpy as np
 
@@ -27,6 +27,9 @@ from plannerlab.errors import PlannerlabError
 ESCAPES = ("none", "detour", "random_detour", "rrtconnect")
 #: how the field and the step are computed (``backend`` setting)
 BACKENDS = ("compiled", "numpy")
+#: the default of a distance setting derived from the robot: None until
+#: :meth:`ClearanceSettings.for_robot` sets it (typed as the float it then is)
+DERIVED: float = cast(float, None)
 #: significant digits of the size ratio (a ratio computed in another base frame rounds
 #: to the same value: Arm-Z's is exactly 1.0 wherever its base stands)
 RATIO_DIGITS = 6
@@ -187,7 +190,7 @@ class ClearanceSettings:
     r1: float = 1.0
     r2: float = 1.0
     clearance_weight: float = 0.2
-    margin_m: float | None = None
+    margin_m: float = DERIVED
     direction: str = "gauss_newton"
     damping: float = 0.1
     max_step_rad: float = 0.0
@@ -196,18 +199,18 @@ class ClearanceSettings:
     stall_min_decrease: float = 1e-3
     goal_depth: float = 0.3
     deepen_iterations: int = 100
-    min_clearance_m: float | None = None
-    hold_band_m: float | None = None
+    min_clearance_m: float = DERIVED
+    hold_band_m: float = DERIVED
     settle_iterations: int = 100
     settle_fraction: float = 0.7
     escape: str = "none"
     max_escapes: int = 3
     escape_checks: int = 50000
-    approach_m: float | None = None
+    approach_m: float = DERIVED
     retract_step: int = 2
-    subgoal_pos_tol_m: float | None = None
+    subgoal_pos_tol_m: float = DERIVED
     subgoal_angle_tol_deg: float = 30.0
-    retract_jitter_m: float | None = None
+    retract_jitter_m: float = DERIVED
     escape_goal_samples: int = 4
     hold_clearance: bool = True
     backend: str = "compiled"
@@ -256,6 +259,7 @@ class ClearanceSettings:
 
 __all__ = [
     "BACKENDS",
+    "DERIVED",
     "DERIVED_DISTANCES",
     "ESCAPES",
     "ClearanceSettings",

@@ -62,7 +62,7 @@ from plannerlab.planners.base import (
 )
 from plannerlab.planners.clearance import SetupStopped
 from plannerlab.planners.context import LegPlanner, PlanningContext
-from plannerlab.planners.descent_settings import resolve_distances
+from plannerlab.planners.descent_settings import DERIVED, resolve_distances
 from plannerlab.planners.gradient_clearance import ClearanceDescent, ClearanceSettings, LegPath
 from plannerlab.problem.scene import Box, Cylinder, Scene, Sphere
 from plannerlab.robots.base import Array, joint_difference
@@ -124,14 +124,14 @@ class FollowLeaderSettings:
 
     voxel_m: float = 0.0
     max_voxels: int = 1_000_000
-    extra_clearance_m: float | None = None
-    centre_m: float | None = None
+    extra_clearance_m: float = DERIVED
+    centre_m: float = DERIVED
     centre_weight: float = 4.0
-    pad_m: float | None = None
-    approach_m: float | None = None
-    subgoal_pos_tol_m: float | None = None
+    pad_m: float = DERIVED
+    approach_m: float = DERIVED
+    subgoal_pos_tol_m: float = DERIVED
     subgoal_angle_tol_deg: float = 45.0
-    stride_m: float | None = None
+    stride_m: float = DERIVED
     track_approach: bool = False
     escape: str = "none"
     random_grid: bool = False
