@@ -67,6 +67,9 @@ from plannerlab.planners.gradient_clearance import ClearanceDescent, ClearanceSe
 from plannerlab.problem.scene import Box, Cylinder, Scene, Sphere
 from plannerlab.robots.base import Array, joint_difference
 
+#: the default voxel is at least the arm's reach over this (50: a 1-m arm's voxel is at
+#: least 2 cm; an Arm-Z's, 16.8 m / 50 = 0.34 m, is its tip's half radius, 0.375 m)
+VOXELS_PER_REACH = 50.0
 #: the distance settings of :class:`FollowLeaderSettings` derived from the robot (see
 #: :mod:`~plannerlab.planners.descent_settings`): their values on Arm-Z [m]
 DERIVED_DISTANCES: dict[str, float] = {
@@ -89,8 +92,9 @@ class FollowLeaderSettings:
     (:class:`ClearanceSettings`), overridden as ``descent.<key>``.
 
     Attributes:
-        voxel_m: edge of the search grid's voxels [m]; 0: half the tip module's radius,
-            but never so fine that the search box holds more than ``max_voxels`` voxels
+        voxel_m: edge of the search grid's voxels [m]; 0: half the tip module's radius
+            or a fiftieth of the arm's reach, the larger (0.375 on Arm-Z), but never so
+            fine that the search box holds more than ``max_voxels`` voxels
             (then the edge that fits, :func:`grid_voxel_m`).
         max_voxels: the most voxels the search grid may hold [1]: the grid's memory and
             time cap (measured: about 400 bytes and 3 µs a voxel while it is built and
@@ -473,7 +477,9 @@ class FollowLeader(LegPlanner):
         base = F0[0, :3, 3]
         reach = float(np.sum(np.linalg.norm(np.diff(F0[:, :3, 3], axis=0), axis=1)))
         r_tip = float(np.asarray(robot.link_radii_m)[-1])
-        voxel = s.voxel_m if s.voxel_m > 0 else 0.5 * r_tip
+        # half the tip's radius, but no finer than the reach over VOXELS_PER_REACH: a thin
+        # robot's grid need not resolve its own thickness (an Arm-Z's is its tip's, 0.375 m)
+        voxel = s.voxel_m if s.voxel_m > 0 else max(0.5 * r_tip, reach / VOXELS_PER_REACH)
         offset = None
         weight = s.centre_weight
         if rng is not None:
