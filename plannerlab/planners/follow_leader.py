@@ -67,8 +67,7 @@ from plannerlab.planners.gradient_clearance import ClearanceDescent, ClearanceSe
 from plannerlab.problem.scene import Box, Cylinder, Scene, Sphere
 from plannerlab.robots.base import Array, joint_difference
 
-#: the default voxel is at least the arm's reach over this (50: a 1-m arm's voxel is at
-#: least 2 cm; an Arm-Z's, 16.8 m / 50 = 0.34 m, is its tip's half radius, 0.375 m)
+#: the default voxel is at least the reach over this (Arm-Z's 0.34 m < its 0.375 m)
 VOXELS_PER_REACH = 50.0
 #: the distance settings of :class:`FollowLeaderSettings` derived from the robot (see
 #: :mod:`~plannerlab.planners.descent_settings`): their values on Arm-Z [m]
@@ -244,11 +243,7 @@ def grid_voxel_m(
     """The voxel edge [m] of a search grid over a box of ``extent_m`` (3,): ``voxel_m``
     when its grid holds at most ``max_voxels`` voxels, else the smallest edge whose grid
     does (coarser: the path keeps its clearance, it only finds narrower gaps less well).
-    A ``voxel_m`` the user set (``voxel_set``) that passes the cap is refused.
-
-    Raises:
-        PlannerlabError: ``voxel_set`` and the grid would pass the cap.
-    """
+    A ``voxel_m`` the user set (``voxel_set``) that passes the cap: PlannerlabError."""
     if grid_voxels(extent_m, voxel_m) <= max_voxels:
         return float(voxel_m)
     if voxel_set:
@@ -477,8 +472,7 @@ class FollowLeader(LegPlanner):
         base = F0[0, :3, 3]
         reach = float(np.sum(np.linalg.norm(np.diff(F0[:, :3, 3], axis=0), axis=1)))
         r_tip = float(np.asarray(robot.link_radii_m)[-1])
-        # half the tip's radius, but no finer than the reach over VOXELS_PER_REACH: a thin
-        # robot's grid need not resolve its own thickness (an Arm-Z's is its tip's, 0.375 m)
+        # a thin robot's grid need not resolve its own thickness (voxel_m's docstring)
         voxel = s.voxel_m if s.voxel_m > 0 else max(0.5 * r_tip, reach / VOXELS_PER_REACH)
         offset = None
         weight = s.centre_weight
