@@ -4,7 +4,7 @@
 
 Reads ``STORE_DIR/<problem>/trials.jsonl`` (written by ``results/escapes/run.sh``), prints
 the Markdown tables that ``results/escapes.md`` holds between its ``<!-- headline -->`` and
-``<!-- /table -->`` marks (and rewrites them there, and the headline table in the README
+``<!-- /table -->`` marks (and rewrites them there, and the headline table in docs/results.md
 between ``<!-- escapes -->`` marks), and draws ``STORE_DIR/progress_traps.png`` and
 ``STORE_DIR/progress_tasks.png``. Only trials that ran (not killed, no error) count
 as runs; a trial killed past its wall-clock limit counts as run and failed.
@@ -249,7 +249,9 @@ def figures(data: dict[str, list[dict[str, Any]]], store_dir: Path) -> None:
             + (" of the legs still to go" if task else " of the best goal distance")
             + f" against planning time ({TIME_LIMIT_S:.0f} s per leg)",
             t_max_s=TIME_LIMIT_S * (7 if task else 1),
-            ylabel="legs still to go (median)" if task else "best goal distance (median)",
+            ylabel="legs still to go (median)"
+            if task
+            else "best goal distance (median) [x tolerance; 0: in the goal]",
         )
         save(fig, store_dir / f"progress_{name}.png")
 
@@ -271,7 +273,7 @@ def main() -> None:
         old = md.read_text()
         new = re.sub(r"<!-- headline -->.*<!-- /table -->\n", lambda _: text, old, flags=re.S)
         md.write_text(new)
-    readme = ROOT / "README.md"  # the headline table there too, between its own marks
+    readme = ROOT / "docs" / "results.md"  # the headline table there too, between its marks
     old = readme.read_text()
     head = "<!-- escapes -->\n" + headline(rs, TRAPS + TASKS) + "<!-- /escapes -->"
     readme.write_text(
