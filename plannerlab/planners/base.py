@@ -17,7 +17,7 @@ from __future__ import annotations
 import dataclasses
 import math
 import time
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
 from typing import Any, Protocol, runtime_checkable
 
 import numpy as np
@@ -34,6 +34,7 @@ __all__ = [
     "LegRun",
     "Progress",
     "PlanResult",
+    "StepClock",
     "Planner",
     "Status",
     "Stepper",
@@ -206,20 +207,38 @@ class BudgetTracker:
     :meth:`child`: its own limits and clock; its checks are this tracker's too (they are
     the shared checker's), and what it is charged is charged here as well.
 
+    Time is read on :attr:`clock`, a callable giving seconds: ``clock`` if given, else
+    the budget's (``Budget.clock``), else the parent's, else :func:`time.perf_counter`.
+    Every look at the time of a solve (its limit, its progress rows, its result's
+    ``time_s``, OMPL's termination condition, a set-up's stop) goes through it, so a
+    test that gives its own clock (:class:`StepClock`) checks a time limit without the
+    wall clock. Sub-budgets (:meth:`remaining`) carry the clock.
+
     Args:
         budget: the limits (a field None: no limit of that kind).
         checker: the collision checker whose ``checks`` count (None: charged checks only).
         parent: the tracker of the solve this one is a sub-solve of (:meth:`child`).
+        clock: the clock (default: as above).
     """
 
     def __init__(
-        self, budget: Any, checker: Any | None = None, parent: BudgetTracker | None = None
+        self,
+        budget: Any,
+        checker: Any | None = None,
+        parent: BudgetTracker | None = None,
+        clock: Callable[[], float] | None = None,
     ) -> None:
         self.budget = budget
         self.checker = checker
         self.parent = parent
+        if clock is None:
+            clock = getattr(budget, "clock", None)
+        if clock is None:
+            clock = parent.clock if parent is not None else time.perf_counter
+        #: the clock time is read on [s]
+        self.clock: Callable[[], float] = clock
         self._checks0 = checker.checks if checker is not None else 0
-        self._t0 = time.perf_counter()
+        self._t0 = float(clock())
         #: iterations charged from sub-solves
         self.iterations = 0
         #: collision checks charged (sub-solves, checks made elsewhere)
@@ -229,14 +248,20 @@ class BudgetTracker:
 
     @property
     def elapsed_s(self) -> float:
-        """Seconds since the tracker was made."""
-        return time.perf_counter() - self._t0
+        """Seconds since the tracker was made, on :attr:`clock`."""
+        return float(self.clock()) - self._t0
 
     @property
     def checks_used(self) -> int:
         """Collision checks used: the checker's since the start, plus those charged."""
         own = (self.checker.checks - self._checks0) if self.checker is not None else 0
         return own + self.charged_checks
+
+    def time_up(self) -> bool:
+        """Whether the time limit is reached (False without one): the poll of a set-up
+        (a field, a grid, a pool) that is not counted in iterations or checks."""
+        tl = self.budget.time_limit_s
+        return tl is not None and self.elapsed_s >= tl
 
     def checks_left(self) -> int | None:
         """Collision checks still allowed (None: no such limit)."""
@@ -286,13 +311,13 @@ class BudgetTracker:
             return None
         if checks_cap is not None:
             ch = checks_cap if ch is None else min(ch, checks_cap)
-        return Budget(max_iterations=it, max_collision_checks=ch, time_limit_s=tl)
+        return Budget(max_iterations=it, max_collision_checks=ch, time_limit_s=tl, clock=self.clock)
 
     def child(self, budget: Any) -> BudgetTracker:
         """The tracker of a sub-solve on this tracker's checker within ``budget`` (a slice
         of :meth:`remaining`): its clock and checks count from now; its checks are seen
         here through the shared checker, and its charged checks are charged here too."""
-        return BudgetTracker(budget, self.checker, parent=self)
+        return BudgetTracker(budget, self.checker, parent=self, clock=self.clock)
 
     def charge(self, sub: PlanResult, *, checks: bool = True) -> None:
         """Count a sub-solve's iterations, collision checks and FK calls as this solve's.
@@ -313,6 +338,40 @@ class BudgetTracker:
         self.charged_checks += int(checks)
         if self.parent is not None:
             self.parent.charge_checks(checks)
+
+
+class StepClock:
+    """A clock a test controls: it advances ``read_s`` at every read and ``check_s`` per
+    unit of ``work()`` (for example a checker's collision checks), from 0. Given as
+    ``Budget(time_limit_s=..., clock=StepClock(...))``, a planner's time limit is checked
+    on the planner's own work rather than on the machine's load: the same verdict on any
+    machine. ``reads`` counts the reads.
+
+    Args:
+        read_s: seconds each read advances the clock (> 0, so a loop that polls it ends).
+        check_s: seconds per unit of ``work()``.
+        work: a non-decreasing count of work done (None: none).
+    """
+
+    def __init__(
+        self, read_s: float, check_s: float = 0.0, work: Callable[[], int] | None = None
+    ) -> None:
+        if not read_s > 0:
+            raise PlannerlabError(f"StepClock: read_s must be > 0, got {read_s}")
+        self.read_s = float(read_s)
+        self.check_s = float(check_s)
+        self.work = work
+        self.reads = 0
+
+    def now(self) -> float:
+        """The time without a read [s]."""
+        done = self.work() if self.work is not None else 0
+        return self.reads * self.read_s + done * self.check_s
+
+    def __call__(self) -> float:
+        t = self.now()
+        self.reads += 1
+        return t
 
 
 class LegRun:

@@ -4,6 +4,14 @@ each other, with their gradient in joint space.
 Each link capsule (axis segment ``a → b``, radius ``r``) is represented by ``k`` spheres of
 radius ``r`` centred at ``p = a + t (b − a)`` for evenly spaced ``t`` in [0, 1], spaced at
 most ``0.4 r`` apart (so the spheres under-cover the capsule by less than 2 % of r).
+
+**Bounded.** A thin link (a 1-mm radius) would need thousands of spheres at that spacing,
+and the pairs grow as their square: the spheres are at most :data:`MAX_SPHERES` in all,
+so the spacing of the links whose ``0.4 r`` would pass that grows, every link alike,
+to ``max(0.4 r, spacing)`` with one spacing for the whole robot (the field then
+under-covers those links a little more; it only steers, the checker decides). The pair
+lists are built with numpy, and a ``stop()`` the builder is given (the leg's time limit)
+is asked between the links: building a field counts against the solve's time.
 Obstacles are exact (boxes, cylinders, spheres: signed point distances), so the field is
 a close, slightly optimistic estimate of the checker's distances; validity is always
 decided by the collision checker, the field only steers. The pairs are the checker's
@@ -21,12 +29,55 @@ Only numpy here; no collision library.
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
 
+from plannerlab.errors import PlannerlabError
 from plannerlab.problem.scene import Box, Cylinder, Scene, Sphere
 from plannerlab.robots.base import Array, Robot
+
+#: the most spheres a field holds (its self pairs grow as the square: 5e5 at most, some
+#: 25 MB and tens of milliseconds per state evaluated in numpy; Arm-Z holds 95, the
+#: continuum chain of continuum_case3 680)
+MAX_SPHERES = 1000
+
+
+class SetupStopped(PlannerlabError):
+    """A planner's set-up (a field, a grid) stopped because its ``stop()`` said so (the
+    solve's time limit was reached while it was being built)."""
+
+
+def sphere_counts(lengths_m: Array, radii_m: Array, max_spheres: int = MAX_SPHERES) -> Array:
+    """Spheres per link: ``max(2, ceil(length / spacing) + 1)`` with the spacing ``0.4 r``,
+    or, when those would be more than ``max_spheres`` in all, ``max(0.4 r, h)`` with the
+    smallest common ``h`` that keeps them within it (bisection on h)."""
+    lengths = np.asarray(lengths_m, dtype=float)
+    radii = np.asarray(radii_m, dtype=float)
+    if max_spheres < 2 * len(lengths):
+        raise PlannerlabError(
+            f"clearance field: {len(lengths)} links need at least {2 * len(lengths)} "
+            f"spheres, more than the cap of {max_spheres}"
+        )
+
+    def counts(h: float) -> Array:
+        spacing = np.maximum(0.4 * radii, h)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            k = np.where(spacing > 0, np.ceil(lengths / np.where(spacing > 0, spacing, 1.0)), 0.0)
+        return np.maximum(2, k.astype(np.int64) + 1)
+
+    n = counts(0.0)
+    if int(n.sum()) <= max_spheres:
+        return n
+    lo, hi = 0.0, float(lengths.max())  # at hi every link has 2 spheres
+    for _ in range(60):
+        mid = 0.5 * (lo + hi)
+        if int(counts(mid).sum()) <= max_spheres:
+            hi = mid
+        else:
+            lo = mid
+    return counts(hi)
 
 
 @dataclass(frozen=True)
@@ -96,9 +147,21 @@ class ClearanceField:
         scene: the obstacles.
         margin_m: pairs farther apart than this cost nothing.
         include_self: also link against link.
+        max_spheres: the most spheres in all (see the module docstring).
+        stop: asked between the links while the pairs are built; True raises
+            :class:`SetupStopped` (None: never).
     """
 
-    def __init__(self, robot: Robot, scene: Scene, margin_m: float, include_self: bool = True):
+    def __init__(
+        self,
+        robot: Robot,
+        scene: Scene,
+        margin_m: float,
+        include_self: bool = True,
+        *,
+        max_spheres: int = MAX_SPHERES,
+        stop: Callable[[], bool] | None = None,
+    ):
         if not margin_m > 0:
             raise ValueError(f"margin_m must be > 0, got {margin_m}")
         self.robot = robot
@@ -109,27 +172,36 @@ class ClearanceField:
         q_ref = np.clip(np.zeros(robot.dof), robot.lower, robot.upper)
         seg = robot.link_segments(q_ref)
         lengths = np.linalg.norm(seg[:, 1] - seg[:, 0], axis=-1)
-        counts = [
-            max(2, int(np.ceil(ln / (0.4 * r))) + 1) for ln, r in zip(lengths, radii, strict=True)
-        ]
+        counts = sphere_counts(lengths, radii, max_spheres)
         self._link = np.concatenate([np.full(k, i) for i, k in enumerate(counts)])
         self._t = np.concatenate([np.linspace(0.0, 1.0, k) for k in counts])
         self._r = radii[self._link]
-        moving = np.array([self._link[s] not in robot.fixed_links for s in range(len(self._t))])
-        self._scene_spheres = np.flatnonzero(moving)
-        excluded = robot.excluded_pairs
+        fixed = np.zeros(L, dtype=bool)
+        fixed[[i for i in robot.fixed_links if 0 <= i < L]] = True
+        self._scene_spheres = np.flatnonzero(~fixed[self._link])
+        # the link pairs checked against each other: not the same link, not excluded,
+        # not both fixed
+        allowed = ~np.eye(L, dtype=bool) & ~(fixed[:, None] & fixed[None, :])
+        for i, j in robot.excluded_pairs:
+            allowed[i, j] = allowed[j, i] = False
         ia, ib = [], []
-        for a in range(len(self._t)):
-            for b in range(a + 1, len(self._t)):
-                i, j = int(self._link[a]), int(self._link[b])
-                if i == j or (min(i, j), max(i, j)) in excluded:
-                    continue
-                if i in robot.fixed_links and j in robot.fixed_links:
-                    continue
-                ia.append(a)
-                ib.append(b)
-        self._self_a = np.array(ia, dtype=int) if include_self else np.zeros(0, dtype=int)
-        self._self_b = np.array(ib, dtype=int) if include_self else np.zeros(0, dtype=int)
+        if include_self:
+            # the sphere pairs a < b in order (a first), link by link of a
+            starts = np.concatenate([[0], np.cumsum(counts)])
+            spheres = np.arange(len(self._t))
+            for i in range(L):
+                if stop is not None and stop():
+                    raise SetupStopped(
+                        f"the clearance field of {L} links stopped at link {i}: time is up"
+                    )
+                later = spheres[starts[i] :]  # spheres of link i and after
+                ok = allowed[i, self._link[later]] & (later >= starts[i + 1])
+                b = later[ok]
+                for a in range(int(starts[i]), int(starts[i + 1])):
+                    ia.append(np.full(len(b), a))
+                    ib.append(b)
+        self._self_a = np.concatenate(ia).astype(int) if ia else np.zeros(0, dtype=int)
+        self._self_b = np.concatenate(ib).astype(int) if ib else np.zeros(0, dtype=int)
         self._n_links = L
         self._analytic = getattr(robot, "kind", "") == "armz"
 

@@ -87,9 +87,12 @@ class PlanningContext:
         contact: bool = False,
     ) -> PlanningContext:
         """The context of leg ``leg``: the checker (``checker``, or the problem's, built
-        here), then ``warm_up(problem, leg, q_start)`` (a planner's one-off costs: its
-        field, its compiled kernels), then the tracker, whose clock starts now, and the
-        start-state check (one collision check when the start is free), counted by it.
+        here), then ``warm_up(problem, leg, q_start)`` (a planner's one-off costs of the
+        process: its compiled kernels loaded), then the tracker, whose clock
+        (``budget.clock``, default the wall's) starts now, and the start-state check (one
+        collision check when the start is free), counted by it. A planner's set-up for
+        the problem (a clearance field, a grid, a goal pool) is built in ``plan``, in the
+        leg's time, and stops when that is spent.
 
         Args:
             problem: the problem; ``leg`` the leg's index.
@@ -97,7 +100,8 @@ class PlanningContext:
             q_start: (dof,) start (default: the problem's start).
             checker: the problem's checker when the caller has one (one per problem).
             stepper: the simulator of a closed-loop planner.
-            warm_up: a planner's one-off preparation, kept outside the limits.
+            warm_up: a planner's one-off preparation of the process (compiled kernels
+                loaded), kept outside the limits.
             contact: the leg of a contact-permitting planner (its paths touch obstacles
                 by design): its start is not checked for collision, and its tracker
                 counts only the checks the planner charges (its contact classification),
@@ -197,7 +201,9 @@ class LegPlanner:
     (:meth:`PlanningContext.for_planner`) and plans in it.
 
     A subclass sets ``name`` and ``settings`` and implements :meth:`plan`; it may
-    implement :meth:`warm_up` (one-off costs kept outside the time limit) and set
+    implement :meth:`warm_up` (one-off costs of the process, compiled kernels loaded,
+    kept outside the time limit; set-up for the problem belongs in :meth:`plan`, inside
+    it: ``ctx.tracker.time_up`` is its poll) and set
     ``allows_contact`` (a planner whose paths touch obstacles by design: no start check).
     """
 

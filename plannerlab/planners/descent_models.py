@@ -121,7 +121,7 @@ class CompiledModel:
         self._settings = s
         # distances beyond both the margin and the hold's floor matter to no test of the
         # descent (the spacious test looks only below min_clearance_m)
-        self._core = CompiledField(field, far_m=max(s.margin_m, s.min_clearance_m + 0.01))
+        self._core = CompiledField(field, far_m=max(s.margin_m, s.min_clearance_m + s.hold_band_m))
 
     def point(self, goal, q: Array, d_ref: Array | None = None):
         s = self._settings
@@ -143,7 +143,7 @@ class CompiledModel:
         """The held step, projected in the metric of the step's quadratic model at q
         (:meth:`ClearanceDescent._metric`, which the compiled evaluation returns)."""
         metric = self.point(goal, q).metric
-        floor = self._settings.min_clearance_m + 0.01
+        floor = self._settings.min_clearance_m + self._settings.hold_band_m
         return self._core.hold_clearance(q, direction, floor, metric)
 
     def warm_up(self, goal, q: Array) -> None:

@@ -135,10 +135,11 @@ class DescentStep:
         self, field: ClearanceField, q: Array, direction: Array, metric: Array | None = None
     ) -> Array:
         """The step ``direction`` (dof,) changed as little as possible so that no sphere
-        pair within 1 cm of ``min_clearance_m`` comes closer (to first order: it moves
-        away at a small angle, 0.1 of its gradient's full rate), so the descent slides
-        along the clearance floor instead of stalling against it (a step that would take
-        such a pair closer is refused, and the descent otherwise only shrinks its step).
+        pair within ``hold_band_m`` (1 cm on Arm-Z) of ``min_clearance_m`` comes closer
+        (to first order: it moves away at a small angle, 0.1 of its gradient's full
+        rate), so the descent slides along the clearance floor instead of stalling
+        against it (a step that would take such a pair closer is refused, and the
+        descent otherwise only shrinks its step).
         Active-set projection, at most 10 rounds.
 
         "As little as possible" is measured in ``metric`` (A, the quadratic model's
@@ -150,7 +151,7 @@ class DescentStep:
         s = self.settings
         p, J = field._centres_and_jacobians(q)
         d, n, a, b = field._pairs(p)
-        active = np.flatnonzero(d < s.min_clearance_m + 0.01)
+        active = np.flatnonzero(d < s.min_clearance_m + s.hold_band_m)
         if active.size == 0:
             return direction
         G = np.einsum("ck,ckj->cj", n[active], J[a[active]])

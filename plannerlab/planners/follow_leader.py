@@ -60,49 +60,81 @@ from plannerlab.planners.base import (
     settings_dict,
     with_overrides,
 )
+from plannerlab.planners.clearance import SetupStopped
 from plannerlab.planners.context import LegPlanner, PlanningContext
+from plannerlab.planners.descent_settings import DERIVED, resolve_distances
 from plannerlab.planners.gradient_clearance import ClearanceDescent, ClearanceSettings, LegPath
 from plannerlab.problem.scene import Box, Cylinder, Scene, Sphere
 from plannerlab.robots.base import Array, joint_difference
+
+#: the default voxel is at least the reach over this (Arm-Z's 0.34 m < its 0.375 m)
+VOXELS_PER_REACH = 50.0
+#: the distance settings of :class:`FollowLeaderSettings` derived from the robot (see
+#: :mod:`~plannerlab.planners.descent_settings`): their values on Arm-Z [m]
+DERIVED_DISTANCES: dict[str, float] = {
+    "extra_clearance_m": 0.05,
+    "centre_m": 1.5,
+    "pad_m": 3.0,
+    "approach_m": 2.5,
+    "subgoal_pos_tol_m": 0.5,
+    "stride_m": 1.0,
+}
 
 
 @dataclass(frozen=True)
 class FollowLeaderSettings:
     """Settings of follow-the-leader.
 
+    Distances marked *derived* default to None: Arm-Z's value (given) scaled to the
+    robot's size (:mod:`~plannerlab.planners.descent_settings`: the typical link length
+    over Arm-Z's module); a value set wins. The clearance descent's settings are its own
+    (:class:`ClearanceSettings`), overridden as ``descent.<key>``.
+
     Attributes:
-        voxel_m: edge of the search grid's voxels [m]; 0: half the tip module's radius.
+        voxel_m: edge of the search grid's voxels [m]; 0: half the tip module's radius
+            or a fiftieth of the arm's reach, the larger (0.375 on Arm-Z), but never so
+            fine that the search box holds more than ``max_voxels`` voxels
+            (then the edge that fits, :func:`grid_voxel_m`).
+        max_voxels: the most voxels the search grid may hold [1]: the grid's memory and
+            time cap (measured: about 400 bytes and 3 µs a voxel while it is built and
+            searched, so 1e6 voxels take about 400 MB and 3 s; an Arm-Z's grid holds at
+            most 0.78e6, bounded by its reach). A ``voxel_m`` set that would pass it is
+            refused with an error naming both.
         extra_clearance_m: clearance the tip path keeps beyond the tip module's radius and
-            the problem's safety margin [m].
-        centre_m: distance from the obstacles below which a path step costs more [m].
+            the problem's safety margin [m]; derived, 0.05 on Arm-Z.
+        centre_m: distance from the obstacles below which a path step costs more [m];
+            derived, 1.5 on Arm-Z.
         centre_weight: how much more: a step at distance d costs its length times
-            ``1 + centre_weight · max(0, 1 − d / centre_m)``.
+            ``1 + centre_weight · max(0, 1 − d / centre_m)`` [1].
         pad_m: the search box reaches this far beyond the start tip, the goal, its
-            approach point and the arm's base [m] (and never beyond the arm's reach from
-            its base); doubled while no path is found, up to the reach.
-        approach_m: the path ends at ``p_d − approach_m · n_d``, the goal's approach point.
-        subgoal_pos_tol_m, subgoal_angle_tol_deg: tolerances of the moving sub-goal.
-        stride_m: spacing of the sub-goals along the path's segments after its first [m].
+            approach point and the arm's base (and never beyond the arm's reach from its
+            base); doubled while no path is found, up to the reach [m]; derived, 3 on
+            Arm-Z.
+        approach_m: the path ends at ``p_d − approach_m · n_d``, the goal's approach
+            point, then goes in along the goal's normal [m]; derived, 2.5 on Arm-Z.
+        subgoal_pos_tol_m: position tolerance of the moving sub-goal [m]; derived, 0.5
+            on Arm-Z.
+        subgoal_angle_tol_deg: angle tolerance of the moving sub-goal [deg].
+        stride_m: spacing of the sub-goals along the path's segments after its first
+            [m]; derived, 1 on Arm-Z.
         track_approach: also sub-goals every ``stride_m`` from the approach point towards
             the goal, looking along the goal's normal (the finish then starts closer).
         escape: "none" or "detour" (the clearance descent's detour from a stall).
         random_grid: shift the grid by a random fraction of a voxel and scale
             ``centre_weight`` by a random factor in [0.5, 1.5] (the seed's draw).
-        max_replans: (``random_grid``) new leader paths drawn from where a try ended.
-
-    The clearance descent's settings are its own (:class:`ClearanceSettings`), overridden
-    as ``descent.<key>``.
+        max_replans: (``random_grid``) new leader paths drawn from where a try ended [1].
     """
 
     voxel_m: float = 0.0
-    extra_clearance_m: float = 0.05
-    centre_m: float = 1.5
+    max_voxels: int = 1_000_000
+    extra_clearance_m: float = DERIVED
+    centre_m: float = DERIVED
     centre_weight: float = 4.0
-    pad_m: float = 3.0
-    approach_m: float = 2.5
-    subgoal_pos_tol_m: float = 0.5
+    pad_m: float = DERIVED
+    approach_m: float = DERIVED
+    subgoal_pos_tol_m: float = DERIVED
     subgoal_angle_tol_deg: float = 45.0
-    stride_m: float = 1.0
+    stride_m: float = DERIVED
     track_approach: bool = False
     escape: str = "none"
     random_grid: bool = False
@@ -111,13 +143,30 @@ class FollowLeaderSettings:
     def __post_init__(self) -> None:
         if not self.voxel_m >= 0:
             raise PlannerlabError(f"voxel_m must be >= 0, got {self.voxel_m}")
+        if self.max_voxels < 8:
+            raise PlannerlabError(f"max_voxels must be >= 8, got {self.max_voxels}")
         if self.escape not in ("none", "detour"):
             raise PlannerlabError(f"escape setting: 'none' or 'detour', got {self.escape!r}")
-        for key in ("stride_m", "subgoal_pos_tol_m", "centre_m"):
-            if not getattr(self, key) > 0:
-                raise PlannerlabError(f"{key} must be > 0, got {getattr(self, key)}")
+        for key in ("stride_m", "subgoal_pos_tol_m", "centre_m", "pad_m"):
+            value = getattr(self, key)
+            if value is not None and not value > 0:
+                raise PlannerlabError(f"{key} must be > 0, got {value}")
+        for key in ("extra_clearance_m", "approach_m"):
+            value = getattr(self, key)
+            if value is not None and not value >= 0:
+                raise PlannerlabError(f"{key} must be >= 0, got {value}")
         if self.max_replans < 0:
             raise PlannerlabError(f"max_replans must be >= 0, got {self.max_replans}")
+
+    @property
+    def resolved(self) -> bool:
+        """Whether every derived distance has a value."""
+        return all(getattr(self, k) is not None for k in DERIVED_DISTANCES)
+
+    def for_robot(self, robot: Any) -> FollowLeaderSettings:
+        """These settings with every derived distance that is None set for ``robot``."""
+        out: FollowLeaderSettings = resolve_distances(self, DERIVED_DISTANCES, robot)
+        return out
 
 
 # ---------------------------------------------------------------------- workspace search
@@ -181,6 +230,38 @@ def grid_distance_m(scene: Scene, axes: list[Array], cap_m: float) -> Array:
     return d
 
 
+def grid_voxels(extent_m: Array, voxel_m: float) -> int:
+    """Voxels of the search grid over a box of ``extent_m`` (3,) [m] with edge ``voxel_m``
+    (one more per axis for the grid's shift, as :func:`tip_path` lays it)."""
+    shape = np.maximum(np.ceil(np.asarray(extent_m, dtype=float) / voxel_m).astype(int) + 2, 2)
+    return int(np.prod(shape.astype(float)))
+
+
+def grid_voxel_m(
+    extent_m: Array, voxel_m: float, max_voxels: int, *, voxel_set: bool = False
+) -> float:
+    """The voxel edge [m] of a search grid over a box of ``extent_m`` (3,): ``voxel_m``
+    when its grid holds at most ``max_voxels`` voxels, else the smallest edge whose grid
+    does (coarser: the path keeps its clearance, it only finds narrower gaps less well).
+    A ``voxel_m`` the user set (``voxel_set``) that passes the cap: PlannerlabError."""
+    if grid_voxels(extent_m, voxel_m) <= max_voxels:
+        return float(voxel_m)
+    if voxel_set:
+        raise PlannerlabError(
+            f"follow-the-leader: voxel_m = {voxel_m:g} m gives a search grid of "
+            f"{grid_voxels(extent_m, voxel_m):.3g} voxels over a box of "
+            f"{np.round(np.asarray(extent_m, dtype=float), 3).tolist()} m, more than "
+            f"max_voxels = {max_voxels}: set a coarser voxel_m (or leave it at 0: "
+            "coarsened to fit)"
+        )
+    edge = float(voxel_m)
+    while grid_voxels(extent_m, edge) > max_voxels:
+        # the edge at which the volume alone would fit, then a little more for the ceilings
+        vol = float(np.prod(np.maximum(np.asarray(extent_m, dtype=float), edge)))
+        edge = max(edge * 1.01, (vol / max_voxels) ** (1.0 / 3.0))
+    return edge
+
+
 #: the 13 grid offsets of a 26-neighbourhood, one of each opposite pair
 _OFFSETS = np.array(
     [(i, j, k) for i in (-1, 0, 1) for j in (-1, 0, 1) for k in (-1, 0, 1) if (i, j, k) > (0, 0, 0)]
@@ -221,12 +302,16 @@ def tip_path(
     reach_m: float,
     offset_m: Array | None = None,
     stop: Callable[[], bool] | None = None,
+    max_voxels: int | None = None,
+    voxel_set: bool = False,
 ) -> TipPath | None:
     """The leader's path from ``start_m`` to the approach point ``goal_m − approach_m ·
     goal_n`` on the free voxels (obstacle distance >= ``clearance_m``), then to ``goal_m``;
     None when the two are not connected. The start and the approach point are joined to
     their nearest free voxel (a tip that starts close to a wall). See the module docstring.
     ``stop()`` is asked between the stages (distances, graph, search): True gives None.
+    The grid holds at most ``max_voxels`` voxels (:func:`grid_voxel_m`): a finer
+    ``voxel_m`` is coarsened to fit, or, when the user set it (``voxel_set``), refused.
     """
     start = np.asarray(start_m, dtype=float)
     goal = np.asarray(goal_m, dtype=float)
@@ -236,6 +321,8 @@ def tip_path(
     hi = np.max(pts, axis=0) + pad_m
     lo = np.maximum(lo, np.asarray(reach_centre_m) - reach_m)
     hi = np.minimum(hi, np.asarray(reach_centre_m) + reach_m)
+    if max_voxels is not None:
+        voxel_m = grid_voxel_m(hi - lo, voxel_m, max_voxels, voxel_set=voxel_set)
     lo = lo + (np.zeros(3) if offset_m is None else np.asarray(offset_m) - voxel_m)
     shape = np.maximum(np.ceil((hi - lo) / voxel_m).astype(int) + 1, 2)
     axes = [lo[k] + voxel_m * np.arange(shape[k]) for k in range(3)]
@@ -250,6 +337,8 @@ def tip_path(
     w_node = 1.0 + centre_weight * np.maximum(0.0, 1.0 - dist[free] / centre_m)
     rows, cols, vals = [], [], []
     for off in _OFFSETS:
+        if stop is not None and stop():  # the graph's 13 directions: a poll each
+            return None
         nb = ijk + off
         ok = np.all((nb >= 0) & (nb < shape), axis=1)
         a = np.flatnonzero(ok)
@@ -335,13 +424,32 @@ class FollowLeader(LegPlanner):
         )
         self._finish = ClearanceDescent(name, replace(descent, escape="none"))
         self._detour = ClearanceDescent(name, replace(descent, escape="detour"), escape_planner)
+        self.escape_planner = escape_planner
+        #: (robot, this planner with its distances derived for it) (see :meth:`for_robot`)
+        self._resolved: tuple[Any, FollowLeader] | None = None
+
+    def for_robot(self, robot: Any) -> FollowLeader:
+        """This planner with its derived distance settings (and its descents') set for
+        ``robot``; itself when none is left to derive."""
+        if self.settings.resolved and self.descent_settings.resolved:
+            return self
+        cached = self._resolved
+        if cached is not None and cached[0] is robot:
+            return cached[1]
+        planner = FollowLeader(
+            self.name,
+            self.settings.for_robot(robot),
+            self.descent_settings.for_robot(robot),
+            self.escape_planner,
+        )
+        self._resolved = (robot, planner)
+        return planner
 
     def warm_up(self, problem, leg: int, q_start: Array) -> None:
-        """The fields of the tracking and the finishing descents (their compiled kernels
-        loaded), before the leg's tracker starts: one-off costs outside the limits."""
-        goal = problem.goal(leg)
-        for descent in (self._track, self._finish):
-            descent.model(problem).warm_up(goal, q_start)
+        """The descents' compiled kernels loaded before the leg's tracker starts (a
+        one-off cost of the process, outside the limits). Their fields and the leader's
+        grid are set-up, built in the solve's time."""
+        self._track.warm_up(problem, leg, q_start)
 
     def leader_path(
         self,
@@ -353,6 +461,9 @@ class FollowLeader(LegPlanner):
     ) -> TipPath | None:
         """The leader's path from the tip of ``q`` into leg's goal (randomised with rng;
         None when there is none, or ``stop()`` said so)."""
+        resolved = self.for_robot(problem.robot)
+        if resolved is not self:
+            return resolved.leader_path(problem, leg, q, rng, stop)
         s = self.settings
         robot = problem.robot
         goal = problem.goal(leg)
@@ -361,7 +472,8 @@ class FollowLeader(LegPlanner):
         base = F0[0, :3, 3]
         reach = float(np.sum(np.linalg.norm(np.diff(F0[:, :3, 3], axis=0), axis=1)))
         r_tip = float(np.asarray(robot.link_radii_m)[-1])
-        voxel = s.voxel_m if s.voxel_m > 0 else 0.5 * r_tip
+        # a thin robot's grid need not resolve its own thickness (voxel_m's docstring)
+        voxel = s.voxel_m if s.voxel_m > 0 else max(0.5 * r_tip, reach / VOXELS_PER_REACH)
         offset = None
         weight = s.centre_weight
         if rng is not None:
@@ -384,6 +496,8 @@ class FollowLeader(LegPlanner):
                 reach_m=reach,
                 offset_m=offset,
                 stop=stop,
+                max_voxels=s.max_voxels,
+                voxel_set=s.voxel_m > 0,
             )
             if leader is not None or pad >= reach or (stop is not None and stop()):
                 return leader
@@ -462,6 +576,9 @@ class FollowLeader(LegPlanner):
 
     def plan(self, ctx: PlanningContext, rng: np.random.Generator) -> PlanResult:
         """Plan the leader's path, follow it, finish with the leg's descent."""
+        resolved = self.for_robot(ctx.robot)
+        if resolved is not self:
+            return resolved.plan(ctx, rng)
         s = self.settings
         problem, leg, robot, goal, tracker = ctx.problem, ctx.leg, ctx.robot, ctx.goal, ctx.tracker
         q0 = ctx.q_start
@@ -479,6 +596,11 @@ class FollowLeader(LegPlanner):
         if ctx.start_problem is not None:
             return done(Status.INVALID_START, ctx.start_problem)
         leg_path.note([q0])
+        try:  # the descents' fields: set-up, in the leg's time
+            for descent in (self._track, self._finish):
+                descent.model(problem, tracker.time_up)
+        except SetupStopped as exc:
+            return done(Status.BUDGET_EXHAUSTED, f"{tracker.exhausted() or 'time is up'}: {exc}")
         draw_rng = rng if s.random_grid else None
         attempts = 1 + (s.max_replans if s.random_grid else 0)
         reason = ""

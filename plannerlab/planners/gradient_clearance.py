@@ -75,7 +75,7 @@ from plannerlab.planners.base import (
     Status,
     with_overrides,
 )
-from plannerlab.planners.clearance import ClearanceField
+from plannerlab.planners.clearance import ClearanceField, SetupStopped
 from plannerlab.planners.context import LegPlanner, PlanningContext, plan_in
 from plannerlab.planners.descent_models import CompiledModel, Model, NumpyModel
 from plannerlab.planners.descent_settings import ClearanceSettings
@@ -99,6 +99,22 @@ class ClearanceDescent(DescentStep, LegPlanner):
         self.escape_planner = escape_planner
         #: (problem, its model): the field of the last problem solved (see :meth:`model`)
         self._model_cache: tuple[Any, Model] | None = None
+        #: (robot, this descent with its distances derived for it) (see :meth:`for_robot`)
+        self._resolved: tuple[Any, ClearanceDescent] | None = None
+
+    def for_robot(self, robot: Any) -> ClearanceDescent:
+        """This descent with its derived distance settings (None: ``margin_m``,
+        ``min_clearance_m``, ``approach_m``, …) set for ``robot``
+        (:meth:`ClearanceSettings.for_robot`); itself when none is left to derive. Every
+        entry point plans with it, so a solve's result records the values used."""
+        if self.settings.resolved:
+            return self
+        cached = self._resolved
+        if cached is not None and cached[0] is robot:
+            return cached[1]
+        descent = ClearanceDescent(self.name, self.settings.for_robot(robot), self.escape_planner)
+        self._resolved = (robot, descent)
+        return descent
 
     # ------------------------------------------------------------------ pieces
     def _settle(
@@ -138,15 +154,28 @@ class ClearanceDescent(DescentStep, LegPlanner):
                 radius *= 0.5
         return used
 
-    def model(self, problem) -> Model:
+    def backend_for(self, robot: Any) -> str:
+        """The engine the field runs on for ``robot``: "compiled" (the ``backend``
+        setting's default) on an Arm-Z, else "numpy"."""
+        if self.settings.backend == "compiled" and getattr(robot, "kind", "") == "armz":
+            return "compiled"
+        return "numpy"
+
+    def model(self, problem, stop: Callable[[], bool] | None = None) -> Model:
         """The field and step of ``problem`` on the ``backend`` setting's engine (built
-        once per problem and kept: building the field's pair lists takes milliseconds)."""
+        once per problem and kept: building the field's pair lists takes milliseconds,
+        and is bounded, :data:`~plannerlab.planners.clearance.MAX_SPHERES`). It is built
+        in the first solve's time: ``stop()`` (the leg's time limit) is asked while it is
+        built, and True raises :class:`~plannerlab.planners.clearance.SetupStopped`."""
+        resolved = self.for_robot(problem.robot)
+        if resolved is not self:
+            return resolved.model(problem, stop)
         cached = self._model_cache
         if cached is not None and cached[0] is problem:
             return cached[1]
-        field = ClearanceField(problem.robot, problem.scene, self.settings.margin_m)
+        field = ClearanceField(problem.robot, problem.scene, self.settings.margin_m, stop=stop)
         model: Model
-        if self.settings.backend == "compiled" and getattr(problem.robot, "kind", "") == "armz":
+        if self.backend_for(problem.robot) == "compiled":
             model = CompiledModel(self, field)
         else:
             model = NumpyModel(self, field)
@@ -170,11 +199,14 @@ class ClearanceDescent(DescentStep, LegPlanner):
         the states are not checked (goal selection near q_start). ``iterations_before``:
         iterations the leg has already used (the budget is the leg's, ``ctx.tracker``).
         """
+        resolved = self.for_robot(ctx.robot)
+        if resolved is not self:
+            return resolved.descend(ctx, q_start, goal, iterations_before, checked=checked)
         s = self.settings
         problem, robot, tracker = ctx.problem, ctx.robot, ctx.tracker
         checker = ctx.checker if checked else None
         goal = goal if goal is not None else ctx.goal
-        model = self.model(problem)
+        model = self.model(problem, tracker.time_up)
         max_step = s.max_step_rad if s.max_step_rad > 0 else problem.joint_step / 2
         q = np.array(q_start, dtype=float)
         path = [q.copy()]
@@ -266,7 +298,13 @@ class ClearanceDescent(DescentStep, LegPlanner):
         the part of the arm that F does not need to move stays where it is. One check.
         The goal finder (:data:`~plannerlab.planners.context.NearGoal`) this descent
         hands its ``rrtconnect`` escape, with its own settings."""
-        status, _, path, _, _ = self.leg_descent(ctx, q, checked=False)
+        resolved = self.for_robot(ctx.robot)
+        if resolved is not self:
+            return resolved.near_goal_state(ctx, q)
+        try:
+            status, _, path, _, _ = self.leg_descent(ctx, q, checked=False)
+        except SetupStopped:  # out of time while building the field: no goal found
+            return None
         q_goal = path[-1]
         if status is Status.SOLVED and ctx.checker.is_valid(q_goal):
             return q_goal
@@ -286,6 +324,9 @@ class ClearanceDescent(DescentStep, LegPlanner):
         sub-goal tolerances: the tip comes in along the inspection normal), then to the
         goal; if the approach stalls, the descent to the goal continues from there. A goal
         state (:class:`JointGoal`) has no approach point."""
+        resolved = self.for_robot(ctx.robot)
+        if resolved is not self:
+            return resolved.leg_descent(ctx, q_start, used, checked=checked)
         s = self.settings
         goal = ctx.goal
         path = [np.array(q_start)]
@@ -428,13 +469,21 @@ class ClearanceDescent(DescentStep, LegPlanner):
 
     # ------------------------------------------------------------------ solve
     def warm_up(self, problem, leg: int, q_start: Array) -> None:
-        """Build the field (and for the compiled backend, load or compile its core) before
-        the leg's tracker starts, like the checker: a one-off cost outside the limits."""
-        self.model(problem).warm_up(problem.goal(leg), q_start)
+        """For the compiled backend on an Arm-Z, load (or compile) its kernels before the
+        leg's tracker starts, like the checker's core: a one-off cost of the process,
+        outside the limits. The problem's field is set-up, built in the solve's time
+        (:meth:`model`)."""
+        if self.backend_for(problem.robot) == "compiled":
+            from plannerlab.planners._descent_core import warm_up
+
+            warm_up()
 
     def plan(self, ctx: PlanningContext, rng: np.random.Generator) -> PlanResult:
         """Descend F from the context's start into its leg's goal region; at a stall,
         escape from the stall state (``escape`` setting) and descend again."""
+        resolved = self.for_robot(ctx.robot)
+        if resolved is not self:
+            return resolved.plan(ctx, rng)
         s = self.settings
         problem, robot, goal, tracker = ctx.problem, ctx.robot, ctx.goal, ctx.tracker
         q0 = ctx.q_start
@@ -457,13 +506,17 @@ class ClearanceDescent(DescentStep, LegPlanner):
                     "descent_rad": descent_rad,
                     "escapes": escapes_log,
                     # what ran: "compiled" falls back to numpy for robots other than Arm-Z
-                    "descent_backend": self.model(problem).backend,
+                    "descent_backend": self.backend_for(robot),
                 },
             )
 
         if ctx.start_problem is not None:
             return done(Status.INVALID_START, ctx.start_problem)
         leg_path.note([q0])
+        try:  # the set-up, in the leg's time
+            self.model(problem, tracker.time_up)
+        except SetupStopped as exc:
+            return done(Status.BUDGET_EXHAUSTED, f"{tracker.exhausted() or 'time is up'}: {exc}")
         q = q0
         while True:
             st, reason, seg, tr, it = self.leg_descent(ctx, q, leg_path.iterations)

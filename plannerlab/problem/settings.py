@@ -4,7 +4,8 @@ and ``[simulation]`` tables, their types (:class:`Budget`, :class:`SimSettings`)
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from collections.abc import Callable
+from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
@@ -30,18 +31,30 @@ MAX_SAFETY_MARGIN_M = 0.5
 class Budget:
     """Limits of one planning call. ``None`` means no limit of that kind.
 
-    Regression tests use iterations or collision checks; time limits are for benchmarks.
+    Regression tests use iterations or collision checks; time limits are for benchmarks,
+    or for tests on a clock the test controls.
+
+    Attributes:
+        max_iterations: the planner's iterations.
+        max_collision_checks: collision checks.
+        time_limit_s: seconds on ``clock``, set-up included.
+        clock: the clock ``time_limit_s`` is read on: a callable giving seconds (None:
+            ``time.perf_counter``). A test gives its own (for example
+            :class:`~plannerlab.planners.base.StepClock`) so that a time limit is checked
+            without the wall clock; it is not part of the budget's record (``to_dict``).
     """
 
     max_iterations: int | None = None
     max_collision_checks: int | None = None
     time_limit_s: float | None = None
+    clock: Callable[[], float] | None = field(default=None, repr=False, compare=False)
 
     def replace(self, **changes: Any) -> Budget:
         values = {
             "max_iterations": self.max_iterations,
             "max_collision_checks": self.max_collision_checks,
             "time_limit_s": self.time_limit_s,
+            "clock": self.clock,
         }
         values.update({k: v for k, v in changes.items() if v is not None})
         return Budget(**values)  # type: ignore[arg-type]

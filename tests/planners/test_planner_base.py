@@ -8,7 +8,8 @@ import pytest
 from conftest import toy_problem
 
 from plannerlab.collision.fcl_checker import CollisionChecker
-from plannerlab.planners.base import BudgetTracker, LegRun, PlanResult, Status
+from plannerlab.errors import PlannerlabError
+from plannerlab.planners.base import BudgetTracker, LegRun, PlanResult, Status, StepClock
 from plannerlab.planners.gradient import GradientSettings
 from plannerlab.problem.load import Budget
 from plannerlab.robots.paths import path_length
@@ -71,6 +72,39 @@ def test_a_time_limit_counts_from_the_trackers_start():
     assert tracker.exhausted() == "time limit of 1e-09 s reached"
     assert tracker.remaining() is None
     assert BudgetTracker(Budget(time_limit_s=3600.0)).remaining() is not None
+
+
+def test_a_tracker_reads_the_budgets_clock_and_hands_it_to_sub_budgets_and_children():
+    clock = StepClock(0.1)
+    budget = Budget(time_limit_s=1.0, clock=clock)
+    tracker = BudgetTracker(budget)  # its start: the clock's first read, 0
+    assert tracker.clock is clock
+    assert tracker.elapsed_s == pytest.approx(0.1)
+    sub = tracker.remaining()  # read at 0.2: 0.8 s left, on the same clock
+    assert sub is not None and sub.clock is clock
+    assert sub.time_limit_s == pytest.approx(0.8)
+    child = tracker.child(sub)
+    assert child.clock is clock and child.elapsed_s == pytest.approx(0.1)
+    while tracker.exhausted() is None:
+        pass
+    assert clock.reads == 11  # 0, 0.1, ... 1.0: the limit is reached at the 11th read
+    assert tracker.time_up() and tracker.remaining() is None
+    # the clock is no part of the budget's record or equality
+    assert "clock" not in budget.to_dict()
+    assert budget.replace(max_iterations=3).clock is clock
+
+
+def test_a_step_clock_counts_work_and_an_explicit_clock_wins():
+    done = [0]
+    clock = StepClock(1e-3, 1e-5, lambda: done[0])
+    tracker = BudgetTracker(Budget(time_limit_s=0.5), clock=clock)
+    done[0] = 10_000
+    assert tracker.elapsed_s == pytest.approx(1e-3 + 0.1)
+    assert not tracker.time_up()
+    done[0] = 60_000
+    assert tracker.time_up()
+    with pytest.raises(PlannerlabError, match="read_s"):
+        StepClock(0.0)
 
 
 def test_a_leg_runs_result_has_the_paths_errors_cost_and_the_trackers_counts():

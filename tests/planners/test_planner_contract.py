@@ -21,7 +21,9 @@ steers it, cannot cost the solve; test_ompl_planners sweeps budgets and seeds fo
 
 OMPL seeds are process-global and take effect only before OMPL's first generator exists,
 so the OMPL determinism check runs each of the two trials in a fresh ``spawn`` process.
-Regression budgets are collision checks, never wall-clock time.
+Regression budgets are collision checks, never wall-clock time: the time-limit check runs
+on a clock the test controls (``Budget.clock``, a :class:`~plannerlab.planners.base.
+StepClock`); the wall-clock check is ``bench/time_limit_bench.py``.
 """
 
 from __future__ import annotations
@@ -265,48 +267,64 @@ def test_iteration_budget_respected(name: str) -> None:
     assert r.iterations <= limit, (r.iterations, r.reason)
 
 
-#: the time-limit check: a room where no planner finishes in the limit, so each runs until
-#: its limit stops it (the one test here that reads a clock: it asserts a limit, not a speed)
+#: the time-limit check, on a clock the test controls (no wall clock: a loaded machine
+#: gives the same verdict): a room where no planner finishes early, so each runs until its
+#: limit stops it. The clock (:class:`StepClock`) advances READ_S at every look at it and
+#: CHECK_S per collision check (about a real check's cost), so a planner that checks long
+#: stretches without looking at the clock is late on it too.
 TIME_LIMIT_S = 0.3
-#: a planner may end this late: 1 % (the re-check of a found path) plus one poll interval
-#: of its loop, generous for a loaded 2-core machine
-TIME_SLACK_S = 0.2
+READ_S = 1e-3
+CHECK_S = 1e-5
+#: one loop of a planner after its last look before the limit: this many looks at the
+#: clock (the loop's own, the result's) and collision checks (an edge, an RRT extension,
+#: the 1 % re-check of a path found just before the limit)
+LOOP_READS = 30
+LOOP_CHECKS = 3_000
+TIME_SLACK_S = TIME_LIMIT_S * 0.01 + LOOP_READS * READ_S + LOOP_CHECKS * CHECK_S
+
+
+def timed_solve(
+    name: str, problem: Problem, limit_s: float, seed: int = SEED, read_s: float = READ_S
+) -> Any:
+    """Solve leg 0 of ``problem`` with only a time limit, on a :class:`StepClock` counting
+    the checks of the problem's checker; returns the result, the clock's time when the
+    solve returned (from 0 before the context is built: set-up included) and the clock."""
+    from plannerlab.collision.fcl_checker import problem_checker
+    from plannerlab.planners.base import StepClock
+    from plannerlab.planners.context import PlanningContext
+
+    planner = make_planner(name, OVERRIDES.get(name, {}))
+    checker = problem_checker(problem) if not getattr(planner, "allows_contact", False) else None
+    clock = StepClock(read_s, CHECK_S, (lambda: checker.checks) if checker is not None else None)
+    budget = Budget(time_limit_s=limit_s, clock=clock)
+    rng = np.random.default_rng(seed)
+    if REGISTRY[name].needs_stepper:
+        from plannerlab.sim import SimWorld
+
+        with SimWorld(problem.robot, problem.scene, gravity_mps2=(0.0, 0.0, 0.0)) as world:
+            ctx = PlanningContext.for_planner(
+                planner, problem, 0, budget, checker=checker, stepper=world
+            )
+            r = planner.plan(ctx, rng)
+    else:
+        ctx = PlanningContext.for_planner(planner, problem, 0, budget, checker=checker)
+        r = planner.plan(ctx, rng)
+    return r, clock.now(), clock
 
 
 @pytest.mark.parametrize("name", PARAMS)
 def test_time_limit_respected(name: str) -> None:
-    import time
-
+    """Each planner returns within its time limit plus one loop, on the test's clock."""
     from plannerlab.problem.catalog import load_problem
 
     robots = REGISTRY[name].robots
     problem = load_problem(
         "continuum_case3" if robots is not None and "armz" not in robots else "armz_inspection"
     )
-    planner = make_planner(name, OVERRIDES.get(name, {}))
-    budget = Budget(time_limit_s=TIME_LIMIT_S)
-    # engines loaded before the clock (once per process, not the planner's time)
-    CollisionChecker(problem.robot, problem.scene)
-    if name.startswith("ompl.") or "rrtconnect" in name:
-        import plannerlab.planners.ompl  # noqa: F401
-    if name.startswith("gradient.clearance"):  # the compiled descent's kernels
-        from plannerlab.planners._descent_core import warm_up
-
-        warm_up()
-    if name.startswith("native."):  # the compiled planners' kernels
-        from plannerlab.planners.native.warm import warm_up as warm_native
-
-        warm_native()
-    t0 = time.perf_counter()
-    if REGISTRY[name].needs_stepper:
-        from plannerlab.sim import SimWorld
-
-        with SimWorld(problem.robot, problem.scene, gravity_mps2=(0.0, 0.0, 0.0)) as world:
-            t0 = time.perf_counter()
-            r = planner.solve(problem, 0, budget, np.random.default_rng(SEED), stepper=world)
-    else:
-        r = planner.solve(problem, 0, budget, np.random.default_rng(SEED))
-    wall_s = time.perf_counter() - t0
-    assert wall_s <= TIME_LIMIT_S * 1.01 + TIME_SLACK_S, (wall_s, r.status, r.reason)
-    if r.status is Status.BUDGET_EXHAUSTED:
+    r, t_s, clock = timed_solve(name, problem, TIME_LIMIT_S)
+    assert t_s <= TIME_LIMIT_S + TIME_SLACK_S, (t_s, clock.reads, r.status, r.reason)
+    # the result's time is the clock's, not the wall's
+    assert r.time_s <= t_s
+    if r.status is Status.BUDGET_EXHAUSTED:  # stopped by the limit, and not before it
         assert "time limit" in r.reason, r.reason
+        assert t_s >= TIME_LIMIT_S, (t_s, r.reason)

@@ -81,7 +81,6 @@ from __future__ import annotations
 
 import dataclasses
 import math
-import time
 from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Any, ClassVar
@@ -574,7 +573,7 @@ class ChordArcPlanner(LegPlanner):
                 "m off the robot's plane",
                 q0[None],
             )
-        t_search = time.perf_counter()
+        t_search = tracker.clock()
         try:
             res = solve_chord_arc(query, _capped(s, budget.max_iterations))
         except ChordArcInputError as exc:  # only the target can be wrong per leg
@@ -582,7 +581,7 @@ class ChordArcPlanner(LegPlanner):
                 raise
             grown = " (obstacles grown by the link radius)" if s.inflate_by_radius else ""
             return result(Status.INVALID_GOAL, str(exc) + grown, q0[None])
-        search_s = time.perf_counter() - t_search
+        search_s = tracker.clock() - t_search
         srch = res.search
         search = _search_counts(srch, search_s)
         dropped: list[ContactSolution] = [

@@ -32,6 +32,8 @@ class Guard:
         #: checks held back for the re-check of the best path found so far: the checker
         #: refuses to spend them, so that path's re-check always fits the budget
         self.reserve = 0
+        #: the time limit was seen reached (time only goes on)
+        self._time_up = False
 
     def iterations(self) -> int:
         return self.iteration_source() if self.iteration_source is not None else self.polls
@@ -47,9 +49,13 @@ class Guard:
         return self.exhausted() is not None
 
     def out_of_time(self) -> bool:
-        """The time limit is reached."""
+        """The time limit is reached (once it is, the clock is not read again: the
+        validity callbacks that refuse past it cost no look at the clock)."""
+        if self._time_up:
+            return True
         tl = self.tracker.budget.time_limit_s
-        return tl is not None and self.tracker.elapsed_s >= tl
+        self._time_up = tl is not None and self.tracker.elapsed_s >= tl
+        return self._time_up
 
     def _out_of_time(self) -> bool:
         """Past the time limit: refuse, so that loops which do not poll the termination
