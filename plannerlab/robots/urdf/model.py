@@ -26,19 +26,29 @@ Every ``<collision>`` element becomes one capsule (a plannerlab "link", named
   (it covers the cylinder; the rounded ends stick out by one radius);
 * a box: the capsule along its longest edge, radius the half-diagonal of the other two
   (covers the box, conservative);
-* a mesh: refused (spherize the robot, as MotionBenchMaker's Panda is).
+* a mesh (STL, OBJ, DAE; ``package://``, ``file://`` or a path relative to the URDF,
+  searched as :func:`~plannerlab.robots.urdf.meshes.resolve_mesh` says): a conservative
+  cover of zero-length capsules (spheres), one capsule per sphere
+  (:func:`~plannerlab.robots.urdf.meshes.sphere_cover`: every vertex and a dense surface
+  sample inside, outward excess at most ``cover_excess_m``, cached on disk);
+  :attr:`UrdfChain.mesh_covers` reports each. The simulator is given the meshes
+  themselves (:meth:`UrdfChain.urdf`): verdicts are measured on the real geometry.
+
+A link that moves and has no ``<collision>`` is never checked; :attr:`UrdfChain.notes`
+names every such link (and logs a warning).
 
 Capsules on the root body are fixed (never checked against the scene). Self-collision
 is not checked between capsules on one body, between capsules of neighbouring bodies
 (parent and child of a movable joint), nor between links named in the SRDF's
 ``<disable_collisions>`` or in the problem's allowed-collision pairs.
 
-Only numpy (and ``yourdfpy`` for parsing) is used here.
+Only numpy (``yourdfpy`` for parsing, ``trimesh`` for meshes) is used here.
 """
 
 from __future__ import annotations
 
 import difflib
+import logging
 import math
 import xml.etree.ElementTree as ET
 from dataclasses import dataclass, field
@@ -52,6 +62,7 @@ from plannerlab.errors import PlannerlabError
 from plannerlab.robots.base import Array, urdf_origin
 
 MOVABLE = ("revolute", "continuous", "prismatic")
+_LOG = logging.getLogger(__name__)
 
 
 class UrdfError(PlannerlabError):
@@ -240,15 +251,77 @@ class _Capsules:
     radii: list[float]
 
 
-def _capsules(tree: _Tree, placed: dict[str, tuple[int, Array]], path: Path) -> _Capsules:
-    """One capsule per ``<collision>`` element (see the module docstring)."""
+@dataclass(frozen=True)
+class MeshCover:
+    """How one ``<collision>`` mesh of a URDF link became spheres: the link, the file,
+    the number of spheres, the largest outward excess of the cover [m] (an upper bound),
+    the points verified inside it, whether depths were measured to the mesh (watertight)
+    or its convex hull, and whether it came from the disk cache."""
+
+    link: str
+    file: str
+    spheres: int
+    max_excess_m: float
+    points_verified: int
+    watertight: bool
+    cached: bool
+
+
+@dataclass(frozen=True)
+class CoverSettings:
+    """Mesh handling of a URDF: folders searched for ``package://`` paths, the largest
+    outward excess of a link's sphere cover [m], the most spheres per mesh, and the
+    cover cache folder (None: no cache)."""
+
+    mesh_paths: tuple[Path, ...] = ()
+    excess_m: float = 0.01
+    max_spheres: int = 256
+    cache_dir: Path | None = None
+
+
+def _capsules(
+    tree: _Tree, placed: dict[str, tuple[int, Array]], path: Path, cover: CoverSettings
+) -> tuple[_Capsules, list[MeshCover], dict[str, Path]]:
+    """One capsule per primitive ``<collision>`` element and a sphere cover per mesh (see
+    the module docstring); the covers' reports and every collision mesh's file."""
+    from plannerlab.robots.urdf.meshes import MeshError, resolve_mesh, sphere_cover
+
     caps = _Capsules([], [], [], [], [], [])
+    reports: list[MeshCover] = []
+    mesh_files: dict[str, Path] = {}
     for lname, link in tree.links.items():
         b, T_link = placed[lname]
         cols = list(link.collisions)
-        for k, col in enumerate(cols):
+        pieces: list[tuple[Array, Array, float]] = []  # per capsule: a, b, radius (body)
+        for col in cols:
             T = T_link @ (np.eye(4) if col.origin is None else np.asarray(col.origin, float))
             g = col.geometry
+            if g.mesh is not None:
+                where = f"link {lname} of {path.name}"
+                try:
+                    file = resolve_mesh(str(g.mesh.filename), path, cover.mesh_paths, where)
+                    scale = np.ones(3) if g.mesh.scale is None else np.asarray(g.mesh.scale, float)
+                    sc = sphere_cover(
+                        file, scale, cover.excess_m, cover.max_spheres, where, cover.cache_dir
+                    )
+                except MeshError as exc:
+                    raise UrdfError("urdf", str(exc)) from None
+                mesh_files[str(g.mesh.filename)] = file
+                reports.append(
+                    MeshCover(
+                        lname,
+                        str(file),
+                        len(sc.radii_m),
+                        sc.max_excess_m,
+                        sc.points_verified,
+                        sc.watertight,
+                        sc.cached,
+                    )
+                )
+                centres = sc.centres_m @ T[:3, :3].T + T[:3, 3]
+                for c, r in zip(centres, sc.radii_m, strict=True):
+                    pieces.append((c, c, float(r)))
+                continue
             if g.sphere is not None:
                 r, half = float(g.sphere.radius), np.zeros(3)
             elif g.cylinder is not None:
@@ -264,20 +337,22 @@ def _capsules(tree: _Tree, placed: dict[str, tuple[int, Array]], path: Path) -> 
             else:
                 raise UrdfError(
                     "urdf",
-                    f"collision geometry a plannerlab robot can check (sphere, cylinder, "
-                    f"box); link {lname} of {path.name} has a mesh: use a spherized URDF",
+                    f"collision geometry a sphere, cylinder, box or mesh; link {lname} of "
+                    f"{path.name} has none of them in a <collision>",
                 )
             c = T[:3, 3]
             d = T[:3, :3] @ half
-            caps.names.append(lname if len(cols) == 1 else f"{lname}#{k}")
+            pieces.append((c - d, c + d, r))
+        for k, (a, bb, r) in enumerate(pieces):
+            caps.names.append(lname if len(pieces) == 1 else f"{lname}#{k}")
             caps.link.append(lname)
             caps.body.append(b)
-            caps.a.append(c - d)
-            caps.b.append(c + d)
+            caps.a.append(a)
+            caps.b.append(bb)
             caps.radii.append(r)
     if not caps.names:
         raise UrdfError("urdf", f"collision elements; {path.name} has none")
-    return caps
+    return caps, reports, mesh_files
 
 
 def _excluded_pairs(
@@ -335,6 +410,12 @@ class UrdfChain:
         srdf_path: an SRDF whose ``disable_collisions`` pairs are not checked, or None.
         allowed_collisions: more URDF link pairs that are not checked.
         T_world_base: (4, 4) pose of the root link in the world.
+        mesh_paths: folders searched for ``package://`` mesh paths (see
+            :mod:`plannerlab.robots.urdf.meshes`).
+        cover_excess_m: the largest outward excess of a mesh's sphere cover [m].
+        cover_max_spheres: the most spheres a mesh's cover may have.
+        cover_cache: keep covers on disk; ``cover_cache_dir`` (None:
+            ``~/.cache/plannerlab/covers``).
     """
 
     urdf_path: Path
@@ -344,6 +425,11 @@ class UrdfChain:
     srdf_path: Path | None = None
     allowed_collisions: tuple[tuple[str, str], ...] = ()
     T_world_base: Array = field(default_factory=lambda: np.eye(4))
+    mesh_paths: tuple[Path, ...] = ()
+    cover_excess_m: float = 0.01
+    cover_max_spheres: int = 256
+    cover_cache: bool = True
+    cover_cache_dir: Path | None = None
 
     kind: str = field(default="urdf", init=False)
     dof: int = field(init=False)
@@ -361,6 +447,13 @@ class UrdfChain:
     link_urdf_names: tuple[str, ...] = field(init=False, repr=False)
     #: an upper bound of the tip's distance from the root link's origin [m]
     max_reach_m: float = field(init=False, repr=False)
+    #: how each collision mesh became spheres (empty for a URDF of primitives)
+    mesh_covers: tuple[MeshCover, ...] = field(init=False, repr=False)
+    #: links that move (not on the root body) and have no collision geometry
+    links_without_geometry: tuple[str, ...] = field(init=False, repr=False)
+    #: warnings about the model, in words (also logged)
+    notes: tuple[str, ...] = field(init=False, repr=False)
+    _mesh_files: dict[str, Path] = field(init=False, repr=False)
     # the chain's fixed data (see __post_init__)
     _body_links: tuple[str, ...] = field(init=False, repr=False)
     _parent_body: Any = field(init=False, repr=False)
@@ -409,7 +502,31 @@ class UrdfChain:
         if not (norm > 1e-9 and math.isfinite(norm)):
             raise UrdfError("tip_axis", f"a non-zero axis, got {list(self.tip_axis)}")
         R_body_tip = T_body_tip[:3, :3] @ (tip_axis / norm)
-        caps = _capsules(tree, placed, path)
+        from plannerlab.robots.urdf.meshes import default_cache_dir
+
+        settings = CoverSettings(
+            tuple(Path(p) for p in self.mesh_paths),
+            float(self.cover_excess_m),
+            int(self.cover_max_spheres),
+            (
+                None
+                if not self.cover_cache
+                else Path(self.cover_cache_dir)
+                if self.cover_cache_dir is not None
+                else default_cache_dir()
+            ),
+        )
+        caps, covers, mesh_files = _capsules(tree, placed, path, settings)
+        bare = [n for n, link in tree.links.items() if placed[n][0] > 0 and not link.collisions]
+        notes = []
+        if bare:
+            shown = [n + (" (it has a visual)" if tree.links[n].visuals else "") for n in bare]
+            notes.append(
+                f"{path.name}: {len(bare)} moving link(s) without collision geometry, never "
+                f"checked: {', '.join(shown)}"
+            )
+        for note in notes:
+            _LOG.warning(note)
         excluded = _excluded_pairs(
             caps, parent_body, tree.links, self.srdf_path, self.allowed_collisions, path
         )
@@ -438,6 +555,10 @@ class UrdfChain:
         s(self, "excluded_pairs", frozenset(excluded))
         s(self, "frozen_joints", tree.frozen)
         s(self, "max_reach_m", float(reach))
+        s(self, "mesh_covers", tuple(covers))
+        s(self, "links_without_geometry", tuple(bare))
+        s(self, "notes", tuple(notes))
+        s(self, "_mesh_files", mesh_files)
         s(self, "_body_links", (tree.root, *(j.child for j in tree.movable)))
         s(self, "_parent_body", np.array(parent_body, dtype=int))
         s(self, "_pre", frozen_array(pre))
@@ -548,20 +669,31 @@ class UrdfChain:
 
     # ------------------------------------------------------------------ URDF
     def urdf(self) -> str:
-        """The URDF text for the simulator: the file as it is, with relative mesh paths
-        made absolute, visuals whose mesh file is missing left out (they are only looks;
-        PyBullet refuses a file naming a missing mesh) and the frozen joints (see the
-        module) made fixed at their value."""
+        """The URDF text for the simulator: the file as it is (its collision meshes, the
+        real geometry, included), with every collision mesh path made absolute (as
+        resolved for the covers, ``package://`` included), visual meshes resolved the same
+        way or left out when they cannot be (they are only looks; PyBullet refuses a file
+        naming a missing mesh) and the frozen joints (see the module) made fixed at their
+        value."""
+        from plannerlab.robots.urdf.meshes import MeshError, resolve_mesh
+
         tree = ET.parse(self.urdf_path)
         root = tree.getroot()
-        folder = self.urdf_path.resolve().parent
         for link in root.iter("link"):
+            for col in link.findall("collision"):
+                for mesh in col.iter("mesh"):
+                    fn = mesh.get("filename", "")
+                    if fn in self._mesh_files:
+                        mesh.set("filename", str(self._mesh_files[fn]))
             for visual in link.findall("visual"):
                 for mesh in visual.iter("mesh"):
                     fn = mesh.get("filename", "")
-                    if fn and "://" not in fn and not Path(fn).is_absolute():
-                        mesh.set("filename", str(folder / fn))
-                    if "://" in fn or not Path(mesh.get("filename", "")).is_file():
+                    try:
+                        mesh.set(
+                            "filename",
+                            str(resolve_mesh(fn, self.urdf_path, tuple(self.mesh_paths), "")),
+                        )
+                    except MeshError:
                         # a visual whose mesh is not there (PyBullet refuses the file)
                         link.remove(visual)
                         break
@@ -604,4 +736,11 @@ class UrdfChain:
         return ET.tostring(root, encoding="unicode")
 
 
-__all__ = ["UrdfChain", "UrdfError", "axis_motion", "read_srdf_disabled"]
+__all__ = [
+    "CoverSettings",
+    "MeshCover",
+    "UrdfChain",
+    "UrdfError",
+    "axis_motion",
+    "read_srdf_disabled",
+]
