@@ -2,7 +2,8 @@
 
 The robot's links are capsules (see :class:`plannerlab.robots.base.Robot`); obstacles are
 boxes, cylinders, spheres and meshes (the core checks a mesh's cover of boxes, FCL its
-triangles: :mod:`plannerlab.problem.scene`). Two backends answer the same questions with the same meaning:
+triangles: :mod:`plannerlab.problem.scene`). Two backends answer the same questions with
+the same meaning:
 
 * ``"core"`` (:mod:`plannerlab.collision.core`): numba-compiled kinematics, broad phase and
   exact capsule tests over whole batches; the default whenever every obstacle is a shape it

@@ -39,15 +39,16 @@ def _mesh(reader: TableReader, name: str, T: np.ndarray) -> Mesh:
     try:
         if not path.is_file():
             raise MeshError(
-                str(path), where, "the file does not exist", "fix file (relative to the problem file)"
+                str(path),
+                where,
+                "the file does not exist",
+                "fix file (relative to the problem file)",
             )
         V, F = load_mesh(path, scale, where)
         cover = box_cover(V, F, max_boxes, where, str(path))
     except MeshError as exc:
         raise reader.fail("file", f"a mesh plannerlab can read and cover; {exc}") from None
-    return Mesh(
-        name, T, str(path), scale, V, F, cover.centres_m, cover.half_m, cover.max_excess_m
-    )
+    return Mesh(name, T, str(path), scale, V, F, cover.centres_m, cover.half_m, cover.max_excess_m)
 
 
 def _obstacle(reader: TableReader) -> Obstacle | Mesh:

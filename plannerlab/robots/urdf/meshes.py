@@ -25,8 +25,9 @@ Sphere covers (:func:`sphere_cover`), for the capsule model of a robot link:
 
 The surface is covered exactly; the solid's inside is covered where the interior
 spheres reach (an obstacle wholly inside a link without touching its surface is not
-seen). A mesh that is not watertight has no inside: depths are measured to its convex
-hull instead, and the report says so. More than ``max_spheres`` spheres, or a surface
+seen). A mesh that is not watertight has no inside: its convex hull is covered instead
+(depths measured to it; PyBullet, too, checks a moving link's mesh as its convex hull),
+and the report says so. More than ``max_spheres`` spheres, or a surface
 needing more than :data:`MAX_COVER_TRIANGLES` small triangles, is refused
 (:class:`MeshError`: raise ``cover_excess_m`` or ``cover_max_spheres``, or simplify).
 
@@ -62,7 +63,7 @@ MAX_MESH_FACES: int = 2_000_000
 #: the most small triangles a sphere cover may cut a surface into
 MAX_COVER_TRIANGLES: int = 60_000
 #: bump when the cover algorithm changes (part of the cache key)
-COVER_VERSION: int = 1
+COVER_VERSION: int = 2
 #: surface points checked against every cover (besides every vertex)
 VERIFY_SAMPLES: int = 20_000
 
@@ -213,7 +214,9 @@ def _small_triangles(V: Array, F: np.ndarray, edge_m: float, where: str, file: s
     import trimesh
 
     tri = V[F]
-    area = float(np.sum(np.linalg.norm(np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0]), axis=1)) / 2)
+    area = float(
+        np.sum(np.linalg.norm(np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0]), axis=1)) / 2
+    )
     # a triangle of edges <= e has area <= e^2 sqrt(3)/4; subdivision reaches about a third
     estimate = len(F) + area / (0.1 * edge_m**2)
     if estimate > MAX_COVER_TRIANGLES:
@@ -229,8 +232,7 @@ def _small_triangles(V: Array, F: np.ndarray, edge_m: float, where: str, file: s
         raise MeshError(
             file,
             where,
-            f"too large to cover within the limits: {len(Fs)} triangles of "
-            f"{edge_m * 1e3:.3g} mm",
+            f"too large to cover within the limits: {len(Fs)} triangles of {edge_m * 1e3:.3g} mm",
             "raise cover_excess_m in [robot], or scale/simplify the mesh",
         )
     return np.asarray(Vs, dtype=float)[np.asarray(Fs)]
@@ -254,12 +256,25 @@ def _depths(V: Array, F: np.ndarray, pts: Array) -> tuple[Array, bool]:
 def _compute_sphere_cover(
     V: Array, F: np.ndarray, excess_m: float, max_spheres: int, where: str, file: str
 ) -> SphereCover:
+    import trimesh
+
+    mesh = trimesh.Trimesh(V, F, process=True)
+    V_in = V
+    if not (mesh.is_watertight and mesh.is_volume):
+        # no inside: the convex hull is the solid (as PyBullet sees a moving mesh)
+        hull = mesh.convex_hull
+        V, F = np.asarray(hull.vertices, dtype=float), np.asarray(hull.faces, dtype=np.int64)
     tris = _small_triangles(V, F, excess_m, where, file)
     corners = tris.reshape(-1, 3)
     lo, hi = V.min(axis=0), V.max(axis=0)
     ext = hi - lo
     step = max(float(ext.max()) / 16.0, excess_m / 2.0)
-    axes = [np.arange(lo[k] + step / 2, hi[k], step) if ext[k] > step else np.array([(lo[k] + hi[k]) / 2]) for k in range(3)]
+    axes = [
+        np.arange(lo[k] + step / 2, hi[k], step)
+        if ext[k] > step
+        else np.array([(lo[k] + hi[k]) / 2])
+        for k in range(3)
+    ]
     grid = np.stack(np.meshgrid(*axes, indexing="ij"), axis=-1).reshape(-1, 3)
     depth, watertight = _depths(V, F, grid)
     inner = depth > 1e-6
@@ -324,14 +339,14 @@ def _compute_sphere_cover(
     u[flip], v[flip] = 1 - u[flip], 1 - v[flip]
     t = tri[pick]
     samples = t[:, 0] + u[:, None] * (t[:, 1] - t[:, 0]) + v[:, None] * (t[:, 2] - t[:, 0])
-    pts = np.concatenate([V, corners, samples])
+    pts = np.concatenate([V_in, V, corners, samples])
     inside = np.zeros(len(pts), dtype=bool)
     for s in range(0, len(pts), 20_000):
         d = np.linalg.norm(pts[s : s + 20_000, None, :] - C[None], axis=-1) - Rr[None]
         inside[s : s + 20_000] = (d <= 1e-9).any(axis=1)
     if not inside.all():  # pragma: no cover - the construction covers every corner
         raise MeshError(file, where, "its sphere cover failed verification", "report this")
-    return SphereCover(C, Rr, float(max(excess)), len(V) + VERIFY_SAMPLES, watertight)
+    return SphereCover(C, Rr, float(max(excess)), len(V_in) + VERIFY_SAMPLES, watertight)
 
 
 def sphere_cover(
@@ -454,7 +469,11 @@ def box_cover(V: Array, F: np.ndarray, max_boxes: int, where: str, file: str) ->
     pitch = max(ext / 48.0, 1e-4)
     tri_area = V[F]
     area = float(
-        np.sum(np.linalg.norm(np.cross(tri_area[:, 1] - tri_area[:, 0], tri_area[:, 2] - tri_area[:, 0]), axis=1))
+        np.sum(
+            np.linalg.norm(
+                np.cross(tri_area[:, 1] - tri_area[:, 0], tri_area[:, 2] - tri_area[:, 0]), axis=1
+            )
+        )
         / 2
     )
     while len(F) + area / (0.1 * (pitch / 2) ** 2) > 4 * MAX_COVER_TRIANGLES:
@@ -472,9 +491,7 @@ def box_cover(V: Array, F: np.ndarray, max_boxes: int, where: str, file: str) ->
             b = np.array([b[1] for b in boxes], dtype=float)
             low = lo + a * pitch - pitch / 2.0
             high = lo + b * pitch + pitch / 2.0
-            return BoxCover(
-                (low + high) / 2.0, (high - low) / 2.0, pitch, (3**0.5 + 0.5) * pitch
-            )
+            return BoxCover((low + high) / 2.0, (high - low) / 2.0, pitch, (3**0.5 + 0.5) * pitch)
         pitch *= 2.0
     raise MeshError(  # pragma: no cover - a pitch of the whole extent gives one box
         file, where, f"no cover in {max_boxes} boxes", "raise the box limit"
