@@ -13,7 +13,7 @@ used to read the plan and problem files.
     python bench/mesh_referee.py results/plans/*.json [--step 0.005]
 
 Prints per leg: states checked, the smallest distance to the scene [mm] (at most 0:
-touching; 10 mm: nothing within PyBullet's query distance), and the verdict.
+touching; 100 mm: nothing within the query distance), and the verdict.
 """
 
 from __future__ import annotations
@@ -33,7 +33,7 @@ from scipy.spatial.transform import Rotation
 from plannerlab.problem.catalog import load_problem
 from plannerlab.problem.scene import Box, Cylinder, Sphere
 
-QUERY_M = 0.01  # closest points reported up to this distance
+QUERY_M = 0.1  # closest points reported up to this distance [m]
 
 
 def _quat(T: np.ndarray) -> list[float]:
