@@ -141,6 +141,7 @@ both.
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import time
 from collections.abc import Sequence
@@ -155,6 +156,7 @@ from plannerlab.record.execution import ContactRecord, Execution
 from plannerlab.robots.base import Array, Robot, joint_difference
 from plannerlab.sim.measure import (
     Clearance,
+    geometry_notes,
     plan_deviation,
     sampled_clearance,
 )
@@ -488,39 +490,7 @@ def _run(
         min_clearance_pair=clear.pair,
         clearance_samples=clear.samples,
         solver=world.solver,
-        geometry=geometry_notes(problem),
     )
-
-
-def geometry_notes(problem: Problem) -> dict[str, str]:
-    """Which geometry each figure of an execution is measured on (the record's
-    ``geometry``): the re-check on the planning model; contacts and clearance on what
-    PyBullet loads: the robot's URDF as it is (its collision meshes when it has any:
-    the real geometry, not the covers planned with) and the scene's mesh obstacles as
-    triangles; the deviation on the planning model's capsules."""
-    robot = problem.robot
-    covers = getattr(robot, "mesh_covers", ())
-    meshes = problem.scene.meshes
-    scene_note = (
-        f"; mesh obstacles {', '.join(m.name for m in meshes)} as their triangles" if meshes else ""
-    )
-    if covers:
-        excess = max(c.max_excess_m for c in covers)
-        plan = (
-            f"planning model: {len(covers)} collision meshes as sphere covers "
-            f"(outward excess <= {excess * 1e3:.3g} mm)"
-        )
-        sim = f"real meshes: the URDF's {len(covers)} collision meshes{scene_note}"
-    else:
-        plan = "planning model: the robot's capsules"
-        sim = f"planning model: the robot's URDF as planned with{scene_note}"
-    recheck_scene = "; mesh obstacles as their cover boxes" if meshes else ""
-    return {
-        "recheck": plan + recheck_scene,
-        "contacts": sim,
-        "min_clearance_m": sim,
-        "max_deviation_m": "planning model: the robot's capsules (axis end points and radii)",
-    }
 
 
 def execute(
@@ -609,7 +579,7 @@ def execute(
         ) as world,
         SimWorld(problem.robot, problem.scene) as probe,
     ):
-        return _run(
+        ex = _run(
             world,
             checker,
             problem,
@@ -628,6 +598,7 @@ def execute(
             grid_per_knot=grid_per_knot,
             interpolant=interpolant,
         )
+    return dataclasses.replace(ex, geometry=geometry_notes(problem))
 
 
 def execute_legs(
@@ -702,4 +673,5 @@ def execute_legs(
                     interpolant=interpolant,
                 )
             )
-    return out
+    geometry = geometry_notes(problem)
+    return [dataclasses.replace(ex, geometry=geometry) for ex in out]

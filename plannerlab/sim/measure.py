@@ -61,7 +61,7 @@ from __future__ import annotations
 import math
 from collections.abc import Iterable
 from dataclasses import dataclass
-from typing import Protocol
+from typing import Any, Protocol
 
 import numpy as np
 
@@ -325,7 +325,39 @@ def sampled_clearance(
     )
 
 
+def geometry_notes(problem: Any) -> dict[str, str]:
+    """Which geometry each figure of an execution is measured on (the record's
+    ``geometry``): the re-check on the planning model; contacts and clearance on what
+    PyBullet loads: the robot's URDF as it is (its collision meshes when it has any:
+    the real geometry, not the covers planned with) and the scene's mesh obstacles as
+    triangles; the deviation on the planning model's capsules."""
+    robot = problem.robot
+    covers = getattr(robot, "mesh_covers", ())
+    meshes = problem.scene.meshes
+    scene_note = (
+        f"; mesh obstacles {', '.join(m.name for m in meshes)} as their triangles" if meshes else ""
+    )
+    if covers:
+        excess = max(c.max_excess_m for c in covers)
+        plan = (
+            f"planning model: {len(covers)} collision meshes as sphere covers "
+            f"(outward excess <= {excess * 1e3:.3g} mm)"
+        )
+        sim = f"real meshes: the URDF's {len(covers)} collision meshes{scene_note}"
+    else:
+        plan = "planning model: the robot's capsules"
+        sim = f"planning model: the robot's URDF as planned with{scene_note}"
+    recheck_scene = "; mesh obstacles as their cover boxes" if meshes else ""
+    return {
+        "recheck": plan + recheck_scene,
+        "contacts": sim,
+        "min_clearance_m": sim,
+        "max_deviation_m": "planning model: the robot's capsules (axis end points and radii)",
+    }
+
+
 __all__ = [
+    "geometry_notes",
     "CLEARANCE_MAX_DISTANCE_M",
     "CLEARANCE_RESOLUTION_M",
     "Clearance",

@@ -19,7 +19,7 @@ from plannerlab.errors import ProblemError
 from plannerlab.problem.load import problem_from_dict
 from plannerlab.robots.urdf.meshes import MeshError, sphere_cover
 from plannerlab.robots.urdf.model import UrdfChain, UrdfError, read_srdf_disabled
-from plannerlab.robots.urdf.srdf import disabled_pairs, write_srdf
+from plannerlab.run.srdf import disabled_pairs, write_srdf
 
 DATA = Path(__file__).resolve().parents[1] / "data" / "mesh_arm"
 URDF = DATA / "mesh_arm.urdf"

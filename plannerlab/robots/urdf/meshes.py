@@ -420,6 +420,34 @@ def _atomic_savez(path: Path, **arrays: Array) -> None:
         return
 
 
+@dataclass(frozen=True)
+class MeshCover:
+    """How one ``<collision>`` mesh of a URDF link became spheres: the link, the file,
+    the number of spheres, the largest outward excess of the cover [m] (an upper bound),
+    the points verified inside it, whether depths were measured to the mesh (watertight)
+    or its convex hull, and whether it came from the disk cache."""
+
+    link: str
+    file: str
+    spheres: int
+    max_excess_m: float
+    points_verified: int
+    watertight: bool
+    cached: bool
+
+
+@dataclass(frozen=True)
+class CoverSettings:
+    """Mesh handling of a URDF: folders searched for ``package://`` paths, the largest
+    outward excess of a link's sphere cover [m], the most spheres per mesh, and the
+    cover cache folder (None: no cache)."""
+
+    mesh_paths: tuple[Path, ...] = ()
+    excess_m: float = 0.01
+    max_spheres: int = 256
+    cache_dir: Path | None = None
+
+
 # ---------------------------------------------------------------------- box covers
 @dataclass(frozen=True)
 class BoxCover:
@@ -500,6 +528,8 @@ def box_cover(V: Array, F: np.ndarray, max_boxes: int, where: str, file: str) ->
 
 __all__ = [
     "BoxCover",
+    "CoverSettings",
+    "MeshCover",
     "MeshError",
     "SphereCover",
     "box_cover",

@@ -59,7 +59,8 @@ import numpy as np
 from numpy.typing import NDArray
 
 from plannerlab.errors import PlannerlabError
-from plannerlab.robots.base import Array, urdf_origin
+from plannerlab.robots.base import Array
+from plannerlab.robots.urdf.meshes import CoverSettings, MeshCover
 
 MOVABLE = ("revolute", "continuous", "prismatic")
 _LOG = logging.getLogger(__name__)
@@ -249,34 +250,6 @@ class _Capsules:
     a: list[Array]
     b: list[Array]
     radii: list[float]
-
-
-@dataclass(frozen=True)
-class MeshCover:
-    """How one ``<collision>`` mesh of a URDF link became spheres: the link, the file,
-    the number of spheres, the largest outward excess of the cover [m] (an upper bound),
-    the points verified inside it, whether depths were measured to the mesh (watertight)
-    or its convex hull, and whether it came from the disk cache."""
-
-    link: str
-    file: str
-    spheres: int
-    max_excess_m: float
-    points_verified: int
-    watertight: bool
-    cached: bool
-
-
-@dataclass(frozen=True)
-class CoverSettings:
-    """Mesh handling of a URDF: folders searched for ``package://`` paths, the largest
-    outward excess of a link's sphere cover [m], the most spheres per mesh, and the
-    cover cache folder (None: no cache)."""
-
-    mesh_paths: tuple[Path, ...] = ()
-    excess_m: float = 0.01
-    max_spheres: int = 256
-    cache_dir: Path | None = None
 
 
 def _capsules(
@@ -669,71 +642,12 @@ class UrdfChain:
 
     # ------------------------------------------------------------------ URDF
     def urdf(self) -> str:
-        """The URDF text for the simulator: the file as it is (its collision meshes, the
-        real geometry, included), with every collision mesh path made absolute (as
-        resolved for the covers, ``package://`` included), visual meshes resolved the same
-        way or left out when they cannot be (they are only looks; PyBullet refuses a file
-        naming a missing mesh) and the frozen joints (see the module) made fixed at their
-        value."""
-        from plannerlab.robots.urdf.meshes import MeshError, resolve_mesh
+        """The URDF text for the simulator (:func:`~plannerlab.robots.urdf.sim_text.
+        simulator_urdf`): the file with its real collision meshes, paths made absolute,
+        missing visuals left out, the frozen joints fixed at their value."""
+        from plannerlab.robots.urdf.sim_text import simulator_urdf
 
-        tree = ET.parse(self.urdf_path)
-        root = tree.getroot()
-        for link in root.iter("link"):
-            for col in link.findall("collision"):
-                for mesh in col.iter("mesh"):
-                    fn = mesh.get("filename", "")
-                    if fn in self._mesh_files:
-                        mesh.set("filename", str(self._mesh_files[fn]))
-            for visual in link.findall("visual"):
-                for mesh in visual.iter("mesh"):
-                    fn = mesh.get("filename", "")
-                    try:
-                        mesh.set(
-                            "filename",
-                            str(resolve_mesh(fn, self.urdf_path, tuple(self.mesh_paths), "")),
-                        )
-                    except MeshError:
-                        # a visual whose mesh is not there (PyBullet refuses the file)
-                        link.remove(visual)
-                        break
-        for joint in root.iter("joint"):
-            name = joint.get("name", "")
-            if name not in self.frozen_joints:
-                continue
-            value = self.frozen_joints[name]
-            if value != 0.0:
-                from plannerlab.robots.base import pose_matrix
-
-                o = joint.find("origin")
-                xyz = (
-                    [0.0, 0.0, 0.0]
-                    if o is None
-                    else [float(v) for v in o.get("xyz", "0 0 0").split()]
-                )
-                rpy = (
-                    [0.0, 0.0, 0.0]
-                    if o is None
-                    else [float(v) for v in o.get("rpy", "0 0 0").split()]
-                )
-                ax = joint.find("axis")
-                axis = np.array(
-                    [1.0, 0.0, 0.0]
-                    if ax is None
-                    else [float(v) for v in ax.get("xyz", "1 0 0").split()]
-                )
-                motion = axis_motion(
-                    axis / np.linalg.norm(axis), np.asarray(value), joint.get("type") == "prismatic"
-                )
-                T = np.asarray(pose_matrix(xyz, rpy)) @ motion
-                if o is not None:
-                    joint.remove(o)
-                joint.append(ET.fromstring(urdf_origin(T)))
-            joint.set("type", "fixed")
-            for tag in ("mimic", "limit"):
-                for e in joint.findall(tag):
-                    joint.remove(e)
-        return ET.tostring(root, encoding="unicode")
+        return simulator_urdf(self)
 
 
 __all__ = [

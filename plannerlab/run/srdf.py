@@ -102,7 +102,7 @@ def write_srdf(pairs: list[DisabledPair], path: Path, robot_name: str) -> None:
     """An SRDF holding the pairs as ``<disable_collisions>`` elements."""
     root = ET.Element("robot", name=robot_name)
     root.append(
-        ET.Comment(" written by plannerlab.robots.urdf.srdf.disabled_pairs (seeded sampling) ")
+        ET.Comment(" written by plannerlab.run.srdf.disabled_pairs (seeded sampling) ")
     )
     for d in pairs:
         ET.SubElement(root, "disable_collisions", link1=d.link1, link2=d.link2, reason=d.reason)
