@@ -158,9 +158,10 @@ class CollisionChecker:
         # a mesh obstacle's cover boxes each stand for the mesh's real triangles (one
         # BVHModel per mesh, shared): the boxes' bounds pre-test, the triangles decide
         bvh = {m.name: self._make_mesh(m) for m in scene.meshes}
+        cover_of = [getattr(o, "cover_of", "") for o in scene.obstacles]
         self._obstacles = [
-            bvh[o.cover_of] if getattr(o, "cover_of", "") else self._make_obstacle(o)
-            for o in scene.obstacles
+            bvh[m] if m else self._make_obstacle(o)
+            for o, m in zip(scene.obstacles, cover_of, strict=True)
         ]
         self._obs_lo, self._obs_hi = scene.aabbs()
         moving = np.array([i not in robot.fixed_links for i in range(L)])

@@ -66,7 +66,7 @@ def disabled_pairs(
         for b in links[i + 1 :]:
             if body[a] == body[b] or frozenset((body[a], body[b])) in neighbours:
                 out[frozenset((a, b))] = "Adjacent"
-    checker = CollisionChecker(bare, Scene(), backend="core")
+    checker = CollisionChecker(bare, Scene(), backend="core")  # type: ignore[arg-type]
 
     def colliding(q: np.ndarray) -> set[frozenset[str]]:
         found = set()
@@ -101,9 +101,7 @@ def disabled_pairs(
 def write_srdf(pairs: list[DisabledPair], path: Path, robot_name: str) -> None:
     """An SRDF holding the pairs as ``<disable_collisions>`` elements."""
     root = ET.Element("robot", name=robot_name)
-    root.append(
-        ET.Comment(" written by plannerlab.run.srdf.disabled_pairs (seeded sampling) ")
-    )
+    root.append(ET.Comment(" written by plannerlab.run.srdf.disabled_pairs (seeded sampling) "))
     for d in pairs:
         ET.SubElement(root, "disable_collisions", link1=d.link1, link2=d.link2, reason=d.reason)
     ET.indent(root)

@@ -50,6 +50,7 @@ import os
 import tempfile
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -288,7 +289,7 @@ def _compute_sphere_cover(
     # round 0: the inner grid and a sample of centroids; later rounds: the centroids of
     # what is left (each covers at least its own triangle: the cover always completes)
     sample = rng.choice(nT, size=min(nT, 1500), replace=False)
-    cand = np.concatenate([grid[inner], centroids[sample]])
+    cand: Array | None = np.concatenate([grid[inner], centroids[sample]])
     D = np.concatenate([depth[inner], np.zeros(len(sample))])
     while uncovered.any():
         left = np.flatnonzero(uncovered)
@@ -403,7 +404,7 @@ def sphere_cover(
     return cover
 
 
-def _atomic_savez(path: Path, **arrays: Array) -> None:
+def _atomic_savez(path: Path, **arrays: Any) -> None:
     """np.savez to a temporary file in the same folder, then renamed (readers never see
     half a file); an unwritable cache is skipped."""
     try:

@@ -313,16 +313,16 @@ def _capsules(
                     f"collision geometry a sphere, cylinder, box or mesh; link {lname} of "
                     f"{path.name} has none of them in a <collision>",
                 )
-            c = T[:3, 3]
+            mid = T[:3, 3]
             d = T[:3, :3] @ half
-            pieces.append((c - d, c + d, r))
-        for k, (a, bb, r) in enumerate(pieces):
+            pieces.append((mid - d, mid + d, r))
+        for k, (end_a, end_b, rad) in enumerate(pieces):
             caps.names.append(lname if len(pieces) == 1 else f"{lname}#{k}")
             caps.link.append(lname)
             caps.body.append(b)
-            caps.a.append(a)
-            caps.b.append(bb)
-            caps.radii.append(r)
+            caps.a.append(end_a)
+            caps.b.append(end_b)
+            caps.radii.append(rad)
     if not caps.names:
         raise UrdfError("urdf", f"collision elements; {path.name} has none")
     return caps, reports, mesh_files
