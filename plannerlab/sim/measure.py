@@ -61,6 +61,7 @@ from __future__ import annotations
 import math
 from collections.abc import Iterable
 from dataclasses import dataclass
+from pathlib import Path
 from typing import Any, Protocol
 
 import numpy as np
@@ -220,7 +221,7 @@ def _link_groups(robot: Robot) -> tuple[np.ndarray, list[str]] | None:
     """For a robot whose links are covers of meshes (a URDF robot with ``mesh_covers``):
     where each URDF link's run of capsules starts, and the URDF link names; None for the
     other robots (every capsule its own link)."""
-    if not getattr(robot, "mesh_covers", ()):
+    if not getattr(robot, "mesh_covers", ()) and getattr(robot, "sim_urdf_path", None) is None:
         return None
     urdf = list(robot.link_urdf_names)  # type: ignore[attr-defined]
     starts = [0] + [i for i in range(1, len(urdf)) if urdf[i] != urdf[i - 1]]
@@ -257,6 +258,10 @@ def sampled_clearance(
         )
     k = len(q)
     forced = sorted({int(i) for i in always if 0 <= int(i) < k} | {k - 1})
+    if getattr(robot, "sim_urdf_path", None) is not None:
+        # PyBullet holds another geometry than the capsules (a sim_urdf): how far they
+        # moved bounds nothing of it, so every state is queried
+        forced = list(range(k))
     seg, unit = _segments_axes(robot, q)
     names = list(robot.link_names)
     # A mesh robot: PyBullet measures each URDF link's meshes once (reported on its first
@@ -337,7 +342,13 @@ def geometry_notes(problem: Any) -> dict[str, str]:
     scene_note = (
         f"; mesh obstacles {', '.join(m.name for m in meshes)} as their triangles" if meshes else ""
     )
-    if covers:
+    sim_urdf = getattr(robot, "sim_urdf_path", None)
+    if sim_urdf is not None:
+        plan = "planning model: the robot's capsules" + (
+            f" and sphere covers of {len(covers)} meshes" if covers else ""
+        )
+        sim = f"real meshes: the collision geometry of {Path(sim_urdf).name} (sim_urdf){scene_note}"
+    elif covers:
         excess = max(c.max_excess_m for c in covers)
         plan = (
             f"planning model: {len(covers)} collision meshes as sphere covers "

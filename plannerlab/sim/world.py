@@ -537,7 +537,7 @@ class SimWorld:
         i = self._robot_link.get(pb_link)
         if i is None:
             return self.urdf_link_names[pb_link], None
-        if getattr(self.robot, "mesh_covers", ()):
+        if getattr(self.robot, "mesh_covers", ()) or getattr(self.robot, "sim_urdf_path", None):
             # PyBullet holds the link's meshes, not the spheres covering them
             return self.urdf_link_names[pb_link], i
         return self.robot.link_names[i], i

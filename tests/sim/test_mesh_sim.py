@@ -106,3 +106,64 @@ def test_a_free_path_past_a_mesh_obstacle_is_clean_on_the_meshes(cache: Path) ->
     # clearance sampler reports it only up to its query distance
     assert ex.min_clearance_m > 0.04
     assert "mesh obstacles ball as their triangles" in ex.geometry["min_clearance_m"]
+
+
+def spheres_problem(sim_urdf: str | None) -> Problem:
+    robot: dict[str, object] = {
+        "type": "urdf",
+        "urdf": str(DATA / "mesh_arm_spheres.urdf"),
+        "tip_link": "tool",
+        "mesh_paths": "pkgroot",
+    }
+    if sim_urdf:
+        robot["sim_urdf"] = sim_urdf
+    return problem_from_dict(
+        {
+            "problem": {"name": "mesh_arm_spheres"},
+            "robot": robot,
+            "start": {"q": [0.0, 0.0, 0.0]},
+            "goals": [{"name": "g", "q": [0.3, 0.0, 0.0], "joint_tol_rad": 0.05}],
+            "planning": {"safety_margin_m": 0.0},
+            # 5 mm off the forearm's spheres, 5 mm into its real 5 cm box
+            "obstacles": [
+                {
+                    "name": "post",
+                    "type": "box",
+                    "center_m": [0.07, 0.0, 0.55],
+                    "size_m": [0.1, 0.2, 0.2],
+                }
+            ],
+        },
+        str(DATA / "p.toml"),
+    )
+
+
+def test_a_spherized_robot_is_judged_on_its_meshes_with_sim_urdf() -> None:
+    """The issue's case: an under-covering spherized model plans a path the real robot
+    cannot take. Judged on the spheres it is "executed cleanly"; with ``sim_urdf`` PyBullet
+    holds the meshes and the verdict is a contact."""
+    path = np.linspace([0.0, 0.0, 0.0], [0.3, 0.0, 0.0], 7)
+    blind = spheres_problem(None)
+    ex = execute(blind, path, leg=0)
+    assert ex.path_valid and ex.success  # the spheres clear the post
+    assert ex.geometry["contacts"].startswith("planning model")
+    real = spheres_problem("mesh_arm.urdf")
+    ex = execute(real, path, leg=0)
+    assert ex.path_valid  # the plan is valid on the model planned with ...
+    assert not ex.success  # ... and the real forearm runs into the post
+    assert {(c.link_name, c.other_name) for c in ex.contacts} == {("fore", "post")}
+    assert ex.min_clearance_m < -0.004
+    assert (
+        ex.geometry["contacts"].startswith("real meshes")
+        and "mesh_arm.urdf" in (ex.geometry["contacts"])
+    )
+
+
+def test_a_sim_urdf_without_the_chain_s_links_is_refused(tmp_path: Path) -> None:
+    other = tmp_path / "other.urdf"
+    text = (DATA / "mesh_arm.urdf").read_text().replace('"fore"', '"forearm"')
+    other.write_text(text)
+    from plannerlab.errors import ProblemError
+
+    with pytest.raises(ProblemError, match=r"robot.sim_urdf.*lacks.*fore"):
+        spheres_problem(str(other))

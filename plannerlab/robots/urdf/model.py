@@ -389,6 +389,10 @@ class UrdfChain:
         cover_max_spheres: the most spheres a mesh's cover may have.
         cover_cache: keep covers on disk; ``cover_cache_dir`` (None:
             ``~/.cache/plannerlab/covers``).
+        sim_urdf_path: the robot's real geometry for the simulator: a URDF with the same
+            joints and links (its collision meshes, say, where ``urdf_path`` is a
+            spherized copy); PyBullet loads it instead, so execution verdicts are
+            measured on it. None: ``urdf_path`` itself.
     """
 
     urdf_path: Path
@@ -403,6 +407,7 @@ class UrdfChain:
     cover_max_spheres: int = 256
     cover_cache: bool = True
     cover_cache_dir: Path | None = None
+    sim_urdf_path: Path | None = None
 
     kind: str = field(default="urdf", init=False)
     dof: int = field(init=False)
@@ -427,6 +432,7 @@ class UrdfChain:
     #: warnings about the model, in words (also logged)
     notes: tuple[str, ...] = field(init=False, repr=False)
     _mesh_files: dict[str, Path] = field(init=False, repr=False)
+    _sim_mesh_files: dict[str, Path] = field(init=False, repr=False)
     # the chain's fixed data (see __post_init__)
     _body_links: tuple[str, ...] = field(init=False, repr=False)
     _parent_body: Any = field(init=False, repr=False)
@@ -543,6 +549,45 @@ class UrdfChain:
         s(self, "_cap_body", np.array(caps.body, dtype=int))
         s(self, "_cap_a", frozen_array(caps.a))
         s(self, "_cap_b", frozen_array(caps.b))
+        s(self, "_sim_mesh_files", self._check_sim_urdf(tree, settings))
+
+    def _check_sim_urdf(self, tree: _Tree, cover: CoverSettings) -> dict[str, Path]:
+        """The ``sim_urdf`` (the robot's real geometry for the simulator) checked: the
+        chain's joints and links are in it, its collision meshes are found; their files
+        by the name the URDF gives."""
+        from plannerlab.robots.urdf.meshes import MeshError, resolve_mesh
+
+        if self.sim_urdf_path is None:
+            return {}
+        path = Path(self.sim_urdf_path)
+        object.__setattr__(self, "sim_urdf_path", path)
+        try:
+            sim = _load_urdf(path)
+        except UrdfError as exc:
+            raise UrdfError("sim_urdf", exc.expected) from None
+        joints = {j.name for j in sim.joints}
+        links = {link.name: link for link in sim.links}
+        missing = [j for j in (*self.joint_names, *tree.frozen) if j not in joints]
+        missing += [n for n in self.link_frame_names if n not in links]
+        if missing:
+            raise UrdfError(
+                "sim_urdf",
+                f"a URDF with the joints and links of {self.urdf_path.name}; {path.name} "
+                f"lacks {', '.join(missing)}",
+            )
+        files: dict[str, Path] = {}
+        for name, link in links.items():
+            for col in link.collisions:
+                if col.geometry.mesh is None:
+                    continue
+                fn = str(col.geometry.mesh.filename)
+                try:
+                    files[fn] = resolve_mesh(
+                        fn, path, cover.mesh_paths, f"link {name} of {path.name}"
+                    )
+                except MeshError as exc:
+                    raise UrdfError("sim_urdf", str(exc)) from None
+        return files
 
     # ------------------------------------------------------------------ kinematics
     @property

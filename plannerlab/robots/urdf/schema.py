@@ -54,6 +54,7 @@ def build(values: Mapping[str, Any]) -> UrdfChain:
             mesh_paths=mesh_paths,
             cover_excess_m=float(values["cover_excess_m"]),
             cover_max_spheres=int(values["cover_max_spheres"]),
+            sim_urdf_path=Path(values["sim_urdf"]) if values["sim_urdf"] else None,
         )
     except UrdfError as exc:
         raise TableValueError(exc.key, exc.expected) from None
@@ -121,6 +122,14 @@ TABLE = RobotTable(
             minimum=1,
             maximum=4096,
             why_maximum="every sphere is one more capsule to check",
+        ),
+        Key(
+            "sim_urdf",
+            "path",
+            "",
+            "",
+            "the robot's real geometry for the simulator: a URDF with the same joints and "
+            "links (e.g. the mesh original of a spherized urdf), relative to the problem file",
         ),
         *base_pose_keys("root link"),
     ),

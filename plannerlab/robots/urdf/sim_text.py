@@ -23,29 +23,31 @@ def _motion(axis: np.ndarray, value: float, prismatic: bool) -> np.ndarray:
 
 
 def simulator_urdf(chain: Any) -> str:
-    """The URDF text for the simulator: the file as it is (its collision meshes, the
-    real geometry, included), with every collision mesh path made absolute (as
+    """The URDF text for the simulator: the file (``sim_urdf`` when given) as it is (its
+    collision meshes, the real geometry, included), with every collision mesh path made absolute (as
     resolved for the covers, ``package://`` included), visual meshes resolved the same
     way or left out when they cannot be (they are only looks; PyBullet refuses a file
     naming a missing mesh) and the frozen joints (see the module) made fixed at their
     value."""
     from plannerlab.robots.urdf.meshes import MeshError, resolve_mesh
 
-    tree = ET.parse(chain.urdf_path)
+    source = chain.sim_urdf_path or chain.urdf_path
+    mesh_files = chain._sim_mesh_files if chain.sim_urdf_path else chain._mesh_files
+    tree = ET.parse(source)
     root = tree.getroot()
     for link in root.iter("link"):
         for col in link.findall("collision"):
             for mesh in col.iter("mesh"):
                 fn = mesh.get("filename", "")
-                if fn in chain._mesh_files:
-                    mesh.set("filename", str(chain._mesh_files[fn]))
+                if fn in mesh_files:
+                    mesh.set("filename", str(mesh_files[fn]))
         for visual in link.findall("visual"):
             for mesh in visual.iter("mesh"):
                 fn = mesh.get("filename", "")
                 try:
                     mesh.set(
                         "filename",
-                        str(resolve_mesh(fn, chain.urdf_path, tuple(chain.mesh_paths), "")),
+                        str(resolve_mesh(fn, source, tuple(chain.mesh_paths), "")),
                     )
                 except MeshError:
                     # a visual whose mesh is not there (PyBullet refuses the file)
