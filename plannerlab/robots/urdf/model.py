@@ -47,7 +47,6 @@ Only numpy (``yourdfpy`` for parsing, ``trimesh`` for meshes) is used here.
 
 from __future__ import annotations
 
-import difflib
 import logging
 import math
 import xml.etree.ElementTree as ET
@@ -60,25 +59,12 @@ from numpy.typing import NDArray
 
 from plannerlab.errors import PlannerlabError
 from plannerlab.robots.base import Array
+from plannerlab.robots.urdf.errors import UrdfError, hint
 from plannerlab.robots.urdf.meshes import CoverSettings, MeshCover
+from plannerlab.robots.urdf.pairs import excluded_pairs, read_srdf_disabled
 
 MOVABLE = ("revolute", "continuous", "prismatic")
 _LOG = logging.getLogger(__name__)
-
-
-class UrdfError(PlannerlabError):
-    """A URDF, SRDF or link name the family cannot use; ``key`` is the ``[robot]`` key
-    to blame (``urdf``, ``tip_link``, ``srdf``, ``allowed_collisions``)."""
-
-    def __init__(self, key: str, expected: str) -> None:
-        self.key = key
-        self.expected = expected
-        super().__init__(f"[robot.{key}] {expected}")
-
-
-def _hint(name: str, names: list[str]) -> str:
-    close = difflib.get_close_matches(name, names, n=1)
-    return f" (did you mean {close[0]!r}?)" if close else ""
 
 
 def axis_motion(axis: Array, q: Array, prismatic: bool) -> Array:
@@ -94,15 +80,6 @@ def axis_motion(axis: Array, q: Array, prismatic: bool) -> Array:
     c = np.cos(q)[..., None, None]
     T[..., :3, :3] = np.eye(3) + s * K + (1.0 - c) * (K @ K)
     return T
-
-
-def read_srdf_disabled(path: Path) -> list[tuple[str, str]]:
-    """The ``<disable_collisions link1= link2=>`` pairs of an SRDF file."""
-    try:
-        root = ET.parse(path).getroot()
-    except (OSError, ET.ParseError) as exc:
-        raise UrdfError("srdf", f"a readable SRDF (XML) file; {path}: {exc}") from None
-    return [(str(e.get("link1")), str(e.get("link2"))) for e in root.iter("disable_collisions")]
 
 
 def _joint_axis(j: Any) -> Array:
@@ -179,7 +156,7 @@ def _chain(urdf: Any, tip_link: str, path: Path) -> _Tree:
     if tip_link not in links:
         raise UrdfError(
             "tip_link",
-            f"a link of {path.name}, got {tip_link!r}{_hint(tip_link, list(links))}; "
+            f"a link of {path.name}, got {tip_link!r}{hint(tip_link, list(links))}; "
             f"its links: {', '.join(links)}",
         )
     # the chain: root -> tip
@@ -328,43 +305,6 @@ def _capsules(
     return caps, reports, mesh_files
 
 
-def _excluded_pairs(
-    caps: _Capsules,
-    parent_body: list[int],
-    links: dict[str, Any],
-    srdf_path: Path | None,
-    allowed_collisions: tuple[tuple[str, str], ...],
-    path: Path,
-) -> set[tuple[int, int]]:
-    """Capsule pairs never checked: on one body, on neighbouring bodies, or of links the
-    SRDF or the problem's allowed-collision pairs name."""
-    disabled: set[frozenset[str]] = set()
-    if srdf_path is not None:
-        for l1, l2 in read_srdf_disabled(Path(srdf_path)):
-            disabled.add(frozenset((l1, l2)))
-    for l1, l2 in allowed_collisions:
-        for n in (l1, l2):
-            if n not in links:
-                raise UrdfError(
-                    "allowed_collisions",
-                    f"pairs of links of {path.name}; {n!r} is not one{_hint(n, list(links))}",
-                )
-        disabled.add(frozenset((l1, l2)))
-    neighbours = {frozenset((parent_body[i], i + 1)) for i in range(len(parent_body))}
-    excluded = set()
-    L = len(caps.names)
-    for i in range(L):
-        for j2 in range(i + 1, L):
-            bi, bj = caps.body[i], caps.body[j2]
-            if (
-                bi == bj
-                or frozenset((bi, bj)) in neighbours
-                or frozenset((caps.link[i], caps.link[j2])) in disabled
-            ):
-                excluded.add((i, j2))
-    return excluded
-
-
 def _frozen_array(a: Any, dtype: Any = float) -> Any:
     out = np.array(a, dtype=dtype)
     out.setflags(write=False)
@@ -506,7 +446,7 @@ class UrdfChain:
             )
         for note in notes:
             _LOG.warning(note)
-        excluded = _excluded_pairs(
+        excluded = excluded_pairs(
             caps, parent_body, tree.links, self.srdf_path, self.allowed_collisions, path
         )
         T_wb = np.array(self.T_world_base, dtype=float)
