@@ -40,7 +40,7 @@ edges at most half the voxel pitch, every corner marks its voxel, closed shells 
 filled (``scipy.ndimage.binary_fill_holes``), the filled voxels are merged greedily into
 boxes, and each box is grown by half a pitch (every surface point lies within half a
 pitch of a marked corner): the boxes hold the whole surface and the filled inside. The
-pitch is doubled until at most ``max_boxes`` boxes remain.
+pitch grows by a quarter until at most ``max_boxes`` boxes remain.
 """
 
 from __future__ import annotations
@@ -507,7 +507,7 @@ def box_cover(V: Array, F: np.ndarray, max_boxes: int, where: str, file: str) ->
     )
     while len(F) + area / (0.1 * (pitch / 2) ** 2) > 4 * MAX_COVER_TRIANGLES:
         pitch *= 2.0
-    for _ in range(12):
+    for _ in range(40):
         Vs, Fs = trimesh.remesh.subdivide_to_size(V, F, max_edge=pitch / 2.0, max_iter=30)
         idx = np.floor((np.asarray(Vs) - lo) / pitch).astype(np.int64)
         shape = tuple(int(n) for n in idx.max(axis=0) + 1)
@@ -521,7 +521,7 @@ def box_cover(V: Array, F: np.ndarray, max_boxes: int, where: str, file: str) ->
             low = lo + a * pitch - pitch / 2.0
             high = lo + b * pitch + pitch / 2.0
             return BoxCover((low + high) / 2.0, (high - low) / 2.0, pitch, (3**0.5 + 0.5) * pitch)
-        pitch *= 2.0
+        pitch *= 1.25
     raise MeshError(  # pragma: no cover - a pitch of the whole extent gives one box
         file, where, f"no cover in {max_boxes} boxes", "raise the box limit"
     )
