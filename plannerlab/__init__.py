@@ -15,7 +15,8 @@ The data flow is one way: problem file → :func:`load_problem` → planner
 (:func:`make_planner`, :func:`solve`) → record (:class:`Plan`, :class:`PlanResult`) →
 :func:`execute` (:class:`Execution`) → table (:func:`compare`, :func:`summarise`,
 :func:`markdown_report`); figures with :func:`snapshot_figure` and :func:`trace_figure`,
-animations with :func:`animate_plan`.
+animations with :func:`animate_plan`; an interactive 3-D view in the browser (or inline in a
+notebook) with :func:`view`.
 
 The command line is this API's first client (``plannerlab/cli/`` imports nothing else of
 the package but its records), so whatever a command does is here too: plan files
@@ -41,6 +42,7 @@ if TYPE_CHECKING:
     from plannerlab.planners import make_planner, planner_names
     from plannerlab.plot.animate import animate_plan
     from plannerlab.plot.plans import snapshot_figure, trace_figure
+    from plannerlab.plot.view import Viewer
     from plannerlab.problem.catalog import list_problems, load_problem
     from plannerlab.problem.load import Budget, Problem
     from plannerlab.record.execution import Execution
@@ -74,6 +76,7 @@ _EXPORTS: dict[str, str] = {
     "snapshot_figure": "plannerlab.plot.plans:snapshot_figure",
     "trace_figure": "plannerlab.plot.plans:trace_figure",
     "animate_plan": "plannerlab.plot.animate:animate_plan",
+    "Viewer": "plannerlab.plot.view:Viewer",
 }
 
 __all__ = [
@@ -87,6 +90,7 @@ __all__ = [
     "Problem",
     "Status",
     "Trial",
+    "Viewer",
     "animate_plan",
     "compare",
     "execute",
@@ -100,6 +104,7 @@ __all__ = [
     "solve",
     "summarise",
     "trace_figure",
+    "view",
 ]
 
 
@@ -205,6 +210,74 @@ __all__ += [
     "write_reports",
     "write_variants",
 ]
+
+
+def view(
+    plan: Any,
+    execution: Any = None,
+    *,
+    problem: Any = None,
+    host: str = "127.0.0.1",
+    port: int = 0,
+    mesh_dirs: Any = (),
+    max_frames: int = 300,
+    fps: float = 20.0,
+) -> Viewer:
+    """Serve an interactive 3-D view of a plan (and its execution) and return the running
+    :class:`Viewer` (its ``url``; ``close()`` stops it; in a notebook it shows inline).
+
+    Args:
+        plan: a :class:`Plan`, or a plan file (``PLAN.json``): its problem file is loaded
+            and the plan checked against it, and ``PLAN.exec.json`` beside it (written by
+            ``plannerlab execute``) is shown when ``execution`` is None.
+        execution: an :class:`ExecutionFile` (or its path), or :class:`Execution` records;
+            None: the one beside a plan file, else none (the planned motion only).
+        problem: the plan's problem (default: the problem file the plan names).
+        host, port: where to serve (port 0: any free port; a port in use is an error).
+        mesh_dirs: more folders to find a URDF robot's visual meshes in.
+        max_frames: timeline frames per leg; fps: frames per second when playing.
+
+    Raises:
+        PlannerlabError: an unreadable plan or execution file, a problem file that is
+            gone or changed, a plan that does not fit its problem, a port in use.
+    """
+    from pathlib import Path
+
+    from plannerlab.plot.view import serve
+    from plannerlab.record.plan import ExecutionFile, execution_path
+    from plannerlab.run.clearance import link_clearance
+    from plannerlab.run.plan_check import check_plan, read_checked_plan, read_plan
+
+    executions: Any = ()
+    if isinstance(plan, str | Path):
+        plan_file = Path(plan)
+        if problem is None:  # found from the plan's folder, its recorded path or by name
+            plan, problem = read_checked_plan(plan_file)
+        else:
+            plan = read_plan(plan_file)
+            check_plan(plan, problem, plan_file)
+        beside = execution_path(plan_file)
+        if execution is None and beside.is_file():
+            execution = beside
+    elif problem is None:
+        problem = plan.load_problem()
+    if isinstance(execution, str | Path):
+        execution = ExecutionFile.load(execution)
+    if isinstance(execution, ExecutionFile):
+        executions = execution.executions
+    elif execution is not None:
+        executions = (execution,) if hasattr(execution, "q_actual_rad") else tuple(execution)
+    return serve(
+        problem,
+        plan,
+        executions,
+        host=host,
+        port=port,
+        clearance=link_clearance(problem),
+        mesh_dirs=mesh_dirs,
+        max_frames=max_frames,
+        fps=fps,
+    )
 
 
 def __getattr__(name: str) -> Any:

@@ -14,7 +14,7 @@ from collections.abc import Iterator, Sequence
 from rich.console import Console
 from rich.markup import escape
 
-from plannerlab.cli import animate, execute, planners, plot, problems, solve, variants
+from plannerlab.cli import animate, execute, planners, plot, problems, solve, variants, view
 from plannerlab.cli.tables import make_console
 from plannerlab.errors import PlannerlabError
 
@@ -111,7 +111,7 @@ def build_parser() -> argparse.ArgumentParser:
     )
     sub = parser.add_subparsers(dest="command", required=True, metavar="SUBCOMMAND")
 
-    for module in (problems, planners, solve, execute, plot, animate, variants):
+    for module in (problems, planners, solve, execute, plot, animate, view, variants):
         module.add_parser(sub)
     from plannerlab.cli.ik import add_ik_parser
 

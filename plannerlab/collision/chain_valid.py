@@ -1,4 +1,5 @@
-"""Validity of a URDF chain's states in one fused compiled call (:class:`ChainValidity`):
+"""Validity of a chain's states in one fused compiled call (:class:`ChainValidity`; every
+robot family's chain, :mod:`plannerlab.collision.chain`, and the compiled model's state test):
 kinematics and the capsule tests of :mod:`plannerlab.collision.core` (moving capsules
 against every obstacle, the checked link pairs) with the same verdicts, built for speed.
 
@@ -9,12 +10,16 @@ against every obstacle, the checked link pairs) with the same verdicts, built fo
   sliced in the kernel without a reshape, so a call passes the states and three arrays.
 * **Kinematics about z.** Each joint's axis is turned onto its frame's z axis once (the
   turn folded into the fixed transforms and the capsules' points), so a joint costs one
-  affine product and a turn of two columns; body frames are 3 x 4.
+  affine product and a turn of two columns; body frames are 3 x 4, made from scalars (a
+  view per joint cost more than its arithmetic), with a joint coupling (IRb-6) applied
+  once per state into a scratch, never tested per joint (that test alone made the
+  kinematics 2.5 times slower).
 * **Bounding balls.** The capsules are sorted by body and, within a body, into clusters of
-  a few neighbours; a body ball, then cluster balls (grown by ``_BOUND_PAD_M`` beyond
+  a few neighbours; a body ball, then cluster balls (grown by ``chain_pack._BOUND_PAD_M`` beyond
   rounding) are tested before the capsules under them, against the scene (after the
   obstacle's world box) and between bodies; a body's capsules are placed in the world only
-  when one of its balls is not clear.
+  when one of its balls is not clear. Between links, balls around chunks of four
+  consecutive bodies come first: a pair of chunks apart skips all its body pairs.
 * **Spheres in closed form.** A zero-length capsule (a spherized URDF's spheres) against a
   box, a sphere or another sphere is tested inline with the very floats of
   :mod:`plannerlab.collision.geometry`; against a cylinder by geometry's own reject and
@@ -32,6 +37,18 @@ from typing import Any
 import numpy as np
 from numba import njit
 
+from plannerlab.collision.chain_pack import (  # the packing, and its layout
+    _BOUND_PAD_M,
+    _CHUNK,
+    _H_DOF,
+    _H_I,
+    _H_L,
+    _H_NB,
+    _H_NCL,
+    _H_NCPL,
+    _H_NOBS,
+    _pack,
+)
 from plannerlab.collision.geometry import (
     BOX,
     SPHERE,
@@ -41,16 +58,7 @@ from plannerlab.collision.geometry import (
     seg_seg,
 )
 
-# the int array: a header of counts, then the sections (see _pack), flat
-_H_DOF, _H_NB, _H_L, _H_NOBS, _H_NCL = range(5)
-_I_SECTIONS = (
-    *("parent", "prism", "body_cl", "cl_start", "order", "kind", "issph", "moving"),
-    *("allowed", "any_cl", "groups"),
-)
-_H_I = 5
-_HEADER = _H_I + len(_I_SECTIONS) + 1  # + 1: the end of the last section
 _SCRATCH = 64  # floats of w (capsule tests)
-_CLUSTER = 6  # capsules per cluster at most
 _F64 = np.dtype(np.float64)
 
 
@@ -123,36 +131,65 @@ def _bound_apart(kind, R, c, h, x0, x1, x2, rb):
 
 
 @njit(cache=True, nogil=True, inline="always")
-def _body_frames(q, T0, parent, prism, pre, Bf):
-    """Body frames (nb, 3, 4) of one state; each joint turns (or slides) about its frame's
-    z axis (the chain's axes are folded into ``pre`` and the capsules by ``_pack``)."""
+def _frames_of(v, T0, parent, prism, pre, Bf):
+    """Body frames (nb, 3, 4) from the chain's joint values v (n,); each joint turns (or
+    slides) about its frame's z axis. Scalars, not views: a view per joint and 3-d
+    indexing cost more than the arithmetic."""
     for a in range(3):
         for b in range(4):
             Bf[0, a, b] = T0[a, b]
-    for i in range(q.shape[0]):
-        F = Bf[parent[i]]
-        P = pre[i]
-        G = Bf[i + 1]
+    for i in range(parent.shape[0]):
+        qi = v[i]
+        f = parent[i]
+        p00, p01, p02, p03 = pre[i, 0, 0], pre[i, 0, 1], pre[i, 0, 2], pre[i, 0, 3]
+        p10, p11, p12, p13 = pre[i, 1, 0], pre[i, 1, 1], pre[i, 1, 2], pre[i, 1, 3]
+        p20, p21, p22, p23 = pre[i, 2, 0], pre[i, 2, 1], pre[i, 2, 2], pre[i, 2, 3]
+        slide = prism[i] != 0
+        cq = 1.0
+        sq = 0.0
+        if not slide:
+            cq = math.cos(qi)
+            sq = math.sin(qi)
         for a in range(3):
-            f0, f1, f2 = F[a, 0], F[a, 1], F[a, 2]
-            for b in range(4):
-                G[a, b] = f0 * P[0, b] + f1 * P[1, b] + f2 * P[2, b]
-            G[a, 3] += F[a, 3]
-        if prism[i]:
-            for a in range(3):
-                G[a, 3] += q[i] * G[a, 2]
-        else:
-            cq = math.cos(q[i])
-            sq = math.sin(q[i])
-            for a in range(3):
-                g0, g1 = G[a, 0], G[a, 1]
-                G[a, 0] = cq * g0 + sq * g1
-                G[a, 1] = cq * g1 - sq * g0
+            f0, f1, f2, f3 = Bf[f, a, 0], Bf[f, a, 1], Bf[f, a, 2], Bf[f, a, 3]
+            g0 = f0 * p00 + f1 * p10 + f2 * p20
+            g1 = f0 * p01 + f1 * p11 + f2 * p21
+            g2 = f0 * p02 + f1 * p12 + f2 * p22
+            g3 = f0 * p03 + f1 * p13 + f2 * p23
+            g3 += f3
+            if slide:
+                g3 += qi * g2
+                Bf[i + 1, a, 0] = g0
+                Bf[i + 1, a, 1] = g1
+            else:
+                Bf[i + 1, a, 0] = cq * g0 + sq * g1
+                Bf[i + 1, a, 1] = cq * g1 - sq * g0
+            Bf[i + 1, a, 2] = g2
+            Bf[i + 1, a, 3] = g3
+
+
+@njit(cache=True, nogil=True, inline="always")
+def _body_frames(q, T0, parent, prism, pre, Bf, cpl, v):
+    """Body frames (nb, 3, 4) of one state q (the chain's axes are folded into ``pre`` and
+    the capsules by ``_pack``). ``cpl``: the coupling's (starts, indices, coefficients),
+    empty without one; with one, the chain's joint values ``Σ_k cpl_val[k] q[cpl_idx[k]]``
+    go through the scratch v (n,) first (tested once here, not per joint: ~2.5 times
+    faster kinematics)."""
+    cpl_start, cpl_idx, cpl_val = cpl
+    if cpl_start.shape[0] == 0:
+        _frames_of(q, T0, parent, prism, pre, Bf)
+        return
+    for i in range(parent.shape[0]):
+        x = 0.0
+        for k in range(cpl_start[i], cpl_start[i + 1]):
+            x += cpl_val[k // 3, k % 3] * q[cpl_idx[k]]
+        v[i] = x
+    _frames_of(v, T0, parent, prism, pre, Bf)
 
 
 @njit(cache=True, nogil=True, inline="always")
 def _iv(idat, k):
-    """Int section k (see ``_I_SECTIONS``), flat."""
+    """Int section k (see ``chain_pack._I_SECTIONS``), flat."""
     return idat[idat[_H_I + k] : idat[_H_I + k + 1]]
 
 
@@ -161,6 +198,7 @@ def _unpack(P, M, idat):
     """Views of the packed arrays (see ``_pack``): slices only (a reshape costs some 30 ns
     in numba, a slice about one)."""
     dof, nb, L, n, ncl = idat[_H_DOF], idat[_H_NB], idat[_H_L], idat[_H_NOBS], idat[_H_NCL]
+    ncpl = idat[_H_NCPL]
     ints = (
         _iv(idat, 0),
         _iv(idat, 1),
@@ -173,8 +211,11 @@ def _unpack(P, M, idat):
         _iv(idat, 8),
         _iv(idat, 9),
         _iv(idat, 10),
+        _iv(idat, 13),
     )
     o = 3 * L + 2 * nb + 2 * ncl  # the obstacles' rows of P
+    e = o + 4 * n  # the coupling's coefficients, three a row, after the obstacles
+    cpl = (_iv(idat, 11), _iv(idat, 12), P[e : e + (ncpl + 2) // 3])
     floats = (
         M[0],
         M[1 : 1 + dof],
@@ -194,7 +235,7 @@ def _unpack(P, M, idat):
         P[o + 2 * n : o + 3 * n],
         P[o + 3 * n : o + 4 * n],
     )
-    return ints, floats
+    return ints, floats, cpl
 
 
 @njit(cache=True, nogil=True, inline="always")
@@ -288,11 +329,12 @@ def _state_ok(q, V, S):
     holding a checked pair: the bodies' balls, then per pair of clusters holding one their
     balls, then the pairs. A body's capsules are placed only when one of its balls is not
     clear; the first hit ends the test."""
-    (parent, prism, body_cl, cl_start, order, kinds, issph, moving, allowed, any_cl, groups) = V[0]
+    (parent, prism, body_cl, cl_start, order, kinds, issph, moving, allowed, any_cl) = V[0][:10]
+    groups, cgroups = V[0][10], V[0][11]
     (T0, pre, cap_a, cap_b, rad, rads, bc, br, brs, cl_c, cl_r, cl_rs, Rs, cs, hs) = V[1][:15]
     olo, ohi = V[1][15], V[1][16]
     Bf, Cw, Kw, X, Y, done, w = S
-    _body_frames(q, T0, parent, prism, pre, Bf)
+    _body_frames(q, T0, parent, prism, pre, Bf, V[2], done)  # done: reset below
     nb = bc.shape[0]
     for b in range(nb):
         x, y, z = bc[b, 0], bc[b, 1], bc[b, 2]
@@ -333,40 +375,68 @@ def _state_ok(q, V, S):
                     return False
     ncl = Kw.shape[0]
     L = X.shape[0]
-    for g in range(groups.shape[0] // 2):
-        bu, bv = groups[2 * g], groups[2 * g + 1]
-        if bu != bv and _apart(Cw, bu, Cw, bv, brs[bu] + brs[bv]):
-            continue
-        for b in (bu, bv):
-            if done[b] == 0.0:
-                _place_body(Bf, cap_a, cap_b, issph, body_cl, cl_start, cl_c, b, X, Y, Kw)
-                done[b] = 1.0
-        for Ku in range(body_cl[bu], body_cl[bu + 1]):
-            if bu != bv and _apart(Kw, Ku, Cw, bv, cl_rs[Ku] + brs[bv]):
+    # balls around chunks of _CHUNK consecutive bodies (around their body balls), rows
+    # (x, y, z, r) after the capsule tests' scratch
+    cb = w[_SCRATCH:]
+    if cgroups.shape[0] > 0:
+        for c in range((nb + _CHUNK - 1) // _CHUNK):
+            b0, b1 = c * _CHUNK, min(nb, (c + 1) * _CHUNK)
+            x, y, z = 0.0, 0.0, 0.0
+            for b in range(b0, b1):
+                x += Cw[b, 0]
+                y += Cw[b, 1]
+                z += Cw[b, 2]
+            k = 1.0 / (b1 - b0)
+            x, y, z = x * k, y * k, z * k
+            r = 0.0
+            for b in range(b0, b1):
+                dx, dy, dz = Cw[b, 0] - x, Cw[b, 1] - y, Cw[b, 2] - z
+                r = max(r, math.sqrt(dx * dx + dy * dy + dz * dz) + brs[b])
+            cb[4 * c], cb[4 * c + 1], cb[4 * c + 2], cb[4 * c + 3] = x, y, z, r + _BOUND_PAD_M
+    for t in range(cgroups.shape[0] // 4):
+        cu, cv = cgroups[4 * t], cgroups[4 * t + 1]
+        if cu != cv:
+            dx = cb[4 * cu] - cb[4 * cv]
+            dy = cb[4 * cu + 1] - cb[4 * cv + 1]
+            dz = cb[4 * cu + 2] - cb[4 * cv + 2]
+            rr = cb[4 * cu + 3] + cb[4 * cv + 3]
+            if dx * dx + dy * dy + dz * dz > rr * rr:
+                continue  # the chunks' balls are apart: none of their body pairs touch
+        for g in range(cgroups[4 * t + 2], cgroups[4 * t + 3]):
+            bu, bv = groups[2 * g], groups[2 * g + 1]
+            if bu != bv and _apart(Cw, bu, Cw, bv, brs[bu] + brs[bv]):
                 continue
-            for Kv in range(Ku if bu == bv else body_cl[bv], body_cl[bv + 1]):
-                if any_cl[Ku * ncl + Kv] == 0:
+            for b in (bu, bv):
+                if done[b] == 0.0:
+                    _place_body(Bf, cap_a, cap_b, issph, body_cl, cl_start, cl_c, b, X, Y, Kw)
+                    done[b] = 1.0
+            for Ku in range(body_cl[bu], body_cl[bu + 1]):
+                if bu != bv and _apart(Kw, Ku, Cw, bv, cl_rs[Ku] + brs[bv]):
                     continue
-                if Ku != Kv and _apart(Kw, Ku, Kw, Kv, cl_rs[Ku] + cl_rs[Kv]):
-                    continue
-                for i in range(cl_start[Ku], cl_start[Ku + 1]):
-                    if Ku != Kv and issph[i] and _apart(X, i, Kw, Kv, rads[i] + cl_rs[Kv]):
+                for Kv in range(Ku if bu == bv else body_cl[bv], body_cl[bv + 1]):
+                    if any_cl[Ku * ncl + Kv] == 0:
                         continue
-                    j0 = i + 1 if Ku == Kv else cl_start[Kv]
-                    for j in range(j0, cl_start[Kv + 1]):
-                        if allowed[i * L + j] and _pair_hit(i, j, issph, rads, X, Y):
-                            return False
+                    if Ku != Kv and _apart(Kw, Ku, Kw, Kv, cl_rs[Ku] + cl_rs[Kv]):
+                        continue
+                    for i in range(cl_start[Ku], cl_start[Ku + 1]):
+                        if Ku != Kv and issph[i] and _apart(X, i, Kw, Kv, rads[i] + cl_rs[Kv]):
+                            continue
+                        j0 = i + 1 if Ku == Kv else cl_start[Kv]
+                        for j in range(j0, cl_start[Kv + 1]):
+                            if allowed[i * L + j] and _pair_hit(i, j, issph, rads, X, Y):
+                                return False
     return True
 
 
 @njit(cache=True, nogil=True)
 def _scratch(idat):
     """Per-call scratch of :func:`_state_ok`: (body frames, body ball centres, cluster ball
-    centres, capsule ends a and b, placed flags, capsule-test scratch)."""
+    centres, capsule ends a and b, placed flags (nb: also the coupled joint values while
+    the frames are made), capsule-test scratch (then the chunk balls))."""
     nb, L, ncl = idat[_H_NB], idat[_H_L], idat[_H_NCL]
     Bf = np.empty((nb, 3, 4))
     W = np.empty((nb + ncl + 2 * L, 3))
-    aux = np.zeros(nb + _SCRATCH)
+    aux = np.zeros(nb + _SCRATCH + 4 * ((nb + _CHUNK - 1) // _CHUNK))
     return (
         Bf,
         W[:nb],
@@ -422,9 +492,9 @@ def chain_points(Q, P, M, idat, out):
     (parent, prism, body_cl, cl_start, _, _, issph) = V[0][:7]
     (T0, pre, cap_a, cap_b) = V[1][:4]
     cl_c = V[1][9]
-    Bf, _, Kw, X, Y, _, _ = _scratch(idat)
+    Bf, _, Kw, X, Y, v, _ = _scratch(idat)
     for s in range(Q.shape[0]):
-        _body_frames(Q[s], T0, parent, prism, pre, Bf)
+        _body_frames(Q[s], T0, parent, prism, pre, Bf, V[2], v)
         for b in range(Bf.shape[0]):
             _place_body(Bf, cap_a, cap_b, issph, body_cl, cl_start, cl_c, b, X, Y, Kw)
         for l in range(X.shape[0]):
@@ -432,164 +502,6 @@ def chain_points(Q, P, M, idat, out):
                 out[s, l, 0, a] = X[l, a]
                 out[s, l, 1, a] = X[l, a] if issph[l] else Y[l, a]
     return out
-
-
-# ---------------------------------------------------------------------- packing (once)
-_BOUND_PAD_M = 1e-9  # grows every bounding ball beyond rounding: a ball clear is clear
-
-
-def _align(u: np.ndarray) -> np.ndarray:
-    """A rotation A (3, 3) with A e_z = u (the identity for u = e_z)."""
-    z = np.asarray(u, dtype=float)
-    if np.array_equal(z, [0.0, 0.0, 1.0]):
-        return np.eye(3)
-    e = np.eye(3)[int(np.argmin(np.abs(z)))]
-    x = np.cross(e, z)
-    x /= np.linalg.norm(x)
-    return np.column_stack([x, np.cross(z, x), z])
-
-
-def _ball(centres: np.ndarray, reach: np.ndarray) -> tuple[np.ndarray, float]:
-    """A ball around points each grown by its own reach: (centre, radius), radius -1 for none."""
-    if len(centres) == 0:
-        return np.zeros(3), -1.0
-    c = (centres.min(axis=0) + centres.max(axis=0)) / 2.0
-    return c, float(np.max(np.linalg.norm(centres - c, axis=1) + reach)) + _BOUND_PAD_M
-
-
-def _clusters(points: np.ndarray, idx: np.ndarray, size: int) -> list[np.ndarray]:
-    """idx cut into groups of at most ``size`` neighbours (halved along the widest axis of
-    their points, recursively)."""
-    if len(idx) <= size:
-        return [idx]
-    p = points[idx]
-    axis = int(np.argmax(p.max(axis=0) - p.min(axis=0)))
-    by = idx[np.argsort(p[:, axis], kind="stable")]
-    half = len(by) // 2
-    return _clusters(points, by[:half], size) + _clusters(points, by[half:], size)
-
-
-def _pack(
-    robot: Any,
-    radii: np.ndarray,
-    radii_self: np.ndarray,
-    moving: np.ndarray,
-    allowed: np.ndarray,
-    kinds: np.ndarray,
-    Rs: np.ndarray,
-    cs: np.ndarray,
-    hs: np.ndarray,
-    order: np.ndarray | None,
-) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-    """The chain, its capsules, the checked pairs and the scene for :func:`chain_valid`:
-    points, centres and per-capsule, -body, -cluster radii as rows of three (P), frames
-    as 3 x 4 matrices (M), counts and indices (idat); and the capsules' new order (by body,
-    then cluster).
-
-    Each joint's axis u is turned onto its frame's z axis: with A e_z = u, a turn about u
-    is A Rz(q) Aᵀ, so the body frames are kept as B·A and A is folded into the fixed
-    transforms and the capsules' points (the kinematics then turn about z only)."""
-    parent, pre, axes, prismatic, cap_body, cap_a, cap_b = robot.chain_data()
-    dof = len(parent)
-    nb = dof + 1
-    A = [np.eye(3)] + [_align(axes[i]) for i in range(dof)]
-    pre_f = np.empty((dof, 3, 4))
-    for i in range(dof):
-        Ap, Ai = np.eye(4), np.eye(4)
-        Ap[:3, :3], Ai[:3, :3] = A[int(parent[i])], A[i + 1]
-        pre_f[i] = (Ap.T @ np.asarray(pre[i], dtype=float) @ Ai)[:3]
-    cap_body = np.asarray(cap_body, dtype=np.int64)
-    mid = (np.asarray(cap_a, dtype=float) + np.asarray(cap_b, dtype=float)) / 2.0
-    perm_l: list[int] = []
-    cl_start, body_cl = [0], [0]
-    for b in range(nb):
-        for members in _clusters(mid, np.flatnonzero(cap_body == b), _CLUSTER):
-            perm_l.extend(int(m) for m in members)
-            cl_start.append(len(perm_l))
-        body_cl.append(len(cl_start) - 1)
-    perm = np.array(perm_l, dtype=np.int64)
-    body = cap_body[perm]
-    ca = np.array(
-        [A[int(b)].T @ p for b, p in zip(body, np.asarray(cap_a)[perm], strict=True)]
-    ).reshape(-1, 3)
-    cb = np.array(
-        [A[int(b)].T @ p for b, p in zip(body, np.asarray(cap_b)[perm], strict=True)]
-    ).reshape(-1, 3)
-    issph = np.all(np.asarray(cap_a)[perm] == np.asarray(cap_b)[perm], axis=1)
-    rad, rads, mov = radii[perm], radii_self[perm], np.asarray(moving, dtype=bool)[perm]
-
-    def balls(ranges: list[tuple[int, int]]) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """Per range of capsules: centre, radius against the scene (moving capsules only;
-        -1: none) and between links."""
-        c, r, rs = np.zeros((len(ranges), 3)), np.full(len(ranges), -1.0), np.zeros(len(ranges))
-        for k, (l0, l1) in enumerate(ranges):
-            pts = np.concatenate([ca[l0:l1], cb[l0:l1]])
-            c[k], rs[k] = _ball(pts, np.tile(rads[l0:l1], 2))
-            m = np.tile(mov[l0:l1], 2)
-            if m.any():
-                reach = np.tile(rad[l0:l1], 2)[m]
-                r[k] = float(np.max(np.linalg.norm(pts[m] - c[k], axis=1) + reach)) + _BOUND_PAD_M
-        return c, r, rs
-
-    ncl = len(cl_start) - 1
-    cl_c, cl_r, cl_rs = balls([(cl_start[k], cl_start[k + 1]) for k in range(ncl)])
-    bc, br, brs = balls([(cl_start[body_cl[b]], cl_start[body_cl[b + 1]]) for b in range(nb)])
-    # the checked pairs in the new order (i < j), and which clusters and bodies hold one
-    sym = np.asarray(allowed, dtype=bool) | np.asarray(allowed, dtype=bool).T
-    al = np.triu(sym[np.ix_(perm, perm)], 1)
-    cl_of = np.repeat(np.arange(ncl), np.diff(cl_start))
-    any_cl = np.zeros((ncl, ncl), dtype=np.int64)
-    for i, j in zip(*np.nonzero(al), strict=True):
-        any_cl[cl_of[i], cl_of[j]] = 1
-    cl_body = np.repeat(np.arange(nb), np.diff(body_cl))
-    groups = sorted(
-        {(int(cl_body[u]), int(cl_body[v])) for u, v in zip(*np.nonzero(any_cl), strict=True)}
-    )
-    body_order = np.arange(nb)[::-1] if order is None else np.asarray(order)
-    # world boxes around the obstacles (a first, cheaper cull), grown beyond rounding
-    Rs, cs, hs = (np.asarray(a, dtype=float) for a in (Rs, cs, hs))
-    kinds = np.asarray(kinds)
-    sph = (kinds == SPHERE)[:, None]
-    ext = np.where(
-        (kinds == BOX)[:, None],
-        hs,
-        np.where(sph, hs[:, :1], np.stack([hs[:, 0], hs[:, 0], hs[:, 1]], 1)),
-    )
-    half = (np.abs(Rs) @ ext[:, :, None])[..., 0] if len(kinds) else np.zeros((0, 3))
-    half = np.where(sph, ext, half) + _BOUND_PAD_M
-    ints = [
-        np.asarray(parent),
-        np.asarray(prismatic),
-        np.asarray(body_cl),
-        np.asarray(cl_start),
-        body_order,
-        kinds,
-        issph,
-        mov,
-        al,
-        any_cl,
-        np.asarray(groups).reshape(-1, 2),
-    ]
-    head = np.zeros(_HEADER, dtype=np.int64)
-    head[:_H_I] = (dof, nb, len(body), len(kinds), ncl)
-    at = _HEADER
-    for k, a in enumerate(ints):
-        head[_H_I + k] = at
-        at += np.asarray(a).size
-    head[_H_I + len(ints)] = at
-    idat = np.concatenate([head] + [np.asarray(a, dtype=np.int64).reshape(-1) for a in ints])
-    zeros = np.zeros
-    P = np.concatenate(
-        [ca, cb, np.column_stack([rad, rads, zeros(len(rad))]), bc]
-        + [np.column_stack([br, brs, zeros(nb)]), cl_c, np.column_stack([cl_r, cl_rs, zeros(ncl)])]
-        + [cs.reshape(-1, 3), hs.reshape(-1, 3), (cs - half).reshape(-1, 3)]
-        + [(cs + half).reshape(-1, 3)]
-    )
-    R34 = zeros((len(kinds), 3, 4))
-    R34[:, :, :3] = Rs.reshape(-1, 3, 3)
-    T0 = np.asarray(robot.T_world_base, dtype=float)[None, :3]
-    M = np.concatenate([T0, pre_f, R34])
-    return np.ascontiguousarray(P), np.ascontiguousarray(M), idat, perm
 
 
 class ChainValidity:

@@ -103,7 +103,7 @@ from plannerlab.collision.armz import (
     armz_path_advance,
     armz_segments,
 )
-from plannerlab.collision.chain import chain_arrays, chain_segments
+from plannerlab.collision.chain import chain_arrays, chain_parts, chain_segments
 from plannerlab.collision.chain_valid import ChainValidity, chain_state_valid
 from plannerlab.collision.geometry import BOX, CYLINDER, SPHERE
 from plannerlab.collision.kernels import (
@@ -161,6 +161,33 @@ class PairDistances:
 def supports(scene: Scene) -> bool:
     """True when every obstacle of the scene is a shape the core tests exactly."""
     return all(isinstance(o, Box | Cylinder | Sphere) for o in scene.obstacles)
+
+
+def _module_chain(robot: Robot) -> tuple[np.ndarray, np.ndarray] | None:
+    """Arm-Z's fixed transforms (base -> first joint, one module) from its chain, or None
+    for a robot that is not an Arm-Z or whose chain is not a row of identical modules
+    turning about z with a capsule along each module's chord (what collision/armz.py
+    computes)."""
+    if getattr(robot, "kind", "") != "armz" or not callable(getattr(robot, "chain_data", None)):
+        return None
+    parent, pre, axes, prismatic, cap_body, cap_a, cap_b, coupling = chain_parts(robot)
+    n = len(parent)
+    if n < 2:  # one joint: the chain does not hold a whole module (the tip's turn)
+        return None
+    pre = np.asarray(pre, dtype=float)
+    M = pre[1]
+    same = (
+        coupling is None
+        and np.array_equal(parent, np.arange(n))
+        and np.array_equal(axes, np.tile([0.0, 0.0, 1.0], (n, 1)))
+        and not np.any(prismatic)
+        and all(np.array_equal(pre[i], M) for i in range(1, n))
+        and np.array_equal(cap_body, np.arange(n + 1))
+        and not np.any(cap_a)
+        and np.array_equal(cap_b[0], pre[0, :3, 3])
+        and np.array_equal(cap_b[1:], np.tile(M[:3, 3], (n, 1)))
+    )
+    return (pre[0], M) if same else None
 
 
 class Core:
@@ -245,20 +272,23 @@ class Core:
             self.ohi,
         )
         self._continuous = np.ascontiguousarray(robot.continuous, dtype=np.bool_)
-        self._armz = getattr(robot, "kind", "") == "armz"
-        #: a URDF chain: its capsules from compiled kinematics (collision/chain.py)
+        #: Arm-Z's own road (collision/armz.py: its frames, and paths by conservative
+        #: advancement with bounds at the configuration): the module chain's fixed
+        #: transforms, read from its chain (None: another robot)
+        modules = _module_chain(robot)
+        self._armz = modules is not None
+        #: a chain (collision/chain.py): its capsules from compiled kinematics
         self._chain: Any = None
         #: its validity in one fused call per query (collision/chain_valid.py)
         self._fused: ChainValidity | None = None
         if not self._armz and callable(getattr(robot, "chain_data", None)):
             self._chain = chain_arrays(robot)
             self._fused = ChainValidity.of(self)
-        if self._armz:
-            armz: Any = robot  # an ArmZ: its fixed transforms feed the compiled kinematics
-            T0 = np.ascontiguousarray(armz.T_world_base, dtype=np.float64)
+        if modules is not None:
+            T0 = np.ascontiguousarray(robot.T_world_base, dtype=np.float64)
             self._T0 = T0
-            self._T1 = T0 @ armz._T_base_j1
-            self._M = np.ascontiguousarray(armz._M, dtype=np.float64)
+            self._T1 = T0 @ modules[0]
+            self._M = np.ascontiguousarray(modules[1], dtype=np.float64)
         #: armz_path_advance's arguments after (P, first, joint_step, limit)
         self._advance_args: tuple[Any, ...] = ()
         if self._armz and self._rates is not None:
@@ -313,12 +343,13 @@ class Core:
         (:class:`~plannerlab.collision.model.CompiledModel`), built on first use and kept.
 
         Raises:
-            ValueError: the robot gives no serial chain (``chain_data``) to compile.
+            ModelError: the robot gives no serial chain (``chain_data``) to compile and
+                its family registers no builder of its own.
         """
         if self._model is None:
-            from plannerlab.collision.model import model_of_core
+            from plannerlab.collision.model import build_model
 
-            self._model = model_of_core(self)
+            self._model = build_model(self)
         return self._model
 
     # ------------------------------------------------------------------ kinematics

@@ -477,8 +477,8 @@ class CollisionChecker:
         CompiledModel`) of this checker's robot, scene and margin, built once.
 
         Raises:
-            ValueError: the checker has no compiled core (an FCL-only scene) or the robot
-                gives no serial chain.
+            ValueError: the checker has no compiled core (an FCL-only scene).
+            ModelError: the robot gives no serial chain (and its family no builder).
         """
         if self._core is None:
             raise ValueError(

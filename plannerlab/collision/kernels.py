@@ -310,6 +310,7 @@ def chain_first_invalid(
     cap_body,
     cap_a,
     cap_b,
+    coupling,
     radii,
     radii_self,
     moving,
@@ -325,7 +326,7 @@ def chain_first_invalid(
     """:func:`first_invalid` of a URDF chain's states Q (k, dof), kinematics included
     (:func:`~plannerlab.collision.chain.chain_segments`): one compiled call per query."""
     segs = np.empty((Q.shape[0], cap_body.shape[0], 2, 3))
-    chain_segments(Q, T0, parent, pre, axes, prismatic, cap_body, cap_a, cap_b, segs)
+    chain_segments(Q, T0, parent, pre, axes, prismatic, cap_body, cap_a, cap_b, coupling, segs)
     return first_invalid(
         segs, radii, radii_self, moving, allowed, tree, kinds, Rs, cs, hs, olo, ohi
     )

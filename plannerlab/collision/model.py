@@ -16,7 +16,17 @@ what a compiled planner needs without calling back into Python:
   ``ceil(Σ |Δq_i| · edge_weights_i)`` steps, so no point moves more than the margin
   between two checked states (the checker's grid, :meth:`~plannerlab.collision.
   fcl_checker.CollisionChecker.densify`);
-* ``margin_m``.
+* ``margin_m``;
+* ``perm``: the capsules' packed order (capsule ``perm[k]`` of the robot is the ``k``-th
+  packed one; :func:`segments` gives them back in the robot's order).
+
+Every robot family registers the builder of its model (:attr:`plannerlab.robots.registry.
+RobotFamily.model`, ``"module:function"`` called with the built core); the default is the
+generic serial-chain builder :func:`model_of_core`, which needs only the robot's
+``chain_data()`` (:mod:`plannerlab.collision.chain`: parents, fixed transforms, axes,
+sliding joints, capsules, and an optional linear coupling of the joints), so a new family
+takes the compiled road without a special case. :func:`build_model` looks the builder up;
+a robot without a chain gets a :class:`ModelError` naming its kind.
 
 The kernels below are the model's queries in compiled code: one state, a batch, and an
 edge checked on the checker's grid (the very states of ``densify``, bit for bit) in an
@@ -31,7 +41,20 @@ from typing import Any, NamedTuple
 import numpy as np
 from numba import njit
 
-from plannerlab.collision.chain_valid import _pack, _scratch, _state_ok, _unpack
+from plannerlab.collision.chain_pack import _pack
+from plannerlab.collision.chain_valid import (
+    _body_frames,
+    _place_body,
+    _scratch,
+    _state_ok,
+    _unpack,
+)
+from plannerlab.errors import PlannerlabError
+from plannerlab.robots.registry import model_builder
+
+
+class ModelError(PlannerlabError):
+    """A compiled consumer asked for the model of a robot that cannot give one."""
 
 
 class CompiledModel(NamedTuple):
@@ -45,6 +68,7 @@ class CompiledModel(NamedTuple):
     continuous: np.ndarray
     edge_weights: np.ndarray
     margin_m: float
+    perm: np.ndarray
 
 
 def has_chain(robot: Any) -> bool:
@@ -57,8 +81,13 @@ def model_of_core(core: Any) -> CompiledModel:
     the margin, checked pairs, scene arrays and edge weights)."""
     robot = core.robot
     if not has_chain(robot):
-        raise ValueError(f"robot {getattr(robot, 'kind', type(robot).__name__)} gives no chain")
-    P, M, idat, _ = _pack(
+        raise ModelError(
+            f"robot type {getattr(robot, 'kind', type(robot).__name__)!r} gives no serial "
+            "chain (chain_data()) and its family registers no model builder: a compiled "
+            "consumer (native planners, the fused checks) cannot run it; give the robot a "
+            "chain_data() (docs/extending.md)"
+        )
+    P, M, idat, perm = _pack(
         robot,
         core.radii,
         core.radii_self,
@@ -70,7 +99,13 @@ def model_of_core(core: Any) -> CompiledModel:
         core.hs,
         None,
     )
-    f = np.ascontiguousarray
+
+    def f(a: Any, dtype: Any) -> np.ndarray:
+        # a writable C-ordered copy: numba types read-only arrays (a robot's bounds may
+        # be read-only views) apart, and every kernel taking the model would be compiled
+        # and cached twice
+        return np.array(a, dtype=dtype, order="C", copy=True)
+
     return CompiledModel(
         P=P,
         M=M,
@@ -80,7 +115,20 @@ def model_of_core(core: Any) -> CompiledModel:
         continuous=f(robot.continuous, dtype=np.bool_),
         edge_weights=f(core.edge_weights, dtype=np.float64),
         margin_m=float(core.margin_m),
+        perm=f(perm, dtype=np.int64),
     )
+
+
+def build_model(core: Any) -> CompiledModel:
+    """The model of a built core by its robot family's registered builder (the generic
+    serial-chain :func:`model_of_core` unless the family names its own).
+
+    Raises:
+        ModelError: the robot gives no chain and its family no builder of its own.
+    """
+    builder = model_builder(str(getattr(core.robot, "kind", "")))
+    model: CompiledModel = builder(core)
+    return model
 
 
 # ---------------------------------------------------------------------- compiled queries
@@ -90,10 +138,31 @@ def views(m):
     return _unpack(m.P, m.M, m.idat), _scratch(m.idat)
 
 
+#: One state q (dof,) is valid (``V``, ``S`` from :func:`views`): chain_valid's own
+#: kernel under the model's name (a wrapper that passes ``V`` and ``S`` on, even inlined
+#: at numba's level, costs ~0.35 µs a call: ``bench/model_bench.py``)
+state_ok = _state_ok
+
+
 @njit(cache=True, nogil=True)
-def state_ok(q, V, S):
-    """One state q (dof,) is valid (``V``, ``S`` from :func:`views`)."""
-    return _state_ok(q, V, S)
+def segments(Q, m, out):
+    """Capsule axes of a batch in the robot's capsule order, the model's kinematics:
+    Q (k, dof) -> out (k, L, 2, 3) (``robot.link_segments``' numbers to rounding)."""
+    V, S = views(m)
+    (parent, prism, body_cl, cl_start, _, _, issph) = V[0][:7]
+    (T0, pre, cap_a, cap_b) = V[1][:4]
+    cl_c = V[1][9]
+    Bf, _, Kw, X, Y, v, _ = S
+    for s in range(Q.shape[0]):
+        _body_frames(Q[s], T0, parent, prism, pre, Bf, V[2], v)
+        for b in range(Bf.shape[0]):
+            _place_body(Bf, cap_a, cap_b, issph, body_cl, cl_start, cl_c, b, X, Y, Kw)
+        for k in range(X.shape[0]):
+            l = m.perm[k]
+            for a in range(3):
+                out[s, l, 0, a] = X[k, a]
+                out[s, l, 1, a] = X[k, a] if issph[k] else Y[k, a]
+    return out
 
 
 @njit(cache=True, nogil=True)
@@ -137,18 +206,20 @@ def edge_state(q_a, d, j, n, out):
         out[i] = q_a[i] + t * d[i]
 
 
-@njit(cache=True, nogil=True)
-def edge_ok(q_a, q_b, joint_step, m, V, S, d, q, limit):
-    """Check the grid states 1..n of edge q_a -> q_b, coarse to fine (the end state, then
-    the midpoints of ever finer halvings), stopping at the first invalid one or after
-    ``limit`` checks. Returns (status, checks): status 0 all valid, 1 a state is invalid,
-    2 the limit came first (nothing proved), 3 the edge has more than ``limit`` states
-    and was not checked (``checks`` = 0)."""
+@njit(cache=True, nogil=True, inline="always")
+def _edge_visit(q_a, q_b, joint_step, m, V, S, d, q, limit, rec):
+    """:func:`edge_ok`'s loop; ``rec`` (non-empty) records the grid indices j visited, in
+    order (the test's window on the very loop the planners run)."""
     edge_delta(q_a, q_b, m.continuous, d)
     n = edge_count(d, joint_step, m.edge_weights)
+    keep = rec.shape[0] > 0
     checks = 0
     # j = n first (the state the edge reaches), then j in van der Corput order over 1..n-1
     edge_state(q_a, d, n, n, q)
+    if limit < 1:
+        return 2, checks
+    if keep:
+        rec[checks] = n
     checks += 1
     if not _state_ok(q, V, S):
         return 1, checks
@@ -165,9 +236,30 @@ def edge_ok(q_a, q_b, joint_step, m, V, S, d, q, limit):
             if checks >= limit:
                 return 2, checks
             edge_state(q_a, d, j, n, q)
+            if keep:
+                rec[checks] = j
             checks += 1
             if not _state_ok(q, V, S):
                 return 1, checks
             j += 2 * h
         h //= 2
     return 0, checks
+
+
+@njit(cache=True, nogil=True)
+def edge_ok(q_a, q_b, joint_step, m, V, S, d, q, limit):
+    """Check the grid states 1..n of edge q_a -> q_b, coarse to fine (the end state, then
+    the midpoints of ever finer halvings), stopping at the first invalid one or after
+    ``limit`` checks. Returns (status, checks): status 0 all valid, 1 a state is invalid,
+    2 the limit came first (nothing proved)."""
+    return _edge_visit(q_a, q_b, joint_step, m, V, S, d, q, limit, np.empty(0, dtype=np.int64))
+
+
+@njit(cache=True, nogil=True)
+def edge_visits(q_a, q_b, joint_step, m, limit, rec):
+    """:func:`edge_ok` with the grid indices it checks written to ``rec`` (at least the
+    edge's count long) in the order it checks them: returns (status, checks)."""
+    V, S = views(m)
+    d = np.empty(q_a.shape[0])
+    q = np.empty(q_a.shape[0])
+    return _edge_visit(q_a, q_b, joint_step, m, V, S, d, q, limit, rec)

@@ -263,10 +263,13 @@ def run_trial(trial: Trial) -> dict[str, Any]:
     }
     try:
         from plannerlab.problem.catalog import load_problem
-        from plannerlab.run.pipeline import solve_legs
+        from plannerlab.run.pipeline import SharedChecker, solve_legs
 
         problem = load_problem(trial.problem_file)
         budget = problem.budget.replace(**dict(trial.budget))
+        # one checker (and compiled model) per trial: the solve and the execution's
+        # re-check share it
+        shared = SharedChecker(problem)
         plan = solve_legs(
             problem,
             trial.planner,
@@ -275,6 +278,7 @@ def run_trial(trial: Trial) -> dict[str, Any]:
             budget=budget,
             overrides=dict(trial.settings),
             stop_on_failure=True,  # a task fails at its first failed leg
+            shared=shared,
         )
         legs = [_leg_record(r, problem.robot.continuous) for r in plan.legs]
         rec["budget_used"] = budget.to_dict()
@@ -297,7 +301,7 @@ def run_trial(trial: Trial) -> dict[str, Any]:
         if trial.execute and solved_prefix:
             from plannerlab.run.pipeline import execute_results
 
-            executions = execute_results(problem, plan.legs[:solved_prefix])
+            executions = execute_results(problem, plan.legs[:solved_prefix], shared=shared)
             rec["execution"] = _execution_record(executions)
     except Exception as exc:  # a crashing trial is a record, never the end of the run
         last = traceback.format_exception_only(type(exc), exc)[-1].strip()

@@ -22,7 +22,11 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
+from matplotlib.backends.backend_agg import FigureCanvasAgg
+from matplotlib.collections import PolyCollection
 from matplotlib.figure import Figure
+from matplotlib.patches import Patch
+from mpl_toolkits.mplot3d.art3d import Line3DCollection
 
 from plannerlab.errors import PlannerlabError
 from plannerlab.plot.plans import (
@@ -30,6 +34,7 @@ from plannerlab.plot.plans import (
     PLANNED,
     _figure,
     _xy,
+    capsule_outlines,
     chain_points,
     draw_goals,
     draw_scene_2d,
@@ -82,6 +87,41 @@ def motion_frames(
         if e is not None:
             frames.append(Frame(r.leg, r.goal, planned[-1], np.asarray(e.q_final_rad), True))
     return frames
+
+
+def capsule_collections(
+    panels: Sequence[tuple[Any, tuple[int, int] | None]], has_exec: bool
+) -> tuple[list[Any], list[Any]]:
+    """Per panel, the (empty) collections the planned and the executed links' capsules are
+    drawn in: lines as wide as the links in 3-D, the capsules' outlines in the 2-D views;
+    PyBullet's filled orange, the plan's blue outline on top (filled when there is no
+    execution)."""
+    caps_p, caps_e = [], []
+    for ax, dims in panels:
+        if dims is None:
+            cp: Any = Line3DCollection(
+                [], colors=[PLANNED], alpha=0.25 if has_exec else 0.6, capstyle="round", zorder=4
+            )
+            ce: Any = Line3DCollection(
+                [], colors=[EXECUTED], alpha=0.55, capstyle="round", zorder=3
+            )
+        else:
+            cp = PolyCollection(
+                [],
+                facecolors="none" if has_exec else PLANNED,
+                edgecolors=PLANNED,
+                linewidths=0.9,
+                alpha=0.9 if has_exec else 0.45,
+                zorder=5,
+            )
+            ce = PolyCollection(
+                [], facecolors=EXECUTED, edgecolors=EXECUTED, linewidths=0.5, alpha=0.45, zorder=4
+            )
+        ax.add_collection(cp)
+        ax.add_collection(ce)
+        caps_p.append(cp)
+        caps_e.append(ce)
+    return caps_p, caps_e
 
 
 def animation_figure(
@@ -137,7 +177,7 @@ def animation_figure(
             lw=1.6,
             marker="o",
             ms=2,
-            label="planned arm",
+            label="planned arm (link axes)",
             zorder=6,
         )
         (ae,) = ax.plot(
@@ -145,18 +185,44 @@ def animation_figure(
             [],
             *([[]] if ax is ax3 else []),
             color=EXECUTED,
-            lw=4.0,
-            alpha=0.7,
-            label="PyBullet's arm",
+            lw=1.0,
+            alpha=0.9,
+            label="PyBullet's arm (link axes)",
             zorder=5,
         )
         trace_p.append(tp)
         trace_e.append(te)
         arms_p.append(ap)
         arms_e.append(ae)
+    # the links' capsules with their radii: PyBullet's filled orange, the plan's blue
+    # outline on top (filled when there is no execution), so both show where they agree
+    radii = np.asarray(problem.robot.link_radii_m, dtype=float)
+    has_exec = executed_all is not None
+    caps_p, caps_e = capsule_collections(panels, has_exec)
     handles, labels = views[0][0].get_legend_handles_labels()
-    fig.legend(handles, labels, loc="outside lower center", ncols=4, fontsize=8, frameon=False)
-    heading = fig.suptitle(title, fontsize=10)
+    handles += [
+        Patch(
+            facecolor="none" if has_exec else PLANNED,
+            edgecolor=PLANNED,
+            alpha=0.9 if has_exec else 0.45,
+        ),
+        Patch(facecolor=EXECUTED, edgecolor=EXECUTED, alpha=0.45),
+    ]
+    labels += ["planned links (capsules, true radii)", "PyBullet's links (capsules)"]
+    if not has_exec:
+        handles, labels = handles[:-1], labels[:-1]
+    fig.legend(handles, labels, loc="outside lower center", ncols=3, fontsize=8, frameon=False)
+    heading = fig.suptitle(f"{title}\n ", fontsize=10)  # room for the leg's line
+    # lay the figure out once: constrained layout on every frame took a third of the time
+    FigureCanvasAgg(fig).draw()
+    fig.set_layout_engine("none")
+    # capsule widths in the 3-D panel: the panel's points per metre along its widest side
+    box = ax3.get_window_extent()
+    span_m = float(np.max(bounds[1] - bounds[0]))
+    pts_per_m = 0.75 * min(box.width, box.height) * 72.0 / fig.dpi / max(span_m, 1e-9)
+    widths_3d = np.maximum(2.0 * radii * pts_per_m, 0.8)
+    caps_p[0].set_linewidths(widths_3d)
+    caps_e[0].set_linewidths(widths_3d)
     by_leg = {e.leg: e for e in executions}
     exec_index = np.cumsum([f.q_executed is not None for f in frames]) - 1
 
@@ -169,18 +235,34 @@ def animation_figure(
         else:
             line.set_data(*data)
 
+    def set_capsules(coll: Any, seg: Array | None, dims: tuple[int, int] | None) -> None:
+        if dims is None:
+            coll.set_segments([] if seg is None else list(seg))
+        else:
+            coll.set_verts(
+                [] if seg is None else list(capsule_outlines(seg[:, :, list(dims)], radii))
+            )
+
     def update(i: int) -> list[Any]:
         f = frames[i]
         chain_p = chain_points(problem, f.q_planned)
         chain_e = None if f.q_executed is None else chain_points(problem, f.q_executed)
+        seg_p = np.asarray(problem.robot.link_segments(f.q_planned), dtype=float)
+        seg_e = (
+            None
+            if f.q_executed is None
+            else np.asarray(problem.robot.link_segments(f.q_executed), dtype=float)
+        )
         k = int(exec_index[i])
-        for (_ax, dims), ap, ae, tp, te in zip(
-            panels, arms_p, arms_e, trace_p, trace_e, strict=True
+        for (_ax, dims), ap, ae, tp, te, cp, ce in zip(
+            panels, arms_p, arms_e, trace_p, trace_e, caps_p, caps_e, strict=True
         ):
             set_line(ap, chain_p, dims)
             set_line(ae, chain_e, dims)
             set_line(tp, tips_p[: i + 1], dims)
             set_line(te, None if tips_e is None or k < 0 else tips_e[: k + 1], dims)
+            set_capsules(cp, seg_p, dims)
+            set_capsules(ce, seg_e, dims)
         text = f"{title}\nleg {f.leg} '{f.goal}'"
         e = by_leg.get(f.leg)
         if f.final and e is not None:
@@ -188,7 +270,7 @@ def animation_figure(
         elif f.q_executed is None:
             text += ": planned motion (not executed)"
         heading.set_text(text)
-        return [*arms_p, *arms_e, *trace_p, *trace_e, heading]
+        return [*caps_e, *caps_p, *trace_p, *trace_e, *arms_e, *arms_p, heading]
 
     update(0)
     return fig, update
@@ -204,27 +286,57 @@ def write_animation(
     dpi: int = 80,
 ) -> Path:
     """Write the frames (the last one held ``hold_s``) to ``path``: ``.gif`` by Pillow,
-    ``.mp4`` by ffmpeg (an error when ffmpeg is not installed)."""
+    ``.mp4`` by ffmpeg (an error when ffmpeg is not installed).
+
+    A GIF is blitted: what does not move (axes, ticks, scene, goals) is drawn once, and
+    each frame redraws only the artists ``update`` returns onto a copy of it."""
     from matplotlib import animation
 
     path = Path(path)
     suffix = path.suffix.lower()
-    if suffix == ".gif":
-        writer: Any = animation.PillowWriter(fps=fps)
-    elif suffix == ".mp4":
+    if suffix not in (".gif", ".mp4"):
+        raise PlannerlabError(f"{path}: expected a .gif or .mp4 file name")
+    path.parent.mkdir(parents=True, exist_ok=True)
+    if suffix == ".mp4":
         if not animation.writers.is_available("ffmpeg"):
             raise PlannerlabError(
                 f"{path}: MP4 needs ffmpeg on the PATH (not found); write a .gif instead"
             )
-        writer = animation.FFMpegWriter(fps=fps, codec="h264")
-    else:
-        raise PlannerlabError(f"{path}: expected a .gif or .mp4 file name")
-    order = list(range(n_frames)) + [n_frames - 1] * max(int(hold_s * fps) - 1, 0)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    with writer.saving(fig, str(path), dpi=dpi):
-        for i in order:
-            update(i)
-            writer.grab_frame()
+        writer: Any = animation.FFMpegWriter(fps=fps, codec="h264")
+        order = list(range(n_frames)) + [n_frames - 1] * max(int(hold_s * fps) - 1, 0)
+        with writer.saving(fig, str(path), dpi=dpi):
+            for i in order:
+                update(i)
+                writer.grab_frame()
+        return path
+    from PIL import Image
+
+    canvas = fig.canvas if isinstance(fig.canvas, FigureCanvasAgg) else FigureCanvasAgg(fig)
+    fig.set_dpi(dpi)
+    moving = update(0)
+    for a in moving:
+        a.set_animated(True)
+    try:
+        canvas.draw()
+        background = canvas.copy_from_bbox(fig.bbox)
+        images = []
+        for i in range(n_frames):
+            canvas.restore_region(background)
+            for a in update(i):
+                if hasattr(a, "do_3d_projection"):  # a 3-D collection: project it first
+                    a.do_3d_projection()
+                (a.axes or fig).draw_artist(a)
+            w, h = canvas.get_width_height()
+            rgb = Image.frombuffer("RGBA", (w, h), bytes(canvas.buffer_rgba())).convert("RGB")
+            images.append(rgb.quantize(colors=255, method=Image.Quantize.MEDIANCUT))
+    finally:
+        for a in moving:
+            a.set_animated(False)
+    frame_ms = 1000.0 / fps
+    durations = [frame_ms] * (n_frames - 1) + [frame_ms + 1000.0 * hold_s]
+    images[0].save(
+        path, save_all=True, append_images=images[1:], duration=durations, loop=0, disposal=1
+    )
     return path
 
 

@@ -95,6 +95,28 @@ def chain_points(problem: Problem, q: Array) -> Array:
     return np.concatenate([seg[:, 0], seg[-1:, 1]])
 
 
+def capsule_outlines(segments_2d: Array, radii_m: Array, k: int = 10) -> Array:
+    """The outlines (L, 2k, 2) of capsules seen along a world axis: the projection of a
+    capsule of radius r about the axis a-b is the "stadium" of radius r about the
+    projected axis (exact in the orthographic front and top views); a zero-length axis
+    gives a circle. ``segments_2d``: (L, 2, 2) projected axis end points [m]."""
+    seg = np.asarray(segments_2d, dtype=float)
+    r = np.asarray(radii_m, dtype=float)[:, None, None]
+    a, b = seg[:, 0], seg[:, 1]
+    d = b - a
+    n = np.linalg.norm(d, axis=1, keepdims=True)
+    u = np.where(n > 1e-12, d / np.where(n > 1e-12, n, 1.0), [[1.0, 0.0]])
+    v = np.stack([-u[:, 1], u[:, 0]], axis=1)
+    t_b = np.linspace(-np.pi / 2, np.pi / 2, k)
+    t_a = t_b + np.pi
+
+    def ring(c: Array, t: Array) -> Array:
+        cos, sin = np.cos(t)[None, :, None], np.sin(t)[None, :, None]
+        return c[:, None] + r * (cos * u[:, None] + sin * v[:, None])
+
+    return np.concatenate([ring(b, t_b), ring(a, t_a)], axis=1)
+
+
 def tip_points(problem: Problem, path: Array) -> Array:
     """Tip positions (m, 3) in the world [m] along a joint path (m, dof)."""
     p, _n = problem.robot.tip(np.atleast_2d(np.asarray(path, dtype=float)))
@@ -126,7 +148,24 @@ def draw_arm(
     ls: str = "-",
     zorder: float = 3,
 ) -> Any:
-    """The arm at q as a polyline through its capsule axes (the Line2D/Line3D)."""
+    """The arm at q as a polyline through its capsule axes (the Line2D/Line3D); in a 2-D
+    view a main pose (``lw`` >= 2) also gets its links' capsules with their true radii
+    (:func:`capsule_outlines`), lightly filled in its colour."""
+    if dims is not None and lw >= 2:
+        from matplotlib.collections import PolyCollection
+
+        seg = np.asarray(problem.robot.link_segments(np.asarray(q, dtype=float)))
+        outlines = capsule_outlines(seg[:, :, list(dims)], problem.robot.link_radii_m)
+        ax.add_collection(
+            PolyCollection(
+                list(outlines),
+                facecolors=color,
+                edgecolors=color,
+                linewidths=0.4,
+                alpha=0.22 * alpha,
+                zorder=zorder - 0.5,
+            )
+        )
     (line,) = ax.plot(
         *_xy(chain_points(problem, q), dims),
         color=color,
@@ -218,12 +257,12 @@ def _width_ratios(bounds: Array) -> list[float]:
     """Panel widths for equal panel heights: each view as wide as its scene (clipped)."""
     span = np.maximum(bounds[1] - bounds[0], 1e-3)
     flat = float(np.sqrt(max(span[0], span[1]) / span[2]))
-    return [float(np.clip(1.1 * flat, 0.45, 1.6))] + [
-        float(np.clip(span[i] / span[j], 0.25, 3.0)) for i, j in VIEWS.values()
-    ]
+    views = [float(np.clip(span[i] / span[j], 0.25, 3.0)) for i, j in VIEWS.values()]
+    # the 3-D panel at least as wide as the wider view (it was ~250 px in a GIF)
+    return [max(float(np.clip(1.3 * flat, 0.8, 2.0)), max(views))] + views
 
 
-def _figure(bounds: Array, height_in: float = 4.6) -> Figure:
+def _figure(bounds: Array, height_in: float = 5.0) -> Figure:
     width_in = min(height_in * sum(_width_ratios(bounds)) + 0.6, 16.0)
     return Figure(figsize=(width_in, height_in), layout="constrained")
 
@@ -284,7 +323,11 @@ def snapshot_figure(
         if executed_tip is not None:
             draw_trace(ax, executed_tip, dims, EXECUTED, "executed tip trace (PyBullet)")
         for label, q, color in items:
-            draw_arm(ax, problem, q, dims, color, label)
+            # PyBullet's arm wide and under, the others on top: both show where they agree
+            wide = isinstance(color, str) and color == EXECUTED
+            draw_arm(
+                ax, problem, q, dims, color, label, lw=4.5 if wide else 2.5, zorder=3 if wide else 4
+            )
     handles, labels = views[0][0].get_legend_handles_labels()
     fig.legend(
         handles,
@@ -316,7 +359,7 @@ def progress_figure(runs: Mapping[str, Sequence[Any]], title: str) -> Figure:
         for name, rs in runs.items()
         if any(len(r.trace) > 1 for r in rs) and name.startswith("gradient")
     }
-    fig = Figure(figsize=(11 if with_trace else 7, 4), layout="constrained")
+    fig = Figure(figsize=(11 if with_trace else 7, 4.6), layout="constrained")
     ax = fig.add_subplot(1, 2 if with_trace else 1, 1)
     colors = colormaps["tab10"](np.arange(len(runs)) % 10)
     for (name, results), color in zip(runs.items(), colors, strict=True):
@@ -332,12 +375,30 @@ def progress_figure(runs: Mapping[str, Sequence[Any]], title: str) -> Figure:
         ax.step(x, y, where="post", color=color, label=name, lw=1.5)
         for r, t0 in zip(results, _leg_offsets(results), strict=True):
             if r.status.value == "local_minimum" and len(r.progress):
+                labelled = "stalled in a local minimum" in ax.get_legend_handles_labels()[1]
                 ax.scatter(
-                    t0 + r.progress[-1, 0], r.progress[-1, 2], marker="x", color="k", zorder=5
+                    t0 + r.progress[-1, 0],
+                    r.progress[-1, 2],
+                    marker="x",
+                    color="k",
+                    zorder=5,
+                    label=None if labelled else "stalled in a local minimum",
                 )
-    ax.set_yscale("symlog", linthresh=0.1)
+    ax.set_yscale("symlog", linthresh=1.0)
+    ax.set_ylim(bottom=0.0)
     ax.set_xlabel("planning time [s] (legs one after another)")
-    ax.set_ylabel("best goal distance (0: in the goal region)")
+    ax.set_ylabel("best goal distance [x tolerance; 0: in the goal]")
+    ax.text(
+        0.0,
+        -0.2,
+        "goal distance: max(position error / pos_tol, angle error / angle_tol) - 1 for a "
+        "tip goal,\nmax |q - q_goal| / tol_rad - 1 for a joint goal: a leg to a joint goal "
+        "(small tol_rad)\nstarts in the hundreds; that jump is its scale, not a step back",
+        transform=ax.transAxes,
+        fontsize=7,
+        va="top",
+        color="0.3",
+    )
     ax.set_title("progress", fontsize=9)
     ax.grid(alpha=0.3)
     ax.legend(fontsize=8)

@@ -46,23 +46,67 @@ def median_curve(curves: Sequence[SeedCurve], times_s: np.ndarray) -> np.ndarray
     return out
 
 
+#: one colour per planner family (the name before its first "." or "+"; a name with a
+#: "+" is a hybrid: one planner escaping with another)
+FAMILY_COLOURS = {
+    "gradient": "tab:blue",
+    "hybrid": "tab:green",
+    "ompl": "tab:orange",
+    "follow_leader": "tab:purple",
+    "native": "tab:brown",
+    "chord_arc": "tab:pink",
+}
+#: members of one family: line styles, then markers on top
+_STYLES = ("-", "--", ":", "-.")
+_MARKERS = ("", "o", "s", "^", "v", "D")
+
+
+def planner_family(name: str) -> str:
+    """``gradient.clearance`` -> ``gradient``, ``ompl.prm`` -> ``ompl``, and every hybrid
+    (``gradient+rrtconnect``, ``gradient.clearance+detour``) -> ``hybrid``."""
+    return "hybrid" if "+" in name else name.split(".")[0]
+
+
+def planner_styles(planners: Sequence[str]) -> dict[str, dict[str, object]]:
+    """A line style per planner: its family's colour, and within the family a dash
+    pattern (then a marker) of its own, so 14 planners stay apart in 4 to 6 colours."""
+    spare = iter(colormaps["tab10"](range(10)))
+    colours: dict[str, object] = {}
+    out: dict[str, dict[str, object]] = {}
+    count: dict[str, int] = {}
+    for pl in sorted(planners):
+        fam = planner_family(pl)
+        if fam not in colours:
+            colours[fam] = FAMILY_COLOURS.get(fam) or next(spare)
+        k = count.get(fam, 0)
+        count[fam] = k + 1
+        out[pl] = {
+            "color": colours[fam],
+            "ls": _STYLES[k % len(_STYLES)],
+            "marker": _MARKERS[(k // len(_STYLES)) % len(_MARKERS)],
+            "markevery": 0.1,
+            "ms": 3,
+        }
+    return out
+
+
 def progress_panels(
     curves: Mapping[str, Mapping[str, Sequence[SeedCurve]]],
     title: str,
     t_max_s: float,
     columns: int = 3,
-    ylabel: str = "median best goal distance",
+    ylabel: str = "median best goal distance [x tolerance; 0: in the goal]",
 ) -> Figure:
     """``curves[problem][planner]`` = the seeds' curves; one panel per problem, one line
-    per planner (the same colour in every panel), time on a log axis from 10 ms to
-    ``t_max_s``, the value (a goal distance, 0 in the goal region; or a task's legs still
-    to go) on a symlog axis."""
+    per planner (coloured by its family, :func:`planner_styles`, the same in every panel),
+    time on a log axis from 10 ms to ``t_max_s``, the value (a goal distance, 0 in the
+    goal region; or a task's legs still to go) on a linear axis from 0 (it is never
+    negative)."""
     planners = sorted({pl for by_planner in curves.values() for pl in by_planner})
-    cmap = colormaps["tab20"]
-    colour = {pl: cmap(i % 20) for i, pl in enumerate(planners)}
+    style = planner_styles(planners)
     n = max(1, len(curves))
     rows = (n + columns - 1) // columns
-    fig = Figure(figsize=(4.2 * columns, 3.2 * rows + 1.2), layout="constrained")
+    fig = Figure(figsize=(4.2 * columns, 3.2 * rows + 1.6), layout="constrained")
     times_s = np.geomspace(1e-2, t_max_s, 300)
     for k, (problem, by_planner) in enumerate(curves.items()):
         ax = fig.add_subplot(rows, columns, k + 1)
@@ -71,18 +115,34 @@ def progress_panels(
             if not seeds:
                 continue
             y = median_curve(seeds, times_s)
-            ax.step(times_s, y, where="post", color=colour[pl], lw=1.4, label=pl)
+            ax.step(times_s, y, where="post", lw=1.4, label=pl, **style[pl])  # type: ignore[arg-type]
         ax.set_xscale("log")
-        ax.set_yscale("symlog", linthresh=0.1)
+        ax.set_ylim(bottom=0.0)
         ax.set_title(problem, fontsize=9)
         ax.grid(alpha=0.3)
         ax.set_xlabel("planning time [s]", fontsize=8)
         ax.set_ylabel(ylabel, fontsize=8)
         ax.tick_params(labelsize=7)
-    handles = [Line2D([], [], color=colour[pl], lw=1.4, label=pl) for pl in planners]
-    fig.legend(handles=handles, loc="outside lower center", ncols=4, fontsize=7, frameon=False)
+    handles = [Line2D([], [], lw=1.4, label=pl, **style[pl]) for pl in planners]  # type: ignore[arg-type]
+    fig.legend(
+        handles=handles,
+        loc="outside lower center",
+        ncols=4,
+        fontsize=7,
+        frameon=False,
+        title="planner (colour: family; line style: member)",
+        title_fontsize=7,
+    )
     fig.suptitle(title, fontsize=10)
     return fig
 
 
-__all__ = ["SeedCurve", "best_so_far", "median_curve", "progress_panels"]
+__all__ = [
+    "FAMILY_COLOURS",
+    "SeedCurve",
+    "best_so_far",
+    "median_curve",
+    "planner_family",
+    "planner_styles",
+    "progress_panels",
+]

@@ -25,7 +25,7 @@ import numpy as np
 
 from plannerlab.problem.goals import GoalRegion, JointGoal
 from plannerlab.robots.base import Array, Robot, wrap_to_pi
-from plannerlab.robots.registry import goal_sampler
+from plannerlab.robots.registry import goal_sampler, ik_descent
 
 
 class ValidityChecker(Protocol):
@@ -75,6 +75,7 @@ def solve_ik(
     damping: float = 0.05,
     max_step_rad: float = 0.25,
     target_fraction: float = 0.3,
+    descent: Callable[..., tuple[Array, int]] | None = None,
 ) -> IKResult:
     """One damped-least-squares descent from ``q_seed`` towards the goal region.
 
@@ -102,12 +103,20 @@ def solve_ik(
         max_step_rad: largest joint change per step [rad or m].
         target_fraction: stop once both scaled errors are below this fraction of the
             tolerances.
+        descent: the same descent compiled for this robot (its family's ``ik_descent``,
+            :func:`compiled_descent`), called as ``descent(goal, q_seed, max_iterations,
+            damping, max_step_rad, target_fraction) -> (q, steps)``; None: in numpy.
 
     Returns:
         An :class:`IKResult`; ``success`` is False with a reason when the descent ends
         outside the region or in collision.
     """
     del rng  # deterministic descent
+    if descent is not None:
+        q, iterations = descent(
+            goal, q_seed, max_iterations, damping, max_step_rad, target_fraction
+        )
+        return _verdict(robot, goal, q, iterations, checker)
     q = _clamp(robot, np.asarray(q_seed, dtype=float).reshape(robot.dof))
     pos_scale = 1.0 / goal.pos_tol_m
     ang_scale = 1.0 / np.deg2rad(goal.angle_tol_deg)
@@ -130,6 +139,13 @@ def solve_ik(
         if biggest > max_step_rad:
             dq *= max_step_rad / biggest
         q = _clamp(robot, q + dq)
+    return _verdict(robot, goal, q, iterations, checker)
+
+
+def _verdict(
+    robot: Robot, goal: GoalRegion, q: Array, iterations: int, checker: ValidityChecker | None
+) -> IKResult:
+    """A descent's end state judged: inside both tolerances (numpy), then collision-free."""
     # rounded to 1e-9 rad: the descent's linear algebra differs in its last bits between
     # CPUs (BLAS kernels), and a goal state that differs by 1e-16 sends a seeded planner
     # down another road; the rounded state is the one tested and returned
@@ -153,6 +169,13 @@ def solve_ik(
     return IKResult(q, True, iterations, "inside both tolerances", pos_err, ang_err)
 
 
+def compiled_descent(robot: Any) -> Any:
+    """The robot family's compiled IK descent for this robot (its registry entry's
+    ``ik_descent``: URDF chains), or None (the numpy descent)."""
+    factory = ik_descent(getattr(robot, "kind", ""))
+    return None if factory is None else factory(robot)
+
+
 def _analytic_goal_sampler(robot: Any) -> Any:
     """The robot family's analytic goal sampler (:mod:`plannerlab.robots.registry`)."""
     return goal_sampler(getattr(robot, "kind", ""))
@@ -170,6 +193,7 @@ def sample_goal_state(
     uniform_fraction: float = 0.5,
     max_iterations: int = 150,
     stop: Callable[[], bool] | None = None,
+    compiled: bool = True,
 ) -> Array | None:
     """A collision-free state inside both tolerances of ``goal``, or None.
 
@@ -213,6 +237,9 @@ def sample_goal_state(
         uniform_fraction: share of restarts from uniformly random states.
         max_iterations: descent steps per attempt.
         stop: asked before each attempt (a time limit, say); True ends the search (None).
+        compiled: run the descent compiled when the robot's family has one
+            (:func:`compiled_descent`: URDF chains; ``bench/model_bench.py --ik``); the
+            restarts, the region test and the collision check are the same either way.
 
     Returns:
         (dof,) state inside the region and collision-free, or None after ``attempts``
@@ -235,6 +262,7 @@ def sample_goal_state(
             if q is not None and checker.is_valid(q):
                 return np.asarray(q, dtype=float)
         return None
+    descent = compiled_descent(robot) if compiled else None
     for k in range(attempts):
         if stop is not None and stop():
             return None
@@ -244,10 +272,12 @@ def sample_goal_state(
         else:
             sigma = min(noise_start_rad * noise_growth**k, np.pi)
             q0 = seed_list[k % len(seed_list)] + rng.normal(0.0, sigma, robot.dof)
-        result = solve_ik(robot, goal, q0, checker=checker, max_iterations=max_iterations)
+        result = solve_ik(
+            robot, goal, q0, checker=checker, max_iterations=max_iterations, descent=descent
+        )
         if result.success:
             return result.q
     return None
 
 
-__all__ = ["IKResult", "ValidityChecker", "sample_goal_state", "solve_ik"]
+__all__ = ["IKResult", "ValidityChecker", "compiled_descent", "sample_goal_state", "solve_ik"]

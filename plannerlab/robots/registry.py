@@ -19,6 +19,9 @@ from typing import Any
 from plannerlab.errors import UnknownNameError
 from plannerlab.robots.schema import RobotTable
 
+#: the generic serial-chain builder of the compiled model (from ``robot.chain_data()``)
+DEFAULT_MODEL = "plannerlab.collision.model:model_of_core"
+
 
 @dataclass(frozen=True)
 class RobotFamily:
@@ -39,6 +42,16 @@ class RobotFamily:
             every link's length, the last link to the tip).
         gravity_off: why the family's problems default to no gravity when their file has
             no ``[simulation]`` table, or None for the usual -9.81 m/s² along -z.
+        model: ``"module:function"`` building the family's compiled robot–scene model
+            (:class:`~plannerlab.collision.model.CompiledModel`) from a built collision core,
+            called as ``function(core)``; the default is the generic serial-chain builder,
+            which reads the robot's ``chain_data()`` (so a new family with a chain is on the
+            compiled road with no entry of its own).
+        ik_descent: ``"module:function"`` giving a robot's compiled IK descent
+            (``function(robot)`` -> ``descent(goal, q_seed, max_iterations, damping,
+            max_step_rad, target_fraction) -> (q, steps)``) that the numeric goal sampling
+            of :mod:`plannerlab.problem.ik` restarts instead of its numpy descent; None:
+            the numpy descent (on the robot's ``tip_jacobian``).
         summary: one line for the documentation.
     """
 
@@ -47,6 +60,8 @@ class RobotFamily:
     goal_sampler: str | None = None
     reach: str | None = None
     gravity_off: str | None = None
+    model: str = DEFAULT_MODEL
+    ik_descent: str | None = None
     summary: str = ""
 
 
@@ -76,6 +91,7 @@ FAMILIES: dict[str, RobotFamily] = {
     "urdf": RobotFamily(
         "urdf",
         "plannerlab.robots.urdf.schema:TABLE",
+        ik_descent="plannerlab.collision.chain_ik:descent_for",
         summary="any serial chain read from a URDF (yourdfpy), with its collision spheres",
     ),
 }
@@ -120,6 +136,20 @@ def reach_function(kind: str) -> Any:
     return None if entry is None or entry.reach is None else _target(entry.reach)
 
 
+def model_builder(kind: str) -> Any:
+    """The family's builder of its compiled model (see :attr:`RobotFamily.model`); the
+    generic serial-chain builder for a kind that is not registered (a robot built in code)."""
+    entry = FAMILIES.get(kind)
+    return _target(DEFAULT_MODEL if entry is None else entry.model)
+
+
+def ik_descent(kind: str) -> Any:
+    """The family's compiled IK descent factory (see :attr:`RobotFamily.ik_descent`), or
+    None (also for a kind that is not registered)."""
+    entry = FAMILIES.get(kind)
+    return None if entry is None or entry.ik_descent is None else _target(entry.ik_descent)
+
+
 def gravity_off_reason(kind: str) -> str | None:
     """Why the family's problems default to no gravity (None: they do not)."""
     entry = FAMILIES.get(kind)
@@ -127,11 +157,14 @@ def gravity_off_reason(kind: str) -> str | None:
 
 
 __all__ = [
+    "DEFAULT_MODEL",
     "FAMILIES",
     "RobotFamily",
     "family",
     "goal_sampler",
     "gravity_off_reason",
+    "ik_descent",
+    "model_builder",
     "reach_function",
     "robot_table",
 ]

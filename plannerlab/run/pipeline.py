@@ -40,6 +40,24 @@ from plannerlab.record.plan import Plan, file_sha256
 from plannerlab.robots.paths import waypoints
 
 
+class SharedChecker:
+    """A problem's collision checker (``problem_checker``: its clearance margin), built on
+    first use and then the same object for every caller: one per trial, shared by its
+    solve and its execution's re-check (and so one compiled robot–scene model)."""
+
+    def __init__(self, problem: Problem) -> None:
+        self.problem = problem
+        self._checker: Any = None
+
+    def get(self) -> Any:
+        """The checker (built now if it was not)."""
+        if self._checker is None:
+            from plannerlab.collision.fcl_checker import problem_checker
+
+            self._checker = problem_checker(self.problem)
+        return self._checker
+
+
 def canonical_result(r: PlanResult) -> PlanResult:
     """``r`` with its path in the canonical form every road executes and plan files hold:
     its waypoints (``r`` itself when nothing drops)."""
@@ -118,6 +136,7 @@ def solve_legs(
     stop_on_failure: bool = False,
     gui: bool = False,
     on_leg: Callable[[PlanResult], None] | None = None,
+    shared: SharedChecker | None = None,
 ) -> Plan:
     """Solve ``legs`` (default: all) in order; each starts where the previous one ended.
 
@@ -127,6 +146,10 @@ def solve_legs(
     state collides is refused (ProblemError). Closed-loop planners get one PyBullet world
     for the whole task. Every leg's path comes back in its canonical form
     (:func:`canonical_result`): the plan in memory is the plan its file holds.
+
+    ``shared``: the problem's checker built once and shared (with its compiled model) with
+    the execution's re-check (:func:`execute_results`) of the same trial; None: built
+    here when a leg needs it.
     """
     entry = get_entry(planner_name)
     planner = make_planner(planner_name, overrides)
@@ -135,9 +158,8 @@ def solve_legs(
     results: list[PlanResult] = []
     checker = None
     if legs and hasattr(planner, "plan") and not getattr(planner, "allows_contact", False):
-        from plannerlab.collision.fcl_checker import problem_checker
-
-        checker = problem_checker(problem)  # one per problem: every leg's context shares it
+        # one per problem: every leg's context shares it
+        checker = (shared or SharedChecker(problem)).get()
     with ExitStack() as stack:
         stepper = None
         if entry.needs_stepper:
@@ -197,7 +219,11 @@ def solve_legs(
 
 
 def execute_results(
-    problem: Problem, results: Sequence[PlanResult], *, gui: bool = False
+    problem: Problem,
+    results: Sequence[PlanResult],
+    *,
+    gui: bool = False,
+    shared: SharedChecker | None = None,
 ) -> list[Execution]:
     """Execute planned legs in PyBullet: one :class:`Execution` per leg, in order.
 
@@ -211,6 +237,9 @@ def execute_results(
     points on purpose) run in :func:`plannerlab.sim.continuum.execute_chord_arc`, which sorts
     expected from unexpected contacts; each of them starts from its path's first state.
 
+    ``shared``: the problem's checker to re-check the paths with, shared with the solve
+    that planned them (:func:`solve_legs`); None: the executor builds its own.
+
     Raises:
         PlannerlabError: no legs, or a contact plan's leg without a chosen solution.
     """
@@ -223,7 +252,13 @@ def execute_results(
         return [execute_chord_arc(problem, r, gui=gui) for r in results]
     from plannerlab.sim.execute import execute_legs
 
-    return execute_legs(problem, [r.path for r in results], first_leg=results[0].leg, gui=gui)
+    return execute_legs(
+        problem,
+        [r.path for r in results],
+        first_leg=results[0].leg,
+        gui=gui,
+        checker=None if shared is None else shared.get(),
+    )
 
 
 def execute_plan(

@@ -33,6 +33,11 @@ SUITS: tuple[tuple[str, str], ...] = (
     ("gradient", "the Arm-Z paper's method: redundant chains with tip goals, free space"),
     ("chord_arc", "planar continuum robots (contact with the scene by design)"),
     (
+        "native.",
+        "any robot with a compiled model (serial chains: 6-7-joint arms, hyper-redundant "
+        "chains): sampling compiled end to end; tip or joint goals",
+    ),
+    (
         "ompl.",
         "any joint-space robot: 6-7-joint arms (Panda, IRb-6 on its track), "
         "hyper-redundant chains; tip or joint goals",

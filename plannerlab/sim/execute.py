@@ -621,6 +621,7 @@ def execute_legs(
     dt_s: float = DT_S,
     grid_per_knot: int = GRID_PER_KNOT,
     interpolant: str = INTERPOLANT,
+    checker: CollisionChecker | None = None,
 ) -> list[Execution]:
     """Execute consecutive legs in ONE world, each from where the previous one ended.
 
@@ -628,13 +629,16 @@ def execute_legs(
     the state the simulator actually reached (``carried_over=True`` in its record, with
     ``start_offset_rad`` saying how far that was from its path's first waypoint).
     ``leg_paths[i]`` is leg ``first_leg + i``; legs past the problem's last goal are run
-    without a goal. Arguments are those of :func:`execute`.
+    without a goal. Arguments are those of :func:`execute`; ``checker`` the problem's
+    checker (``problem_checker(problem)``) when the caller has it (built once per trial
+    and shared with the solve), else built here.
 
     Returns:
         one :class:`Execution` per path, in order.
     """
     paths = [_check_path(problem, p) for p in leg_paths]
-    checker = problem_checker(problem)
+    if checker is None:
+        checker = problem_checker(problem)
     out: list[Execution] = []
     if gravity_mps2 is None:
         gravity_mps2 = problem.simulation.gravity_mps2

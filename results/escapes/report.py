@@ -249,7 +249,9 @@ def figures(data: dict[str, list[dict[str, Any]]], store_dir: Path) -> None:
             + (" of the legs still to go" if task else " of the best goal distance")
             + f" against planning time ({TIME_LIMIT_S:.0f} s per leg)",
             t_max_s=TIME_LIMIT_S * (7 if task else 1),
-            ylabel="legs still to go (median)" if task else "best goal distance (median)",
+            ylabel="legs still to go (median)"
+            if task
+            else "best goal distance (median) [x tolerance; 0: in the goal]",
         )
         save(fig, store_dir / f"progress_{name}.png")
 

@@ -21,6 +21,7 @@ ENGINE_ROOMS = {
     "ompl": ("planners/ompl/",),
     "pybullet": ("sim/",),
     "matplotlib": ("plot/",),
+    "viser": ("plot/",),
 }
 
 

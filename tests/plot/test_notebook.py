@@ -25,6 +25,14 @@ def test_compare_notebook_runs_headless(tmp_path, monkeypatch):
     assert len(images) >= 2  # the arm snapshot and the progress plot
     gifs = [o for c in nb.cells for o in c.get("outputs", []) if "image/gif" in o.get("data", {})]
     assert len(gifs) == 2  # the motions, planned and executed, inline: Arm-Z's and the Panda's
+    # the interactive 3-D views (viser), Arm-Z's and the Panda's, inline as live pages
+    frames = [
+        o["data"]["text/html"]
+        for c in nb.cells
+        for o in c.get("outputs", [])
+        if "<iframe" in o.get("data", {}).get("text/html", "")
+    ]
+    assert len(frames) == 2 and all('src="http://127.0.0.1:' in f for f in frames)
     # the Panda on the bookshelf, from the files in problems/urdf/panda (no network)
     panda = outputs.split("bookshelf_small_0001 - MotionBenchMaker")[1]
     assert panda.startswith(" bookshelf_small_panda/scene0001")

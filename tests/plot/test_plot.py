@@ -148,7 +148,9 @@ def test_progress_figure_names_each_planner_and_shows_the_escape(plans) -> None:
     fig = trace_figure([plans["gradient"].legs[0], plans["gradient+rrtconnect"].legs[0]], "t")
     ax = fig.axes[0]
     labels = [t.get_text() for t in ax.get_legend().get_texts()]
-    assert labels == ["gradient", "gradient+rrtconnect"]
+    # the planners' lines, and what the cross means (the gradient method stalls)
+    assert labels == ["gradient", "stalled in a local minimum", "gradient+rrtconnect"]
+    assert ax.get_ylim()[0] == 0.0  # a distance: the axis never goes below 0
     hybrid = _line(ax, "gradient+rrtconnect")
     y = np.asarray(hybrid.get_ydata())
     assert y[-1] == 0.0 and y.max() > 1.0  # the drop: stalled far outside, then in
@@ -189,12 +191,12 @@ def test_animation_frames_end_where_pybullet_ended(problem, plans, tmp_path) -> 
     fig, update = animation_figure(problem, frames, "t", [e])
     update(len(frames) - 1)
     ax, (i, j) = _views(fig)["top (x-y)"]
-    arm = _line(ax, "PyBullet's arm")
+    arm = _line(ax, "PyBullet's arm (link axes)")
     np.testing.assert_allclose(arm.get_xdata(), chain_points(problem, q_final)[:, i])
     assert "where PyBullet's arm ended" in fig._suptitle.get_text()
     update(0)
     np.testing.assert_allclose(
-        _line(ax, "planned arm").get_ydata(), chain_points(problem, r.path[0])[:, j]
+        _line(ax, "planned arm (link axes)").get_ydata(), chain_points(problem, r.path[0])[:, j]
     )
     gif = write_animation(fig, update, len(frames), tmp_path / "a.gif", fps=4, hold_s=0)
     with Image.open(gif) as im:

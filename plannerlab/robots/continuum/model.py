@@ -48,6 +48,7 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 
@@ -350,6 +351,32 @@ class ContinuumChain:
         J_n[0, 1:] = -n[1]
         J_n[1, 1:] = n[0]
         return J_p, J_n
+
+    def chain_data(self) -> tuple[Any, ...]:
+        """The robot as a serial chain for the compiled robot-scene model
+        (:mod:`plannerlab.collision.chain`): per joint its parent body (dof,), the fixed
+        transform parent body -> joint frame (dof, 4, 4), its unit axis (dof, 3), whether
+        it slides (dof,); per capsule its body (n,) and end points in that body's frame.
+
+        Body 0 is the port (``T_world_base``); the insertion slides body 1 (the carriage,
+        :meth:`fk`'s frame 0) along x from ``-length_m``; joint ``i`` turns body ``i + 1``
+        (link ``i``) about z, ``ℓ`` along the previous link's x (at the carriage for the
+        first); link ``i``'s capsule runs from its origin to ``(ℓ, 0, 0)``."""
+        n, ell = self.n_links, self.link_length_m
+        dof = self.dof
+        parent = np.arange(dof, dtype=np.int64)
+        pre = np.tile(np.eye(4), (dof, 1, 1))
+        pre[0, 0, 3] = -self.length_m
+        pre[2:, 0, 3] = ell
+        axes = np.tile([0.0, 0.0, 1.0], (dof, 1))
+        axes[0] = (1.0, 0.0, 0.0)
+        prismatic = np.zeros(dof, dtype=bool)
+        prismatic[0] = True
+        cap_body = np.arange(2, n + 2, dtype=np.int64)
+        cap_a = np.zeros((n, 3))
+        cap_b = np.zeros((n, 3))
+        cap_b[:, 0] = ell
+        return parent, pre, axes, prismatic, cap_body, cap_a, cap_b
 
     def link_segments(self, q: Array) -> Array:
         """Capsule axes (n, 2, 3) or (k, n, 2, 3): link i from joint i to joint i + 1."""

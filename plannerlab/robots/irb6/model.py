@@ -73,6 +73,7 @@ from __future__ import annotations
 import math
 from collections.abc import Callable
 from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
@@ -327,6 +328,53 @@ class IRb6:
         Jn[:, 4] = -math.sin(t4) * u + math.cos(t4) * y
         R = self.T_world_base[:3, :3]
         return R @ Jp, R @ Jn
+
+    def chain_data(self) -> tuple[Any, ...]:
+        """The arm as a serial chain for the compiled robot-scene model
+        (:mod:`plannerlab.collision.chain`): parent bodies (6,), fixed transforms
+        (6, 4, 4), unit axes (6, 3), which slide (6,); per capsule its body (5,) and its
+        end points in that body's frame (5, 3) twice; and the coupling (6, 6).
+
+        The chain is :meth:`fk_station`'s: body 0 the station (``T_world_base``), body
+        ``i + 1`` frame ``i`` (carriage, column, lower arm, upper arm, wrist, flange). Its
+        joint values are the URDF's relative angles, ``coupling @ q =``
+        :meth:`urdf_joint_positions` ``(q)``; the lower arm turns about -z (``rot_z(-θ2)``).
+        """
+        parent = np.arange(6, dtype=np.int64)
+        T_wrist_flange0 = trans(self.wrist_to_flange_m, 0.0, 0.0)
+        T_wrist_flange0[:3, :3] = _R_WRIST_FLANGE0
+        pre = np.stack(
+            [
+                np.eye(4),
+                rot_y(self.theta1_zero_azimuth_rad),
+                trans(0.0, self.shoulder_height_m, 0.0),
+                trans(0.0, self.lower_arm_m, 0.0),
+                trans(self.upper_arm_m, 0.0, 0.0),
+                T_wrist_flange0,
+            ]
+        )
+        axes = np.array(
+            [[0, 0, 1], [0, 1, 0], [0, 0, -1], [0, 0, 1], [0, 0, 1], [0, 0, 1]], dtype=float
+        )
+        prismatic = np.array([True, False, False, False, False, False])
+        zlo, zhi = self.track_range_m
+        h = self.rail_height_m
+        cap_body = np.array([0, 2, 3, 4, 5], dtype=np.int64)
+        cap_a = np.array([[0.0, h, zlo], [0, 0, 0], [0, 0, 0], [0, 0, 0], [0, 0, 0]], dtype=float)
+        cap_b = np.array(
+            [
+                [0.0, h, zhi],
+                [0.0, self.shoulder_height_m, 0.0],
+                [0.0, self.lower_arm_m, 0.0],
+                [self.upper_arm_m, 0.0, 0.0],
+                [self.wrist_to_flange_m, 0.0, 0.0],
+            ]
+        )
+        coupling = np.eye(6)
+        coupling[3, 2] = 1.0  # θ2 + θ3
+        coupling[4, 3] = -1.0  # θ4 - θ3
+        coupling[4, 4] = 1.0
+        return parent, pre, axes, prismatic, cap_body, cap_a, cap_b, coupling
 
     def link_segments(self, q: Array) -> Array:
         """Capsule axes in the world: (5, 2, 3) for q (6,), (k, 5, 2, 3) for (k, 6)."""

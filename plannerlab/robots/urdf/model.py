@@ -616,6 +616,12 @@ class UrdfChain:
             self._cap_b,
         )
 
+    def tip_data(self) -> tuple[int, Array, Array]:
+        """The tip on the chain of :meth:`chain_data`, for compiled kinematics
+        (:mod:`plannerlab.collision.chain_ik`): the body carrying it, the tip point (3,)
+        and the unit tip normal (3,) in that body's frame."""
+        return int(self._tip_body), self._T_body_tip[:3, 3].copy(), self._n_body_tip.copy()
+
     def link_segments(self, q: Array) -> Array:
         """Capsule axes in the world: (L, 2, 3) for one q, (k, L, 2, 3) for a batch."""
         B = self._bodies(q)

@@ -1,0 +1,346 @@
+"""Compiled inverse kinematics of a serial chain (a URDF robot) for position + normal goals.
+
+The descent of :func:`plannerlab.problem.ik.solve_ik` (damped least squares on the tip
+position error scaled by ``pos_tol_m`` and the tip normal error scaled by the angle
+tolerance in radians; each step scaled so that no joint moves more than ``max_step_rad``;
+bounded joints clipped, continuous ones wrapped into [-π, π); stop once both errors are
+below ``target_fraction`` of the tolerances) in one numba call per descent, on the chain
+of ``robot.chain_data()`` (:mod:`plannerlab.collision.chain`: parents, fixed transforms,
+axes, sliding joints, an optional coupling) and its tip (``robot.tip_data()``: the body,
+the tip point and normal in its frame). The Jacobian is the chain's own: joint ``i`` turns
+(or slides) about its world axis ``w_i`` through its body's origin ``o_i``, so
+``dp/dv_i = w_i × (p − o_i)`` (``w_i``) and ``dn/dv_i = w_i × n`` (0), and through the
+coupling ``dv/dq``.
+
+A family opts in through its registry entry (:attr:`plannerlab.robots.registry.
+RobotFamily.ik_descent`, the URDF family's is :func:`descent_for`); :mod:`plannerlab.problem.ik`
+then runs its restarts on this descent instead of the numpy one. The goal states it
+returns are checked there as before (the region test in numpy, one collision check).
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+import numpy as np
+from numba import njit
+
+from plannerlab.collision.chain import chain_parts
+
+
+@njit(cache=True, nogil=True)
+def _frames(q, T0, parent, pre, axes, prismatic, coupling, B, v):
+    """Body frames B (n + 1, 4, 4) of state q; v (n,) the chain's joint values."""
+    n = parent.shape[0]
+    for i in range(n):
+        if coupling.shape[0] > 0:
+            x = 0.0
+            for j in range(q.shape[0]):
+                x += coupling[i, j] * q[j]
+            v[i] = x
+        else:
+            v[i] = q[i]
+    for a in range(4):
+        for b in range(4):
+            B[0, a, b] = T0[a, b]
+    M = np.empty((4, 4))
+    P = np.empty((4, 4))
+    for i in range(n):
+        x, y, z = axes[i, 0], axes[i, 1], axes[i, 2]
+        for a in range(4):
+            for b in range(4):
+                M[a, b] = 1.0 if a == b else 0.0
+        if prismatic[i]:
+            M[0, 3] = v[i] * x
+            M[1, 3] = v[i] * y
+            M[2, 3] = v[i] * z
+        else:
+            c = math.cos(v[i])
+            s = math.sin(v[i])
+            t = 1.0 - c
+            M[0, 0] = c + t * x * x
+            M[0, 1] = t * x * y - s * z
+            M[0, 2] = t * x * z + s * y
+            M[1, 0] = t * x * y + s * z
+            M[1, 1] = c + t * y * y
+            M[1, 2] = t * y * z - s * x
+            M[2, 0] = t * x * z - s * y
+            M[2, 1] = t * y * z + s * x
+            M[2, 2] = c + t * z * z
+        F = B[parent[i]]
+        for a in range(4):
+            for b in range(4):
+                acc = 0.0
+                for k in range(4):
+                    acc += F[a, k] * pre[i, k, b]
+                P[a, b] = acc
+        for a in range(4):
+            for b in range(4):
+                acc = 0.0
+                for k in range(4):
+                    acc += P[a, k] * M[k, b]
+                B[i + 1, a, b] = acc
+
+
+@njit(cache=True, nogil=True)
+def _tip(B, tip_body, p_bt, n_bt, p, nv):
+    """Tip position p and normal nv in the world from the body frames."""
+    F = B[tip_body]
+    for a in range(3):
+        p[a] = F[a, 0] * p_bt[0] + F[a, 1] * p_bt[1] + F[a, 2] * p_bt[2] + F[a, 3]
+        nv[a] = F[a, 0] * n_bt[0] + F[a, 1] * n_bt[1] + F[a, 2] * n_bt[2]
+
+
+@njit(cache=True, nogil=True)
+def _errors(p, nv, p_d, n_d):
+    """Position error [m] and angle error [rad] (``GoalRegion.errors_from_tip``)."""
+    dx, dy, dz = p[0] - p_d[0], p[1] - p_d[1], p[2] - p_d[2]
+    c = nv[0] * n_d[0] + nv[1] * n_d[1] + nv[2] * n_d[2]
+    c = min(1.0, max(-1.0, c))
+    return math.sqrt(dx * dx + dy * dy + dz * dz), math.acos(c)
+
+
+@njit(cache=True, nogil=True)
+def _solve6(A, e, x):
+    """x = A⁻¹ e for a symmetric positive definite A (6, 6), by Cholesky (A overwritten)."""
+    n = 6
+    for j in range(n):
+        s = A[j, j]
+        for k in range(j):
+            s -= A[j, k] * A[j, k]
+        d = math.sqrt(max(s, 1e-300))
+        A[j, j] = d
+        for i in range(j + 1, n):
+            s = A[i, j]
+            for k in range(j):
+                s -= A[i, k] * A[j, k]
+            A[i, j] = s / d
+    for i in range(n):
+        s = e[i]
+        for k in range(i):
+            s -= A[i, k] * x[k]
+        x[i] = s / A[i, i]
+    for i in range(n - 1, -1, -1):
+        s = x[i]
+        for k in range(i + 1, n):
+            s -= A[k, i] * x[k]
+        x[i] = s / A[i, i]
+
+
+@njit(cache=True, nogil=True)
+def descend_kernel(
+    q0,
+    T0,
+    parent,
+    pre,
+    axes,
+    prismatic,
+    coupling,
+    path,
+    tip_body,
+    p_bt,
+    n_bt,
+    p_d,
+    n_d,
+    pos_tol,
+    ang_tol,
+    lower,
+    upper,
+    continuous,
+    max_iterations,
+    damping,
+    max_step,
+    target_fraction,
+    q,
+):
+    """One descent from q0 (dof,) into q (dof,): returns (steps, pos_err_m, ang_err_rad)
+    at q. ``path``: the chain joints that move the tip body; ``ang_tol`` [rad]."""
+    dof = q0.shape[0]
+    n = parent.shape[0]
+    B = np.empty((n + 1, 4, 4))
+    v = np.empty(n)
+    p = np.empty(3)
+    nv = np.empty(3)
+    Jv = np.zeros((6, n))
+    J = np.zeros((6, dof))
+    A = np.empty((6, 6))
+    e = np.empty(6)
+    x = np.empty(6)
+    dq = np.empty(dof)
+    two_pi = 2.0 * math.pi
+    for i in range(dof):
+        qi = q0[i]
+        if continuous[i]:
+            qi = (qi + math.pi) % two_pi - math.pi
+        else:
+            qi = min(max(qi, lower[i]), upper[i])
+        q[i] = qi
+    ps = 1.0 / pos_tol
+    an = 1.0 / ang_tol
+    lam2 = damping * damping
+    steps = 0
+    for it in range(max_iterations + 1):
+        _frames(q, T0, parent, pre, axes, prismatic, coupling, B, v)
+        _tip(B, tip_body, p_bt, n_bt, p, nv)
+        pe, ae = _errors(p, nv, p_d, n_d)
+        if (pe <= target_fraction * pos_tol and ae <= target_fraction * ang_tol) or (
+            it == max_iterations
+        ):
+            return steps, pe, ae
+        steps += 1
+        for a in range(3):
+            e[a] = (p_d[a] - p[a]) * ps
+            e[3 + a] = (n_d[a] - nv[a]) * an
+        # the chain's Jacobian (6, n) in its joint values
+        for a in range(6):
+            for i in range(n):
+                Jv[a, i] = 0.0
+        for k in range(path.shape[0]):
+            i = path[k]
+            F = B[i + 1]
+            wx = F[0, 0] * axes[i, 0] + F[0, 1] * axes[i, 1] + F[0, 2] * axes[i, 2]
+            wy = F[1, 0] * axes[i, 0] + F[1, 1] * axes[i, 1] + F[1, 2] * axes[i, 2]
+            wz = F[2, 0] * axes[i, 0] + F[2, 1] * axes[i, 1] + F[2, 2] * axes[i, 2]
+            if prismatic[i]:
+                Jv[0, i], Jv[1, i], Jv[2, i] = wx * ps, wy * ps, wz * ps
+            else:
+                rx, ry, rz = p[0] - F[0, 3], p[1] - F[1, 3], p[2] - F[2, 3]
+                Jv[0, i] = (wy * rz - wz * ry) * ps
+                Jv[1, i] = (wz * rx - wx * rz) * ps
+                Jv[2, i] = (wx * ry - wy * rx) * ps
+                Jv[3, i] = (wy * nv[2] - wz * nv[1]) * an
+                Jv[4, i] = (wz * nv[0] - wx * nv[2]) * an
+                Jv[5, i] = (wx * nv[1] - wy * nv[0]) * an
+        if coupling.shape[0] > 0:
+            for a in range(6):
+                for j in range(dof):
+                    acc = 0.0
+                    for i in range(n):
+                        acc += Jv[a, i] * coupling[i, j]
+                    J[a, j] = acc
+        else:
+            for a in range(6):
+                for j in range(dof):
+                    J[a, j] = Jv[a, j]
+        # dq = Jᵀ (J Jᵀ + λ² I)⁻¹ e
+        for a in range(6):
+            for b in range(a, 6):
+                acc = 0.0
+                for j in range(dof):
+                    acc += J[a, j] * J[b, j]
+                A[a, b] = acc
+                A[b, a] = acc
+            A[a, a] += lam2
+        _solve6(A, e, x)
+        big = 0.0
+        for j in range(dof):
+            acc = 0.0
+            for a in range(6):
+                acc += J[a, j] * x[a]
+            dq[j] = acc
+            big = max(big, abs(acc))
+        scale = max_step / big if big > max_step else 1.0
+        for j in range(dof):
+            qj = q[j] + dq[j] * scale
+            if continuous[j]:
+                qj = (qj + math.pi) % two_pi - math.pi
+            else:
+                qj = min(max(qj, lower[j]), upper[j])
+            q[j] = qj
+    return steps, 0.0, 0.0  # not reached
+
+
+def ik_arrays(robot: Any) -> tuple[Any, ...]:
+    """The chain and tip of a robot as :func:`descend_kernel`'s arrays after ``q0`` and
+    before the goal: (T0, parent, pre, axes, prismatic, coupling, path, tip_body, p_bt,
+    n_bt)."""
+    parent, pre, axes, prismatic, _, _, _, coupling = chain_parts(robot)
+    tip_body, p_bt, n_bt = robot.tip_data()
+    path = []
+    b = int(tip_body)
+    parent = np.asarray(parent, dtype=np.int64)
+    while b > 0:
+        path.append(b - 1)
+        b = int(parent[b - 1])
+    f = np.ascontiguousarray
+    return (
+        f(robot.T_world_base, dtype=np.float64),
+        f(parent),
+        f(pre, dtype=np.float64),
+        f(axes, dtype=np.float64),
+        f(prismatic, dtype=np.bool_),
+        np.zeros((0, 0)) if coupling is None else f(coupling, dtype=np.float64),
+        np.array(path[::-1], dtype=np.int64),
+        int(tip_body),
+        f(p_bt, dtype=np.float64),
+        f(n_bt, dtype=np.float64),
+    )
+
+
+class ChainDescent:
+    """The compiled descent of one robot (its arrays made once; the kernel compiled or
+    loaded from numba's cache when this is built, not inside a search), called as
+    ``descent(goal, q_seed, max_iterations, damping, max_step_rad, target_fraction)`` ->
+    (q (dof,), steps) for a :class:`~plannerlab.problem.goals.GoalRegion` ``goal``: the
+    signature :func:`plannerlab.problem.ik.solve_ik` runs a family's descent with."""
+
+    def __init__(self, robot: Any) -> None:
+        self.dof = int(robot.dof)
+        self._arrays = ik_arrays(robot)
+        f = np.ascontiguousarray
+        self._bounds = (
+            f(robot.lower, dtype=np.float64),
+            f(robot.upper, dtype=np.float64),
+            f(robot.continuous, dtype=np.bool_),
+        )
+        kernel: Any = descend_kernel  # a numba dispatcher
+        if not kernel.signatures:  # compile (first run on the machine) or load it here
+            q = np.clip(np.zeros(self.dof), robot.lower, robot.upper)
+            kernel(
+                q,
+                *self._arrays,
+                *((np.zeros(3), np.ones(3) / 3**0.5, 1.0, 1.0)),
+                *self._bounds,
+                0,
+                0.05,
+                0.25,
+                0.3,
+                np.empty(self.dof),
+            )
+
+    def __call__(
+        self,
+        goal: Any,
+        q_seed: Any,
+        max_iterations: int,
+        damping: float,
+        max_step_rad: float,
+        target_fraction: float,
+    ) -> tuple[np.ndarray, int]:
+        q = np.empty(self.dof)
+        kernel: Any = descend_kernel  # a numba dispatcher
+        steps, _, _ = kernel(
+            np.ascontiguousarray(q_seed, dtype=np.float64).reshape(self.dof),
+            *self._arrays,
+            np.ascontiguousarray(goal.p_world_m, dtype=np.float64),
+            np.ascontiguousarray(goal.n_world, dtype=np.float64),
+            float(goal.pos_tol_m),
+            math.radians(float(goal.angle_tol_deg)),
+            *self._bounds,
+            int(max_iterations),
+            float(damping),
+            float(max_step_rad),
+            float(target_fraction),
+            q,
+        )
+        return q, int(steps)
+
+
+def descent_for(robot: Any) -> ChainDescent:
+    """The registry's entry (:attr:`~plannerlab.robots.registry.RobotFamily.ik_descent`):
+    the compiled descent of a robot with a chain and a tip (``tip_data()``)."""
+    return ChainDescent(robot)
+
+
+__all__ = ["ChainDescent", "descend_kernel", "descent_for", "ik_arrays"]
