@@ -454,7 +454,8 @@ class CoverSettings:
 class BoxCover:
     """Boxes (axis-aligned in the mesh's frame) covering a mesh: centres (b, 3) and half
     sizes (b, 3) [m], the voxel pitch [m] and a bound of how far the boxes reach outside
-    the mesh ((sqrt 3 + 1/2) pitch: a voxel diagonal plus the half-pitch growth)."""
+    the mesh (1.5 sqrt 3 pitch: a voxel diagonal plus the half-pitch growth, whose
+    corner is half a diagonal out)."""
 
     centres_m: Array
     half_m: Array
@@ -520,7 +521,7 @@ def box_cover(V: Array, F: np.ndarray, max_boxes: int, where: str, file: str) ->
             b = np.array([b[1] for b in boxes], dtype=float)
             low = lo + a * pitch - pitch / 2.0
             high = lo + b * pitch + pitch / 2.0
-            return BoxCover((low + high) / 2.0, (high - low) / 2.0, pitch, (3**0.5 + 0.5) * pitch)
+            return BoxCover((low + high) / 2.0, (high - low) / 2.0, pitch, 1.5 * 3**0.5 * pitch)
         pitch *= 1.25
     raise MeshError(  # pragma: no cover - a pitch of the whole extent gives one box
         file, where, f"no cover in {max_boxes} boxes", "raise the box limit"
