@@ -1,7 +1,9 @@
 """Collision checking: the compiled core, with python-fcl as its reference and fallback.
 
 The robot's links are capsules (see :class:`plannerlab.robots.base.Robot`); obstacles are
-boxes, cylinders and spheres. Two backends answer the same questions with the same meaning:
+boxes, cylinders, spheres and meshes (the core checks a mesh's cover of boxes, FCL its
+triangles: :mod:`plannerlab.problem.scene`). Two backends answer the same questions with
+the same meaning:
 
 * ``"core"`` (:mod:`plannerlab.collision.core`): numba-compiled kinematics, broad phase and
   exact capsule tests over whole batches; the default whenever every obstacle is a shape it
@@ -29,7 +31,7 @@ import numpy as np
 from plannerlab.collision.core import Core, PairDistances
 from plannerlab.collision.core import supports as core_supports
 from plannerlab.collision.reach import joint_reach_m, reach_bounds
-from plannerlab.problem.scene import Box, Cylinder, Scene, Sphere
+from plannerlab.problem.scene import Box, Cylinder, Mesh, Scene, Sphere
 from plannerlab.robots.base import Array, Robot
 from plannerlab.robots.paths import densify, edge_counts
 
@@ -153,7 +155,14 @@ class CollisionChecker:
                 for r, ln in zip(self._radii_self, self._lengths, strict=True)
             ]
         )
-        self._obstacles = [self._make_obstacle(o) for o in scene.obstacles]
+        # a mesh obstacle's cover boxes each stand for the mesh's real triangles (one
+        # BVHModel per mesh, shared): the boxes' bounds pre-test, the triangles decide
+        bvh = {m.name: self._make_mesh(m) for m in scene.meshes}
+        cover_of = [getattr(o, "cover_of", "") for o in scene.obstacles]
+        self._obstacles = [
+            bvh[m] if m else self._make_obstacle(o)
+            for o, m in zip(scene.obstacles, cover_of, strict=True)
+        ]
         self._obs_lo, self._obs_hi = scene.aabbs()
         moving = np.array([i not in robot.fixed_links for i in range(L)])
         self._scene_mask = moving[:, None] & np.ones((1, len(self._obstacles)), dtype=bool)
@@ -180,6 +189,19 @@ class CollisionChecker:
             geom = fcl.Sphere(float(o.radius_m))
         T = o.T_world_obstacle
         return fcl.CollisionObject(geom, fcl.Transform(T[:3, :3].copy(), T[:3, 3].copy()))
+
+    @staticmethod
+    def _make_mesh(m: Mesh) -> fcl.CollisionObject:
+        """A mesh obstacle's triangles as an FCL ``BVHModel`` at its pose."""
+        bvh = fcl.BVHModel()
+        bvh.beginModel(len(m.vertices_m), len(m.faces))
+        bvh.addSubModel(
+            np.ascontiguousarray(m.vertices_m, dtype=float),
+            np.ascontiguousarray(m.faces, dtype=np.int32),
+        )
+        bvh.endModel()
+        T = m.T_world_obstacle
+        return fcl.CollisionObject(bvh, fcl.Transform(T[:3, :3].copy(), T[:3, 3].copy()))
 
     def _place(self, seg: Array) -> None:
         """Move the FCL link capsules to the segments (L, 2, 3) of one state."""
@@ -347,11 +369,12 @@ class CollisionChecker:
             scene, selfc = self._candidates(seg[None])
             hits = self._state_pairs(seg, scene[0], selfc[0], first_only=False)
         self.checks += 1
-        names = self.scene.names
-        return tuple(
+        names = self.scene.source_names  # a cover box names its mesh
+        pairs = (
             (self._link_names[a], self._link_names[b] if is_link else names[b])
             for a, b, is_link in hits
         )
+        return tuple(dict.fromkeys(pairs))
 
     def tip(self, q: Array) -> tuple[Array, Array]:
         """The robot's ``tip(q)`` (position [m], face normal) for one q (dof,), from the

@@ -4,6 +4,13 @@ these into FCL objects.
 Every obstacle has a name (unique in its scene), a pose ``T_world_obstacle`` (4, 4) whose
 origin is the shape's centre, and its dimensions in metres. A cylinder's axis is its
 local z.
+
+A **mesh obstacle** (:class:`Mesh`: triangles from a file, at a pose, scaled) enters the
+scene twice: :attr:`Scene.meshes` holds the real triangles (FCL's ``BVHModel`` and
+PyBullet use them), and :attr:`Scene.obstacles` holds its conservative cover of boxes
+(:func:`~plannerlab.robots.urdf.meshes.box_cover`: filled voxels merged into boxes, each
+named ``<mesh>#k`` with ``cover_of = <mesh>``), which every planner and the compiled core
+check exactly, so they see at least the mesh.
 """
 
 from __future__ import annotations
@@ -28,6 +35,8 @@ class Box:
     name: str
     T_world_obstacle: Array
     size_m: Array
+    #: the mesh obstacle this box is a piece of the cover of ("" for a box of its own)
+    cover_of: str = ""
     kind: str = field(default="box", init=False)
 
     def __post_init__(self) -> None:
@@ -75,18 +84,65 @@ class Sphere:
         return np.full(3, self.radius_m)
 
 
+@dataclass(frozen=True, eq=False)
+class Mesh:
+    """Triangles ``vertices_m`` (n, 3) [m, scaled, in the obstacle's frame] and ``faces``
+    (m, 3) read from ``file``, and the boxes covering them (centres and half sizes (b, 3)
+    in the obstacle's frame, reaching at most ``cover_excess_m`` outside the mesh)."""
+
+    name: str
+    T_world_obstacle: Array
+    file: str
+    scale: Array
+    vertices_m: Array
+    faces: np.ndarray
+    cover_centres_m: Array
+    cover_half_m: Array
+    cover_excess_m: float
+    kind: str = field(default="mesh", init=False)
+
+    def __post_init__(self) -> None:
+        for name in ("T_world_obstacle", "scale", "vertices_m", "cover_centres_m", "cover_half_m"):
+            object.__setattr__(self, name, _frozen(getattr(self, name)))
+        faces = np.array(self.faces, dtype=np.int64)
+        faces.setflags(write=False)
+        object.__setattr__(self, "faces", faces)
+
+    def half_extents_world(self) -> Array:
+        """Half sizes of the world-axis-aligned box around the mesh, about its origin."""
+        p = self.vertices_m @ self.T_world_obstacle[:3, :3].T
+        return np.maximum(np.abs(p.max(axis=0)), np.abs(p.min(axis=0)))
+
+    def vertices_world(self) -> Array:
+        """The vertices (n, 3) in the world [m]."""
+        T = self.T_world_obstacle
+        return self.vertices_m @ T[:3, :3].T + T[:3, 3]
+
+    def cover_boxes(self) -> tuple[Box, ...]:
+        """The cover as world boxes named ``<name>#k`` (``cover_of`` = this mesh)."""
+        T = self.T_world_obstacle
+        out = []
+        for k, (c, h) in enumerate(zip(self.cover_centres_m, self.cover_half_m, strict=True)):
+            Tk = T.copy()
+            Tk[:3, 3] = T[:3, :3] @ c + T[:3, 3]
+            out.append(Box(f"{self.name}#{k}", Tk, 2.0 * h, cover_of=self.name))
+        return tuple(out)
+
+
 Obstacle = Box | Cylinder | Sphere
-OBSTACLE_TYPES: tuple[str, ...] = ("box", "cylinder", "sphere")
+OBSTACLE_TYPES: tuple[str, ...] = ("box", "cylinder", "sphere", "mesh")
 
 
 @dataclass(frozen=True, eq=False)
 class Scene:
-    """The static world: a tuple of uniquely named obstacles."""
+    """The static world: a tuple of uniquely named obstacles, and the mesh obstacles
+    (whose cover boxes are among the obstacles, see the module docstring)."""
 
     obstacles: tuple[Obstacle, ...] = ()
+    meshes: tuple[Mesh, ...] = ()
 
     def __post_init__(self) -> None:
-        names = [o.name for o in self.obstacles]
+        names = [o.name for o in self.obstacles] + [m.name for m in self.meshes]
         dup = {n for n in names if names.count(n) > 1}
         if dup:
             raise ValueError(f"obstacle names must be unique; repeated: {sorted(dup)}")
@@ -94,6 +150,18 @@ class Scene:
     @property
     def names(self) -> tuple[str, ...]:
         return tuple(o.name for o in self.obstacles)
+
+    @property
+    def source_names(self) -> tuple[str, ...]:
+        """Per obstacle, the name of what it stands for: its own, or its mesh's."""
+        return tuple(getattr(o, "cover_of", "") or o.name for o in self.obstacles)
+
+    def mesh(self, name: str) -> Mesh:
+        """The mesh obstacle of that name."""
+        for m in self.meshes:
+            if m.name == name:
+                return m
+        raise KeyError(name)
 
     def aabbs(self) -> tuple[Array, Array]:
         """World-axis-aligned bounds of every obstacle: lower (n, 3), upper (n, 3) [m]."""

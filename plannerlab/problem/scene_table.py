@@ -1,21 +1,64 @@
-"""The ``[[obstacles]]`` tables: boxes, cylinders and spheres with unique names → a
-:class:`~plannerlab.problem.scene.Scene`."""
+"""The ``[[obstacles]]`` tables: boxes, cylinders, spheres and meshes with unique names →
+a :class:`~plannerlab.problem.scene.Scene` (a mesh's cover boxes among its obstacles, the
+mesh itself among its meshes)."""
 
 from __future__ import annotations
+
+from pathlib import Path
 
 import numpy as np
 
 from plannerlab.errors import ProblemError
 from plannerlab.problem.reader import TableReader
-from plannerlab.problem.scene import OBSTACLE_TYPES, Box, Cylinder, Obstacle, Scene, Sphere
+from plannerlab.problem.scene import OBSTACLE_TYPES, Box, Cylinder, Mesh, Obstacle, Scene, Sphere
+
+#: the most boxes a mesh obstacle's cover may have (default of ``max_boxes``)
+MESH_MAX_BOXES: int = 64
 
 
-def _obstacle(reader: TableReader) -> Obstacle:
+def _mesh(reader: TableReader, name: str, T: np.ndarray) -> Mesh:
+    """A ``type = "mesh"`` obstacle: its file (relative to the problem file) read, scaled
+    and covered by boxes."""
+    from plannerlab.robots.urdf.meshes import MeshError, box_cover, load_mesh
+
+    reader.unknown_keys(
+        ("name", "type", "center_m", "rpy_deg", "file", "scale", "max_boxes", "note")
+    )
+    file = reader.string("file")
+    folder = Path(reader.source).parent if reader.source != "<memory>" else Path.cwd()
+    path = (folder / file).resolve()
+    raw_scale = reader.raw("scale", 1.0)
+    if isinstance(raw_scale, int | float) and not isinstance(raw_scale, bool):
+        scale = np.full(3, float(raw_scale))
+    else:
+        scale = reader.vector("scale", 3)
+    if not (np.all(np.isfinite(scale)) and np.all(scale > 0)):
+        raise reader.fail("scale", f"a positive number or three, got {raw_scale!r}")
+    max_boxes = reader.integer("max_boxes", MESH_MAX_BOXES, minimum=1, maximum=4096)
+    where = f"obstacle {name!r}"
+    try:
+        if not path.is_file():
+            raise MeshError(
+                str(path),
+                where,
+                "the file does not exist",
+                "fix file (relative to the problem file)",
+            )
+        V, F = load_mesh(path, scale, where)
+        cover = box_cover(V, F, max_boxes, where, str(path))
+    except MeshError as exc:
+        raise reader.fail("file", f"a mesh plannerlab can read and cover; {exc}") from None
+    return Mesh(name, T, str(path), scale, V, F, cover.centres_m, cover.half_m, cover.max_excess_m)
+
+
+def _obstacle(reader: TableReader) -> Obstacle | Mesh:
     name = reader.string("name")
     kind = reader.string("type")
     if kind not in OBSTACLE_TYPES:
         raise reader.fail("type", f"one of {', '.join(OBSTACLE_TYPES)}, got {kind!r}")
     T = reader.pose("center_m", "rpy_deg")
+    if kind == "mesh":
+        return _mesh(reader, name, T)
     if kind == "box":
         reader.unknown_keys(("name", "type", "center_m", "rpy_deg", "size_m", "note"))
         size = reader.vector("size_m", 3)
@@ -47,4 +90,11 @@ def read_scene(top: TableReader) -> Scene:
     for i, n in enumerate(names):
         if names.index(n) != i:
             raise ProblemError(source, f"obstacles[{i}].name", f"a unique name; {n!r} is repeated")
-    return Scene(tuple(obstacles))
+        if "#" in n and any(isinstance(o, Mesh) for o in obstacles):
+            raise ProblemError(
+                source, f"obstacles[{i}].name", f"a name without '#' beside mesh obstacles; {n!r}"
+            )
+    prims: list[Obstacle] = []
+    for o in obstacles:
+        prims.extend(o.cover_boxes() if isinstance(o, Mesh) else (o,))
+    return Scene(tuple(prims), tuple(o for o in obstacles if isinstance(o, Mesh)))

@@ -211,6 +211,12 @@ class Execution:
         min_clearance_pair: (robot link, obstacle or other link) of that clearance.
         clearance_samples: states whose clearance was queried.
         solver: PyBullet's constraint solver ("pgs", "dantzig"; "" when not recorded).
+        geometry: which geometry each figure was measured on, by figure
+            (``recheck``: the FCL/core re-check; ``contacts`` and ``min_clearance_m``:
+            PyBullet; ``max_deviation_m``): ``"planning model"`` (the capsules and
+            sphere covers planned with, mesh obstacles as their cover boxes) or
+            ``"real meshes"`` (the URDF's collision meshes, the scene's triangles),
+            with details; empty in older records.
     """
 
     problem: str
@@ -261,6 +267,7 @@ class Execution:
     clearance_samples: int = 0
     solver: str = ""
     extra: Mapping[str, Any] = field(default_factory=dict)
+    geometry: Mapping[str, str] = field(default_factory=dict)
 
     def __post_init__(self) -> None:
         for name in _ARRAY_FIELDS:
@@ -273,6 +280,7 @@ class Execution:
             object.__setattr__(self, name, read_float(getattr(self, name)))
         object.__setattr__(self, "gravity_mps2", tuple(float(g) for g in self.gravity_mps2))
         object.__setattr__(self, "extra", dict(self.extra))
+        object.__setattr__(self, "geometry", {str(k): str(v) for k, v in self.geometry.items()})
         if self.min_clearance_pair is not None:
             link, other = self.min_clearance_pair
             object.__setattr__(self, "min_clearance_pair", (str(link), str(other)))

@@ -141,6 +141,7 @@ both.
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import time
 from collections.abc import Sequence
@@ -155,6 +156,7 @@ from plannerlab.record.execution import ContactRecord, Execution
 from plannerlab.robots.base import Array, Robot, joint_difference
 from plannerlab.sim.measure import (
     Clearance,
+    geometry_notes,
     plan_deviation,
     sampled_clearance,
 )
@@ -577,7 +579,7 @@ def execute(
         ) as world,
         SimWorld(problem.robot, problem.scene) as probe,
     ):
-        return _run(
+        ex = _run(
             world,
             checker,
             problem,
@@ -596,6 +598,7 @@ def execute(
             grid_per_knot=grid_per_knot,
             interpolant=interpolant,
         )
+    return dataclasses.replace(ex, geometry=geometry_notes(problem))
 
 
 def execute_legs(
@@ -674,4 +677,5 @@ def execute_legs(
                     interpolant=interpolant,
                 )
             )
-    return out
+    geometry = geometry_notes(problem)
+    return [dataclasses.replace(ex, geometry=geometry) for ex in out]

@@ -61,7 +61,8 @@ from __future__ import annotations
 import math
 from collections.abc import Iterable
 from dataclasses import dataclass
-from typing import Protocol
+from pathlib import Path
+from typing import Any, Protocol
 
 import numpy as np
 
@@ -216,6 +217,20 @@ class ClosestPoints(Protocol):
     def link_distances(self, max_distance_m: float) -> tuple[Array, list[str], Array]: ...
 
 
+def _link_groups(robot: Robot) -> tuple[np.ndarray, list[str]] | None:
+    """For a robot whose links are covers of meshes (a URDF robot with ``mesh_covers``):
+    where each URDF link's run of capsules starts, and the URDF link names; None for the
+    other robots (every capsule its own link)."""
+    if not getattr(robot, "mesh_covers", ()) and getattr(robot, "sim_urdf_path", None) is None:
+        return None
+    urdf = list(robot.link_urdf_names)  # type: ignore[attr-defined]
+    starts = [0] + [i for i in range(1, len(urdf)) if urdf[i] != urdf[i - 1]]
+    names = [urdf[i] for i in starts]
+    if len(set(names)) != len(names):  # pragma: no cover - UrdfChain keeps runs together
+        raise PlannerlabError("a URDF link's capsules are not consecutive")
+    return np.array(starts), names
+
+
 def sampled_clearance(
     robot: Robot,
     probe: ClosestPoints,
@@ -243,8 +258,18 @@ def sampled_clearance(
         )
     k = len(q)
     forced = sorted({int(i) for i in always if 0 <= int(i) < k} | {k - 1})
+    if getattr(robot, "sim_urdf_path", None) is not None:
+        # PyBullet holds another geometry than the capsules (a sim_urdf): how far they
+        # moved bounds nothing of it, so every state is queried
+        forced = list(range(k))
     seg, unit = _segments_axes(robot, q)
-    names = robot.link_names
+    names = list(robot.link_names)
+    # A mesh robot: PyBullet measures each URDF link's meshes once (reported on its first
+    # capsule); its distance and how far it can have moved (the most any of its covering
+    # capsules moved: the mesh lies inside them) are taken per URDF link.
+    groups = _link_groups(robot)
+    if groups is not None:
+        starts, names = groups
     best: tuple[float, int, tuple[str, str] | None, bool] = (math.inf, 0, None, False)
     samples = 0
     i = 0
@@ -252,6 +277,14 @@ def sampled_clearance(
     while True:
         probe.set_state(q[i])
         scene, obstacle, pair = probe.link_distances(max_distance_m)
+        if groups is not None:
+            at = np.minimum.reduceat(np.asarray(scene), starts)
+            ends = [*starts[1:], len(scene)]
+            obstacle = [
+                obstacle[int(a + np.argmin(scene[a:b]))] for a, b in zip(starts, ends, strict=True)
+            ]
+            scene = at
+            pair = np.minimum.reduceat(np.minimum.reduceat(pair, starts, axis=0), starts, axis=1)
         samples += 1
         l_scene = int(np.argmin(scene))
         l_a, l_b = np.unravel_index(int(np.argmin(pair)), pair.shape)
@@ -274,6 +307,8 @@ def sampled_clearance(
         while lo < stop:
             hi = min(stop, lo + 128)
             moved = _link_deviation(robot, seg[lo:hi], unit[lo:hi], seg[i][None], unit[i][None])
+            if groups is not None:
+                moved = np.maximum.reduceat(moved, starts, axis=1)
             lower = np.minimum(
                 np.min(scene[None, :] - moved, axis=1),
                 np.min(pair[None] - moved[:, :, None] - moved[:, None, :], axis=(1, 2)),
@@ -295,7 +330,45 @@ def sampled_clearance(
     )
 
 
+def geometry_notes(problem: Any) -> dict[str, str]:
+    """Which geometry each figure of an execution is measured on (the record's
+    ``geometry``): the re-check on the planning model; contacts and clearance on what
+    PyBullet loads: the robot's URDF as it is (its collision meshes when it has any:
+    the real geometry, not the covers planned with) and the scene's mesh obstacles as
+    triangles; the deviation on the planning model's capsules."""
+    robot = problem.robot
+    covers = getattr(robot, "mesh_covers", ())
+    meshes = problem.scene.meshes
+    scene_note = (
+        f"; mesh obstacles {', '.join(m.name for m in meshes)} as their triangles" if meshes else ""
+    )
+    sim_urdf = getattr(robot, "sim_urdf_path", None)
+    if sim_urdf is not None:
+        plan = "planning model: the robot's capsules" + (
+            f" and sphere covers of {len(covers)} meshes" if covers else ""
+        )
+        sim = f"real meshes: the collision geometry of {Path(sim_urdf).name} (sim_urdf){scene_note}"
+    elif covers:
+        excess = max(c.max_excess_m for c in covers)
+        plan = (
+            f"planning model: {len(covers)} collision meshes as sphere covers "
+            f"(outward excess <= {excess * 1e3:.3g} mm)"
+        )
+        sim = f"real meshes: the URDF's {len(covers)} collision meshes{scene_note}"
+    else:
+        plan = "planning model: the robot's capsules"
+        sim = f"planning model: the robot's URDF as planned with{scene_note}"
+    recheck_scene = "; mesh obstacles as their cover boxes" if meshes else ""
+    return {
+        "recheck": plan + recheck_scene,
+        "contacts": sim,
+        "min_clearance_m": sim,
+        "max_deviation_m": "planning model: the robot's capsules (axis end points and radii)",
+    }
+
+
 __all__ = [
+    "geometry_notes",
     "CLEARANCE_MAX_DISTANCE_M",
     "CLEARANCE_RESOLUTION_M",
     "Clearance",

@@ -50,7 +50,7 @@ import numpy as np
 from scipy.spatial.transform import Rotation
 
 from plannerlab.errors import PlannerlabError
-from plannerlab.problem.scene import Box, Cylinder, Obstacle, Scene, Sphere
+from plannerlab.problem.scene import Box, Cylinder, Mesh, Obstacle, Scene, Sphere
 from plannerlab.robots.base import Array, Robot, as_xyz, joint_difference
 from plannerlab.sim.quiet import engine_output_logged
 
@@ -114,7 +114,8 @@ class SimWorld:
 
     Args:
         robot: the robot model; its ``urdf()`` is loaded.
-        scene: static obstacles (boxes, cylinders, spheres at their poses).
+        scene: static obstacles (boxes, cylinders, spheres at their poses; a mesh
+            obstacle as its triangles, not the boxes covering it).
         gui: open PyBullet's GUI instead of the headless DIRECT mode (one per process).
         dt_s: physics time step [s] (paper: 1/240).
         gravity_mps2: gravity in the world frame [m/s²].
@@ -288,7 +289,11 @@ class SimWorld:
         # Obstacles: static bodies; fixed robot links never touch them.
         self._gui = c.getConnectionInfo()["connectionMethod"] == pybullet.GUI
         self.obstacle_names: dict[int, str] = {}
-        for o in self.scene.obstacles:
+        # a mesh obstacle is its triangles here (its cover boxes are the planners')
+        shapes: list[Obstacle | Mesh] = [
+            o for o in self.scene.obstacles if not getattr(o, "cover_of", "")
+        ]
+        for o in [*shapes, *self.scene.meshes]:
             uid = self._make_obstacle(o)
             self.obstacle_names[uid] = o.name
             for i in robot.fixed_links:
@@ -296,9 +301,19 @@ class SimWorld:
                 if a is not None:
                     c.setCollisionFilterPair(self.body, uid, a, -1, 0)
 
-    def _make_obstacle(self, o: Obstacle) -> int:
+    def _make_obstacle(self, o: Obstacle | Mesh) -> int:
         c = self.client
-        if isinstance(o, Box):
+        if isinstance(o, Mesh):
+            # a static body: its triangles as they are (concave), not their convex hull
+            mesh_args = dict(
+                vertices=np.asarray(o.vertices_m, dtype=float).tolist(),
+                indices=np.asarray(o.faces, dtype=int).reshape(-1).tolist(),
+            )
+            shape = c.createCollisionShape(
+                pybullet.GEOM_MESH, flags=pybullet.GEOM_FORCE_CONCAVE_TRIMESH, **mesh_args
+            )
+            visual = dict(shapeType=pybullet.GEOM_MESH, **mesh_args)
+        elif isinstance(o, Box):
             half = [float(s) / 2.0 for s in o.size_m]
             shape = c.createCollisionShape(pybullet.GEOM_BOX, halfExtents=half)
             visual = dict(shapeType=pybullet.GEOM_BOX, halfExtents=half)
@@ -522,6 +537,9 @@ class SimWorld:
         i = self._robot_link.get(pb_link)
         if i is None:
             return self.urdf_link_names[pb_link], None
+        if getattr(self.robot, "mesh_covers", ()) or getattr(self.robot, "sim_urdf_path", None):
+            # PyBullet holds the link's meshes, not the spheres covering them
+            return self.urdf_link_names[pb_link], i
         return self.robot.link_names[i], i
 
     def set_state(self, q_rad: Array) -> None:

@@ -26,19 +26,28 @@ Every ``<collision>`` element becomes one capsule (a plannerlab "link", named
   (it covers the cylinder; the rounded ends stick out by one radius);
 * a box: the capsule along its longest edge, radius the half-diagonal of the other two
   (covers the box, conservative);
-* a mesh: refused (spherize the robot, as MotionBenchMaker's Panda is).
+* a mesh (STL, OBJ, DAE; ``package://``, ``file://`` or a path relative to the URDF,
+  searched as :func:`~plannerlab.robots.urdf.meshes.resolve_mesh` says): a conservative
+  cover of zero-length capsules (spheres), one capsule per sphere
+  (:func:`~plannerlab.robots.urdf.meshes.sphere_cover`: every vertex and a dense surface
+  sample inside, outward excess at most ``cover_excess_m``, cached on disk);
+  :attr:`UrdfChain.mesh_covers` reports each. The simulator is given the meshes
+  themselves (:meth:`UrdfChain.urdf`): verdicts are measured on the real geometry.
+
+A link that moves and has no ``<collision>`` is never checked; :attr:`UrdfChain.notes`
+names every such link (and logs a warning).
 
 Capsules on the root body are fixed (never checked against the scene). Self-collision
 is not checked between capsules on one body, between capsules of neighbouring bodies
 (parent and child of a movable joint), nor between links named in the SRDF's
 ``<disable_collisions>`` or in the problem's allowed-collision pairs.
 
-Only numpy (and ``yourdfpy`` for parsing) is used here.
+Only numpy (``yourdfpy`` for parsing, ``trimesh`` for meshes) is used here.
 """
 
 from __future__ import annotations
 
-import difflib
+import logging
 import math
 import xml.etree.ElementTree as ET
 from dataclasses import dataclass, field
@@ -49,24 +58,13 @@ import numpy as np
 from numpy.typing import NDArray
 
 from plannerlab.errors import PlannerlabError
-from plannerlab.robots.base import Array, urdf_origin
+from plannerlab.robots.base import Array
+from plannerlab.robots.urdf.errors import UrdfError, hint
+from plannerlab.robots.urdf.meshes import CoverSettings, MeshCover
+from plannerlab.robots.urdf.pairs import excluded_pairs, read_srdf_disabled
 
 MOVABLE = ("revolute", "continuous", "prismatic")
-
-
-class UrdfError(PlannerlabError):
-    """A URDF, SRDF or link name the family cannot use; ``key`` is the ``[robot]`` key
-    to blame (``urdf``, ``tip_link``, ``srdf``, ``allowed_collisions``)."""
-
-    def __init__(self, key: str, expected: str) -> None:
-        self.key = key
-        self.expected = expected
-        super().__init__(f"[robot.{key}] {expected}")
-
-
-def _hint(name: str, names: list[str]) -> str:
-    close = difflib.get_close_matches(name, names, n=1)
-    return f" (did you mean {close[0]!r}?)" if close else ""
+_LOG = logging.getLogger(__name__)
 
 
 def axis_motion(axis: Array, q: Array, prismatic: bool) -> Array:
@@ -82,15 +80,6 @@ def axis_motion(axis: Array, q: Array, prismatic: bool) -> Array:
     c = np.cos(q)[..., None, None]
     T[..., :3, :3] = np.eye(3) + s * K + (1.0 - c) * (K @ K)
     return T
-
-
-def read_srdf_disabled(path: Path) -> list[tuple[str, str]]:
-    """The ``<disable_collisions link1= link2=>`` pairs of an SRDF file."""
-    try:
-        root = ET.parse(path).getroot()
-    except (OSError, ET.ParseError) as exc:
-        raise UrdfError("srdf", f"a readable SRDF (XML) file; {path}: {exc}") from None
-    return [(str(e.get("link1")), str(e.get("link2"))) for e in root.iter("disable_collisions")]
 
 
 def _joint_axis(j: Any) -> Array:
@@ -167,7 +156,7 @@ def _chain(urdf: Any, tip_link: str, path: Path) -> _Tree:
     if tip_link not in links:
         raise UrdfError(
             "tip_link",
-            f"a link of {path.name}, got {tip_link!r}{_hint(tip_link, list(links))}; "
+            f"a link of {path.name}, got {tip_link!r}{hint(tip_link, list(links))}; "
             f"its links: {', '.join(links)}",
         )
     # the chain: root -> tip
@@ -240,15 +229,49 @@ class _Capsules:
     radii: list[float]
 
 
-def _capsules(tree: _Tree, placed: dict[str, tuple[int, Array]], path: Path) -> _Capsules:
-    """One capsule per ``<collision>`` element (see the module docstring)."""
+def _capsules(
+    tree: _Tree, placed: dict[str, tuple[int, Array]], path: Path, cover: CoverSettings
+) -> tuple[_Capsules, list[MeshCover], dict[str, Path]]:
+    """One capsule per primitive ``<collision>`` element and a sphere cover per mesh (see
+    the module docstring); the covers' reports and every collision mesh's file."""
+    from plannerlab.robots.urdf.meshes import MeshError, resolve_mesh, sphere_cover
+
     caps = _Capsules([], [], [], [], [], [])
+    reports: list[MeshCover] = []
+    mesh_files: dict[str, Path] = {}
     for lname, link in tree.links.items():
         b, T_link = placed[lname]
         cols = list(link.collisions)
-        for k, col in enumerate(cols):
+        pieces: list[tuple[Array, Array, float]] = []  # per capsule: a, b, radius (body)
+        for col in cols:
             T = T_link @ (np.eye(4) if col.origin is None else np.asarray(col.origin, float))
             g = col.geometry
+            if g.mesh is not None:
+                where = f"link {lname} of {path.name}"
+                try:
+                    file = resolve_mesh(str(g.mesh.filename), path, cover.mesh_paths, where)
+                    scale = np.ones(3) if g.mesh.scale is None else np.asarray(g.mesh.scale, float)
+                    sc = sphere_cover(
+                        file, scale, cover.excess_m, cover.max_spheres, where, cover.cache_dir
+                    )
+                except MeshError as exc:
+                    raise UrdfError("urdf", str(exc)) from None
+                mesh_files[str(g.mesh.filename)] = file
+                reports.append(
+                    MeshCover(
+                        lname,
+                        str(file),
+                        len(sc.radii_m),
+                        sc.max_excess_m,
+                        sc.points_verified,
+                        sc.watertight,
+                        sc.cached,
+                    )
+                )
+                centres = sc.centres_m @ T[:3, :3].T + T[:3, 3]
+                for c, r in zip(centres, sc.radii_m, strict=True):
+                    pieces.append((c, c, float(r)))
+                continue
             if g.sphere is not None:
                 r, half = float(g.sphere.radius), np.zeros(3)
             elif g.cylinder is not None:
@@ -264,57 +287,22 @@ def _capsules(tree: _Tree, placed: dict[str, tuple[int, Array]], path: Path) -> 
             else:
                 raise UrdfError(
                     "urdf",
-                    f"collision geometry a plannerlab robot can check (sphere, cylinder, "
-                    f"box); link {lname} of {path.name} has a mesh: use a spherized URDF",
+                    f"collision geometry a sphere, cylinder, box or mesh; link {lname} of "
+                    f"{path.name} has none of them in a <collision>",
                 )
-            c = T[:3, 3]
+            mid = T[:3, 3]
             d = T[:3, :3] @ half
-            caps.names.append(lname if len(cols) == 1 else f"{lname}#{k}")
+            pieces.append((mid - d, mid + d, r))
+        for k, (end_a, end_b, rad) in enumerate(pieces):
+            caps.names.append(lname if len(pieces) == 1 else f"{lname}#{k}")
             caps.link.append(lname)
             caps.body.append(b)
-            caps.a.append(c - d)
-            caps.b.append(c + d)
-            caps.radii.append(r)
+            caps.a.append(end_a)
+            caps.b.append(end_b)
+            caps.radii.append(rad)
     if not caps.names:
         raise UrdfError("urdf", f"collision elements; {path.name} has none")
-    return caps
-
-
-def _excluded_pairs(
-    caps: _Capsules,
-    parent_body: list[int],
-    links: dict[str, Any],
-    srdf_path: Path | None,
-    allowed_collisions: tuple[tuple[str, str], ...],
-    path: Path,
-) -> set[tuple[int, int]]:
-    """Capsule pairs never checked: on one body, on neighbouring bodies, or of links the
-    SRDF or the problem's allowed-collision pairs name."""
-    disabled: set[frozenset[str]] = set()
-    if srdf_path is not None:
-        for l1, l2 in read_srdf_disabled(Path(srdf_path)):
-            disabled.add(frozenset((l1, l2)))
-    for l1, l2 in allowed_collisions:
-        for n in (l1, l2):
-            if n not in links:
-                raise UrdfError(
-                    "allowed_collisions",
-                    f"pairs of links of {path.name}; {n!r} is not one{_hint(n, list(links))}",
-                )
-        disabled.add(frozenset((l1, l2)))
-    neighbours = {frozenset((parent_body[i], i + 1)) for i in range(len(parent_body))}
-    excluded = set()
-    L = len(caps.names)
-    for i in range(L):
-        for j2 in range(i + 1, L):
-            bi, bj = caps.body[i], caps.body[j2]
-            if (
-                bi == bj
-                or frozenset((bi, bj)) in neighbours
-                or frozenset((caps.link[i], caps.link[j2])) in disabled
-            ):
-                excluded.add((i, j2))
-    return excluded
+    return caps, reports, mesh_files
 
 
 def _frozen_array(a: Any, dtype: Any = float) -> Any:
@@ -335,6 +323,16 @@ class UrdfChain:
         srdf_path: an SRDF whose ``disable_collisions`` pairs are not checked, or None.
         allowed_collisions: more URDF link pairs that are not checked.
         T_world_base: (4, 4) pose of the root link in the world.
+        mesh_paths: folders searched for ``package://`` mesh paths (see
+            :mod:`plannerlab.robots.urdf.meshes`).
+        cover_excess_m: the largest outward excess of a mesh's sphere cover [m].
+        cover_max_spheres: the most spheres a mesh's cover may have.
+        cover_cache: keep covers on disk; ``cover_cache_dir`` (None:
+            ``~/.cache/plannerlab/covers``).
+        sim_urdf_path: the robot's real geometry for the simulator: a URDF with the same
+            joints and links (its collision meshes, say, where ``urdf_path`` is a
+            spherized copy); PyBullet loads it instead, so execution verdicts are
+            measured on it. None: ``urdf_path`` itself.
     """
 
     urdf_path: Path
@@ -344,6 +342,12 @@ class UrdfChain:
     srdf_path: Path | None = None
     allowed_collisions: tuple[tuple[str, str], ...] = ()
     T_world_base: Array = field(default_factory=lambda: np.eye(4))
+    mesh_paths: tuple[Path, ...] = ()
+    cover_excess_m: float = 0.01
+    cover_max_spheres: int = 256
+    cover_cache: bool = True
+    cover_cache_dir: Path | None = None
+    sim_urdf_path: Path | None = None
 
     kind: str = field(default="urdf", init=False)
     dof: int = field(init=False)
@@ -361,6 +365,14 @@ class UrdfChain:
     link_urdf_names: tuple[str, ...] = field(init=False, repr=False)
     #: an upper bound of the tip's distance from the root link's origin [m]
     max_reach_m: float = field(init=False, repr=False)
+    #: how each collision mesh became spheres (empty for a URDF of primitives)
+    mesh_covers: tuple[MeshCover, ...] = field(init=False, repr=False)
+    #: links that move (not on the root body) and have no collision geometry
+    links_without_geometry: tuple[str, ...] = field(init=False, repr=False)
+    #: warnings about the model, in words (also logged)
+    notes: tuple[str, ...] = field(init=False, repr=False)
+    _mesh_files: dict[str, Path] = field(init=False, repr=False)
+    _sim_mesh_files: dict[str, Path] = field(init=False, repr=False)
     # the chain's fixed data (see __post_init__)
     _body_links: tuple[str, ...] = field(init=False, repr=False)
     _parent_body: Any = field(init=False, repr=False)
@@ -409,8 +421,32 @@ class UrdfChain:
         if not (norm > 1e-9 and math.isfinite(norm)):
             raise UrdfError("tip_axis", f"a non-zero axis, got {list(self.tip_axis)}")
         R_body_tip = T_body_tip[:3, :3] @ (tip_axis / norm)
-        caps = _capsules(tree, placed, path)
-        excluded = _excluded_pairs(
+        from plannerlab.robots.urdf.meshes import default_cache_dir
+
+        settings = CoverSettings(
+            tuple(Path(p) for p in self.mesh_paths),
+            float(self.cover_excess_m),
+            int(self.cover_max_spheres),
+            (
+                None
+                if not self.cover_cache
+                else Path(self.cover_cache_dir)
+                if self.cover_cache_dir is not None
+                else default_cache_dir()
+            ),
+        )
+        caps, covers, mesh_files = _capsules(tree, placed, path, settings)
+        bare = [n for n, link in tree.links.items() if placed[n][0] > 0 and not link.collisions]
+        notes = []
+        if bare:
+            shown = [n + (" (it has a visual)" if tree.links[n].visuals else "") for n in bare]
+            notes.append(
+                f"{path.name}: {len(bare)} moving link(s) without collision geometry, never "
+                f"checked: {', '.join(shown)}"
+            )
+        for note in notes:
+            _LOG.warning(note)
+        excluded = excluded_pairs(
             caps, parent_body, tree.links, self.srdf_path, self.allowed_collisions, path
         )
         T_wb = np.array(self.T_world_base, dtype=float)
@@ -438,6 +474,10 @@ class UrdfChain:
         s(self, "excluded_pairs", frozenset(excluded))
         s(self, "frozen_joints", tree.frozen)
         s(self, "max_reach_m", float(reach))
+        s(self, "mesh_covers", tuple(covers))
+        s(self, "links_without_geometry", tuple(bare))
+        s(self, "notes", tuple(notes))
+        s(self, "_mesh_files", mesh_files)
         s(self, "_body_links", (tree.root, *(j.child for j in tree.movable)))
         s(self, "_parent_body", np.array(parent_body, dtype=int))
         s(self, "_pre", frozen_array(pre))
@@ -449,6 +489,45 @@ class UrdfChain:
         s(self, "_cap_body", np.array(caps.body, dtype=int))
         s(self, "_cap_a", frozen_array(caps.a))
         s(self, "_cap_b", frozen_array(caps.b))
+        s(self, "_sim_mesh_files", self._check_sim_urdf(tree, settings))
+
+    def _check_sim_urdf(self, tree: _Tree, cover: CoverSettings) -> dict[str, Path]:
+        """The ``sim_urdf`` (the robot's real geometry for the simulator) checked: the
+        chain's joints and links are in it, its collision meshes are found; their files
+        by the name the URDF gives."""
+        from plannerlab.robots.urdf.meshes import MeshError, resolve_mesh
+
+        if self.sim_urdf_path is None:
+            return {}
+        path = Path(self.sim_urdf_path)
+        object.__setattr__(self, "sim_urdf_path", path)
+        try:
+            sim = _load_urdf(path)
+        except UrdfError as exc:
+            raise UrdfError("sim_urdf", exc.expected) from None
+        joints = {j.name for j in sim.joints}
+        links = {link.name: link for link in sim.links}
+        missing = [j for j in (*self.joint_names, *tree.frozen) if j not in joints]
+        missing += [n for n in self.link_frame_names if n not in links]
+        if missing:
+            raise UrdfError(
+                "sim_urdf",
+                f"a URDF with the joints and links of {self.urdf_path.name}; {path.name} "
+                f"lacks {', '.join(missing)}",
+            )
+        files: dict[str, Path] = {}
+        for name, link in links.items():
+            for col in link.collisions:
+                if col.geometry.mesh is None:
+                    continue
+                fn = str(col.geometry.mesh.filename)
+                try:
+                    files[fn] = resolve_mesh(
+                        fn, path, cover.mesh_paths, f"link {name} of {path.name}"
+                    )
+                except MeshError as exc:
+                    raise UrdfError("sim_urdf", str(exc)) from None
+        return files
 
     # ------------------------------------------------------------------ kinematics
     @property
@@ -554,60 +633,19 @@ class UrdfChain:
 
     # ------------------------------------------------------------------ URDF
     def urdf(self) -> str:
-        """The URDF text for the simulator: the file as it is, with relative mesh paths
-        made absolute, visuals whose mesh file is missing left out (they are only looks;
-        PyBullet refuses a file naming a missing mesh) and the frozen joints (see the
-        module) made fixed at their value."""
-        tree = ET.parse(self.urdf_path)
-        root = tree.getroot()
-        folder = self.urdf_path.resolve().parent
-        for link in root.iter("link"):
-            for visual in link.findall("visual"):
-                for mesh in visual.iter("mesh"):
-                    fn = mesh.get("filename", "")
-                    if fn and "://" not in fn and not Path(fn).is_absolute():
-                        mesh.set("filename", str(folder / fn))
-                    if "://" in fn or not Path(mesh.get("filename", "")).is_file():
-                        # a visual whose mesh is not there (PyBullet refuses the file)
-                        link.remove(visual)
-                        break
-        for joint in root.iter("joint"):
-            name = joint.get("name", "")
-            if name not in self.frozen_joints:
-                continue
-            value = self.frozen_joints[name]
-            if value != 0.0:
-                from plannerlab.robots.base import pose_matrix
+        """The URDF text for the simulator (:func:`~plannerlab.robots.urdf.sim_text.
+        simulator_urdf`): the file with its real collision meshes, paths made absolute,
+        missing visuals left out, the frozen joints fixed at their value."""
+        from plannerlab.robots.urdf.sim_text import simulator_urdf
 
-                o = joint.find("origin")
-                xyz = (
-                    [0.0, 0.0, 0.0]
-                    if o is None
-                    else [float(v) for v in o.get("xyz", "0 0 0").split()]
-                )
-                rpy = (
-                    [0.0, 0.0, 0.0]
-                    if o is None
-                    else [float(v) for v in o.get("rpy", "0 0 0").split()]
-                )
-                ax = joint.find("axis")
-                axis = np.array(
-                    [1.0, 0.0, 0.0]
-                    if ax is None
-                    else [float(v) for v in ax.get("xyz", "1 0 0").split()]
-                )
-                motion = axis_motion(
-                    axis / np.linalg.norm(axis), np.asarray(value), joint.get("type") == "prismatic"
-                )
-                T = np.asarray(pose_matrix(xyz, rpy)) @ motion
-                if o is not None:
-                    joint.remove(o)
-                joint.append(ET.fromstring(urdf_origin(T)))
-            joint.set("type", "fixed")
-            for tag in ("mimic", "limit"):
-                for e in joint.findall(tag):
-                    joint.remove(e)
-        return ET.tostring(root, encoding="unicode")
+        return simulator_urdf(self)
 
 
-__all__ = ["UrdfChain", "UrdfError", "axis_motion", "read_srdf_disabled"]
+__all__ = [
+    "CoverSettings",
+    "MeshCover",
+    "UrdfChain",
+    "UrdfError",
+    "axis_motion",
+    "read_srdf_disabled",
+]

@@ -5,12 +5,16 @@ its constructor.
 the point ``tip_offset_m`` of the tip link's frame, its normal ``tip_axis`` in that frame.
 ``srdf`` (optional, a path relative to the problem file) and ``allowed_collisions`` (URDF
 link pairs) name link pairs whose self-collision is not checked, besides links on one body
-and neighbouring bodies. The root link's pose in the world is ``base_xyz_m`` [m] and
+and neighbouring bodies. Collision meshes become sphere covers
+(:mod:`plannerlab.robots.urdf.meshes`): ``mesh_paths`` are more folders searched for
+``package://`` paths, ``cover_excess_m`` bounds how far a cover reaches outside its mesh,
+``cover_max_spheres`` caps its spheres. The root link's pose in the world is ``base_xyz_m`` [m] and
 ``base_rpy_deg`` [deg]. The table in ``docs/problem-format.md`` lists the same keys.
 """
 
 from __future__ import annotations
 
+import os
 from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
@@ -27,6 +31,17 @@ def build(values: Mapping[str, Any]) -> UrdfChain:
             ``tip_link`` or ``allowed_collisions`` is not in it (on that key).
     """
     srdf = values["srdf"]
+    urdf_folder = Path(values["urdf"]).parent
+    mesh_paths = tuple(
+        (urdf_folder / p).resolve() for p in str(values["mesh_paths"]).split(os.pathsep) if p
+    )
+    missing = [str(p) for p in mesh_paths if not p.is_dir()]
+    if missing:
+        raise TableValueError(
+            "mesh_paths",
+            f"existing folders (relative to the URDF's folder, separated by "
+            f"{os.pathsep!r}); {', '.join(missing)} is not one",
+        )
     try:
         return UrdfChain(
             urdf_path=Path(values["urdf"]),
@@ -36,6 +51,10 @@ def build(values: Mapping[str, Any]) -> UrdfChain:
             srdf_path=Path(srdf) if srdf else None,
             allowed_collisions=tuple((str(a), str(b)) for a, b in values["allowed_collisions"]),
             T_world_base=base_pose(values),
+            mesh_paths=mesh_paths,
+            cover_excess_m=float(values["cover_excess_m"]),
+            cover_max_spheres=int(values["cover_max_spheres"]),
+            sim_urdf_path=Path(values["sim_urdf"]) if values["sim_urdf"] else None,
         )
     except UrdfError as exc:
         raise TableValueError(exc.key, exc.expected) from None
@@ -75,6 +94,42 @@ TABLE = RobotTable(
             (),
             "",
             "URDF link pairs whose self-collision is not checked",
+        ),
+        Key(
+            "mesh_paths",
+            "string",
+            "",
+            "",
+            "folders searched for package:// mesh paths, relative to the URDF's folder, "
+            "separated by ':'",
+        ),
+        Key(
+            "cover_excess_m",
+            "number",
+            0.01,
+            "m",
+            "the largest distance a mesh link's sphere cover may reach outside the mesh",
+            positive=True,
+            maximum=0.5,
+            why_maximum="a cover is an approximation of the link, not a blob around it",
+        ),
+        Key(
+            "cover_max_spheres",
+            "integer",
+            256,
+            "",
+            "the most spheres covering one collision mesh",
+            minimum=1,
+            maximum=4096,
+            why_maximum="every sphere is one more capsule to check",
+        ),
+        Key(
+            "sim_urdf",
+            "path",
+            "",
+            "",
+            "the robot's real geometry for the simulator: a URDF with the same joints and "
+            "links (e.g. the mesh original of a spherized urdf), relative to the problem file",
         ),
         *base_pose_keys("root link"),
     ),
