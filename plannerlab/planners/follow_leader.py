@@ -62,6 +62,7 @@ from plannerlab.planners.base import (
 )
 from plannerlab.planners.context import LegPlanner, PlanningContext
 from plannerlab.planners.gradient_clearance import ClearanceDescent, ClearanceSettings, LegPath
+from plannerlab.problem.goals import GoalRegion, JointGoal
 from plannerlab.problem.scene import Box, Cylinder, Scene, Sphere
 from plannerlab.robots.base import Array, joint_difference
 
@@ -89,6 +90,13 @@ class FollowLeaderSettings:
         random_grid: shift the grid by a random fraction of a voxel and scale
             ``centre_weight`` by a random factor in [0.5, 1.5] (the seed's draw).
         max_replans: (``random_grid``) new leader paths drawn from where a try ended.
+        reverse: when the leader's path forwards ends in a stall, plan the leg backwards
+            (:meth:`FollowLeader.reverse`): from a goal state, the leader into the start's
+            tip, the descent joining the start state, reversed.
+        join_tol_rad: how close [rad] the backward descent comes to the start state
+            before the edge into it is checked.
+        goal_attempts: IK restarts for the goal state the reverse plan starts from (when
+            the problem's start state is not in the leg's goal region).
 
     The clearance descent's settings are its own (:class:`ClearanceSettings`), overridden
     as ``descent.<key>``.
@@ -107,6 +115,9 @@ class FollowLeaderSettings:
     escape: str = "none"
     random_grid: bool = False
     max_replans: int = 3
+    reverse: bool = True
+    join_tol_rad: float = 0.02
+    goal_attempts: int = 40
 
     def __post_init__(self) -> None:
         if not self.voxel_m >= 0:
@@ -203,6 +214,26 @@ class TipPath:
     arc_m: Array
     min_distance_m: float
     free_voxels: int
+
+
+@dataclass(frozen=True)
+class Track:
+    """Follow-the-leader from one state into one goal region (:meth:`FollowLeader.track`).
+
+    Attributes:
+        leader: the leader's path (None: none found).
+        status: how the tracking and the final descent ended (SOLVED: in the region).
+        reason: in words.
+        states: the body states passed through, in order (consecutive ones are accepted
+            steps of the descent: collision-free at the descent's resolution).
+        iterations: descent iterations used.
+    """
+
+    leader: TipPath | None
+    status: Status
+    reason: str
+    states: list[Array]
+    iterations: int
 
 
 def tip_path(
@@ -350,12 +381,13 @@ class FollowLeader(LegPlanner):
         q: Array,
         rng: np.random.Generator | None,
         stop: Callable[[], bool] | None = None,
+        goal: GoalRegion | None = None,
     ) -> TipPath | None:
-        """The leader's path from the tip of ``q`` into leg's goal (randomised with rng;
-        None when there is none, or ``stop()`` said so)."""
+        """The leader's path from the tip of ``q`` into leg's goal, or into ``goal`` when
+        given (randomised with rng; None when there is none, or ``stop()`` said so)."""
         s = self.settings
         robot = problem.robot
-        goal = problem.goal(leg)
+        goal = problem.goal(leg) if goal is None else goal
         p_tip, _ = robot.tip(q)
         F0 = robot.fk(q)
         base = F0[0, :3, 3]
@@ -431,8 +463,6 @@ class FollowLeader(LegPlanner):
     ) -> tuple[Status, str, list[Array], int]:
         """Descend to each sub-goal along the leader's path in turn (:meth:`subgoals`); a
         sub-goal the descent stalls before is passed over, two in a row end the tracking."""
-        from plannerlab.problem.goals import GoalRegion
-
         s = self.settings
         path = [np.array(q0)]
         iterations = 0
@@ -459,6 +489,97 @@ class FollowLeader(LegPlanner):
                 return st, reason, path, iterations
             stalls = 0
         return Status.SOLVED, f"followed {len(goals)} sub-goals", path, iterations
+
+    def track(
+        self,
+        ctx: PlanningContext,
+        q0: Array,
+        goal: GoalRegion,
+        rng: np.random.Generator | None,
+        used: int = 0,
+    ) -> Track:
+        """Follow-the-leader from ``q0`` into ``goal`` (any tip goal region): the leader's
+        path from ``q0``'s tip (randomised with ``rng``, None: the deterministic grid), the
+        tracking descent along it, then the descent into ``goal`` itself (no approach
+        point). The body states it passed through come back whatever the outcome: the
+        reusable part of follow-the-leader (guide states of a sampling planner, the
+        reverse plan). ``used``: iterations the leg has used already."""
+        tracker = ctx.tracker
+
+        def stop() -> bool:
+            return tracker.exhausted(used) is not None
+
+        leader = self.leader_path(ctx.problem, ctx.leg, q0, rng, stop, goal=goal)
+        states = [np.array(q0, dtype=float)]
+        if leader is None:
+            why = tracker.exhausted(used) or "no path for the tip through free workspace"
+            status = Status.BUDGET_EXHAUSTED if tracker.exhausted(used) else Status.FAILED
+            return Track(None, status, why, states, 0)
+        st, reason, seg, it = self._follow(ctx, q0, leader, used)
+        states.extend(seg[1:])
+        if st is Status.BUDGET_EXHAUSTED:
+            return Track(leader, st, reason, states, it)
+        st2, reason2, seg2, _, it2 = self._track.descend(ctx, states[-1], goal, used + it)
+        states.extend(seg2[1:])
+        return Track(leader, st2, f"{reason}; {reason2}", states, it + it2)
+
+    def reverse(
+        self,
+        ctx: PlanningContext,
+        q0: Array,
+        q_goal: Array,
+        rng: np.random.Generator | None,
+        used: int = 0,
+    ) -> Track:
+        """The leg planned backwards, as entering: follow-the-leader from the goal state
+        ``q_goal`` into the tip pose of the start ``q0`` (its tip, looking along its
+        normal: the tip comes in the way it went), then the descent towards the start state
+        itself (a :class:`JointGoal` within ``join_tol_rad``), the edge into ``q0``
+        checked; the states reversed, from ``q0`` to ``q_goal``. What gets a body in gets
+        it out: leaving a room from deep inside, the leader's path forwards leads the tip
+        back through the window its own body fills, and the tracking stalls."""
+        s = self.settings
+        robot, checker = ctx.robot, ctx.checker
+        p0, n0 = robot.tip(q0)
+        tip_goal = GoalRegion("start tip", p0, n0, s.subgoal_pos_tol_m, s.subgoal_angle_tol_deg)
+        tr = self.track(ctx, q_goal, tip_goal, rng, used)
+        states, it = list(tr.states), tr.iterations
+        if tr.status is not Status.SOLVED:
+            return replace(tr, states=states[::-1], reason=f"into the start's tip: {tr.reason}")
+        join = JointGoal.at(robot, "start", q0, s.join_tol_rad)
+        st, reason, seg, _, it2 = self._track.descend(ctx, states[-1], join, used + it)
+        states.extend(seg[1:])
+        it += it2
+        if st is Status.SOLVED:
+            _, bad = checker.check_edge(states[-1], q0, ctx.joint_step)
+            if bad is not None:
+                st, reason = Status.LOCAL_MINIMUM, "the edge into the start state collides"
+            else:
+                states.append(np.array(q0, dtype=float))
+        return Track(
+            tr.leader, st, f"into the start's tip; joined the start: {reason}", states[::-1], it
+        )
+
+    def goal_state(self, ctx: PlanningContext, q0: Array, rng: np.random.Generator) -> Array | None:
+        """A collision-free state in the leg's goal region to plan backwards from: the
+        problem's start state when it is one (a task that ends where it began), else one
+        drawn by IK (:func:`~plannerlab.problem.ik.sample_goal_state`, seeded from the
+        problem's start and ``q0``, within the budget)."""
+        from plannerlab.problem.ik import sample_goal_state
+
+        robot, goal, checker, tracker = ctx.robot, ctx.goal, ctx.checker, ctx.tracker
+        q_rest = np.asarray(ctx.problem.q_start, dtype=float)
+        if bool(goal.contains(robot, q_rest)) and checker.is_valid(q_rest):
+            return q_rest
+        return sample_goal_state(
+            robot,
+            goal,
+            checker,
+            rng,
+            seeds=[q_rest, np.asarray(q0, dtype=float)],
+            attempts=self.settings.goal_attempts,
+            stop=lambda: tracker.exhausted() is not None,
+        )
 
     def plan(self, ctx: PlanningContext, rng: np.random.Generator) -> PlanResult:
         """Plan the leader's path, follow it, finish with the leg's descent."""
@@ -550,6 +671,26 @@ class FollowLeader(LegPlanner):
                 if r.status is not Status.LOCAL_MINIMUM:
                     return done(r.status, r.reason)
                 reason = f"{reason}; detour: {r.reason}"
+        if s.reverse and tracker.exhausted(leg_path.iterations) is None:
+            # plan the leg backwards from a goal state (what gets a body in gets it out)
+            entry = {"attempt": "reverse"}
+            log.append(entry)
+            q_goal = self.goal_state(ctx, q0, rng if s.random_grid else np.random.default_rng(0))
+            if q_goal is None:
+                entry["goal_state"] = "none"
+                reason = f"{reason}; reverse: no goal state"
+            else:
+                tr = self.reverse(ctx, q0, q_goal, draw_rng, leg_path.iterations)
+                leg_path.iterations += tr.iterations
+                entry["reverse"] = tr.status.value
+                if tr.status is Status.SOLVED:
+                    # the forward tries are dropped: the path is the reversed one from q0
+                    del leg_path.path[1:]
+                    leg_path.add(tr.states)
+                    return done(Status.SOLVED, f"planned backwards ({tr.reason})")
+                if tr.status is Status.BUDGET_EXHAUSTED:
+                    return done(tr.status, tr.reason)
+                reason = f"{reason}; reverse: {tr.reason}"
         return done(Status.LOCAL_MINIMUM, reason)
 
 
