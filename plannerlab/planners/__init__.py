@@ -68,6 +68,15 @@ OMPL_PLANNERS: Mapping[str, str] = MappingProxyType(
 )
 
 
+#: sampling planners compiled end to end (``plannerlab.planners.native``): algorithm -> summary
+NATIVE_PLANNERS: Mapping[str, str] = MappingProxyType(
+    {
+        "rrtconnect": "RRT-Connect compiled end to end (numba): sampling, nearest neighbours, "
+        "edges on the re-check's grid and shortcuts in compiled code",
+    }
+)
+
+
 def _rrtconnect(overrides: Mapping[str, Any]) -> Planner:
     """OMPL's RRT-Connect (``ompl.rrtconnect``): the hybrids' escape planner, handed to
     their factories as ``escape_planner``; ``ompl`` is imported on first use."""
@@ -196,6 +205,15 @@ def _entries() -> dict[str, PlannerEntry]:
             uses_rng=False,
         )
     )
+    for algorithm, summary in NATIVE_PLANNERS.items():
+        entries.append(
+            PlannerEntry(
+                f"native.{algorithm}",
+                "plannerlab.planners.native:make",
+                summary,
+                options=MappingProxyType({"algorithm": algorithm}),
+            )
+        )
     for suffix, cls in OMPL_PLANNERS.items():
         entries.append(
             PlannerEntry(
@@ -233,6 +251,7 @@ def make_planner(name: str, overrides: Mapping[str, Any] | None = None) -> Plann
 
 
 __all__ = [
+    "NATIVE_PLANNERS",
     "OMPL_PLANNERS",
     "REGISTRY",
     "PlanResult",

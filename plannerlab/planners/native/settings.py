@@ -1,0 +1,60 @@
+"""Settings of the compiled sampling planners (frozen; overridden by name, see
+:func:`plannerlab.planners.base.with_overrides`). No numba here: read without compiling."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+#: how the goal pool is filled (as the OMPL planners': ``planners/goal_pool.py``)
+GOAL_SELECTIONS = ("ik", "near", "near_or_ik")
+
+
+@dataclass(frozen=True)
+class NativeSettings:
+    """Settings every compiled sampling planner shares.
+
+    Attributes:
+        range_rad: longest motion added to a tree at once, Euclidean in joint space
+            (continuous joints the short way round) [rad]; 0: OMPL's default, 20 % of the
+            space's extent (the diagonal of the joint box, π per continuous joint).
+        goal_samples: goal states drawn by IK for a position + normal goal (a joint goal
+            is its one state), as the OMPL planners' pool.
+        max_goal_attempts: IK descents at most to fill the pool.
+        goal_selection: ``"ik"``, ``"near"`` or ``"near_or_ik"`` (see
+            :class:`~plannerlab.planners.ompl.settings.OMPLSettings`).
+        simplify: shorten the found path in compiled code (random shortcuts, then
+            dropping the waypoints whose neighbours see each other), within the budget.
+        shortcut_tries: random shortcuts tried (0: four per waypoint of the found path,
+            at least 32).
+        max_tree_mb: the trees' memory at most [MB] (states and parents); a search that
+            fills it stops with ``budget_exhausted`` and says so.
+        guide_bias: probability that a sample is a guide state (``guides`` of the
+            kernel: a state drawn uniformly from them) perturbed by Gaussian noise
+            ``guide_sigma_rad`` per joint; 0: plain sampling. Set by planners that guide
+            the search (``native.rrtconnect+leader``), which pass their guide states.
+        guide_sigma_rad: standard deviation of that noise [rad].
+    """
+
+    range_rad: float = 0.0
+    goal_samples: int = 4
+    max_goal_attempts: int = 200
+    goal_selection: str = "ik"
+    simplify: bool = True
+    shortcut_tries: int = 0
+    max_tree_mb: float = 256.0
+    guide_bias: float = 0.0
+    guide_sigma_rad: float = 0.1
+
+
+@dataclass(frozen=True)
+class RRTstarSettings(NativeSettings):
+    """RRT* (one tree from the start, goal-biased, rewired in a ball of ``k`` nearest).
+
+    Attributes:
+        goal_bias: probability that a sample is a goal state of the pool.
+        rewire_factor: scales ``k = rewire_factor · e · (1 + 1/dof) · log(n)`` nearest
+            neighbours considered for the parent and rewired (OMPL's k-nearest RRT*).
+    """
+
+    goal_bias: float = 0.05
+    rewire_factor: float = 1.1
