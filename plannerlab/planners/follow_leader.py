@@ -62,7 +62,7 @@ from plannerlab.planners.base import (
 )
 from plannerlab.planners.context import LegPlanner, PlanningContext
 from plannerlab.planners.gradient_clearance import ClearanceDescent, ClearanceSettings, LegPath
-from plannerlab.problem.goals import GoalRegion, JointGoal
+from plannerlab.problem.goals import GoalRegion
 from plannerlab.problem.scene import Box, Cylinder, Scene, Sphere
 from plannerlab.robots.base import Array, joint_difference
 
@@ -90,13 +90,9 @@ class FollowLeaderSettings:
         random_grid: shift the grid by a random fraction of a voxel and scale
             ``centre_weight`` by a random factor in [0.5, 1.5] (the seed's draw).
         max_replans: (``random_grid``) new leader paths drawn from where a try ended.
-        reverse: when the leader's path forwards ends in a stall, plan the leg backwards
-            (:meth:`FollowLeader.reverse`): from a goal state, the leader into the start's
-            tip, the descent joining the start state, reversed.
-        join_tol_rad: how close [rad] the backward descent comes to the start state
-            before the edge into it is checked.
-        goal_attempts: IK restarts for the goal state the reverse plan starts from (when
-            the problem's start state is not in the leg's goal region).
+        retract: when the tries from the start end in a stall, one more try from the
+            start: the tip drawn back along the start's own body first
+            (:meth:`FollowLeader.retract`), then the leader's path from there.
 
     The clearance descent's settings are its own (:class:`ClearanceSettings`), overridden
     as ``descent.<key>``.
@@ -115,9 +111,7 @@ class FollowLeaderSettings:
     escape: str = "none"
     random_grid: bool = False
     max_replans: int = 3
-    reverse: bool = True
-    join_tol_rad: float = 0.02
-    goal_attempts: int = 40
+    retract: bool = True
 
     def __post_init__(self) -> None:
         if not self.voxel_m >= 0:
@@ -344,6 +338,32 @@ def _shortcut(points: Array, scene: Scene, clearance_m: float, step_m: float) ->
     return points[keep]
 
 
+def crosses_body(robot: Any, q: Array, leader: TipPath, step_m: float = 0.1) -> bool:
+    """Whether the leader's path from the tip of ``q`` runs back through the body of
+    ``q``: a point of the path inside the capsule of a module more than a third of the
+    body behind the tip. (Near the tip every path touches the body: the tip turns.)
+    The voxel grid knows the scene, not the body: deep in a room, the way out for the
+    tip leads back through the window its own body fills."""
+    F = robot.fk(q)
+    faces = F[:, :3, 3]
+    radii = np.asarray(robot.link_radii_m, dtype=float)
+    n_links = len(faces) - 1
+    behind = n_links - int(np.ceil(n_links / 3.0))  # links 0 .. behind-1
+    if behind < 1:
+        return False
+    pts, arc = leader.points_m, leader.arc_m
+    s_all = np.arange(0.0, float(arc[-1]), step_m)
+    p = np.stack([np.interp(s_all, arc, pts[:, k]) for k in range(3)], axis=1)  # (m, 3)
+    a, ab = faces[:behind], faces[1 : behind + 1] - faces[:behind]
+    t = np.einsum("mkd,kd->mk", p[:, None, :] - a[None], ab) / np.maximum(
+        np.einsum("kd,kd->k", ab, ab), 1e-12
+    )
+    closest = a[None] + np.clip(t, 0.0, 1.0)[..., None] * ab[None]
+    d = np.linalg.norm(p[:, None, :] - closest, axis=2)  # (m, behind)
+    r = np.resize(radii, behind) if len(radii) < behind else radii[:behind]
+    return bool(np.any(d < r[None, :]))
+
+
 # ---------------------------------------------------------------------- the planner
 class FollowLeader(LegPlanner):
     """Follow-the-leader with the clearance descent (see the module docstring). The
@@ -503,7 +523,7 @@ class FollowLeader(LegPlanner):
         tracking descent along it, then the descent into ``goal`` itself (no approach
         point). The body states it passed through come back whatever the outcome: the
         reusable part of follow-the-leader (guide states of a sampling planner, the
-        reverse plan). ``used``: iterations the leg has used already."""
+        backward branches). ``used``: iterations the leg has used already."""
         tracker = ctx.tracker
 
         def stop() -> bool:
@@ -523,63 +543,60 @@ class FollowLeader(LegPlanner):
         states.extend(seg2[1:])
         return Track(leader, st2, f"{reason}; {reason2}", states, it + it2)
 
-    def reverse(
-        self,
-        ctx: PlanningContext,
-        q0: Array,
-        q_goal: Array,
-        rng: np.random.Generator | None,
-        used: int = 0,
-    ) -> Track:
-        """The leg planned backwards, as entering: follow-the-leader from the goal state
-        ``q_goal`` into the tip pose of the start ``q0`` (its tip, looking along its
-        normal: the tip comes in the way it went), then the descent towards the start state
-        itself (a :class:`JointGoal` within ``join_tol_rad``), the edge into ``q0``
-        checked; the states reversed, from ``q0`` to ``q_goal``. What gets a body in gets
-        it out: leaving a room from deep inside, the leader's path forwards leads the tip
-        back through the window its own body fills, and the tracking stalls."""
+    def _sees_approach(self, ctx: PlanningContext, q: Array) -> bool:
+        """Whether the straight line from the tip of ``q`` to the leg goal's approach
+        point keeps the leader's clearance from the scene (the retract has got the tip
+        out)."""
         s = self.settings
-        robot, checker = ctx.robot, ctx.checker
-        p0, n0 = robot.tip(q0)
-        tip_goal = GoalRegion("start tip", p0, n0, s.subgoal_pos_tol_m, s.subgoal_angle_tol_deg)
-        tr = self.track(ctx, q_goal, tip_goal, rng, used)
-        states, it = list(tr.states), tr.iterations
-        if tr.status is not Status.SOLVED:
-            return replace(tr, states=states[::-1], reason=f"into the start's tip: {tr.reason}")
-        join = JointGoal.at(robot, "start", q0, s.join_tol_rad)
-        st, reason, seg, _, it2 = self._track.descend(ctx, states[-1], join, used + it)
-        states.extend(seg[1:])
-        it += it2
-        if st is Status.SOLVED:
-            _, bad = checker.check_edge(states[-1], q0, ctx.joint_step)
-            if bad is not None:
-                st, reason = Status.LOCAL_MINIMUM, "the edge into the start state collides"
-            else:
-                states.append(np.array(q0, dtype=float))
-        return Track(
-            tr.leader, st, f"into the start's tip; joined the start: {reason}", states[::-1], it
+        goal, robot = ctx.goal, ctx.robot
+        p_tip, _ = robot.tip(q)
+        approach = goal.p_world_m - s.approach_m * goal.n_world
+        clearance = (
+            float(np.asarray(robot.link_radii_m)[-1])
+            + ctx.problem.safety_margin_m
+            + s.extra_clearance_m
         )
+        n = max(2, int(np.ceil(np.linalg.norm(approach - p_tip) / 0.1)) + 1)
+        line = p_tip + np.linspace(0.0, 1.0, n)[:, None] * (approach - p_tip)
+        return bool(scene_distance_m(ctx.scene, line).min() >= clearance)
 
-    def goal_state(self, ctx: PlanningContext, q0: Array, rng: np.random.Generator) -> Array | None:
-        """A collision-free state in the leg's goal region to plan backwards from: the
-        problem's start state when it is one (a task that ends where it began), else one
-        drawn by IK (:func:`~plannerlab.problem.ik.sample_goal_state`, seeded from the
-        problem's start and ``q0``, within the budget)."""
-        from plannerlab.problem.ik import sample_goal_state
-
-        robot, goal, checker, tracker = ctx.robot, ctx.goal, ctx.checker, ctx.tracker
-        q_rest = np.asarray(ctx.problem.q_start, dtype=float)
-        if bool(goal.contains(robot, q_rest)) and checker.is_valid(q_rest):
-            return q_rest
-        return sample_goal_state(
-            robot,
-            goal,
-            checker,
-            rng,
-            seeds=[q_rest, np.asarray(q0, dtype=float)],
-            attempts=self.settings.goal_attempts,
-            stop=lambda: tracker.exhausted() is not None,
-        )
+    def retract(self, ctx: PlanningContext, q0: Array, used: int = 0) -> Track:
+        """The tip drawn back along the start's own body: sub-goals at the body's faces
+        from the tip's towards the base's (each looking along the body, within the
+        sub-goal tolerances), tracked by the descent, until the tip sees the leg goal's
+        approach point (:meth:`_sees_approach`); a sub-goal the descent stalls before is
+        passed over, two in a row end it. What got the body in gets it out: the
+        body lies on the curve its tip came in by, so the tip backs out along it while the
+        modules outside take up the length; the leader's path forwards would lead the tip
+        back through the window its own body fills (measured on the far-ended variants:
+        the tracking stalls at sub-goal 2)."""
+        s = self.settings
+        F = ctx.robot.fk(q0)
+        faces, normals = F[:, :3, 3], F[:, :3, 2]
+        states = [np.array(q0, dtype=float)]
+        it = 0
+        stalls = 0
+        reached = 0
+        status, reason = Status.LOCAL_MINIMUM, "no face of the body reached"
+        for k in range(len(faces) - 2, 0, -1):
+            sub = GoalRegion(
+                f"face{k}", faces[k], normals[k], s.subgoal_pos_tol_m, s.subgoal_angle_tol_deg
+            )
+            st, why, seg, _, i = self._track.descend(ctx, states[-1], sub, used + it)
+            it += i
+            states.extend(seg[1:])
+            if st is Status.BUDGET_EXHAUSTED:
+                return Track(None, st, why, states, it)
+            if st is Status.SOLVED:
+                reached, stalls = reached + 1, 0
+                status, reason = Status.SOLVED, f"retracted to face {k}"
+                if self._sees_approach(ctx, states[-1]):
+                    break
+                continue
+            stalls += 1
+            if stalls >= 2:
+                break
+        return Track(None, status, f"{reason} ({reached} faces reached)", states, it)
 
     def plan(self, ctx: PlanningContext, rng: np.random.Generator) -> PlanResult:
         """Plan the leader's path, follow it, finish with the leg's descent."""
@@ -603,7 +620,29 @@ class FollowLeader(LegPlanner):
         draw_rng = rng if s.random_grid else None
         attempts = 1 + (s.max_replans if s.random_grid else 0)
         reason = ""
-        for attempt in range(attempts):
+        retracted = ""
+
+        def retract_from_start() -> PlanResult | None:
+            """The path reset to the start, then the tip drawn back along its own body."""
+            nonlocal retracted
+            del path[1:]
+            tr = self.retract(ctx, q0, leg_path.iterations)
+            leg_path.iterations += tr.iterations
+            leg_path.add(tr.states)
+            retracted = tr.reason
+            log.append({"attempt": "retract", "retract": tr.reason})
+            if tr.status is Status.BUDGET_EXHAUSTED:
+                return done(tr.status, tr.reason)
+            return None
+
+        for attempt in range(attempts + (1 if s.retract else 0)):
+            if attempt == attempts:
+                # one more try: from the start, the tip drawn back along its own body
+                if retracted or tracker.exhausted(leg_path.iterations) is not None:
+                    break
+                out = retract_from_start()
+                if out is not None:
+                    return out
             q = np.array(path[-1])
             if goal.contains(robot, q):
                 return done(Status.SOLVED, "in the goal region")
@@ -613,6 +652,22 @@ class FollowLeader(LegPlanner):
                 return tracker.exhausted(used) is not None
 
             leader = self.leader_path(problem, leg, q, draw_rng, stop)
+            if (
+                s.retract
+                and not retracted
+                and attempt == 0
+                and leader is not None
+                and crosses_body(robot, q0, leader)
+                and not self._sees_approach(ctx, q0)
+            ):
+                # the leader leads the tip back through its own body: retract first
+                out = retract_from_start()
+                if out is not None:
+                    return out
+                q = np.array(path[-1])
+                if goal.contains(robot, q):
+                    return done(Status.SOLVED, f"{retracted}; in the goal region")
+                leader = self.leader_path(problem, leg, q, draw_rng, stop)
             if tracker.exhausted(leg_path.iterations) is not None:
                 return done(Status.BUDGET_EXHAUSTED, str(tracker.exhausted(leg_path.iterations)))
             entry: dict = {
@@ -644,7 +699,8 @@ class FollowLeader(LegPlanner):
             leg_path.add(seg2)
             entry["finish"] = st2.value
             if st2 is Status.SOLVED:
-                return done(st2, f"followed the leader ({reason}); {reason2}")
+                first = f"{retracted}; " if retracted else ""
+                return done(st2, f"{first}followed the leader ({reason}); {reason2}")
             if st2 is not Status.LOCAL_MINIMUM:
                 return done(st2, reason2)
             leg_path.minima += 1
@@ -671,26 +727,6 @@ class FollowLeader(LegPlanner):
                 if r.status is not Status.LOCAL_MINIMUM:
                     return done(r.status, r.reason)
                 reason = f"{reason}; detour: {r.reason}"
-        if s.reverse and tracker.exhausted(leg_path.iterations) is None:
-            # plan the leg backwards from a goal state (what gets a body in gets it out)
-            entry = {"attempt": "reverse"}
-            log.append(entry)
-            q_goal = self.goal_state(ctx, q0, rng if s.random_grid else np.random.default_rng(0))
-            if q_goal is None:
-                entry["goal_state"] = "none"
-                reason = f"{reason}; reverse: no goal state"
-            else:
-                tr = self.reverse(ctx, q0, q_goal, draw_rng, leg_path.iterations)
-                leg_path.iterations += tr.iterations
-                entry["reverse"] = tr.status.value
-                if tr.status is Status.SOLVED:
-                    # the forward tries are dropped: the path is the reversed one from q0
-                    del leg_path.path[1:]
-                    leg_path.add(tr.states)
-                    return done(Status.SOLVED, f"planned backwards ({tr.reason})")
-                if tr.status is Status.BUDGET_EXHAUSTED:
-                    return done(tr.status, tr.reason)
-                reason = f"{reason}; reverse: {tr.reason}"
         return done(Status.LOCAL_MINIMUM, reason)
 
 

@@ -355,7 +355,7 @@ def make(name: str, overrides: Mapping[str, Any] | None = None) -> LeaderPlanner
     f_over = {k: v for k, v in lead.items() if not k.startswith("descent.")}
     d_over = {k[len("descent.") :]: v for k, v in lead.items() if k.startswith("descent.")}
     base = FollowLeaderSettings(
-        random_grid=True, max_replans=settings.leader_max_replans, reverse=False
+        random_grid=True, max_replans=settings.leader_max_replans, retract=False
     )
     fls = with_overrides(base, f_over, f"{name} (leader)")
     descent = with_overrides(ClearanceSettings(), d_over, f"{name} (leader's descent)")
