@@ -25,15 +25,17 @@ def _solve(problem_name: str, seed: int):
 
 
 def test_golden_values_on_the_window_trap():
-    """Seed 0, 200 000 checks: the forward leader reaches the goal (303 body states
-    seed the start tree), the search joins the trees, the path is shortcut and
-    re-checked."""
+    """Seed 0, 200 000 checks: the forward leader reaches the goal (its 303 body states,
+    thinned to 39, seed the start tree, and its end is the goal tree's root: the trees
+    are joined before any sample), the path is shortcut and re-checked."""
     problem, r = _solve("armz_window", 0)
     assert r.status is Status.SOLVED, r.reason
-    assert r.collision_checks == 105_021
-    assert r.iterations == 304
-    assert r.extra["path_length_rad"] == pytest.approx(5.289070638, abs=1e-6)
-    assert r.extra["leader"]["forward"] == {"status": "solved", "states": 303}
+    assert r.collision_checks == 92_548
+    assert r.iterations == 302
+    assert r.extra["path_length_rad"] == pytest.approx(5.814842593, abs=1e-6)
+    assert r.extra["leader"]["forward"]["status"] == "solved"
+    assert r.extra["leader"]["forward"]["states"] == 39
+    assert r.extra["nodes"] == [39, 1]
     checker = problem_checker(problem)
     assert checker.check_path(r.path, problem.joint_step / 4).valid
     assert bool(problem.goal(0).contains(problem.robot, r.path[-1]))
@@ -46,8 +48,8 @@ def test_same_seed_same_run_other_seed_other_run():
     assert a.collision_checks == b.collision_checks
     np.testing.assert_array_equal(a.path, b.path)
     assert c.status is Status.SOLVED
-    assert c.collision_checks == 96_543
-    assert c.extra["path_length_rad"] == pytest.approx(3.447275842, abs=1e-6)
+    assert c.collision_checks == 59_277
+    assert c.extra["path_length_rad"] == pytest.approx(2.682099129, abs=1e-6)
 
 
 def test_bad_settings_are_refused_by_name():
@@ -80,4 +82,21 @@ def test_leaving_from_the_far_wall_retracts_along_the_body():
     assert r.extra["leader"][0]["attempt"] == "retract"
     np.testing.assert_allclose(r.path[0], q_b)
     assert bool(problem.goal(leave).contains(problem.robot, r.path[-1]))
+    assert problem_checker(problem).check_path(r.path, problem.joint_step / 4).valid
+
+
+def test_golden_values_of_a_search_from_backward_branches():
+    """``forward = false`` on armz_window, seed 0, 300 000 checks: four IK goal states
+    root the goal tree, two of them grow a backward branch into the start's tip pose,
+    and the compiled RRT-Connect joins the start to them in 7 iterations."""
+    problem = load_problem("armz_window")
+    planner = make_planner("native.rrtconnect+leader", {"forward": False})
+    budget = Budget(max_iterations=None, max_collision_checks=300_000, time_limit_s=None)
+    r = planner.solve(problem, 0, budget, np.random.default_rng(0))
+    assert r.status is Status.SOLVED, r.reason
+    assert r.extra["search_iterations"] == 7
+    assert r.iterations == 2_106
+    assert r.collision_checks == 166_888
+    assert r.extra["path_length_rad"] == pytest.approx(2.140500016, abs=1e-6)
+    assert [b["status"] for b in r.extra["leader"]["backward"]] == ["solved", "solved"]
     assert problem_checker(problem).check_path(r.path, problem.joint_step / 4).valid

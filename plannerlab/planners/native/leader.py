@@ -71,50 +71,91 @@ class LeaderSettings(NativeSettings):
         guide_bias: (here 0.5) the share of samples drawn near a guide state.
         guide_sigma_rad: (here 0.05) their Gaussian noise per joint [rad].
         forward: follow the leader from the start (a branch of the start tree).
+        retract: when the forward branch does not reach the goal, a second branch: the
+            tip drawn back along the start's own body (:meth:`~plannerlab.planners.
+            follow_leader.FollowLeader.retract`), then the leader from there.
         backward: follow the leader from goal states into the start's tip (branches of
             the goal tree), when the forward branch did not reach the goal.
         backward_goals: goal states to go backwards from, at most.
-        guide_stride: every this many states of a branch is a guide state.
+        guide_stride: every this many states of a branch (thinned to every 8th state of
+            the descent) is a guide state.
         leader_max_replans: new leader paths the forward tracking draws from a stall.
     """
 
     guide_bias: float = 0.5
     guide_sigma_rad: float = 0.05
     forward: bool = True
+    retract: bool = True
     backward: bool = True
     backward_goals: int = 2
-    guide_stride: int = 4
+    guide_stride: int = 1
     leader_max_replans: int = 0
 
 
 @dataclass(frozen=True)
 class Guidance:
-    """What the leader gives the search.
+    """What the leader gives the search: the seeded trees and the guide states.
 
     Attributes:
-        start_branch: (m, dof) states from the start (the first is the start), a chain.
-        goal_states: (g, dof) goal states (roots of the goal tree).
-        goal_branches: per goal root index, a chain of states from it (its first state is
-            the root).
+        start_states, start_parents: (a, dof), (a,) the start tree (row 0 the start,
+            parent -1).
+        goal_states, goal_parents: (b, dof), (b,) the goal tree (a root, parent -1, per
+            goal state).
         guides: (k, dof) guide states of the sampler.
         log: what each step did (the result's ``extra["leader"]``).
         iterations: descent iterations used.
+        reached_node: a node of the start tree in the goal region (-1: none): the trees
+            are joined there (it is a root of the goal tree) before any sample is drawn.
     """
 
-    start_branch: Array
+    start_states: Array
+    start_parents: Array
     goal_states: Array
-    goal_branches: dict[int, Array]
+    goal_parents: Array
     guides: Array
     log: dict[str, Any]
     iterations: int
+    reached_node: int = -1
 
 
-def _verified(ctx: PlanningContext, states: list[Array], step: float) -> Array:
-    """The longest prefix of a chain of states whose edges pass the search's grid check
-    (the descent checks states; the search and the re-check check edges)."""
-    P = np.array(states, dtype=float).reshape(-1, ctx.robot.dof)
+class _Tree:
+    """A tree under construction: states and parents."""
+
+    def __init__(self) -> None:
+        self.Q: list[Array] = []
+        self.P: list[int] = []
+
+    def root(self, q: Array) -> int:
+        self.Q.append(np.asarray(q, dtype=float))
+        self.P.append(-1)
+        return len(self.Q) - 1
+
+    def chain(self, parent: int, states: Array) -> int:
+        """Hang ``states`` (a chain whose first state is the parent's, dropped) below
+        ``parent``; returns the index of its last state."""
+        for q in states[1:]:
+            self.Q.append(np.asarray(q, dtype=float))
+            self.P.append(parent)
+            parent = len(self.Q) - 1
+        return parent
+
+    def arrays(self, dof: int) -> tuple[Array, Array]:
+        return np.array(self.Q, dtype=float).reshape(-1, dof), np.array(self.P, dtype=np.int64)
+
+
+def _verified(ctx: PlanningContext, states: list[Array], step: float, thin: int = 8) -> Array:
+    """A chain of the descent's states fit for a tree, wrapped: every ``thin``-th state
+    (and the last) when the edges between them pass the search's grid check (the
+    descent's states lie a few hundredths of a radian apart; fewer, longer edges make
+    the path's simplification cheaper), else the longest prefix of all of them whose
+    edges pass it (the descent checks states; the search and the re-check check edges)."""
+    P = wrap_to_pi(np.array(states, dtype=float).reshape(-1, ctx.robot.dof), ctx.robot.continuous)
     if len(P) < 2:
         return P
+    if thin > 1 and len(P) > thin:
+        keep = np.unique(np.concatenate([np.arange(0, len(P), thin), [len(P) - 1]]))
+        if ctx.checker.check_path(P[keep], step, mode="grid").valid:
+            return P[keep]
     check = ctx.checker.check_path(P, step, mode="grid")
     if check.valid:
         return P
@@ -133,25 +174,48 @@ def build_guidance(
     ran out or no goal state was found."""
     s = settings
     robot, tracker, goal = ctx.robot, ctx.tracker, ctx.goal
-    cont = robot.continuous
+    dof = robot.dof
     q0 = solve.q0
     step = solve.step
     log: dict[str, Any] = {}
     used = 0
-    start_branch = q0[None].copy()
-    goal_states: list[Array] = []
-    fwd_reached = False
-    if s.forward:
-        tr: Track = leader.track(ctx, q0, goal, rng, used)
+    A, B = _Tree(), _Tree()
+    A.root(q0)
+    chains: list[Array] = [q0[None]]
+    reached: list[Array] = []
+    reached_nodes: list[int] = []
+
+    def out_of_budget() -> PlanResult | None:
+        why = tracker.exhausted(0)
+        return None if why is None else solve.result(Status.BUDGET_EXHAUSTED, why, q0[None])
+
+    def grow_start(parent: int, tr: Track, key: str) -> int:
+        nonlocal used
         used += tr.iterations
-        start_branch = wrap_to_pi(_verified(ctx, tr.states, step), cont)
-        fwd_reached = tr.status is Status.SOLVED and len(start_branch) == len(tr.states)
-        log["forward"] = {"status": tr.status.value, "states": len(start_branch)}
-        if fwd_reached:
-            goal_states.append(start_branch[-1])
-    if tracker.exhausted(0) is not None:
-        return solve.result(Status.BUDGET_EXHAUSTED, str(tracker.exhausted(0)), q0[None])
-    q_rest = wrap_to_pi(np.asarray(ctx.problem.q_start, dtype=float), cont)
+        chain = _verified(ctx, tr.states, step)
+        chains.append(chain)
+        whole = bool(np.allclose(chain[-1], wrap_to_pi(tr.states[-1], robot.continuous)))
+        log[key] = {"status": tr.status.value, "states": len(chain), "reason": tr.reason}
+        end = A.chain(parent, chain)
+        if tr.status is Status.SOLVED and whole and bool(goal.contains(robot, chain[-1])):
+            reached.append(chain[-1])
+            reached_nodes.append(end)
+        return end
+
+    if s.forward:
+        grow_start(0, leader.track(ctx, q0, goal, rng, used), "forward")
+        if not reached and s.retract and tracker.exhausted(0) is None:
+            # leaving from deep inside: the tip drawn back along its own body, then the
+            # leader from there (a second branch of the start tree)
+            end = grow_start(0, leader.retract(ctx, q0, used), "retract")
+            if tracker.exhausted(0) is None:
+                q_r = A.Q[end]
+                grow_start(end, leader.track(ctx, q_r, goal, rng, used), "after_retract")
+    failed = out_of_budget()
+    if failed is not None:
+        return failed
+    goal_states = list(reached)
+    q_rest = wrap_to_pi(np.asarray(ctx.problem.q_start, dtype=float), robot.continuous)
     if bool(goal.contains(robot, q_rest)) and ctx.checker.is_valid(q_rest):
         goal_states.append(q_rest)
     if not goal_states:
@@ -159,36 +223,33 @@ def build_guidance(
         if failed is not None:
             return failed
         goal_states.extend(G)
-    G = np.unique(np.array(goal_states, dtype=float), axis=0)
-    # the forward branch's end first (a goal state that is already joined)
-    if fwd_reached:
-        end = start_branch[-1]
-        G = np.vstack([end[None], G[np.any(G != end, axis=1)]])
-    branches: dict[int, Array] = {}
-    if s.backward and not fwd_reached:
-        p0, n0 = robot.tip(q0)
+    roots = [B.root(g) for g in goal_states]
+    if s.backward and not reached:
+        # from goal states into the start's tip pose (branches of the goal tree)
         from plannerlab.problem.goals import GoalRegion
 
+        p0, n0 = robot.tip(q0)
         ls = leader.settings
         tip_goal = GoalRegion("start tip", p0, n0, ls.subgoal_pos_tol_m, ls.subgoal_angle_tol_deg)
         log["backward"] = []
-        for i in range(min(s.backward_goals, len(G))):
+        for i in roots[: s.backward_goals]:
             if tracker.exhausted(0) is not None:
                 break
-            tb = leader.track(ctx, G[i], tip_goal, rng, used)
+            tb = leader.track(ctx, B.Q[i], tip_goal, rng, used)
             used += tb.iterations
-            chain = wrap_to_pi(_verified(ctx, tb.states, step), cont)
-            branches[i] = chain
+            chain = _verified(ctx, tb.states, step)
+            chains.append(chain)
+            B.chain(i, chain)
             log["backward"].append({"status": tb.status.value, "states": len(chain)})
-    if tracker.exhausted(0) is not None:
-        return solve.result(Status.BUDGET_EXHAUSTED, str(tracker.exhausted(0)), q0[None])
-    chains = [start_branch, *branches.values()]
+    failed = out_of_budget()
+    if failed is not None:
+        return failed
     stride = max(int(s.guide_stride), 1)
     guides = np.vstack([c[::stride] for c in chains] + [c[-1:] for c in chains])
-    log["goal_states"] = len(G)
-    log["guides"] = len(guides)
-    log["iterations"] = used
-    return Guidance(start_branch, G, branches, guides, log, used)
+    QA, PA = A.arrays(dof)
+    QB, PB = B.arrays(dof)
+    log.update(goal_states=len(roots), guides=len(guides), iterations=used)
+    return Guidance(QA, PA, QB, PB, guides, log, used, reached_nodes[0] if reached_nodes else -1)
 
 
 class LeaderSolve(NativeSolve):
@@ -217,38 +278,33 @@ class LeaderSolve(NativeSolve):
             return g
         self.extra["leader"] = g.log
         self.guides = np.ascontiguousarray(g.guides)
-        self.run.progress.note(float(np.min(self.goal.distance(self.robot, g.start_branch))))
+        self.run.progress.note(float(np.min(self.goal.distance(self.robot, g.start_states))))
         rng_state = K.seed_state(self.rng)
         V, S = K_views(model)
         dof = len(q0)
         range_rad = self.s.range_rad or 0.2 * space_extent(model)
         self.extra["range_rad"] = range_rad
         need_free = 2 + math.ceil(space_extent(model) / range_rad)
-        A0 = g.start_branch
-        B_roots = g.goal_states
-        nb = len(B_roots) + sum(len(c) - 1 for c in g.goal_branches.values())
-        seeded = max(len(A0), nb)
+        seeded = max(len(g.start_states), len(g.goal_states))
         hard0 = self.hard_checks()
         cap = max(self.tree_rows(hard0, seeded, dof), need_free + seeded + 1)
         self.extra["tree_rows"] = cap
         rows = min(cap, max(FIRST_ROWS, need_free + seeded + 1))
         QA, PA = np.empty((rows, dof)), np.full(rows, -1, dtype=np.int64)
         QB, PB = np.empty((rows, dof)), np.full(rows, -1, dtype=np.int64)
-        # the start tree: the forward branch, a chain from the start
-        QA[: len(A0)] = A0
-        PA[1 : len(A0)] = np.arange(len(A0) - 1)
-        # the goal tree: a root per goal state, the backward branches hanging from theirs
-        QB[: len(B_roots)] = B_roots
-        nB = len(B_roots)
-        for root, chain in g.goal_branches.items():
-            parent = root
-            for q in chain[1:]:
-                QB[nB] = q
-                PB[nB] = parent
-                parent = nB
-                nB += 1
-        sizes = np.array([len(A0), nB], dtype=np.int64)
+        # the trees as the leader seeded them (the start's branches, the goal states'
+        # roots with their backward branches)
+        na, nb = len(g.start_states), len(g.goal_states)
+        QA[:na], PA[:na] = g.start_states, g.start_parents
+        QB[:nb], PB[:nb] = g.goal_states, g.goal_parents
+        sizes = np.array([na, nb], dtype=np.int64)
         counters = np.zeros(5, dtype=np.int64)
+        if g.reached_node >= 0:
+            # joined already: the meeting node is the reached state, the goal tree's root 0
+            counters[3], counters[4] = g.reached_node, 0
+            self.iterations = g.iterations
+            self.extra["nodes"] = [na, nb]
+            return self._finish(QA, PA, QB, PB, counters, na + nb, model, V, S, rng_state)
         buf = np.empty((4, dof))
         b = self.budget
         max_it = UNLIMITED if b.max_iterations is None else max(b.max_iterations - g.iterations, 1)
@@ -300,8 +356,36 @@ class LeaderSolve(NativeSolve):
         self.extra["nodes"] = [int(sizes[0]), int(sizes[1])]
         if code != K.DONE:
             return self.stopped(code, f"{int(sizes[0])} + {int(sizes[1])} tree nodes")
-        out = np.empty((int(sizes.sum()), dof))
-        k = K.tree_path(trees[0], trees[1], counters[3], trees[2], trees[3], counters[4], out)
+        return self._finish(
+            trees[0],
+            trees[1],
+            trees[2],
+            trees[3],
+            counters,
+            int(sizes.sum()),
+            model,
+            V,
+            S,
+            rng_state,
+        )
+
+    def _finish(
+        self,
+        QA: Array,
+        PA: Array,
+        QB: Array,
+        PB: Array,
+        counters: Array,
+        rows: int,
+        model: Any,
+        V: Any,
+        S: Any,
+        rng_state: Array,
+    ) -> PlanResult:
+        """The path through the meeting nodes (``counters[3]`` in A, ``counters[4]`` in
+        B), shortcut and re-checked."""
+        out = np.empty((rows, QA.shape[1]))
+        k = K.tree_path(QA, PA, counters[3], QB, PB, counters[4], out)
         path = out[:k].copy()
         self.extra["waypoints_raw"] = k
         if self.s.simplify:
