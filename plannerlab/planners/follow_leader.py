@@ -35,6 +35,19 @@ follow-the-leader:
    (no way for the tip at that clearance), the finish alone runs: the planner is then the
    clearance descent.
 
+4. **Leaving from deep inside** (``retract``, on by default): the voxel grid knows the
+   scene, not the body. From the far wall of a room the leader's path leads the tip back
+   across the room and out through the window that its own body fills, and the tracking
+   stalls at the second sub-goal (measured on the far-ended variants
+   ``problems/variants/armz_inspection_v21`` … ``v39``, leaving from B: 5 of 10 stall
+   so; ``gradient.clearance+detour`` stalls at its eighth iteration and no retract of its
+   detour works on 6 of 10). What got the body in gets it out: the body lies on the curve
+   its tip came in by, so the tip is drawn back along the start's own body
+   (:meth:`FollowLeader.retract`: sub-goals at its faces from the tip's towards the
+   base's, each looking along the body) until it sees the goal's approach point, then
+   the leader's path from there. It comes first when the leader's path runs back
+   through the body (:func:`crosses_body`), else after the forward tries.
+
 The search and the tracking are deterministic (``gradient.follow_leader``: its seeds are
 one run). The randomised variant (``+random``, ``random_grid``) shifts the voxel grid by
 a random fraction of a voxel and scales the centring weight by the seed's draw, and draws
