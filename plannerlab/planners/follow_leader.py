@@ -530,19 +530,22 @@ class FollowLeader(LegPlanner):
         goal: GoalRegion,
         rng: np.random.Generator | None,
         used: int = 0,
+        leader: TipPath | None = None,
     ) -> Track:
         """Follow-the-leader from ``q0`` into ``goal`` (any tip goal region): the leader's
         path from ``q0``'s tip (randomised with ``rng``, None: the deterministic grid), the
         tracking descent along it, then the descent into ``goal`` itself (no approach
         point). The body states it passed through come back whatever the outcome: the
         reusable part of follow-the-leader (guide states of a sampling planner, the
-        backward branches). ``used``: iterations the leg has used already."""
+        backward branches). ``used``: iterations the leg has used already; ``leader``:
+        the leader's path when the caller has it already."""
         tracker = ctx.tracker
 
         def stop() -> bool:
             return tracker.exhausted(used) is not None
 
-        leader = self.leader_path(ctx.problem, ctx.leg, q0, rng, stop, goal=goal)
+        if leader is None:
+            leader = self.leader_path(ctx.problem, ctx.leg, q0, rng, stop, goal=goal)
         states = [np.array(q0, dtype=float)]
         if leader is None:
             why = tracker.exhausted(used) or "no path for the tip through free workspace"
@@ -556,7 +559,7 @@ class FollowLeader(LegPlanner):
         states.extend(seg2[1:])
         return Track(leader, st2, f"{reason}; {reason2}", states, it + it2)
 
-    def _sees_approach(self, ctx: PlanningContext, q: Array) -> bool:
+    def sees_approach(self, ctx: PlanningContext, q: Array) -> bool:
         """Whether the straight line from the tip of ``q`` to the leg goal's approach
         point keeps the leader's clearance from the scene (the retract has got the tip
         out)."""
@@ -577,7 +580,7 @@ class FollowLeader(LegPlanner):
         """The tip drawn back along the start's own body: sub-goals at the body's faces
         from the tip's towards the base's (each looking along the body, within the
         sub-goal tolerances), tracked by the descent, until the tip sees the leg goal's
-        approach point (:meth:`_sees_approach`); a sub-goal the descent stalls before is
+        approach point (:meth:`sees_approach`); a sub-goal the descent stalls before is
         passed over, two in a row end it. What got the body in gets it out: the
         body lies on the curve its tip came in by, so the tip backs out along it while the
         modules outside take up the length; the leader's path forwards would lead the tip
@@ -603,7 +606,7 @@ class FollowLeader(LegPlanner):
             if st is Status.SOLVED:
                 reached, stalls = reached + 1, 0
                 status, reason = Status.SOLVED, f"retracted to face {k}"
-                if self._sees_approach(ctx, states[-1]):
+                if self.sees_approach(ctx, states[-1]):
                     break
                 continue
             stalls += 1
@@ -671,7 +674,7 @@ class FollowLeader(LegPlanner):
                 and attempt == 0
                 and leader is not None
                 and crosses_body(robot, q0, leader)
-                and not self._sees_approach(ctx, q0)
+                and not self.sees_approach(ctx, q0)
             ):
                 # the leader leads the tip back through its own body: retract first
                 out = retract_from_start()

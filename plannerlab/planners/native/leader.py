@@ -9,7 +9,11 @@ complete (a share ``1 − guide_bias`` of its samples is uniform, the trees are 
 Guidance, built in the leg's context (its time, checks and iterations are the leg's; it
 stops when they are spent):
 
-1. **Forwards**: follow-the-leader from the start (:meth:`~plannerlab.planners.
+1. **Forwards**: (when the leader's path runs back through the start's own body, as it
+   does leaving a room from its far wall, first a branch that draws the tip back along
+   the body until it sees the goal's approach point, then the leader from there: what got
+   the body in gets it out; :meth:`~plannerlab.planners.follow_leader.FollowLeader.
+   retract`) follow-the-leader from the start (:meth:`~plannerlab.planners.
    follow_leader.FollowLeader.track`: the leader's tip path on a voxel grid shifted by a
    random fraction of a voxel, its centring weight scaled at random, tracked by the
    clearance descent, then the descent into the goal). The body states it passes through
@@ -45,7 +49,12 @@ import numpy as np
 from plannerlab.errors import PlannerlabError
 from plannerlab.planners.base import PlanResult, Status, with_overrides
 from plannerlab.planners.context import PlanningContext
-from plannerlab.planners.follow_leader import FollowLeader, FollowLeaderSettings, Track
+from plannerlab.planners.follow_leader import (
+    FollowLeader,
+    FollowLeaderSettings,
+    Track,
+    crosses_body,
+)
 from plannerlab.planners.gradient_clearance import ClearanceSettings
 from plannerlab.planners.native import kernels as K
 from plannerlab.planners.native.planner import (
@@ -71,9 +80,11 @@ class LeaderSettings(NativeSettings):
         guide_bias: (here 0.5) the share of samples drawn near a guide state.
         guide_sigma_rad: (here 0.05) their Gaussian noise per joint [rad].
         forward: follow the leader from the start (a branch of the start tree).
-        retract: when the forward branch does not reach the goal, a second branch: the
-            tip drawn back along the start's own body (:meth:`~plannerlab.planners.
-            follow_leader.FollowLeader.retract`), then the leader from there.
+        retract: a second branch from the start: the tip drawn back along the start's
+            own body (:meth:`~plannerlab.planners.follow_leader.FollowLeader.retract`),
+            then the leader from there; first when the leader's path runs back through
+            the body (:func:`~plannerlab.planners.follow_leader.crosses_body`), else
+            when the forward branch does not reach the goal.
         backward: follow the leader from goal states into the start's tip (branches of
             the goal tree), when the forward branch did not reach the goal.
         backward_goals: goal states to go backwards from, at most.
@@ -202,15 +213,30 @@ def build_guidance(
             reached_nodes.append(end)
         return end
 
+    def retract_branch() -> None:
+        end = grow_start(0, leader.retract(ctx, q0, used), "retract")
+        if tracker.exhausted(0) is None:
+            grow_start(end, leader.track(ctx, A.Q[end], goal, rng, used), "after_retract")
+
     if s.forward:
-        grow_start(0, leader.track(ctx, q0, goal, rng, used), "forward")
-        if not reached and s.retract and tracker.exhausted(0) is None:
+        lead = leader.leader_path(
+            ctx.problem, ctx.leg, q0, rng, lambda: tracker.exhausted(0) is not None
+        )
+        if (
+            s.retract
+            and lead is not None
+            and crosses_body(robot, q0, lead)
+            and not leader.sees_approach(ctx, q0)
+        ):
+            # the leader's path runs back through the body: the retract branch first
+            log["retract_first"] = True
+            retract_branch()
+        if not reached and tracker.exhausted(0) is None:
+            grow_start(0, leader.track(ctx, q0, goal, rng, used, leader=lead), "forward")
+        if not reached and s.retract and "retract" not in log and tracker.exhausted(0) is None:
             # leaving from deep inside: the tip drawn back along its own body, then the
             # leader from there (a second branch of the start tree)
-            end = grow_start(0, leader.retract(ctx, q0, used), "retract")
-            if tracker.exhausted(0) is None:
-                q_r = A.Q[end]
-                grow_start(end, leader.track(ctx, q_r, goal, rng, used), "after_retract")
+            retract_branch()
     failed = out_of_budget()
     if failed is not None:
         return failed
