@@ -299,9 +299,17 @@ class LeaderSolve(NativeSolve):
             return self.result(Status.INVALID_START, self.ctx.start_problem, q0[None])
         model = self.checker.model
         self.run.progress.note(float(self.goal.distance(self.robot, q0)))
+        t0, c0 = self.tracker.elapsed_s, self.tracker.checks_used
         g = build_guidance(self.leader, self.lsettings, self, self.ctx, self.rng)
         if isinstance(g, PlanResult):
             return g
+        # the guidance's time per check (the descents' steps with their checks): a
+        # conservative first rate, so that the simplification keeps back enough time for
+        # the re-check when the trees are joined before any chunk of the search measured
+        # the kernels' rate
+        made = self.tracker.checks_used - c0
+        if made > 0:
+            self.rate_s = max(self.rate_s, (self.tracker.elapsed_s - t0) / made)
         self.extra["leader"] = g.log
         self.guides = np.ascontiguousarray(g.guides)
         self.run.progress.note(float(np.min(self.goal.distance(self.robot, g.start_states))))
