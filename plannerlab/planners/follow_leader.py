@@ -492,8 +492,21 @@ class FollowLeader(LegPlanner):
         return leader_moves.track(self, ctx, q0, goal, rng, used, leader)
 
     def sees_approach(self, ctx: PlanningContext, q: Array) -> bool:
-        """:func:`plannerlab.planners.leader_moves.sees_approach` with these settings."""
-        return leader_moves.sees_approach(self, ctx, q)
+        """Whether the straight line from the tip of ``q`` to the leg goal's approach
+        point keeps the leader's clearance from the scene (the retract has got the tip
+        out)."""
+        s = self.settings
+        goal, robot = ctx.goal, ctx.robot
+        p_tip, _ = robot.tip(q)
+        approach = goal.p_world_m - s.approach_m * goal.n_world
+        clearance = (
+            float(np.asarray(robot.link_radii_m)[-1])
+            + ctx.problem.safety_margin_m
+            + s.extra_clearance_m
+        )
+        n = max(2, int(np.ceil(np.linalg.norm(approach - p_tip) / 0.1)) + 1)
+        line = p_tip + np.linspace(0.0, 1.0, n)[:, None] * (approach - p_tip)
+        return bool(scene_distance_m(ctx.scene, line).min() >= clearance)
 
     def retract(self, ctx: PlanningContext, q0: Array, used: int = 0) -> Track:
         """:func:`plannerlab.planners.leader_moves.retract` with this planner."""

@@ -1,14 +1,14 @@
 """Follow-the-leader's moves, reusable by other planners: the tracking from one state into
 any tip goal region (:func:`track`, the body states it passes through), and the retract
 for leaving from deep inside (:func:`retract`: the tip drawn back along the start's own
-body until it sees the goal's approach point, :func:`sees_approach`), with
+body until it sees the goal's approach point), with
 :func:`crosses_body`, which says when the leader's path runs back through the body.
 The planner itself is :class:`~plannerlab.planners.follow_leader.FollowLeader`."""
 
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 import numpy as np
 
@@ -17,8 +17,11 @@ from plannerlab.planners.context import PlanningContext
 from plannerlab.problem.goals import GoalRegion
 from plannerlab.robots.base import Array
 
-if TYPE_CHECKING:
-    from plannerlab.planners.follow_leader import FollowLeader, TipPath
+#: a :class:`~plannerlab.planners.follow_leader.FollowLeader` (its tracking descent, its
+#: settings, its leader's path) and a :class:`~plannerlab.planners.follow_leader.TipPath`:
+#: typed loosely so that this module and the planner's form no import cycle
+FollowLeader = Any
+TipPath = Any
 
 
 @dataclass(frozen=True)
@@ -104,31 +107,11 @@ def track(
     return Track(leader, st2, f"{reason}; {reason2}", states, it + it2)
 
 
-def sees_approach(fl: FollowLeader, ctx: PlanningContext, q: Array) -> bool:
-    """Whether the straight line from the tip of ``q`` to the leg goal's approach
-    point keeps the leader's clearance from the scene (the retract has got the tip
-    out)."""
-    s = fl.settings
-    goal, robot = ctx.goal, ctx.robot
-    p_tip, _ = robot.tip(q)
-    approach = goal.p_world_m - s.approach_m * goal.n_world
-    clearance = (
-        float(np.asarray(robot.link_radii_m)[-1])
-        + ctx.problem.safety_margin_m
-        + s.extra_clearance_m
-    )
-    n = max(2, int(np.ceil(np.linalg.norm(approach - p_tip) / 0.1)) + 1)
-    line = p_tip + np.linspace(0.0, 1.0, n)[:, None] * (approach - p_tip)
-    from plannerlab.planners.follow_leader import scene_distance_m
-
-    return bool(scene_distance_m(ctx.scene, line).min() >= clearance)
-
-
 def retract(fl: FollowLeader, ctx: PlanningContext, q0: Array, used: int = 0) -> Track:
     """The tip drawn back along the start's own body: sub-goals at the body's faces
     from the tip's towards the base's (each looking along the body, within the
     sub-goal tolerances), tracked by the descent, until the tip sees the leg goal's
-    approach point (:func:`sees_approach`); a sub-goal the descent stalls before is
+    approach point (``fl.sees_approach``); a sub-goal the descent stalls before is
     passed over, two in a row end it. What got the body in gets it out: the
     body lies on the curve its tip came in by, so the tip backs out along it while the
     modules outside take up the length; the leader's path forwards would lead the tip
@@ -154,7 +137,7 @@ def retract(fl: FollowLeader, ctx: PlanningContext, q0: Array, used: int = 0) ->
         if st is Status.SOLVED:
             reached, stalls = reached + 1, 0
             status, reason = Status.SOLVED, f"retracted to face {k}"
-            if sees_approach(fl, ctx, states[-1]):
+            if fl.sees_approach(ctx, states[-1]):
                 break
             continue
         stalls += 1
