@@ -572,7 +572,7 @@ def make_variant(
 
 def generate(
     count: int,
-    rng: np.random.Generator,
+    rng: np.random.Generator | int,
     *,
     min_clearance_m: float = 0.04,
     max_draws: int | None = None,
@@ -581,9 +581,10 @@ def generate(
     kinds: Sequence[str] = ("paper",),
     first_index: int = 0,
 ) -> list[Variant]:
-    """``count`` kept variants, drawn in order from ``rng`` (a dropped draw is reported
-    through ``progress`` and replaced by the next draw), numbered from ``first_index``;
-    the k-th kept one is of kind ``kinds[k % len(kinds)]`` (:data:`ORDERS`).
+    """``count`` kept variants, drawn in order from ``rng`` (a generator, or a seed for
+    ``numpy.random.default_rng``; a dropped draw is reported through ``progress`` and
+    replaced by the next draw), numbered from ``first_index``; the k-th kept one is of
+    kind ``kinds[k % len(kinds)]`` (:data:`ORDERS`).
 
     Raises:
         VariantError: bad arguments, or fewer than ``count`` kept in ``max_draws`` draws
@@ -600,6 +601,7 @@ def generate(
             "--min-clearance: a clearance in [0, 0.75) m (the module radius), "
             f"got {min_clearance_m}"
         )
+    rng = np.random.default_rng(rng)  # a Generator passes through unchanged
     max_draws = max_draws or 3 * count
     kept: list[Variant] = []
     draw = 0

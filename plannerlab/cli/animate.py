@@ -14,27 +14,24 @@ from plannerlab.errors import PlannerlabError
 
 
 def cmd_animate(args: argparse.Namespace, console: Console) -> int:
-    from plannerlab.plot.animate import animate_plan
-    from plannerlab.run.plan_check import read_checked_plan
+    import plannerlab as pl
 
     if args.frames < 2:
         raise PlannerlabError(f"--frames: expected >= 2, got {args.frames}")
     if args.fps < 1:
         raise PlannerlabError(f"--fps: expected >= 1, got {args.fps}")
-    plan, problem = read_checked_plan(args.plan)
+    plan, problem = pl.read_checked_plan(args.plan)
     out = Path(args.out) if args.out else Path(args.plan).with_suffix(f".{args.format}")
     executions = plan_executions(args.plan)
     note = "with its execution record (PLAN.exec.json)"
     if not executions and not args.no_execute:
-        from plannerlab.run.pipeline import execute_results
-
         with console.status(f"executing {len(plan.legs)} legs in PyBullet (none recorded)"):
-            executions = execute_results(problem, plan.legs)
+            executions = pl.execute_results(problem, plan.legs)
         note = "executed now (no PLAN.exec.json beside the plan; `plannerlab execute` writes one)"
     elif not executions:
         note = "planned motion only (--no-execute)"
     with console.status(f"drawing {args.frames} frames"):
-        path = animate_plan(plan, problem, out, executions, max_frames=args.frames, fps=args.fps)
+        path = pl.animate_plan(plan, problem, out, executions, max_frames=args.frames, fps=args.fps)
     if args.json:
         print(json.dumps({"animation": str(path), "executed": bool(executions)}))
     else:

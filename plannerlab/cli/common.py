@@ -1,5 +1,5 @@
 """What the subcommands share: budget and leg flags, setting overrides; numbers are
-formatted by :func:`plannerlab.comparison.report.fmt`, as in the tables."""
+formatted by :func:`plannerlab.record.cells.fmt`, as in the tables."""
 
 from __future__ import annotations
 

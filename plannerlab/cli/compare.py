@@ -200,12 +200,7 @@ def _json_safe(x: Any) -> Any:
 
 # ---------------------------------------------------------------------- command
 def cmd_compare(args: argparse.Namespace, console: Console) -> int:
-    from plannerlab.comparison.report import machine_info, write_reports
-    from plannerlab.comparison.runner import run_spec
-    from plannerlab.comparison.spec import ComparisonSpec
-    from plannerlab.comparison.statistics import summarise
-    from plannerlab.comparison.store import TrialStore, default_name, store_path
-    from plannerlab.comparison.trial import ERROR_STATUS, TIMEOUT_STATUS, parse_seeds
+    import plannerlab as pl
     from plannerlab.record.files import versions
 
     # -- validate everything before the first process starts
@@ -218,10 +213,10 @@ def cmd_compare(args: argparse.Namespace, console: Console) -> int:
         if v is not None and v <= 0:
             raise PlannerlabError(f"{flag}: expected > 0, got {v}")
     planners = list(dict.fromkeys(_split(args.planners)))
-    spec = ComparisonSpec.build(
+    spec = pl.ComparisonSpec.build(
         args.problems,
         planners,
-        parse_seeds(args.seeds),
+        pl.parse_seeds(args.seeds),
         budget={
             "max_iterations": args.max_iterations,
             "max_collision_checks": args.max_checks,
@@ -236,11 +231,11 @@ def cmd_compare(args: argparse.Namespace, console: Console) -> int:
         trial_timeout_s=args.trial_timeout,
         retry_errors=args.retry_errors,
     )
-    name = args.name or default_name(spec.problem_names, list(spec.planners))
+    name = args.name or pl.default_store_name(spec.problem_names, list(spec.planners))
     if not re.fullmatch(r"[A-Za-z0-9._+-]+", name) or name in (".", ".."):
         raise PlannerlabError(f"--name: letters, digits and . _ + - only, got {name!r}")
     folder = Path(args.out) / name
-    store = TrialStore(store_path(args.out, name))
+    store = pl.TrialStore(pl.store_path(args.out, name))
     command = _command(args)
     trials = spec.trials
 
@@ -267,7 +262,7 @@ def cmd_compare(args: argparse.Namespace, console: Console) -> int:
 
     def on_done(rec: dict[str, Any], skipped: bool) -> None:
         counts["skipped" if skipped else "ran"] += 1
-        if rec.get("status") in (ERROR_STATUS, TIMEOUT_STATUS):
+        if rec.get("status") in (pl.ERROR_STATUS, pl.TIMEOUT_STATUS):
             counts["errors"] += 1
         last = (
             ""
@@ -278,7 +273,7 @@ def cmd_compare(args: argparse.Namespace, console: Console) -> int:
 
     try:
         with progress:
-            run = run_spec(spec, store, on_done)
+            run = pl.run_spec(spec, store, on_done)
     except KeyboardInterrupt:
         done = counts["ran"] + counts["skipped"]
         console.print(
@@ -292,21 +287,23 @@ def cmd_compare(args: argparse.Namespace, console: Console) -> int:
 
     # -- report
     records = sorted(run.records, key=spec.sort_key)
-    rows = summarise(records)
+    rows = pl.summarise(records)
     meta = {
         "command": command,
         **spec.to_dict(),
         "seeds_spec": args.seeds,
         "ran": run.ran,
         "skipped": run.skipped,
-        "errors": sum(1 for r in records if r.get("status") in (ERROR_STATUS, TIMEOUT_STATUS)),
+        "errors": sum(
+            1 for r in records if r.get("status") in (pl.ERROR_STATUS, pl.TIMEOUT_STATUS)
+        ),
         "started_at": started.isoformat(timespec="seconds"),
         "wall_s": wall_s,
         "store": str(store.path),
         "versions": versions(),
-        "machine": machine_info(),
+        "machine": pl.machine_info(),
     }
-    files = write_reports(folder, name, records, rows, meta)
+    files = pl.write_reports(folder, name, records, rows, meta)
 
     if args.json:
         print(
@@ -328,7 +325,7 @@ def cmd_compare(args: argparse.Namespace, console: Console) -> int:
         )
         return 0
     _print_tables(console, rows, columns)
-    errors = [r for r in records if r.get("status") == ERROR_STATUS]
+    errors = [r for r in records if r.get("status") == pl.ERROR_STATUS]
     if errors:
         console.print(
             f"[red]{len(errors)} trial(s) raised[/red] (rerun them with "
@@ -357,6 +354,6 @@ def _print_tables(console: Console, rows: list[dict[str, Any]], columns: list[st
         "checks summed over legs. All columns: --wide, report.md, summary.csv.[/dim]",
         highlight=False,
     )
-    from plannerlab.comparison.report import BUDGET_NOTE
+    import plannerlab as pl
 
-    console.print(f"[dim]{escape(BUDGET_NOTE)}[/dim]", highlight=False)
+    console.print(f"[dim]{escape(pl.BUDGET_NOTE)}[/dim]", highlight=False)

@@ -106,31 +106,31 @@ def _stdout_to_stderr(active: bool) -> Iterator[None]:
 def _thickness_figure(thin: Any, thick: Any, problem: Any, out: Path) -> Path:
     """Where the paper's zero-thickness curves and the robot of the problem's radius part,
     from the two legs' contact plans."""
-    from plannerlab.plot.continuum import save, searched, thickness_figure
+    import plannerlab as pl
 
     thin_plan, thick_plan = thin.contact_plan, thick.contact_plan
     r = problem.robot.link_radius_m
-    kept = {s.contact_indices for s in searched(thick_plan)}
-    lost = [s.contact_indices for s in searched(thin_plan) if s.contact_indices not in kept]
+    kept = {s.contact_indices for s in thick_plan.searched}
+    lost = [s.contact_indices for s in thin_plan.searched if s.contact_indices not in kept]
     title = (
-        f"{problem.name}: {len(searched(thin_plan))} zero-thickness solution(s) (paper), "
-        f"{len(searched(thick_plan))} for r = {r * 1e3:g} mm"
+        f"{problem.name}: {len(thin_plan.searched)} zero-thickness solution(s) (paper), "
+        f"{len(thick_plan.searched)} for r = {r * 1e3:g} mm"
         + (f"; lost: {', '.join(str(list(c)) for c in lost)}" if lost else "")
     )
-    fig = thickness_figure(thin_plan, thick_plan, title=title)
-    return save(fig, out / f"{problem.name}_thickness.png")
+    fig = pl.continuum_thickness_figure(thin_plan, thick_plan, title=title)
+    return pl.save_figure(fig, out / f"{problem.name}_thickness.png")
 
 
 def _figure(problem: Any, result: Any, out: Path) -> Path:
     """Fig. 4: the search's curves, the planner's kept and dropped ones."""
-    from plannerlab.plot.continuum import draw_case
+    import plannerlab as pl
 
     plan = result.contact_plan
     title = (
         f"{problem.name}: {len(plan.solutions)} solution(s), "
         f"{len(plan.collision_points_m)} collision points"
     )
-    return draw_case(plan, out / f"{problem.name}.png", title=title)
+    return pl.continuum_case_figure(plan, out / f"{problem.name}.png", title=title)
 
 
 def _write(row: Any, figures: Path | None, out: Path | None) -> dict[str, str]:
@@ -158,8 +158,8 @@ def _write(row: Any, figures: Path | None, out: Path | None) -> dict[str, str]:
 
 def cmd_continuum(args: argparse.Namespace, console: Console) -> int:
     """``plannerlab continuum``: print the table (or JSON); write the figures and plans."""
+    import plannerlab as pl
     from plannerlab.cli.common import parse_overrides
-    from plannerlab.comparison.continuum import case_name, run_case
     from plannerlab.errors import PlannerlabError
     from plannerlab.record.codec import dumps
 
@@ -176,10 +176,10 @@ def cmd_continuum(args: argparse.Namespace, console: Console) -> int:
     with console.status("chord_arc") as status, _stdout_to_stderr(args.json):
         for case in args.cases:
             status.update(
-                f"chord_arc on {case_name(case)}: {args.runs} runs"
+                f"chord_arc on {pl.continuum_case_name(case)}: {args.runs} runs"
                 + (" and PyBullet" if args.execute else "")
             )
-            rows.append(run_case(case, args.runs, overrides, execute=args.execute))
+            rows.append(pl.run_continuum_case(case, args.runs, overrides, execute=args.execute))
             written.append(_write(rows[-1], figures, out))
     if args.json:
         doc = {

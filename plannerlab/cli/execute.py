@@ -13,18 +13,50 @@ from rich.table import Table
 
 from plannerlab.cli.common import require_display
 from plannerlab.cli.solve import add_plan_arguments, leg_table, solve_and_save
-from plannerlab.cli.tables import table
-from plannerlab.comparison.report import fmt
+from plannerlab.cli.tables import Kind, natural_width, table
 from plannerlab.errors import PlanFileError, PlannerlabError
+from plannerlab.record.cells import fmt
 from plannerlab.record.codec import dumps
 
+#: columns the "why not" column gets at least (its phrases wrap at spaces)
+WHY_MIN_WIDTH = 22
 
-def execution_table(legs: Any, executions: Any) -> Table:
+
+def why_table(legs: Any, executions: Any) -> Table:
+    """Why each leg is not ok (the execution table's last column, on its own where the
+    terminal is too narrow for both)."""
+    t = table(
+        "execution in PyBullet: why not ok",
+        [("leg", "num"), ("goal", "name"), ("ok", "name"), ("why not", "text")],
+        compact=True,
+    )
+    for r, e in zip(legs, executions, strict=True):
+        ok = "[green]yes[/green]" if e.success else "[red]no[/red]"
+        t.add_row(str(r.leg), escape(str(r.goal)), ok, escape("; ".join(e.failures)))
+    return t
+
+
+def print_execution_tables(console: Console, legs: Any, executions: Any) -> None:
+    """The execution table with its "why not" column, or, where the terminal has no
+    room for that column, the table without it and :func:`why_table` under it."""
+    narrow = execution_table(legs, executions, why=False)
+    if natural_width(console, narrow) + WHY_MIN_WIDTH <= console.width:
+        console.print(execution_table(legs, executions))
+        return
+    console.print(narrow)
+    if not all(e.success for e in executions):
+        console.print(why_table(legs, executions))
+
+
+def execution_table(legs: Any, executions: Any, why: bool = True) -> Table:
     """One row per executed leg: FCL re-check, tip errors, the largest deviation of the
     robot's collision geometry from the plan and the smallest simulated
-    clearance [mm], contacts, wall time, verdict (the joint tracking error, informational
-    since the verdict is in metres, and the trajectory's duration are in ``--json``);
-    which pairs collided or touched goes in the caption (names never cut)."""
+    clearance [mm], contacts, wall time, verdict and (``why``) why a leg is not ok (one
+    phrase per failed test: :attr:`~plannerlab.record.execution.Execution.failures`);
+    the joint tracking error, informational since the verdict is in metres, and the
+    trajectory's duration are in ``--json``; which pairs collided or touched goes in the
+    caption (names never cut)."""
+    why_column: list[tuple[str, Kind]] = [("why not", "text")] if why else []
     t = table(
         "execution in PyBullet",
         [
@@ -38,9 +70,12 @@ def execution_table(legs: Any, executions: Any) -> Table:
             ("con-\ntacts", "num"),
             ("wall s", "num"),
             ("ok", "name"),
+            *why_column,
         ],
         compact=True,
     )
+    if why:
+        t.columns[-1].min_width = WHY_MIN_WIDTH
     notes = []
     for r, e in zip(legs, executions, strict=True):
         names = [f"{c.link_name} x {c.other_name}" for c in e.unexpected_contacts]
@@ -66,6 +101,7 @@ def execution_table(legs: Any, executions: Any) -> Table:
             str(len(names)),
             fmt(e.wall_time_s),
             "[green]yes[/green]" if e.success else "[red]no[/red]",
+            *([escape("; ".join(e.failures))] if why else []),
         )
     if notes:
         t.caption = escape("\n".join(notes))
@@ -73,16 +109,17 @@ def execution_table(legs: Any, executions: Any) -> Table:
 
 
 def cmd_execute(args: argparse.Namespace, console: Console) -> int:
+    import plannerlab as pl
     from plannerlab.record.files import versions
     from plannerlab.record.plan import ExecutionFile, execution_path
-    from plannerlab.run.pipeline import execute_plan
-    from plannerlab.run.plan_check import check_plan, read_plan
 
     require_display(args.gui)
     if args.problem.endswith(".json"):
         plan_file = Path(args.problem)
-        plan = read_plan(plan_file)
+        plan = pl.read_plan(plan_file)
         changed = plan.problem_changed()
+        if changed and plan.problem_path() is None:
+            raise PlanFileError(f"{plan_file}: {changed}")
         if changed and not args.allow_changed_problem:
             raise PlanFileError(
                 f"{plan_file}: {changed}; plan again, or pass --allow-changed-problem "
@@ -99,18 +136,18 @@ def cmd_execute(args: argparse.Namespace, console: Console) -> int:
     out = Path(args.out) if args.out else execution_path(plan_file)
     problem = plan.load_problem()
     if args.problem.endswith(".json"):
-        check_plan(plan, problem, args.problem)
+        pl.check_plan(plan, problem, args.problem)
     if not args.json:
         console.print(f"simulation: {problem.simulation.origin}", highlight=False)
     with console.status(f"executing {len(plan.legs)} legs in PyBullet"):
-        executions = execute_plan(plan, problem, gui=args.gui)
+        executions = pl.execute(plan, problem, gui=args.gui)
     record = ExecutionFile.of(plan, plan_file, executions, versions())
     record.save(out)
     if args.json:
         print(dumps(record.to_dict()))
         return 1 if args.strict and not record.success else 0
     console.print(leg_table(plan, f"{plan.planner} on {plan.problem}, seed {plan.seed}: plan"))
-    console.print(execution_table(plan.legs, executions))
+    print_execution_tables(console, plan.legs, executions)
     console.print(f"execution written to {out} (plan: {plan_file})")
     return 1 if args.strict and not all(e.success for e in executions) else 0
 

@@ -12,17 +12,16 @@ the track; ``--frame world`` reads them in the world frame of ``--problem``'s ro
 angles in degrees. Exit status: 0 when a solution exists, 1 when the pose is unreachable,
 2 on bad input (the CLI's main prints the :class:`PlannerlabError`).
 
-Argument parsing and printing only; the solver is :mod:`plannerlab.robots.irb6.ik`.
+Argument parsing and printing only; the solver is :func:`plannerlab.irb6_ik`
+(:mod:`plannerlab.robots.irb6.ik`).
 """
 
 from __future__ import annotations
 
 import argparse
 import json
-import math
 from typing import Any
 
-import numpy as np
 from rich.console import Console
 from rich.markup import escape
 from rich.table import Table
@@ -89,34 +88,18 @@ def add_ik_parser(subparsers: Any) -> argparse.ArgumentParser:
     return p
 
 
-# ---------------------------------------------------------------------- helpers
-def _finite3(values: Any, option: str) -> np.ndarray:
-    v = np.asarray(values, dtype=float)
-    if v.shape != (3,) or not np.all(np.isfinite(v)):
-        shown = ", ".join(str(x) for x in values)
-        raise PlannerlabError(f"{option} expects three finite numbers, got ({shown})")
-    return v
-
-
-def _finite(value: float | None, option: str) -> float | None:
-    if value is not None and not math.isfinite(value):
-        raise PlannerlabError(f"{option} expects a finite angle in degrees, got {value}")
-    return value
-
-
+# ---------------------------------------------------------------------- command
 def _robot(args: argparse.Namespace) -> tuple[Any, str | None]:
-    """The IRb-6 model (defaults, or a problem's [robot] table) and the problem's name."""
-    from plannerlab.robots.irb6.model import IRb6
+    """The IRb-6 model (None: the defaults, or a problem's [robot] table) and the
+    problem's name."""
+    import plannerlab as pl
 
     if args.problem is None:
         if args.frame == "world":
             raise PlannerlabError("--frame world needs --problem (the world of which problem?)")
-        return IRb6(), None
-    from plannerlab.problem.catalog import resolve_problem_path
-    from plannerlab.problem.load import parse_problem
-
-    problem = parse_problem(resolve_problem_path(args.problem))
-    if not isinstance(problem.robot, IRb6):
+        return None, None
+    problem = pl.load_problem(args.problem)
+    if problem.robot.kind != "irb6":
         raise PlannerlabError(
             f"--problem {args.problem}: its robot is {problem.robot.kind!r}; "
             f"'plannerlab ik irb6' needs a problem with [robot] type = \"irb6\""
@@ -124,95 +107,20 @@ def _robot(args: argparse.Namespace) -> tuple[Any, str | None]:
     return problem.robot, problem.name
 
 
-def _rotation_error_rad(R_a: np.ndarray, R_b: np.ndarray) -> float:
-    """Angle of the rotation R_a^T R_b [rad], accurate for small angles too."""
-    R = R_a.T @ R_b
-    skew = 0.5 * np.array([R[2, 1] - R[1, 2], R[0, 2] - R[2, 0], R[1, 0] - R[0, 1]])
-    return float(math.atan2(float(np.linalg.norm(skew)), 0.5 * (float(np.trace(R)) - 1.0)))
-
-
-def ik_report(
-    robot: Any,
-    p_station_m: np.ndarray,
-    c_station: np.ndarray,
-    roll_rad: float,
-    previous_theta5_rad: float | None,
-) -> dict[str, Any]:
-    """Solve one pose and check every solution with the forward kinematics.
-
-    Returns:
-        A JSON-able dict: ``case``, ``lambda0_intervals_m``, ``R_wew_m``, ``R_zew_m``,
-        ``solutions`` (each with ``q``, ``lambda0_m``, ``theta_deg``, ``pos_err_m``,
-        ``rot_err_deg``, ``approach_err_deg``), ``reachable``, ``reason_code``, ``reason``.
-    """
-    from plannerlab.robots.irb6.ik import pose_from_approach, solve_ik
-
-    T_target = pose_from_approach(p_station_m, c_station, roll_rad)
-    answer = solve_ik(robot, T_target, previous_theta5_rad)
-    solutions = []
-    for q in answer.solutions:
-        T_fk = robot.fk_station(q)[5]
-        pos_err = float(np.linalg.norm(T_fk[:3, 3] - T_target[:3, 3]))
-        cos_c = float(np.clip(T_fk[:3, 2] @ T_target[:3, 2], -1.0, 1.0))
-        solutions.append(
-            {
-                "q": [float(v) for v in q],
-                "lambda0_m": float(q[0]),
-                "theta_deg": [math.degrees(float(v)) for v in q[1:]],
-                "pos_err_m": pos_err,
-                "rot_err_deg": math.degrees(_rotation_error_rad(T_target[:3, :3], T_fk[:3, :3])),
-                "approach_err_deg": math.degrees(math.acos(cos_c)),
-            }
-        )
-    return {
-        "case": answer.case,
-        "lambda0_intervals_m": [[float(lo), float(hi)] for lo, hi in answer.lambda0_intervals_m],
-        "R_wew_m": answer.inner_radius_m,
-        "R_zew_m": answer.outer_radius_m,
-        "reachable": answer.ok,
-        "reason_code": answer.reason_code,
-        "reason": answer.reason,
-        "solutions": solutions,
-    }
-
-
-# ---------------------------------------------------------------------- command
 def cmd_ik(args: argparse.Namespace, console: Console) -> int:
     """Run ``plannerlab ik``: 0 with solutions, 1 when unreachable (bad input raises)."""
-    p_in = _finite3(args.position, "--position")
-    c_in = _finite3(args.approach, "--approach")
-    norm = float(np.linalg.norm(c_in))
-    if norm < 1e-12:
-        raise PlannerlabError(
-            "--approach must be a non-zero direction vector (c = 0, 0, 0 has no direction)"
-        )
-    c_in = c_in / norm
-    roll_deg = _finite(args.roll, "--roll")
-    prev_deg = _finite(args.previous_theta5, "--previous-theta5")
+    import plannerlab as pl
+
     robot, problem_name = _robot(args)
-    if args.frame == "world":
-        T_base_world = np.linalg.inv(robot.T_world_base)
-        p_s = T_base_world[:3, :3] @ p_in + T_base_world[:3, 3]
-        c_s = T_base_world[:3, :3] @ c_in
-    else:
-        p_s, c_s = p_in, c_in
-    report = ik_report(
-        robot,
-        p_s,
-        c_s,
-        math.radians(float(roll_deg or 0.0)),
-        None if prev_deg is None else math.radians(prev_deg),
+    report = pl.irb6_ik(
+        args.position,
+        args.approach,
+        args.roll,
+        args.previous_theta5,
+        robot=robot,
+        frame=args.frame,
     )
-    out = {
-        "robot": args.robot,
-        "problem": problem_name,
-        "frame": args.frame,
-        "position_station_m": [float(v) for v in p_s],
-        "approach_station": [float(v) for v in c_s],
-        "roll_deg": float(roll_deg or 0.0),
-        "previous_theta5_deg": prev_deg,
-        **report,
-    }
+    out = {"robot": args.robot, "problem": problem_name, **report}
     if args.json:
         print(json.dumps(out, indent=1))
     else:
@@ -262,4 +170,4 @@ def _print(console: Console, out: dict[str, Any]) -> None:
     console.print(s)
 
 
-__all__ = ["IK_ROBOTS", "add_ik_parser", "cmd_ik", "ik_report"]
+__all__ = ["IK_ROBOTS", "add_ik_parser", "cmd_ik"]

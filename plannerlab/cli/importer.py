@@ -12,8 +12,8 @@ from rich.markup import escape
 
 
 def cmd_import_mbm(args: argparse.Namespace, console: Console) -> int:
+    from plannerlab import mbm
     from plannerlab.errors import PlannerlabError
-    from plannerlab.problem import mbm
 
     urdf, srdf = args.urdf, args.srdf
     sources: list[Path] = list(args.source)
@@ -76,9 +76,9 @@ def cmd_import_mbm(args: argparse.Namespace, console: Console) -> int:
 
 
 def mbm_default_joint_step() -> float:
-    from plannerlab.problem.mbm import DEFAULT_JOINT_STEP_RAD
+    import plannerlab as pl
 
-    return DEFAULT_JOINT_STEP_RAD
+    return pl.mbm.DEFAULT_JOINT_STEP_RAD
 
 
 def add_parser(sub: Any) -> None:

@@ -20,12 +20,11 @@ def plan_executions(plan_file: str | Path) -> list[Any]:
 
 
 def cmd_plot(args: argparse.Namespace, console: Console) -> int:
-    from plannerlab.plot.plans import plot_plan
-    from plannerlab.run.plan_check import read_checked_plan
+    import plannerlab as pl
 
-    plan, problem = read_checked_plan(args.plan)
+    plan, problem = pl.read_checked_plan(args.plan)
     out_dir = Path(args.out) if args.out else Path(args.plan).with_suffix("")
-    files = plot_plan(plan, problem, out_dir, plan_executions(args.plan))
+    files = pl.plot_plan(plan, problem, out_dir, plan_executions(args.plan))
     if args.json:
         print(json.dumps([str(f) for f in files]))
     else:

@@ -17,15 +17,15 @@ WIDE = 120
 
 
 def cmd_problems(args: argparse.Namespace, console: Console) -> int:
+    import plannerlab as pl
     from plannerlab.errors import PlannerlabError
-    from plannerlab.problem.catalog import list_problems, problem_origin
-    from plannerlab.problem.load import parse_problem
 
     rows: list[dict[str, Any]] = []
-    for path in list_problems():
-        row: dict[str, Any] = {"name": path.stem, "file": str(path), "from": problem_origin(path)}
+    for path, origin, group in pl.problem_catalog():
+        row: dict[str, Any] = {"name": path.stem, "file": str(path), "from": origin}
+        row["group"] = group
         try:
-            p = parse_problem(path)
+            p = pl.parse_problem(path)
         except PlannerlabError as exc:  # a broken local file is listed with its error
             row.update(error=str(exc), robot="-", dof=None, legs=[], obstacles=None)
             row["description"] = f"error: {exc}"
@@ -53,27 +53,35 @@ def cmd_problems(args: argparse.Namespace, console: Console) -> int:
         ("obstacles", "num"),
         ("legs", "text"),
     ]
-    t = table("problems", cols + ([("description", "text")] if beside else []), compact=True)
-    for r in rows:
-        cells = [
-            r["name"],
-            r["from"],
-            r["robot"],
-            "-" if r["dof"] is None else str(r["dof"]),
-            "-" if r["obstacles"] is None else str(r["obstacles"]),
-            ", ".join(r["legs"]),
-        ]
-        t.add_row(*[escape(c) for c in cells], *([escape(r["description"])] if beside else []))
-    console.print(t)
-    if not beside:
-        for r in rows:
-            console.print(f"[bold]{escape(r['name'])}[/bold]: {escape(r['description'])}")
+    groups = list(dict.fromkeys((r["from"], r["group"]) for r in rows))
+    for origin, group in groups:
+        members = [r for r in rows if (r["from"], r["group"]) == (origin, group)]
+        title = "problems" if not group else f"problems in {group}/"
+        if len(groups) > 1 and not group and origin == "./problems":
+            title = "problems in ./problems"
+        t = table(title, cols + ([("description", "text")] if beside else []), compact=True)
+        for r in members:
+            cells = [
+                r["name"],
+                r["from"],
+                r["robot"],
+                "-" if r["dof"] is None else str(r["dof"]),
+                "-" if r["obstacles"] is None else str(r["obstacles"]),
+                ", ".join(r["legs"]),
+            ]
+            t.add_row(*[escape(c) for c in cells], *([escape(r["description"])] if beside else []))
+        console.print(t)
+        if not beside:
+            for r in members:
+                console.print(f"[bold]{escape(r['name'])}[/bold]: {escape(r['description'])}")
     return 0
 
 
 def add_parser(sub: Any) -> None:
     p = sub.add_parser(
-        "problems", help="list the problems: ./problems first, then the bundled ones"
+        "problems",
+        help="list the problems: ./problems first, then the bundled ones (with their "
+        "sub-folders: urdf/panda, variants), one table per folder",
     )
     p.add_argument("--json", action="store_true", help="print one JSON document")
     p.set_defaults(func=cmd_problems)

@@ -20,7 +20,7 @@ from plannerlab.cli.common import (
     seed_int,
 )
 from plannerlab.cli.tables import table
-from plannerlab.comparison.report import fmt
+from plannerlab.record.cells import fmt
 from plannerlab.record.codec import dumps
 
 
@@ -66,14 +66,13 @@ def _default_plan_path(problem: str, planner: str, seed: int) -> Path:
 def solve_and_save(args: argparse.Namespace, console: Console, out: Path | None = None) -> Any:
     """Solve as the flags say and write the plan file (``out``, default beside the
     results); return the plan and where it went."""
-    from plannerlab.problem.catalog import load_problem
-    from plannerlab.run.pipeline import legs_from_spec, solve_legs
+    import plannerlab as pl
 
-    problem = load_problem(args.problem)
+    problem = pl.load_problem(args.problem)
     if not getattr(args, "json", False):
         console.print(f"problem {problem.name} from {problem.source}", highlight=False)
     overrides = parse_overrides(args.set)
-    legs = legs_from_spec(problem, args.legs)
+    legs = pl.legs_from_spec(problem, args.legs)
     n_legs = len(legs) if legs is not None else problem.legs
     out = out or _default_plan_path(problem.name, args.planner, args.seed)
     out.parent.mkdir(parents=True, exist_ok=True)  # a path that cannot exist fails now
@@ -89,7 +88,7 @@ def solve_and_save(args: argparse.Namespace, console: Console, out: Path | None 
         )
 
     with status:
-        plan = solve_legs(
+        plan = pl.solve(
             problem,
             args.planner,
             args.seed,
@@ -107,7 +106,7 @@ def cmd_solve(args: argparse.Namespace, console: Console) -> int:
     require_display(args.gui)
     plan, out = solve_and_save(args, console, Path(args.out) if args.out else None)
     if args.json:
-        print(dumps(plan.to_dict()))
+        print(dumps(plan.to_dict(out)))
     else:
         console.print(leg_table(plan, f"{plan.planner} on {plan.problem}, seed {plan.seed}"))
         console.print(f"plan written to {out}")

@@ -24,8 +24,8 @@ from rich.console import Console
 from rich.markup import escape
 from rich.table import Table
 
-from plannerlab.comparison.report import fmt, mm
 from plannerlab.errors import UnknownNameError
+from plannerlab.record.cells import fmt, mm
 
 #: width of piped output when neither COLUMNS nor a terminal says otherwise
 PIPE_WIDTH = 100

@@ -84,15 +84,13 @@ def add_parser(subparsers: Any) -> argparse.ArgumentParser:
 
 
 def cmd_variants(args: argparse.Namespace, console: Console) -> int:
-    import numpy as np
-
-    from plannerlab.variants import VariantError, generate, write_variants
+    import plannerlab as pl
 
     out = args.out
     from pathlib import Path
 
     if Path(out).exists() and not Path(out).is_dir():
-        raise VariantError(f"--out {out}: a folder, but a file is in the way")
+        raise pl.VariantError(f"--out {out}: a folder, but a file is in the way")
     command = "plannerlab variants " + " ".join(
         shlex.quote(a)
         for a in [
@@ -111,9 +109,9 @@ def cmd_variants(args: argparse.Namespace, console: Console) -> int:
     def progress(line: str) -> None:
         print(line, file=sys.stderr, flush=True)
 
-    kept = generate(
+    kept = pl.generate_variants(
         args.count,
-        np.random.default_rng(args.seed),
+        args.seed,
         min_clearance_m=args.min_clearance,
         max_draws=args.max_draws,
         command=command,
@@ -121,6 +119,6 @@ def cmd_variants(args: argparse.Namespace, console: Console) -> int:
         kinds=tuple(k.strip() for k in args.kind.split(",") if k.strip()),
         first_index=args.first_index,
     )
-    for path in write_variants(kept, out):
+    for path in pl.write_variants(kept, out):
         print(path)
     return 0

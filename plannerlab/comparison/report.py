@@ -63,6 +63,7 @@ from typing import Any
 
 from plannerlab.comparison.statistics import SUMMARY_COLUMNS
 from plannerlab.comparison.trial import ERROR_STATUS, TOTAL_KEYS
+from plannerlab.record.cells import fmt, mm
 from plannerlab.record.files import write_json_atomic, write_text_atomic
 from plannerlab.record.leg import Status
 
@@ -291,24 +292,6 @@ def summary_csv(rows: Iterable[Mapping[str, Any]]) -> str:
 
 
 # ---------------------------------------------------------------------- Markdown
-def mm(x: Any) -> Any:
-    """Metres to millimetres for a table cell (None and NaN pass through)."""
-    return None if x is None else 1e3 * float(x)
-
-
-def fmt(x: Any, digits: int = 3) -> str:
-    """A number for a table: 3 significant digits, "-" for missing/NaN."""
-    if x is None:
-        return "-"
-    if isinstance(x, bool):
-        return "yes" if x else "no"
-    if isinstance(x, float):
-        if not math.isfinite(x):
-            return "-"
-        return f"{x:.{digits}g}" if abs(x) < 1e3 else f"{x:.0f}"
-    return str(x)
-
-
 def summary_cells(row: Mapping[str, Any], executed: bool) -> list[str]:
     """The cells of one planner's line in a per-problem table (see :data:`TABLE_HEADERS`)."""
     cells = [

@@ -73,6 +73,8 @@ NATIVE_PLANNERS: Mapping[str, str] = MappingProxyType(
     {
         "rrtconnect": "RRT-Connect compiled end to end (numba): sampling, nearest neighbours, "
         "edges on the re-check's grid and shortcuts in compiled code",
+        "rrtstar": "RRT* compiled end to end (numba): k-nearest rewiring, goal-biased, "
+        "shortens its best path until the budget is spent",
     }
 )
 

@@ -39,14 +39,44 @@ def list_problems(cwd: Path | None = None) -> list[Path]:
 def problem_origin(path: Path) -> str:
     """Where a listed problem file comes from: ``"bundled"`` or ``"./problems"``."""
     d = problems_dir()
-    return "bundled" if d.is_dir() and path.parent.resolve() == d.resolve() else "./problems"
+    if d.is_dir() and path.resolve().is_relative_to(d.resolve()):
+        return "bundled"
+    return "./problems"
+
+
+def _grouped(folder: Path) -> list[tuple[Path, str]]:
+    """Every problem file under ``folder``: (file, group), the group being its sub-folder
+    (``""`` at the top, ``urdf/panda``, ``variants``); the top first, then each group,
+    each sorted by name."""
+    if not folder.is_dir():
+        return []
+    out = [(p, p.parent.relative_to(folder).as_posix()) for p in folder.rglob("*.toml")]
+    return sorted(((p, "" if g == "." else g) for p, g in out), key=lambda x: (x[1], x[0].name))
+
+
+def problem_catalog(cwd: Path | None = None) -> list[tuple[Path, str, str]]:
+    """Every problem there is, for ``plannerlab problems``: (file, origin, group) with
+    origin ``"./problems"`` or ``"bundled"`` and group the sub-folder (``""``, or e.g.
+    ``urdf/panda``, ``variants``). The files of ``./problems`` (relative to ``cwd``) and
+    its sub-folders come first, then the bundled ones no local file of the same name
+    shadows. Each resolves by its name (:func:`resolve_problem_path`), a file of a
+    sub-folder when no other problem has its name."""
+    local_dir = (cwd or Path.cwd()) / "problems"
+    bundled_dir = problems_dir()
+    bundled = [(p, "bundled", g) for p, g in _grouped(bundled_dir)]
+    if local_dir.is_dir() and bundled_dir.is_dir() and local_dir.samefile(bundled_dir):
+        return bundled  # run from the repository: ./problems is the bundled folder
+    local = [(p, "./problems", g) for p, g in _grouped(local_dir)]
+    names = {p.stem for p, _, _ in local}
+    return local + [row for row in bundled if row[0].stem not in names]
 
 
 def resolve_problem_path(name_or_path: str | Path, cwd: Path | None = None) -> Path:
     """A problem file from a path or a problem's name (``armz_pocket``).
 
     A name is looked up in ``./problems`` (relative to ``cwd``, default the current
-    directory) first, then in :func:`problems_dir` (the bundled problems).
+    directory) first, then in :func:`problems_dir` (the bundled problems), then in their
+    sub-folders (``variants/``, ``urdf/panda/``: a name found in exactly one of them).
     """
     p = Path(name_or_path)
     if p.suffix == ".toml" or p.exists() or len(p.parts) > 1:
@@ -57,6 +87,9 @@ def resolve_problem_path(name_or_path: str | Path, cwd: Path | None = None) -> P
     candidate = problems_dir() / f"{name_or_path}.toml"
     if candidate.exists():
         return candidate
+    nested = [p for p, _, _ in problem_catalog(cwd) if p.stem == str(name_or_path)]
+    if len(nested) == 1:
+        return nested[0]
     raise UnknownNameError("problem", str(name_or_path), [q.stem for q in list_problems(cwd)])
 
 

@@ -55,6 +55,10 @@ class IKResult:
     angle_err_deg: float
 
 
+#: IK results are rounded to this many decimals [rad or m] (see :func:`solve_ik`)
+_ROUND_DECIMALS = 9
+
+
 def _clamp(robot: Robot, q: Array) -> Array:
     """Clip bounded joints into their limits and wrap continuous ones into [-pi, pi)."""
     q = np.where(robot.continuous, q, np.clip(q, robot.lower, robot.upper))
@@ -126,6 +130,10 @@ def solve_ik(
         if biggest > max_step_rad:
             dq *= max_step_rad / biggest
         q = _clamp(robot, q + dq)
+    # rounded to 1e-9 rad: the descent's linear algebra differs in its last bits between
+    # CPUs (BLAS kernels), and a goal state that differs by 1e-16 sends a seeded planner
+    # down another road; the rounded state is the one tested and returned
+    q = _clamp(robot, np.round(q, _ROUND_DECIMALS) + 0.0)
     pos_err, ang_err = (float(v) for v in goal.errors(robot, q))
     inside = pos_err <= goal.pos_tol_m and ang_err <= goal.angle_tol_deg
     if not inside:

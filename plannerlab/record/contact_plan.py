@@ -256,6 +256,12 @@ class ContactPlan:
         return None if self.chosen is None else self.solutions[self.chosen]
 
     @property
+    def searched(self) -> tuple[ContactSolution, ...]:
+        """The solutions the search's motion check passed: the kept ones and those the
+        chain's check dropped (joint bounds, thickness)."""
+        return self.solutions + tuple(d for d in self.dropped if d.stage == "chain")
+
+    @property
     def expected_contacts(self) -> tuple[PlannedContact, ...]:
         """The chosen solution's expected contacts (none without a choice)."""
         sol = self.chosen_solution

@@ -334,6 +334,41 @@ class Execution:
         )
 
     @property
+    def failures(self) -> tuple[str, ...]:
+        """Why :attr:`success` is False, one short phrase per failed test (none when it
+        succeeded): the re-check's colliding pair, the first unexpected contact, a
+        negative clearance with its pair, the deviation over its limit, the goal missed."""
+        out: list[str] = []
+        if self.path_valid is False:
+            pair = " x ".join(self.recheck_pairs[0]) if self.recheck_pairs else "a pair"
+            out.append(f"re-check: {pair} collide")
+        if self.trajectory_valid is False:
+            out.append("retimed trajectory collides")
+        bad = self.unexpected_contacts
+        if bad:
+            more = f" (+{len(bad) - 1} more)" if len(bad) > 1 else ""
+            out.append(f"contact {bad[0].link_name} x {bad[0].other_name}{more}")
+        if not self.clear:
+            pair = f" ({' x '.join(self.min_clearance_pair)})" if self.min_clearance_pair else ""
+            out.append(f"clearance {1e3 * self.min_clearance_m:.3g} mm{pair}")
+        if not self.followed:
+            if math.isnan(self.max_deviation_limit_m):
+                out.append(
+                    f"tracking {self.max_track_err_rad:.3g} > {self.track_err_limit_rad:.3g} rad"
+                )
+            else:
+                out.append(
+                    f"deviation {1e3 * self.max_deviation_m:.3g} > "
+                    f"{1e3 * self.max_deviation_limit_m:.3g} mm"
+                )
+        if self.goal_reached is False:
+            out.append(
+                f"tip outside the goal ({self.final_pos_err_m:.3g} m, "
+                f"{self.final_angle_err_deg:.3g}°)"
+            )
+        return tuple(out)
+
+    @property
     def max_track_err_rad(self) -> float:
         """Largest per-waypoint tracking error [rad] (0 for an empty log)."""
         return float(np.max(self.track_err_rad, initial=0.0))

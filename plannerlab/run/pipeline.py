@@ -181,7 +181,8 @@ def solve_legs(
             q = r.path[-1]
             if stop_on_failure and r.status is not Status.SOLVED:
                 break
-    problem_file = Path(problem.source) if Path(problem.source).is_file() else None
+    # resolved: the plan finds its problem from any working directory
+    problem_file = Path(problem.source).resolve() if Path(problem.source).is_file() else None
     return Plan(
         problem=problem.name,
         problem_file=str(problem_file) if problem_file else "",

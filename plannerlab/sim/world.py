@@ -47,13 +47,16 @@ from types import TracebackType
 from typing import Any
 
 import numpy as np
-import pybullet
-from pybullet_utils.bullet_client import BulletClient
 from scipy.spatial.transform import Rotation
 
 from plannerlab.errors import PlannerlabError
 from plannerlab.problem.scene import Box, Cylinder, Obstacle, Scene, Sphere
 from plannerlab.robots.base import Array, Robot, as_xyz, joint_difference
+from plannerlab.sim.quiet import engine_output_logged
+
+with engine_output_logged("pybullet import"):  # its build time, printed by C code
+    import pybullet
+    from pybullet_utils.bullet_client import BulletClient
 
 #: the paper's control step [s]
 DT_S: float = 1.0 / 240.0
@@ -158,15 +161,20 @@ class SimWorld:
             raise PlannerlabError(f"solver must be one of {', '.join(SOLVERS)}, got {solver!r}")
         self.solver = solver
         self._continuous = np.asarray(robot.continuous, dtype=bool)
-        self._client: BulletClient | None = BulletClient(
-            connection_mode=pybullet.GUI if gui else pybullet.DIRECT
-        )
+        # argv[0]=, a GUI's OpenGL report, the solver's name: C code's, logged
+        with engine_output_logged("pybullet connect"):
+            self._client: BulletClient | None = BulletClient(
+                connection_mode=pybullet.GUI if gui else pybullet.DIRECT
+            )
         try:
-            self._build(max_force)
-            if solver != "pgs":
-                self.client.setPhysicsEngineParameter(constraintSolverType=SOLVERS[solver])
-            if solver_iterations is not None:
-                self.client.setPhysicsEngineParameter(numSolverIterations=int(solver_iterations))
+            with engine_output_logged("pybullet set-up"):
+                self._build(max_force)
+                if solver != "pgs":
+                    self.client.setPhysicsEngineParameter(constraintSolverType=SOLVERS[solver])
+                if solver_iterations is not None:
+                    self.client.setPhysicsEngineParameter(
+                        numSolverIterations=int(solver_iterations)
+                    )
         except BaseException:
             self.close()
             raise

@@ -4,7 +4,7 @@
 
 Reads ``STORE_DIR/<problem>/trials.jsonl`` (written by ``results/escapes/run.sh``), prints
 the Markdown tables that ``results/escapes.md`` holds between its ``<!-- headline -->`` and
-``<!-- /table -->`` marks (and rewrites them there, and the headline table in the README
+``<!-- /table -->`` marks (and rewrites them there, and the headline table in docs/results.md
 between ``<!-- escapes -->`` marks), and draws ``STORE_DIR/progress_traps.png`` and
 ``STORE_DIR/progress_tasks.png``. Only trials that ran (not killed, no error) count
 as runs; a trial killed past its wall-clock limit counts as run and failed.
@@ -285,7 +285,7 @@ def main() -> None:
         old = md.read_text()
         new = re.sub(r"<!-- headline -->.*<!-- /table -->\n", lambda _: text, old, flags=re.S)
         md.write_text(new)
-    readme = ROOT / "README.md"  # the headline table there too, between its own marks
+    readme = ROOT / "docs" / "results.md"  # the headline table there too, between its marks
     old = readme.read_text()
     head = "<!-- escapes -->\n" + headline(rs, TRAPS + TASKS) + "<!-- /escapes -->"
     readme.write_text(

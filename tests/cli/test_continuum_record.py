@@ -45,10 +45,14 @@ def test_json_embeds_the_plan_and_execution_records(continuum_run) -> None:
     assert case["runs"] == 2 and case["same_every_run"] is True
     assert case["paper"] == {"time_s": 0.04, "collision_points": 5, "solutions": 1}
     assert case["search_median_s"] > 0 and case["solve_median_s"] > 0
-    # the plan entry is the plan file's content
+    # the plan entry is the plan file's content, which adds where the problem file is
+    # from the plan's own folder
     plan_file = out / f"{CASE}.plan.json"
     assert case["files"]["plan_file"] == str(plan_file)
-    assert case["plan"] == json.loads(plan_file.read_text())
+    saved = json.loads(plan_file.read_text())
+    from_plan = saved.pop("problem_file_from_plan")
+    assert case["plan"] == saved
+    assert (plan_file.parent / from_plan).resolve() == Path(saved["problem_file"]).resolve()
     plan = Plan.load(plan_file)
     (leg,) = plan.legs
     assert plan.planner == "chord_arc" and plan.seed == 0 and plan.problem == CASE

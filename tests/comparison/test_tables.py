@@ -223,6 +223,11 @@ def test_execution_table_keeps_obstacle_names_whole(width: int) -> None:
             duration_s=162.125,
             wall_time_s=41.9,
             success=False,
+            failures=(
+                "re-check: module_16 x boulder collide",
+                "contact module_17 x boulder (+2 more)",
+                "clearance -3.1 mm (module_17 x boulder)",
+            ),
         ),
         NS(
             path_valid=True,
@@ -239,6 +244,7 @@ def test_execution_table_keeps_obstacle_names_whole(width: int) -> None:
             duration_s=3.5,
             wall_time_s=0.9,
             success=True,
+            failures=(),
         ),
     ]
     lines = _render(width, lambda c: c.print(execution_table(legs, executions)))

@@ -197,7 +197,7 @@ def _room_table() -> list[tuple[tuple[str, ...], tuple[str, ...]]]:
             p for p in re.findall(r"`([^`]+)`", cells[0]) if "/" in p or p.endswith(".py")
         )
         tokens = tuple(
-            re.sub(r"\s*\(.*?\)", "", t).strip()
+            re.sub(r"\s*\(.*?\)", "", t).strip().strip("`")
             for t in cells[-1].split(",")
             if t.strip() not in ("", "—")
         )
@@ -223,7 +223,7 @@ def _allowed(i: int, rows) -> tuple[set[int], set[str]]:
             j
             for j, (paths, _) in enumerate(rows)
             for p in paths
-            if p.startswith(token + "/") or p in (token + ".py", token + "/")
+            if p.startswith(token + "/") or p in (token, token + ".py", token + "/")
         }
         if matched:
             room_rows |= matched
@@ -268,6 +268,33 @@ def test_every_module_imports_only_what_its_room_may_import():
                 if top not in packages and top.split("_")[0] not in packages:
                     offenders.append(f"{rel}:{line} imports the package {top}")
     assert offenders == []
+
+
+def test_the_cli_is_a_client_of_the_public_api():
+    """A subcommand imports nothing of plannerlab but the public API (``plannerlab``),
+    ``record``, ``errors`` and ``cli/`` itself; of the third-party packages only rich:
+    what a command needs, a notebook finds in ``plannerlab`` too (issue 28, item 6)."""
+    allowed = ("plannerlab.cli", "plannerlab.record", "plannerlab.errors")
+    offenders = []
+    for module, path in MODULES.items():
+        if not (module.startswith("plannerlab.cli") or module == "plannerlab.__main__"):
+            continue
+        for name, line in _imports(module, path):
+            top = name.split(".")[0]
+            if top == "plannerlab":
+                if name != "plannerlab" and not name.startswith(allowed):
+                    offenders.append(f"{_module_rel(path)}:{line} imports {name}")
+            elif top not in sys.stdlib_module_names and top not in ("__future__", "rich"):
+                offenders.append(f"{_module_rel(path)}:{line} imports the package {top}")
+    assert offenders == []
+
+
+def test_the_cli_row_of_the_room_table_names_only_the_api_and_record():
+    rows = _room_table()
+    cli_rows, packages = _allowed(_room_of("cli/main.py", rows), rows)
+    named = {rows[i][0][0] for i in cli_rows}
+    assert named == {"cli/", "__init__.py", "record/"}
+    assert packages == {"rich"}
 
 
 def test_the_room_check_sees_an_import_out_of_its_room():

@@ -16,6 +16,14 @@ The hybrids' checks were 14 378 and 24 694 before each leg got one planning cont
 sub-solves (each descent after the first, each RRT-Connect escape) checked their start,
 a state of the path checked already, again; 3 and 10 checks fewer, the paths the same.
 
+Re-pinned at the stop after 73e31a2 (six cases: the OMPL toy, PRM, PRM*, both hybrids'
+RRT-Connect escapes, multistart): on this machine (AMD EPYC) 73e31a2 itself gave other
+checks (and four other paths) than the values pinned on an earlier machine. Two causes:
+goal states drawn by the IK descent differed in their last bits (its linear algebra runs
+CPU-specific BLAS kernels; IK results are now rounded to 1e-9 rad,
+``problem/ik._ROUND_DECIMALS``), and compiled code runs on the host CPU's instructions
+(numba compiles for it), which moves a few step sizes by a float's last bit.
+
 Problems: ``toy`` (conftest.toy_problem), ``toy_joint`` (the toy with the goal state whose
 tip pose its goal region is), ``armz_behind_plate`` (test_escape_goals: the clearance
 descent stalls at a plate and escapes with RRT-Connect), the rest bundled.
@@ -30,28 +38,28 @@ import pytest
 #: (planner, problem, check budget, seed) -> (status, checks, iterations, minima,
 #: escapes, path digest)
 GOLDEN = {
-    ("ompl.rrtconnect", "toy", 20_000, 5): ("solved", 933, 1, 0, 0, "329421407dad09f6"),
+    ("ompl.rrtconnect", "toy", 20_000, 5): ("solved", 945, 1, 0, 0, "329421407dad09f6"),
     ("ompl.kpiece1", "toy", 20_000, 5): ("solved", 1168, 18, 0, 0, "b39b50323c865506"),
     ("gradient.follow_leader", "toy", 20_000, 5): ("solved", 564, 587, 0, 0, "61d72f1330090571"),
     ("gradient+rrtconnect", "armz_pocket", 30_000, 3): (
         "solved",
-        14414,  # the descent's steps confirmed in metres (+39 checks, same path)
+        11919,
         131,
         2,
         2,
-        "dea25a25e2abb420",
+        "625be33c04fa1282",
     ),
     ("gradient.multistart", "armz_pocket", 30_000, 3): (
         # restarts checked in metres: fewer of them are clear, the budget runs out first
         "budget_exhausted",
-        30013,
-        1074,
+        30003,
+        1076,
         7,
         7,
-        "1d8fdcf342e3f1cd",
+        "482129b54811cde8",
     ),
-    ("ompl.prm", "toy", 20_000, 5): ("solved", 17612, 72, 0, 0, "429e64a7746baed4"),
-    ("ompl.prmstar", "toy", 20_000, 5): ("solved", 19925, 76, 0, 0, "c0daa7e1398b7050"),
+    ("ompl.prm", "toy", 20_000, 5): ("solved", 17925, 72, 0, 0, "429e64a7746baed4"),
+    ("ompl.prmstar", "toy", 20_000, 5): ("solved", 20000, 76, 0, 0, "bf38396b893ee331"),
     ("ompl.rrtconnect", "toy_joint", 20_000, 5): ("solved", 600, 1, 0, 0, "5e54a2caaa73d393"),
     ("gradient.clearance", "armz_pocket", 20_000, 0): (
         "solved",
@@ -80,11 +88,11 @@ GOLDEN = {
     ),
     ("gradient.clearance+rrtconnect", "armz_behind_plate", 60_000, 0): (
         "solved",
-        3151,
+        3071,
         244,
         1,
         1,
-        "30c5d4df45629854",
+        "425bdabf890f3091",
     ),
     ("gradient.follow_leader+random", "armz_thin_wall", 20_000, 0): (
         "solved",

@@ -11,13 +11,26 @@ with no Python call per state.
   whole budget shortening its best path.
 
 Modules: ``settings`` (frozen settings), ``kernels`` (the compiled search),
-``planner`` (one solve: the goal pool, the chunks and the budget, the re-check),
+``solve`` (one solve: the goal pool, the chunks and the budget, the re-check, and
+RRT-Connect's), ``planner`` (the planner class and the registry's factory),
 ``rrtstar`` (RRT*'s kernel and solve), ``warm`` (kernels loaded before the clock).
 """
 
 from __future__ import annotations
 
-from plannerlab.planners.native.planner import NativePlanner, NativeSolve, make
-from plannerlab.planners.native.settings import NativeSettings, RRTstarSettings
+from plannerlab.planners.native.planner import NativePlanner, make
+from plannerlab.planners.native.settings import (
+    NativeSettings,
+    RRTConnectSettings,
+    RRTstarSettings,
+)
+from plannerlab.planners.native.solve import NativeSolve
 
-__all__ = ["NativePlanner", "NativeSettings", "NativeSolve", "RRTstarSettings", "make"]
+__all__ = [
+    "NativePlanner",
+    "NativeSettings",
+    "NativeSolve",
+    "RRTConnectSettings",
+    "RRTstarSettings",
+    "make",
+]

@@ -11,11 +11,13 @@ edges child → parent (the path runs from a goal tree's leaf to its root), shor
 the path. The re-check ``checker.check_path(path, step, mode="grid")`` thus checks states
 the search checked, bit for bit, and a returned path passes it by construction.
 
-Budgets: a kernel call runs until a *soft* limit on its checks (the chunk: the caller
-looks at the clock between chunks) or iterations is passed at the end of an iteration, or
-a *hard* limit on checks (the budget) would be crossed inside one (the edge is then left
-unproved and the search stops). Chunks end between iterations, so the search does not
-depend on how it is cut into chunks: the same seed gives the same path.
+Budgets: a kernel call runs until a *soft* limit on its checks is passed (the chunk:
+the caller looks at the clock between chunks; given only with a time limit), checked
+between two edges (an edge is never cut short by it, so every chunk makes progress), or
+until a *hard* one (the budget) is reached, if need be inside an edge, which is then left
+unproved, or the iteration budget is used up. Without a time limit there is one chunk,
+so the search does not depend on the machine: the same seed gives the same path, checks
+and iterations.
 
 Generator: xoshiro256+ (state: 4 uint64, seeded by :func:`seed_state`); doubles from
 its upper 53 bits; Gaussian noise by Box–Muller.
@@ -41,6 +43,12 @@ HARD = 2
 ITERATIONS = 3
 #: a tree has no room for another iteration's nodes: grow its arrays and call again
 FULL = 4
+
+# node flags (F arrays): the edge to the node's parent is checked on its coarse states, on
+# all of them, or was found invalid on its fine states (the node and its subtree are dead)
+COARSE = 0
+CHECKED = 1
+DEAD = 2
 
 _U11 = np.uint64(11)
 _U17 = np.uint64(17)
@@ -137,13 +145,16 @@ def distance2(a, b, continuous):
 
 
 @njit(cache=True, nogil=True)
-def nearest(Q, n, q, continuous, any_continuous):
-    """Index of the state of Q[:n] nearest to q (brute force over contiguous rows, each
-    row's sum abandoned once it exceeds the best)."""
+def nearest(Q, n, q, continuous, any_continuous, F):
+    """Index of the state of Q[:n] nearest to q, rows with ``F[r] == DEAD`` left out
+    (brute force over contiguous rows, each row's sum abandoned once it exceeds the
+    best); -1 when every row is dead."""
     best = np.inf
     best_i = -1
     dof = q.shape[0]
     for r in range(n):
+        if F[r] == DEAD:
+            continue
         acc = 0.0
         if any_continuous:
             for i in range(dof):
@@ -189,40 +200,48 @@ def steer(q_from, q_to, range_rad, continuous, d, out):
 
 # ---------------------------------------------------------------------- edges
 @njit(cache=True, nogil=True)
-def edge_free(q_a, q_b, joint_step, m, V, S, d, q, limit, near_a_first):
-    """Check the grid states 1..n of edge q_a -> q_b (those of ``densify``; q_a itself is
-    not one), the new end first (``near_a_first``: j = 1, the state next to q_a; else
-    j = n, the state reaching q_b), then the midpoints of ever finer halvings (the way
-    VAMP checks a whole edge at once). No check is made once ``limit`` checks were made.
+def edge_free(q_a, q_b, joint_step, m, V, S, d, q, limit, near_a_first, every=1, fine=False):
+    """Check grid states of edge q_a -> q_b (states 1..n of ``densify``; q_a itself is
+    not one) in an order that finds a collision early: the new end first
+    (``near_a_first``: j = 1, the state next to q_a; else j = n, the state reaching q_b),
+    then the midpoints of ever finer halvings (the way VAMP checks a whole edge at once).
 
-    Returns (status, checks): 0 every state is valid, 1 one is invalid, 2 the limit came
-    first (nothing proved)."""
+    ``every`` (a power of two) splits the grid in two: the *coarse* states (the ends and
+    every ``every``-th state) are checked with ``fine`` False, the others with ``fine``
+    True; ``every`` = 1 checks all at once. No check is made once ``limit`` checks were
+    made.
+
+    Returns (status, checks): 0 every state asked is valid, 1 one is invalid, 2 the limit
+    came first (nothing proved)."""
     edge_delta(q_a, q_b, m.continuous, d)
     n = edge_count(d, joint_step, m.edge_weights)
     first = 1 if near_a_first else n
     if limit <= 0:
         return 2, 0
-    edge_state(q_a, d, first, n, q)
-    checks = 1
-    if not state_ok(q, V, S):
-        return 1, checks
-    if n == 1:
-        return 0, checks
-    if near_a_first:  # then the far end, j = n
-        if checks >= limit:
-            return 2, checks
-        edge_state(q_a, d, n, n, q)
+    checks = 0
+    if not fine:
+        edge_state(q_a, d, first, n, q)
         checks += 1
         if not state_ok(q, V, S):
             return 1, checks
+        if n == 1:
+            return 0, checks
+        if near_a_first:  # then the far end, j = n
+            if checks >= limit:
+                return 2, checks
+            edge_state(q_a, d, n, n, q)
+            checks += 1
+            if not state_ok(q, V, S):
+                return 1, checks
     step = 1
     while step < n:
         step *= 2
-    h = step // 2
-    while h >= 1:
+    h = step // 2 if not fine else every // 2
+    h_end = every if not fine else 1
+    while h >= h_end:
         j = h
         while j < n:
-            if j != first:
+            if not (fine and near_a_first and j == 1) and not (not fine and j == first):
                 if checks >= limit:
                     return 2, checks
                 edge_state(q_a, d, j, n, q)
@@ -243,31 +262,86 @@ def edge_states(q_a, q_b, joint_step, m, d):
 
 # ---------------------------------------------------------------------- RRT-Connect
 @njit(cache=True, nogil=True)
-def _grow(Qt, Pt, nt, goal_tree, near, q_to, range_rad, joint_step, m, V, S, buf, limit):
-    """Grow tree (Qt, Pt) of nt nodes from node ``near`` (-1: the nearest) towards q_to:
-    a node at most ``range_rad`` on, added at index nt when its edge is free.
+def _tree_edge(Qt, Pt, c, goal_tree, joint_step, m, V, S, buf, limit, every, fine):
+    """:func:`edge_free` on the edge of node c to its parent, in the direction the path
+    runs (start tree parent -> child, goal tree child -> parent)."""
+    p = Pt[c]
+    if goal_tree:
+        return edge_free(Qt[c], Qt[p], joint_step, m, V, S, buf[2], buf[3], limit, True,
+                         every, fine)  # fmt: skip
+    return edge_free(Qt[p], Qt[c], joint_step, m, V, S, buf[2], buf[3], limit, False,
+                     every, fine)  # fmt: skip
+
+
+@njit(cache=True, nogil=True)
+def _grow(Qt, Pt, Ft, Rt, nt, goal_tree, near, q_to, range_rad, joint_step, m, V, S, buf,
+          limit, every, dd):  # fmt: skip
+    """Grow tree (Qt, Pt, Ft, Rt) of nt nodes from node ``near`` (-1: the nearest live one)
+    towards q_to: a node at most ``range_rad`` on, added at index nt when the coarse
+    states of its edge are free (all of them with ``every`` = 1).
+
+    Dynamic domain (``dd`` = (radius, min_radius, alpha) [rad, rad, 1], radius > 0; only
+    for the nearest-node step): a sample farther from its nearest node than the node's
+    radius ``Rt`` is dropped unchecked; a node's first failed extension sets its radius
+    to ``radius``, later ones shrink it by (1 - alpha) down to ``min_radius``, successes
+    grow it by (1 + alpha) (Yershova et al. 2005, as VAMP's RRT-Connect).
 
     Returns (code, checks, near): code 0 trapped, 1 advanced, 2 reached q_to, 3 the
-    hard limit came first."""
+    hard limit came first, 4 dropped by the dynamic domain."""
+    domain = near < 0 and dd[0] > 0.0
     if near < 0:
-        near = nearest(Qt, nt, q_to, m.continuous, m.continuous.any())
-    target = buf[1]
-    reached = steer(Qt[near], q_to, range_rad, m.continuous, buf[2], target)
-    if goal_tree:  # the path runs child -> parent here
-        status, checks = edge_free(
-            target, Qt[near], joint_step, m, V, S, buf[2], buf[3], limit, True
-        )
-    else:
-        status, checks = edge_free(
-            Qt[near], target, joint_step, m, V, S, buf[2], buf[3], limit, False
-        )
+        near = nearest(Qt, nt, q_to, m.continuous, m.continuous.any(), Ft)
+        if domain and distance2(Qt[near], q_to, m.continuous) > Rt[near] * Rt[near]:
+            return 4, 0, near
+    Qt[nt] = Qt[near]  # the new row's parent edge, from near to the target
+    Pt[nt] = near
+    reached = steer(Qt[near], q_to, range_rad, m.continuous, buf[2], Qt[nt])
+    status, checks = _tree_edge(Qt, Pt, nt, goal_tree, joint_step, m, V, S, buf, limit, every,
+                                False)  # fmt: skip
     if status == 2:
         return 3, checks, near
     if status == 1:
+        if domain:
+            Rt[near] = dd[0] if Rt[near] == np.inf else max(Rt[near] * (1.0 - dd[2]), dd[1])
         return 0, checks, near
-    Qt[nt] = target
-    Pt[nt] = near
+    if domain and Rt[near] != np.inf:
+        Rt[near] *= 1.0 + dd[2]
+    Ft[nt] = CHECKED if every == 1 else COARSE
+    Rt[nt] = np.inf
     return (2 if reached else 1), checks, near
+
+
+@njit(cache=True, nogil=True)
+def _kill(Pt, Ft, c, n):
+    """Node c and its subtree are dead (parents come before their children)."""
+    Ft[c] = DEAD
+    for i in range(c + 1, n):
+        if Pt[i] >= 0 and Ft[Pt[i]] == DEAD:
+            Ft[i] = DEAD
+
+
+@njit(cache=True, nogil=True)
+def _certify(QA, PA, FA, a, QB, PB, FB, b, sizes, joint_step, m, V, S, buf, limit, every):
+    """Check the fine states of the found path's edges not checked in full (A's chain
+    from a, B's from b), each marked CHECKED when free; an invalid one kills its node's
+    subtree. Returns (status, checks): 0 the path is checked, 1 an edge failed, 2 the
+    limit came first."""
+    checks = 0
+    for t in range(2):
+        Qt, Pt, Ft, c = (QA, PA, FA, a) if t == 0 else (QB, PB, FB, b)
+        while Pt[c] >= 0:
+            if Ft[c] == COARSE:
+                status, k = _tree_edge(Qt, Pt, c, t == 1, joint_step, m, V, S, buf,
+                                       limit - checks, every, True)  # fmt: skip
+                checks += k
+                if status == 2:
+                    return 2, checks
+                if status == 1:
+                    _kill(Pt, Ft, c, sizes[t])
+                    return 1, checks
+                Ft[c] = CHECKED
+            c = Pt[c]
+    return 0, checks
 
 
 @njit(cache=True, nogil=True)
@@ -277,8 +351,12 @@ def rrtc_run(
     S,
     QA,
     PA,
+    FA,
+    RA,
     QB,
     PB,
+    FB,
+    RB,
     sizes,
     counters,
     rng,
@@ -287,6 +365,8 @@ def rrtc_run(
     guide_sigma_rad,
     range_rad,
     joint_step,
+    every,
+    dd,
     max_iterations,
     soft_checks,
     hard_checks,
@@ -295,10 +375,18 @@ def rrtc_run(
 ):
     """RRT-Connect iterations until a path, a limit, or a full tree.
 
-    Trees: A (QA (cap_a, dof) states, PA parents, -1 at the root: the start) and B (the
-    goal tree, a root per goal state); ``sizes`` (2,) their node counts. ``counters``
-    (5,) int64 carries the search across calls: iterations, checks, the tree to grow
-    next (0 A, 1 B), and on a path the meeting node in A and in B (equal states).
+    Trees: A (QA (cap_a, dof) states, PA parents, -1 at the root: the start, FA flags,
+    RA dynamic-domain radii, inf: none) and B (the goal tree, a root per goal state);
+    ``sizes`` (2,) their node counts.
+    ``counters`` (6,) int64 carries the search across calls: iterations, checks, the tree
+    to grow next (0 A, 1 B), on a path the meeting node in A and in B (equal states), and
+    the found paths whose fine check failed.
+
+    Lazy fine checks (``every`` > 1, a power of two): a tree edge is checked on its coarse
+    states (its ends and every ``every``-th grid state) when it is added; the others only
+    when a path through it is found (:func:`_certify`); a failure kills the subtree below
+    it and the search goes on. With ``every`` = 1 every edge is checked in full at once.
+    ``dd``: the dynamic domain of the extension (:func:`_grow`; radius 0: none).
 
     Each iteration draws a sample (:func:`sample`: uniform, or a guide state perturbed,
     with probability ``guide_bias``; ``guides`` (k, dof), k = 0 for none), extends the
@@ -307,16 +395,20 @@ def rrtc_run(
     RRT-Connect); the trees then swap roles.
 
     Limits: ``max_iterations`` (total), ``soft_checks`` (total checks after which this
-    call returns :data:`CHUNK` at the end of an iteration), ``hard_checks`` (total checks
-    never crossed: :data:`HARD`), ``need_free`` (free rows each tree needs before an
+    call returns :data:`CHUNK` between two edges: a connection stops where it got to, its
+    nodes checked), ``hard_checks`` (total checks never crossed, inside an edge if need
+    be: :data:`HARD`), ``need_free`` (free rows each tree needs before an
     iteration starts, else :data:`FULL`). ``buf`` (4, dof) scratch.
 
     Returns a code (:data:`CHUNK`, :data:`DONE`, :data:`HARD`, :data:`ITERATIONS`,
     :data:`FULL`)."""
     q_rand = buf[0]
+    no_domain = np.zeros(3)  # the connection steps have none
     while True:
         if counters[0] >= max_iterations:
             return ITERATIONS
+        if counters[1] >= hard_checks:
+            return HARD
         if counters[1] >= soft_checks:
             return CHUNK
         if QA.shape[0] - sizes[0] < need_free or QB.shape[0] - sizes[1] < need_free:
@@ -326,12 +418,14 @@ def rrtc_run(
         t = counters[2]
         counters[2] = 1 - t
         if t == 0:
-            Qt, Pt, Qo, Po = QA, PA, QB, PB
+            Qt, Pt, Ft, Rt, Qo, Po, Fo, Ro = QA, PA, FA, RA, QB, PB, FB, RB
         else:
-            Qt, Pt, Qo, Po = QB, PB, QA, PA
+            Qt, Pt, Ft, Rt, Qo, Po, Fo, Ro = QB, PB, FB, RB, QA, PA, FA, RA
         code, c, _ = _grow(
             Qt,
             Pt,
+            Ft,
+            Rt,
             sizes[t],
             t == 1,
             -1,
@@ -343,11 +437,13 @@ def rrtc_run(
             S,
             buf,
             hard_checks - counters[1],
+            every,
+            dd,
         )
         counters[1] += c
         if code == 3:
             return HARD
-        if code == 0:
+        if code == 0 or code == 4:
             continue
         new_t = sizes[t]
         sizes[t] += 1
@@ -360,6 +456,8 @@ def rrtc_run(
             code, c, _ = _grow(
                 Qo,
                 Po,
+                Fo,
+                Ro,
                 sizes[o],
                 o == 1,
                 near,
@@ -371,6 +469,8 @@ def rrtc_run(
                 S,
                 buf,
                 hard_checks - counters[1],
+                every,
+                no_domain,
             )
             counters[1] += c
             if code == 3:
@@ -380,9 +480,21 @@ def rrtc_run(
             near = sizes[o]
             sizes[o] += 1
             if code == 2:
-                counters[3] = new_t if t == 0 else near
-                counters[4] = near if t == 0 else new_t
+                a = new_t if t == 0 else near
+                b = near if t == 0 else new_t
+                status, c = _certify(QA, PA, FA, a, QB, PB, FB, b, sizes, joint_step, m, V,
+                                     S, buf, hard_checks - counters[1], every)  # fmt: skip
+                counters[1] += c
+                if status == 2:
+                    return HARD
+                if status == 1:  # a fine state of the path collides: search on
+                    counters[5] += 1
+                    break
+                counters[3] = a
+                counters[4] = b
                 return DONE
+            if counters[1] >= soft_checks:  # the connection so far stays (checked nodes)
+                return CHUNK
 
 
 @njit(cache=True, nogil=True)
@@ -438,16 +550,20 @@ def _try_shortcut(P, k, i, j, m, V, S, joint_step, buf, limit):
 @njit(cache=True, nogil=True)
 def shortcut_run(P, k, m, V, S, joint_step, rng, tries, counters, soft_checks, hard_checks, buf):
     """Shorten the path P[:k] in place: ``tries`` random shortcuts (states i < j - 1
-    drawn uniformly, the edge P[i] -> P[j] replacing those between when free), then one
-    pass dropping each waypoint whose neighbours see each other. ``counters`` (3,) int64
+    drawn uniformly, the edge P[i] -> P[j] replacing those between when free; they end
+    early once as many tries in a row failed as the path has such pairs), then one pass
+    dropping each waypoint whose neighbours see each other. ``counters`` (4,) int64
     carries the work across calls: shortcuts tried, checks, the pass's position (0: not
-    started). Limits as :func:`rrtc_run` (``soft_checks``, ``hard_checks``: totals).
+    started), tries failed in a row. Limits as :func:`rrtc_run` (``soft_checks``,
+    ``hard_checks``: totals).
 
     Returns (k, code): :data:`CHUNK` (call again), :data:`DONE`, :data:`HARD`."""
     while counters[0] < tries:
-        if k < 3:
+        if k < 3 or counters[3] >= (k - 1) * (k - 2) // 2:
             counters[0] = tries
             break
+        if counters[1] >= hard_checks:
+            return k, HARD
         if counters[1] >= soft_checks:
             return k, CHUNK
         counters[0] += 1
@@ -457,9 +573,12 @@ def shortcut_run(P, k, m, V, S, joint_step, rng, tries, counters, soft_checks, h
         counters[1] += c
         if code == 2:
             return k, HARD
+        counters[3] = 0 if code == 1 else counters[3] + 1
     if counters[2] == 0:
         counters[2] = 1
     while counters[2] < k - 1:
+        if counters[1] >= hard_checks:
+            return k, HARD
         if counters[1] >= soft_checks:
             return k, CHUNK
         i = counters[2]

@@ -53,24 +53,24 @@ from plannerlab.planners.follow_leader import FollowLeader, FollowLeaderSettings
 from plannerlab.planners.gradient_clearance import ClearanceSettings
 from plannerlab.planners.leader_moves import Track, crosses_body
 from plannerlab.planners.native import kernels as K
-from plannerlab.planners.native.planner import (
+from plannerlab.planners.native.planner import NativePlanner, _check_settings
+from plannerlab.planners.native.settings import RRTConnectSettings
+from plannerlab.planners.native.solve import (
     FIRST_ROWS,
     UNLIMITED,
     K_views,
-    NativePlanner,
     NativeSolve,
-    _check_settings,
     space_extent,
+    writable_model,
 )
-from plannerlab.planners.native.settings import NativeSettings
 from plannerlab.robots.base import Array, wrap_to_pi
 
 __all__ = ["LeaderSettings", "LeaderPlanner", "Guidance", "make"]
 
 
 @dataclass(frozen=True)
-class LeaderSettings(NativeSettings):
-    """Settings of ``native.rrtconnect+leader`` (besides :class:`NativeSettings`).
+class LeaderSettings(RRTConnectSettings):
+    """Settings of ``native.rrtconnect+leader`` (besides :class:`RRTConnectSettings`).
 
     Attributes:
         guide_bias: (here 0.5) the share of samples drawn near a guide state.
@@ -293,7 +293,7 @@ class LeaderSolve(NativeSolve):
         q0 = self.q0
         if self.ctx.start_problem is not None:
             return self.result(Status.INVALID_START, self.ctx.start_problem, q0[None])
-        model = self.checker.model
+        model = writable_model(self.checker.model)
         self.run.progress.note(float(self.goal.distance(self.robot, q0)))
         t0, c0 = self.tracker.elapsed_s, self.tracker.checks_used
         g = build_guidance(self.leader, self.lsettings, self, self.ctx, self.rng)
@@ -320,25 +320,31 @@ class LeaderSolve(NativeSolve):
         cap = max(self.tree_rows(hard0, seeded, dof), need_free + seeded + 1)
         self.extra["tree_rows"] = cap
         rows = min(cap, max(FIRST_ROWS, need_free + seeded + 1))
-        QA, PA = np.empty((rows, dof)), np.full(rows, -1, dtype=np.int64)
-        QB, PB = np.empty((rows, dof)), np.full(rows, -1, dtype=np.int64)
         # the trees as the leader seeded them (the start's branches, the goal states'
-        # roots with their backward branches)
+        # roots with their backward branches), their edges checked in full
         na, nb = len(g.start_states), len(g.goal_states)
-        QA[:na], PA[:na] = g.start_states, g.start_parents
-        QB[:nb], PB[:nb] = g.goal_states, g.goal_parents
+        trees: list[np.ndarray] = []
+        for Q0, P0 in ((g.start_states, g.start_parents), (g.goal_states, g.goal_parents)):
+            Q, P = np.empty((rows, dof)), np.full(rows, -1, dtype=np.int64)
+            F = np.full(rows, K.CHECKED, dtype=np.int8)
+            R = np.full(rows, np.inf)
+            Q[: len(Q0)], P[: len(P0)] = Q0, P0
+            trees += [Q, P, F, R]
         sizes = np.array([na, nb], dtype=np.int64)
-        counters = np.zeros(5, dtype=np.int64)
+        counters = np.zeros(6, dtype=np.int64)
         if g.reached_node >= 0:
             # joined already: the meeting node is the reached state, the goal tree's root 0
             counters[3], counters[4] = g.reached_node, 0
             self.iterations = g.iterations
             self.extra["nodes"] = [na, nb]
-            return self._finish(QA, PA, QB, PB, counters, na + nb, model, V, S, rng_state)
+            return self._finish(trees, counters, na + nb, model, V, S, rng_state)
+        dd = np.zeros(3)
+        if getattr(self.s, "dynamic_domain", False):
+            dd[:] = (2.0 * range_rad, 0.5 * range_rad, 1e-4)
+        every = int(getattr(self.s, "lazy_every", 1))
         buf = np.empty((4, dof))
         b = self.budget
         max_it = UNLIMITED if b.max_iterations is None else max(b.max_iterations - g.iterations, 1)
-        trees = [QA, PA, QB, PB]
         self._charged = 0
         s = self.s
 
@@ -348,10 +354,7 @@ class LeaderSolve(NativeSolve):
                     model,
                     V,
                     S,
-                    trees[0],
-                    trees[1],
-                    trees[2],
-                    trees[3],
+                    *trees,
                     sizes,
                     counters,
                     rng_state,
@@ -360,6 +363,8 @@ class LeaderSolve(NativeSolve):
                     s.guide_sigma_rad,
                     range_rad,
                     self.step,
+                    every,
+                    dd,
                     max_it,
                     soft,
                     hard,
@@ -373,12 +378,10 @@ class LeaderSolve(NativeSolve):
             self.iterations = g.iterations + int(counters[0])
             if code == K.FULL and len(trees[0]) < cap:
                 grown = min(cap, 4 * len(trees[0]))
-                for t in (0, 2):
-                    Q = np.empty((grown, dof))
-                    Q[: len(trees[t])] = trees[t]
-                    P = np.full(grown, -1, dtype=np.int64)
-                    P[: len(trees[t + 1])] = trees[t + 1]
-                    trees[t], trees[t + 1] = Q, P
+                for i, arr in enumerate(trees):
+                    bigger = np.full((grown,) + arr.shape[1:], -1, dtype=arr.dtype)
+                    bigger[: len(arr)] = arr
+                    trees[i] = bigger
                 continue
             break
         self.extra["planning_checks"] = int(counters[1])
@@ -386,25 +389,12 @@ class LeaderSolve(NativeSolve):
         self.extra["nodes"] = [int(sizes[0]), int(sizes[1])]
         if code != K.DONE:
             return self.stopped(code, f"{int(sizes[0])} + {int(sizes[1])} tree nodes")
-        return self._finish(
-            trees[0],
-            trees[1],
-            trees[2],
-            trees[3],
-            counters,
-            int(sizes.sum()),
-            model,
-            V,
-            S,
-            rng_state,
-        )
+        self.extra["paths_failing_fine_check"] = int(counters[5])
+        return self._finish(trees, counters, int(sizes.sum()), model, V, S, rng_state)
 
     def _finish(
         self,
-        QA: Array,
-        PA: Array,
-        QB: Array,
-        PB: Array,
+        trees: list[np.ndarray],
         counters: Array,
         rows: int,
         model: Any,
@@ -414,8 +404,8 @@ class LeaderSolve(NativeSolve):
     ) -> PlanResult:
         """The path through the meeting nodes (``counters[3]`` in A, ``counters[4]`` in
         B), shortcut and re-checked."""
-        out = np.empty((rows, QA.shape[1]))
-        k = K.tree_path(QA, PA, counters[3], QB, PB, counters[4], out)
+        out = np.empty((rows, trees[0].shape[1]))
+        k = K.tree_path(trees[0], trees[1], counters[3], trees[4], trees[5], counters[4], out)
         path = out[:k].copy()
         self.extra["waypoints_raw"] = k
         if self.s.simplify:

@@ -47,6 +47,28 @@ class NativeSettings:
 
 
 @dataclass(frozen=True)
+class RRTConnectSettings(NativeSettings):
+    """RRT-Connect.
+
+    Attributes:
+        lazy_every: a tree edge is checked, when it is added, on its coarse states only:
+            its ends and every ``lazy_every``-th state of its grid (a power of two); the
+            others only when a path through it is found (a failure there drops the
+            edge's subtree and the search goes on). Most tree edges are never on a path,
+            so most of their states are never checked; the returned path's are all. 1:
+            every edge in full at once.
+        dynamic_domain: the dynamic domain of the extension step (Yershova et al. 2005;
+            VAMP's RRT-Connect has it on): a sample farther from its nearest node than
+            that node's radius is dropped unchecked; a failed extension gives its node a
+            radius of 2 ``range_rad`` and shrinks it slowly to ``range_rad`` / 2. Off:
+            OMPL's RRT-Connect (``ompl.rrtconnect``'s algorithm).
+    """
+
+    lazy_every: int = 16
+    dynamic_domain: bool = False
+
+
+@dataclass(frozen=True)
 class RRTstarSettings(NativeSettings):
     """RRT* (one tree from the start, goal-biased, rewired in a ball of ``k`` nearest).
 

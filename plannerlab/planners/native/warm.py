@@ -13,7 +13,11 @@ def warm_up(model: Any | None = None) -> None:
     model to run them on; default: a two-joint chain in an empty room)."""
     from plannerlab.collision.model import views
     from plannerlab.planners.native import kernels as K
+    from plannerlab.planners.native import rrtstar as R
 
+    entries = (views, K.rrtc_run, K.tree_path, K.shortcut_run, R.rrtstar_run, R.chain)
+    if model is None and all(getattr(f, "signatures", True) for f in entries):
+        return  # loaded in this process already
     if model is None:
         model = _tiny_model()
     V, S = views(model)
@@ -21,15 +25,26 @@ def warm_up(model: Any | None = None) -> None:
     Q = np.zeros((4, dof))
     P = np.full(4, -1, dtype=np.int64)
     sizes = np.array([1, 1], dtype=np.int64)
-    counters = np.zeros(5, dtype=np.int64)
+    counters = np.zeros(6, dtype=np.int64)
     rng = np.array([1, 2, 3, 4], dtype=np.uint64)
     buf = np.empty((4, dof))
     guides = np.zeros((0, dof))
+    F = np.ones(4, dtype=np.int8)
+    radii = np.full(4, np.inf)
     K.rrtc_run(
-        model, V, S, Q, P, Q, P, sizes, counters, rng, guides, 0.0, 0.1, 1.0, 0.1, 0, 0, 0, 1, buf
-    )
+        model, V, S, Q, P, F, radii, Q, P, F, radii, sizes, counters, rng, guides, 0.0, 0.1,
+        1.0, 0.1, 8, np.zeros(3), 0, 0, 0, 1, buf,
+    )  # fmt: skip
     K.tree_path(Q, P, 0, Q, P, 0, Q.copy())
-    K.shortcut_run(Q, 1, model, V, S, 0.1, rng, 0, np.zeros(3, dtype=np.int64), 0, 0, buf)
+    K.shortcut_run(Q, 1, model, V, S, 0.1, rng, 0, np.zeros(4, dtype=np.int64), 0, 0, buf)
+    cost = np.zeros(4)
+    R.rrtstar_run(
+        model, V, S, Q, P, cost, P.copy(), P.copy(), P.copy(), P.copy(), F,
+        np.array([1, 0], dtype=np.int64),
+        np.array([0, 0, -1, 0], dtype=np.int64), rng, guides, 0.0, guides, 0.0, 0.1, 1.0, 0.1,
+        1.0, 0, 0, 0, buf, np.empty(4, dtype=np.int64), np.empty(4), np.empty(4, dtype=np.int64),
+    )  # fmt: skip
+    R.chain(Q, P, 0, Q.copy())
 
 
 def _tiny_model() -> Any:
@@ -40,4 +55,5 @@ def _tiny_model() -> Any:
     from plannerlab.robots.base import trans
 
     scene = Scene((Sphere("far", trans(5.0, 0.0, 0.0), 0.1),))
-    return CollisionChecker(ArmZ(n_modules=3), scene, margin_m=0.01).model
+    robot: Any = ArmZ(n_modules=3)
+    return CollisionChecker(robot, scene, margin_m=0.01).model

@@ -1,0 +1,25 @@
+"""A record's numbers as table cells: the one formatting of the terminal tables and the
+Markdown reports (3 significant digits, "-" for a missing number)."""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+
+def mm(x: Any) -> Any:
+    """Metres to millimetres for a table cell (None and NaN pass through)."""
+    return None if x is None else 1e3 * float(x)
+
+
+def fmt(x: Any, digits: int = 3) -> str:
+    """A number for a table: 3 significant digits, "-" for missing/NaN."""
+    if x is None:
+        return "-"
+    if isinstance(x, bool):
+        return "yes" if x else "no"
+    if isinstance(x, float):
+        if not math.isfinite(x):
+            return "-"
+        return f"{x:.{digits}g}" if abs(x) < 1e3 else f"{x:.0f}"
+    return str(x)
