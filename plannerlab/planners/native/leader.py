@@ -150,20 +150,34 @@ class _Tree:
         return np.array(self.Q, dtype=float).reshape(-1, dof), np.array(self.P, dtype=np.int64)
 
 
-def _verified(ctx: PlanningContext, states: list[Array], step: float, thin: int = 8) -> Array:
+def _verified(
+    ctx: PlanningContext, states: list[Array], step: float, used: int, thin: int = 8
+) -> Array:
     """A chain of the descent's states fit for a tree, wrapped: every ``thin``-th state
     (and the last) when the edges between them pass the search's grid check (the
     descent's states lie a few hundredths of a radian apart; fewer, longer edges make
     the path's simplification cheaper), else the longest prefix of all of them whose
-    edges pass it (the descent checks states; the search and the re-check check edges)."""
+    edges pass it (the descent checks states; the search and the re-check check edges).
+    Within the leg's budget (``used``: its iterations so far): a check cut short by it
+    keeps the first state only."""
+    tracker = ctx.tracker
     P = wrap_to_pi(np.array(states, dtype=float).reshape(-1, ctx.robot.dof), ctx.robot.continuous)
     if len(P) < 2:
         return P
+
+    def stop() -> bool:
+        return tracker.exhausted(used) is not None
+
     if thin > 1 and len(P) > thin:
         keep = np.unique(np.concatenate([np.arange(0, len(P), thin), [len(P) - 1]]))
-        if ctx.checker.check_path(P[keep], step, mode="grid").valid:
+        check = ctx.checker.check_path(P[keep], step, stop=stop, chunk=64, mode="grid")
+        if not check.complete:
+            return P[:1]
+        if check.valid:
             return P[keep]
-    check = ctx.checker.check_path(P, step, mode="grid")
+    check = ctx.checker.check_path(P, step, stop=stop, chunk=64, mode="grid")
+    if not check.complete:
+        return P[:1]
     if check.valid:
         return P
     bad = check.first_invalid_edge
@@ -193,13 +207,13 @@ def build_guidance(
     reached_nodes: list[int] = []
 
     def out_of_budget() -> PlanResult | None:
-        why = tracker.exhausted(0)
+        why = tracker.exhausted(used)
         return None if why is None else solve.result(Status.BUDGET_EXHAUSTED, why, q0[None])
 
     def grow_start(parent: int, tr: Track, key: str) -> int:
         nonlocal used
         used += tr.iterations
-        chain = _verified(ctx, tr.states, step)
+        chain = _verified(ctx, tr.states, step, used)
         chains.append(chain)
         whole = bool(np.allclose(chain[-1], wrap_to_pi(tr.states[-1], robot.continuous)))
         log[key] = {"status": tr.status.value, "states": len(chain), "reason": tr.reason}
@@ -211,12 +225,12 @@ def build_guidance(
 
     def retract_branch() -> None:
         end = grow_start(0, leader.retract(ctx, q0, used), "retract")
-        if tracker.exhausted(0) is None:
+        if tracker.exhausted(used) is None:
             grow_start(end, leader.track(ctx, A.Q[end], goal, rng, used), "after_retract")
 
     if s.forward:
         lead = leader.leader_path(
-            ctx.problem, ctx.leg, q0, rng, lambda: tracker.exhausted(0) is not None
+            ctx.problem, ctx.leg, q0, rng, lambda: tracker.exhausted(used) is not None
         )
         if (
             s.retract
@@ -227,9 +241,9 @@ def build_guidance(
             # the leader's path runs back through the body: the retract branch first
             log["retract_first"] = True
             retract_branch()
-        if not reached and tracker.exhausted(0) is None:
+        if not reached and tracker.exhausted(used) is None:
             grow_start(0, leader.track(ctx, q0, goal, rng, used, leader=lead), "forward")
-        if not reached and s.retract and "retract" not in log and tracker.exhausted(0) is None:
+        if not reached and s.retract and "retract" not in log and tracker.exhausted(used) is None:
             # leaving from deep inside: the tip drawn back along its own body, then the
             # leader from there (a second branch of the start tree)
             retract_branch()
@@ -255,11 +269,11 @@ def build_guidance(
         tip_goal = GoalRegion("start tip", p0, n0, ls.subgoal_pos_tol_m, ls.subgoal_angle_tol_deg)
         log["backward"] = []
         for i in roots[: s.backward_goals]:
-            if tracker.exhausted(0) is not None:
+            if tracker.exhausted(used) is not None:
                 break
             tb = leader.track(ctx, B.Q[i], tip_goal, rng, used)
             used += tb.iterations
-            chain = _verified(ctx, tb.states, step)
+            chain = _verified(ctx, tb.states, step, used)
             chains.append(chain)
             B.chain(i, chain)
             log["backward"].append({"status": tb.status.value, "states": len(chain)})
