@@ -14,7 +14,8 @@ then::
 
 What is timed: for plannerlab the whole ``solve`` call of one leg (goal state handed over,
 RRT-Connect, simplification, interpolation, plannerlab's own re-check at
-``joint_step / 4`` and, when it refuses the path, the repair), after one untimed warm-up solve that loads the compiled core; for
+``joint_step / 4`` and, when it refuses the path, the repair), after one untimed warm-up
+solve that loads the compiled core; for
 MPlib its OMPL ``planner.plan`` call (RRT-Connect and simplification in C++; the TOPP-RA
 retiming of ``plan_qpos`` is left out, as plannerlab's solve does not retime), on a
 planner built before the clock starts. Both get the same RRT-Connect range (OMPL's

@@ -19,8 +19,17 @@ from noisy restarts: not from any planner. A variant whose goals are not all wit
 dropped before any planner sees it. The witnesses are written as ``[witness]
 goal_states_rad`` (one state per goal, in leg order), which the loader validates.
 
+**Kinds** (:data:`ORDERS`): the same rooms and goals, visited in another order. ``paper``
+visits A–E in the paper's order and ends at E, 1.7–5 m sideways of the window, near the
+near wall. ``far_ltr`` and ``far_rtl`` end on the far wall, far from the window, so that
+``leave`` starts deep in the room: left to right (A, B, C, then E and D: the task ends in
+the far corner on the window's side) and right to left (E, D, C, A, B: it ends in the far
+corner of the other side, 5–7 m sideways of the window). "Left" is the side of A and B
+before mirroring.
+
 Everything random comes from the ``numpy.random.Generator`` passed in: a fixed seed gives
-the same files.
+the same files (the kind draws nothing: the ``paper`` kind's files are those made before
+kinds existed).
 """
 
 from __future__ import annotations
@@ -46,6 +55,18 @@ RHO_M = 0.8
 WALL_M = 0.3
 #: fewest and most modules of a variant's arm (the paper's has 24)
 MODULES_RANGE = (20, 32)
+#: the order of the legs of each kind of variant (goal names, see the module docstring)
+ORDERS: dict[str, tuple[str, ...]] = {
+    "paper": ("enter", "A", "B", "C", "D", "E", "leave"),
+    "far_ltr": ("enter", "A", "B", "C", "E", "D", "leave"),
+    "far_rtl": ("enter", "E", "D", "C", "A", "B", "leave"),
+}
+#: what each kind is, in words (the files' headers)
+KIND_NOTES: dict[str, str] = {
+    "paper": "A-E in the paper's order, ending at E by the near wall",
+    "far_ltr": "left to right (A, B, C, E, D), ending at D in the far corner on the window's side",
+    "far_rtl": "right to left (E, D, C, A, B), ending at B in the far corner away from the window",
+}
 
 
 class VariantError(PlannerlabError):
@@ -83,11 +104,13 @@ class VariantSpec:
     n_modules: int
     room: Room
     extras: dict[str, Any] = field(default_factory=dict)
+    kind: str = "paper"
 
 
 # ---------------------------------------------------------------------- drawing
-def draw_spec(index: int, rng: np.random.Generator) -> VariantSpec:
-    """One variant's room, window and arm, drawn from ``rng``.
+def draw_spec(index: int, rng: np.random.Generator, kind: str = "paper") -> VariantSpec:
+    """One variant's room, window and arm, drawn from ``rng``; ``kind`` (:data:`ORDERS`)
+    orders its legs and draws nothing.
 
     The paper's room (interior x ∈ [−7.5, 2.6], y ∈ [5, 10], z ∈ [2.5, 7.5], window
     x ∈ [−2.5, 0.5], z ∈ [3.5, 6.5]) is scaled about the base by s ∈ [0.85, 1.3], shifted
@@ -97,6 +120,8 @@ def draw_spec(index: int, rng: np.random.Generator) -> VariantSpec:
     base's x (the arm leans into it from the rest pose), its centre z within ±0.6 m of the
     room's mid-height, at least 0.5 m from every edge of the wall.
     """
+    if kind not in ORDERS:
+        raise VariantError(f"--kind: one of {', '.join(ORDERS)}, got {kind!r}")
     scale = float(rng.uniform(0.85, 1.3))
     shift = (
         float(rng.uniform(-1.0, 1.0)),
@@ -119,7 +144,7 @@ def draw_spec(index: int, rng: np.random.Generator) -> VariantSpec:
     dz = min(0.6, 0.5 * (z1 - z0) - h / 2 - 0.5)
     cz = float(rng.uniform(zc - dz, zc + dz)) if dz > 0 else zc
     room = Room(x0, x1, y0, y1, z0, z1, cx - w / 2, cx + w / 2, cz - h / 2, cz + h / 2)
-    return VariantSpec(index, scale, shift, mirrored, n_modules, room)
+    return VariantSpec(index, scale, shift, mirrored, n_modules, room, kind=kind)
 
 
 # ---------------------------------------------------------------------- the problem file
@@ -185,7 +210,8 @@ def rest_tip(n_modules: int) -> tuple[list[float], list[float]]:
 
 
 def goal_tables(spec: VariantSpec) -> list[dict[str, Any]]:
-    """The seven ``[[goals]]`` tables, placed relative to the walls as in the paper."""
+    """The seven ``[[goals]]`` tables, placed relative to the walls as in the paper, in
+    the order of the spec's kind (:data:`ORDERS`)."""
     r = spec.room
     zc = 0.5 * (r.z0 + r.z1)
     s2 = math.sqrt(0.5)
@@ -222,7 +248,8 @@ def goal_tables(spec: VariantSpec) -> list[dict[str, Any]]:
         for g in goals:
             g["p_m"] = [-g["p_m"][0], *g["p_m"][1:]]
             g["n"] = [-g["n"][0], *g["n"][1:]]
-    return goals
+    by_name = {g["name"]: g for g in goals}
+    return [by_name[name] for name in ORDERS[spec.kind]]
 
 
 def problem_document(spec: VariantSpec, name: str) -> dict[str, Any]:
@@ -235,6 +262,7 @@ def problem_document(spec: VariantSpec, name: str) -> dict[str, Any]:
                 f"{', '.join(f'{v:+.2f}' for v in spec.shift_m)} m"
                 + (", mirrored" if spec.mirrored else "")
                 + f", {spec.n_modules} modules"
+                + ("" if spec.kind == "paper" else f", visited {KIND_NOTES[spec.kind]}")
             ),
         },
         "robot": {
@@ -512,10 +540,11 @@ def make_variant(
     rng: np.random.Generator,
     min_clearance_m: float = 0.04,
     command: str = "",
+    kind: str = "paper",
 ) -> Variant | str:
-    """Draw variant ``index`` and find its witnesses: the kept :class:`Variant`, or why it
-    was dropped (a string)."""
-    spec = draw_spec(index, rng)
+    """Draw variant ``index`` of ``kind`` and find its witnesses: the kept
+    :class:`Variant`, or why it was dropped (a string)."""
+    spec = draw_spec(index, rng, kind)
     name = f"armz_inspection_v{index:02d}"
     doc = problem_document(spec, name)
     problem = problem_from_dict(doc, f"<variant {name}>")
@@ -549,10 +578,13 @@ def generate(
     max_draws: int | None = None,
     command: str = "",
     progress: Callable[[str], None] | None = None,
+    kinds: Sequence[str] = ("paper",),
+    first_index: int = 0,
 ) -> list[Variant]:
     """``count`` kept variants, drawn in order from ``rng`` (a generator, or a seed for
     ``numpy.random.default_rng``; a dropped draw is reported through ``progress`` and
-    replaced by the next draw).
+    replaced by the next draw), numbered from ``first_index``; the k-th kept one is of
+    kind ``kinds[k % len(kinds)]`` (:data:`ORDERS`).
 
     Raises:
         VariantError: bad arguments, or fewer than ``count`` kept in ``max_draws`` draws
@@ -560,6 +592,10 @@ def generate(
     """
     if count < 1:
         raise VariantError(f"--count: a number of variants >= 1, got {count}")
+    if not kinds or any(k not in ORDERS for k in kinds):
+        raise VariantError(f"--kind: each one of {', '.join(ORDERS)}, got {list(kinds)}")
+    if first_index < 0:
+        raise VariantError(f"--first-index: a number >= 0, got {first_index}")
     if not (0.0 <= min_clearance_m < 0.75):
         raise VariantError(
             "--min-clearance: a clearance in [0, 0.75) m (the module radius), "
@@ -575,7 +611,9 @@ def generate(
                 f"only {len(kept)} of {count} variants kept in {max_draws} draws "
                 "(each needs a witness for every goal)"
             )
-        v = make_variant(len(kept), rng, min_clearance_m, command)
+        v = make_variant(
+            first_index + len(kept), rng, min_clearance_m, command, kinds[len(kept) % len(kinds)]
+        )
         draw += 1
         if isinstance(v, str):
             if progress:

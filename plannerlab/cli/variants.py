@@ -1,6 +1,8 @@
 """``plannerlab variants``: variants of the Arm-Z paper's task on rooms it has never seen.
 
     plannerlab variants armz_inspection --count 20 --seed 0 --out problems/variants/
+    plannerlab variants armz_inspection --count 20 --seed 1 --kind far_ltr,far_rtl \
+        --first-index 20 --out problems/variants/
 
 Draws rooms (scaled, shifted, mirrored; the window moved and resized; 20-32 modules),
 places the goals relative to the walls as in the paper, finds a collision-free witness
@@ -63,6 +65,20 @@ def add_parser(subparsers: Any) -> argparse.ArgumentParser:
         metavar="N",
         help="give up after N draws (default: 3 x --count)",
     )
+    p.add_argument(
+        "--kind",
+        default="paper",
+        metavar="K[,K...]",
+        help="kinds of variant, taken in turn: paper (A-E in the paper's order), far_ltr, "
+        "far_rtl (ending on the far wall, visited left to right / right to left)",
+    )
+    p.add_argument(
+        "--first-index",
+        type=int,
+        default=0,
+        metavar="N",
+        help="number of the first variant (its file armz_inspection_vNN.toml)",
+    )
     p.set_defaults(func=cmd_variants)
     return p
 
@@ -86,6 +102,8 @@ def cmd_variants(args: argparse.Namespace, console: Console) -> int:
             "--min-clearance",
             f"{args.min_clearance:g}",
         ]
+        + ([] if args.kind == "paper" else ["--kind", args.kind])
+        + ([] if args.first_index == 0 else ["--first-index", str(args.first_index)])
     )
 
     def progress(line: str) -> None:
@@ -98,6 +116,8 @@ def cmd_variants(args: argparse.Namespace, console: Console) -> int:
         max_draws=args.max_draws,
         command=command,
         progress=progress,
+        kinds=tuple(k.strip() for k in args.kind.split(",") if k.strip()),
+        first_index=args.first_index,
     )
     for path in pl.write_variants(kept, out):
         print(path)

@@ -216,6 +216,14 @@ def _entries() -> dict[str, PlannerEntry]:
                 options=MappingProxyType({"algorithm": algorithm}),
             )
         )
+    entries.append(
+        PlannerEntry(
+            "native.rrtconnect+leader",
+            "plannerlab.planners.native.leader:make",
+            "native.rrtconnect helped by follow-the-leader: its body states from the start "
+            "and from goal states into the start's tip seed both trees and bias the samples",
+        )
+    )
     for suffix, cls in OMPL_PLANNERS.items():
         entries.append(
             PlannerEntry(

@@ -35,6 +35,19 @@ follow-the-leader:
    (no way for the tip at that clearance), the finish alone runs: the planner is then the
    clearance descent.
 
+4. **Leaving from deep inside** (``retract``, on by default): the voxel grid knows the
+   scene, not the body. From the far wall of a room the leader's path leads the tip back
+   across the room and out through the window that its own body fills, and the tracking
+   stalls at the second sub-goal (measured on the far-ended variants
+   ``problems/variants/armz_inspection_v21`` … ``v39``, leaving from B: 5 of 10 stall
+   so; ``gradient.clearance+detour`` stalls at its eighth iteration and no retract of its
+   detour works on 6 of 10). What got the body in gets it out: the body lies on the curve
+   its tip came in by, so the tip is drawn back along the start's own body
+   (:meth:`FollowLeader.retract`: sub-goals at its faces from the tip's towards the
+   base's, each looking along the body) until it sees the goal's approach point, then
+   the leader's path from there. It comes first when the leader's path runs back
+   through the body (:func:`crosses_body`), else after the forward tries.
+
 The search and the tracking are deterministic (``gradient.follow_leader``: its seeds are
 one run). The randomised variant (``+random``, ``random_grid``) shifts the voxel grid by
 a random fraction of a voxel and scales the centring weight by the seed's draw, and draws
@@ -49,10 +62,9 @@ from dataclasses import dataclass, replace
 from typing import Any
 
 import numpy as np
-from scipy.sparse import coo_matrix
-from scipy.sparse.csgraph import dijkstra
 
 from plannerlab.errors import PlannerlabError
+from plannerlab.planners import leader_moves
 from plannerlab.planners.base import (
     Planner,
     PlanResult,
@@ -64,7 +76,9 @@ from plannerlab.planners.clearance import SetupStopped
 from plannerlab.planners.context import LegPlanner, PlanningContext
 from plannerlab.planners.descent_settings import DERIVED, resolve_distances
 from plannerlab.planners.gradient_clearance import ClearanceDescent, ClearanceSettings, LegPath
-from plannerlab.problem.scene import Box, Cylinder, Scene, Sphere
+from plannerlab.planners.leader_grid import TipPath, scene_distance_m, tip_path
+from plannerlab.planners.leader_moves import Track, crosses_body
+from plannerlab.problem.goals import GoalRegion
 from plannerlab.robots.base import Array, joint_difference
 
 #: the default voxel is at least the reach over this (Arm-Z's 0.34 m < its 0.375 m)
@@ -123,6 +137,12 @@ class FollowLeaderSettings:
         random_grid: shift the grid by a random fraction of a voxel and scale
             ``centre_weight`` by a random factor in [0.5, 1.5] (the seed's draw).
         max_replans: (``random_grid``) new leader paths drawn from where a try ended [1].
+        retract: when the tries from the start end in a stall, one more try from the
+            start: the tip drawn back along the start's own body first
+            (:meth:`FollowLeader.retract`), then the leader's path from there.
+
+    The clearance descent's settings are its own (:class:`ClearanceSettings`), overridden
+    as ``descent.<key>``.
     """
 
     voxel_m: float = 0.0
@@ -139,6 +159,7 @@ class FollowLeaderSettings:
     escape: str = "none"
     random_grid: bool = False
     max_replans: int = 3
+    retract: bool = True
 
     def __post_init__(self) -> None:
         if not self.voxel_m >= 0:
@@ -169,240 +190,6 @@ class FollowLeaderSettings:
         return out
 
 
-# ---------------------------------------------------------------------- workspace search
-def scene_distance_m(scene: Scene, points_m: Array) -> Array:
-    """Signed distance [m] of points (k, 3) to the nearest obstacle (inf without any)."""
-    p = np.asarray(points_m, dtype=float).reshape(-1, 3)
-    d = np.full(len(p), np.inf)
-    for o in scene.obstacles:
-        T = o.T_world_obstacle
-        local = (p - T[:3, 3]) @ T[:3, :3]
-        if isinstance(o, Box):
-            q = np.abs(local) - o.size_m / 2.0
-            di = np.linalg.norm(np.maximum(q, 0.0), axis=1) + np.minimum(q.max(axis=1), 0.0)
-        elif isinstance(o, Cylinder):
-            q = np.stack(
-                [
-                    np.hypot(local[:, 0], local[:, 1]) - o.radius_m,
-                    np.abs(local[:, 2]) - o.length_m / 2,
-                ],
-                axis=1,
-            )
-            di = np.linalg.norm(np.maximum(q, 0.0), axis=1) + np.minimum(q.max(axis=1), 0.0)
-        elif isinstance(o, Sphere):
-            di = np.linalg.norm(local, axis=1) - o.radius_m
-        else:  # pragma: no cover - the scene's types are closed
-            raise PlannerlabError(f"obstacle {o.name}: unknown kind {o.kind!r}")
-        d = np.minimum(d, di)
-    return d
-
-
-def grid_distance_m(scene: Scene, axes: list[Array], cap_m: float) -> Array:
-    """Obstacle distances [m] at the points of the grid ``axes`` (three 1-D arrays of
-    coordinates), exact up to ``cap_m`` and ``inf`` beyond it: each obstacle is measured
-    only in the block of the grid within ``cap_m`` of its bounding box."""
-    shape = tuple(len(a) for a in axes)
-    d = np.full(shape, np.inf)
-    for o in scene.obstacles:
-        T = o.T_world_obstacle
-        half = o.half_extents_world()
-        block = []
-        for k in range(3):
-            lo = np.searchsorted(axes[k], T[k, 3] - half[k] - cap_m, side="left")
-            hi = np.searchsorted(axes[k], T[k, 3] + half[k] + cap_m, side="right")
-            block.append(slice(int(lo), int(hi)))
-        if any(b.start >= b.stop for b in block):
-            continue
-        sub = [axes[k][block[k]] for k in range(3)]
-        if isinstance(o, Box) and np.allclose(np.abs(T[:3, :3]), np.eye(3)):
-            # an axis-aligned box: separable, no point array needed
-            qx, qy, qz = ((np.abs(sub[k] - T[k, 3]) - o.size_m[k] / 2.0) for k in range(3))
-            qx, qy, qz = qx[:, None, None], qy[None, :, None], qz[None, None, :]
-            di = np.sqrt(
-                np.maximum(qx, 0.0) ** 2 + np.maximum(qy, 0.0) ** 2 + np.maximum(qz, 0.0) ** 2
-            ) + np.minimum(np.maximum(np.maximum(qx, qy), qz), 0.0)
-        else:
-            pts = np.stack(np.meshgrid(*sub, indexing="ij"), axis=-1).reshape(-1, 3)
-            di = scene_distance_m(Scene((o,)), pts).reshape(tuple(len(a) for a in sub))
-        view = d[block[0], block[1], block[2]]
-        np.minimum(view, di, out=view)
-    d[d > cap_m] = np.inf
-    return d
-
-
-def grid_voxels(extent_m: Array, voxel_m: float) -> int:
-    """Voxels of the search grid over a box of ``extent_m`` (3,) [m] with edge ``voxel_m``
-    (one more per axis for the grid's shift, as :func:`tip_path` lays it)."""
-    shape = np.maximum(np.ceil(np.asarray(extent_m, dtype=float) / voxel_m).astype(int) + 2, 2)
-    return int(np.prod(shape.astype(float)))
-
-
-def grid_voxel_m(
-    extent_m: Array, voxel_m: float, max_voxels: int, *, voxel_set: bool = False
-) -> float:
-    """The voxel edge [m] of a search grid over a box of ``extent_m`` (3,): ``voxel_m``
-    when its grid holds at most ``max_voxels`` voxels, else the smallest edge whose grid
-    does (coarser: the path keeps its clearance, it only finds narrower gaps less well).
-    A ``voxel_m`` the user set (``voxel_set``) that passes the cap: PlannerlabError."""
-    if grid_voxels(extent_m, voxel_m) <= max_voxels:
-        return float(voxel_m)
-    if voxel_set:
-        raise PlannerlabError(
-            f"follow-the-leader: voxel_m = {voxel_m:g} m gives a search grid of "
-            f"{grid_voxels(extent_m, voxel_m):.3g} voxels over a box of "
-            f"{np.round(np.asarray(extent_m, dtype=float), 3).tolist()} m, more than "
-            f"max_voxels = {max_voxels}: set a coarser voxel_m (or leave it at 0: "
-            "coarsened to fit)"
-        )
-    edge = float(voxel_m)
-    while grid_voxels(extent_m, edge) > max_voxels:
-        # the edge at which the volume alone would fit, then a little more for the ceilings
-        vol = float(np.prod(np.maximum(np.asarray(extent_m, dtype=float), edge)))
-        edge = max(edge * 1.01, (vol / max_voxels) ** (1.0 / 3.0))
-    return edge
-
-
-#: the 13 grid offsets of a 26-neighbourhood, one of each opposite pair
-_OFFSETS = np.array(
-    [(i, j, k) for i in (-1, 0, 1) for j in (-1, 0, 1) for k in (-1, 0, 1) if (i, j, k) > (0, 0, 0)]
-)
-
-
-@dataclass(frozen=True)
-class TipPath:
-    """The leader's path.
-
-    Attributes:
-        points_m: (m, 3) from the start tip to the goal, the last two the approach point
-            and the goal point [m].
-        arc_m: (m,) arc length at each point [m].
-        min_distance_m: the smallest obstacle distance of the grid part [m].
-        free_voxels: how many voxels of the search box were free.
-    """
-
-    points_m: Array
-    arc_m: Array
-    min_distance_m: float
-    free_voxels: int
-
-
-def tip_path(
-    scene: Scene,
-    start_m: Array,
-    goal_m: Array,
-    goal_n: Array,
-    *,
-    clearance_m: float,
-    approach_m: float,
-    voxel_m: float,
-    centre_m: float,
-    centre_weight: float,
-    pad_m: float,
-    reach_centre_m: Array,
-    reach_m: float,
-    offset_m: Array | None = None,
-    stop: Callable[[], bool] | None = None,
-    max_voxels: int | None = None,
-    voxel_set: bool = False,
-) -> TipPath | None:
-    """The leader's path from ``start_m`` to the approach point ``goal_m − approach_m ·
-    goal_n`` on the free voxels (obstacle distance >= ``clearance_m``), then to ``goal_m``;
-    None when the two are not connected. The start and the approach point are joined to
-    their nearest free voxel (a tip that starts close to a wall). See the module docstring.
-    ``stop()`` is asked between the stages (distances, graph, search): True gives None.
-    The grid holds at most ``max_voxels`` voxels (:func:`grid_voxel_m`): a finer
-    ``voxel_m`` is coarsened to fit, or, when the user set it (``voxel_set``), refused.
-    """
-    start = np.asarray(start_m, dtype=float)
-    goal = np.asarray(goal_m, dtype=float)
-    approach = goal - approach_m * np.asarray(goal_n, dtype=float)
-    pts = np.vstack([start, approach, goal, reach_centre_m])
-    lo = np.min(pts, axis=0) - pad_m
-    hi = np.max(pts, axis=0) + pad_m
-    lo = np.maximum(lo, np.asarray(reach_centre_m) - reach_m)
-    hi = np.minimum(hi, np.asarray(reach_centre_m) + reach_m)
-    if max_voxels is not None:
-        voxel_m = grid_voxel_m(hi - lo, voxel_m, max_voxels, voxel_set=voxel_set)
-    lo = lo + (np.zeros(3) if offset_m is None else np.asarray(offset_m) - voxel_m)
-    shape = np.maximum(np.ceil((hi - lo) / voxel_m).astype(int) + 1, 2)
-    axes = [lo[k] + voxel_m * np.arange(shape[k]) for k in range(3)]
-    dist = grid_distance_m(scene, axes, max(centre_m, clearance_m) + voxel_m)
-    free = dist >= clearance_m
-    n_free = int(free.sum())
-    if n_free == 0 or (stop is not None and stop()):
-        return None
-    index = np.full(tuple(shape), -1, dtype=np.int64)
-    index[free] = np.arange(n_free)
-    ijk = np.argwhere(free)
-    w_node = 1.0 + centre_weight * np.maximum(0.0, 1.0 - dist[free] / centre_m)
-    rows, cols, vals = [], [], []
-    for off in _OFFSETS:
-        if stop is not None and stop():  # the graph's 13 directions: a poll each
-            return None
-        nb = ijk + off
-        ok = np.all((nb >= 0) & (nb < shape), axis=1)
-        a = np.flatnonzero(ok)
-        b = index[nb[ok, 0], nb[ok, 1], nb[ok, 2]]
-        keep = b >= 0
-        a, b = a[keep], b[keep]
-        length = voxel_m * float(np.linalg.norm(off))
-        rows.append(a)
-        cols.append(b)
-        vals.append(length * 0.5 * (w_node[a] + w_node[b]))
-    graph = coo_matrix(
-        (np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))),
-        shape=(n_free, n_free),
-    ).tocsr()
-    centres = lo + voxel_m * ijk
-    if stop is not None and stop():
-        return None
-
-    def nearest(p: Array) -> int:
-        return int(np.argmin(np.linalg.norm(centres - p, axis=1)))
-
-    i0, i1 = nearest(start), nearest(approach)
-    cost, pred = dijkstra(graph, directed=False, indices=i0, return_predecessors=True)
-    if not np.isfinite(cost[i1]) or (stop is not None and stop()):
-        return None
-    chain = [i1]
-    while chain[-1] != i0:
-        chain.append(int(pred[chain[-1]]))
-    grid_pts = centres[chain[::-1]]
-    points = np.vstack([start, grid_pts, approach, goal])
-    # drop repeated points (start or approach on a voxel centre)
-    seg = np.linalg.norm(np.diff(points, axis=0), axis=1)
-    points = points[np.concatenate([[True], seg > 1e-9])]
-    points = _shortcut(points, scene, clearance_m, voxel_m / 3)
-    arc = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(points, axis=0), axis=1))])
-    return TipPath(points, arc, float(dist[free][chain].min()), n_free)
-
-
-def _shortcut(points: Array, scene: Scene, clearance_m: float, step_m: float) -> Array:
-    """The path with every point skipped whose neighbours see each other with the same
-    clearance (greedy, from the start; the first and last two points kept)."""
-    if len(points) <= 3:
-        return points
-    keep = [0]
-    i = 0
-    last = len(points) - 2  # the approach point
-    while i < last:
-        j = last
-        while j > i + 1:
-            a, b = points[i], points[j]
-            n = max(2, int(np.ceil(np.linalg.norm(b - a) / step_m)) + 1)
-            line = a + np.linspace(0.0, 1.0, n)[:, None] * (b - a)
-            # the start may be closer to a wall than clearance_m: do not ask more than it has
-            need = min(clearance_m, float(scene_distance_m(scene, a[None])[0]))
-            if float(scene_distance_m(scene, line).min()) >= need - 1e-9:
-                break
-            j -= 1
-        keep.append(j)
-        i = j
-    keep.append(len(points) - 1)
-    return points[keep]
-
-
-# ---------------------------------------------------------------------- the planner
 class FollowLeader(LegPlanner):
     """Follow-the-leader with the clearance descent (see the module docstring). The
     tracking, the finish and the detour are descents in the leg's context: one checker,
@@ -458,15 +245,16 @@ class FollowLeader(LegPlanner):
         q: Array,
         rng: np.random.Generator | None,
         stop: Callable[[], bool] | None = None,
+        goal: GoalRegion | None = None,
     ) -> TipPath | None:
-        """The leader's path from the tip of ``q`` into leg's goal (randomised with rng;
-        None when there is none, or ``stop()`` said so)."""
+        """The leader's path from the tip of ``q`` into leg's goal, or into ``goal`` when
+        given (randomised with rng; None when there is none, or ``stop()`` said so)."""
         resolved = self.for_robot(problem.robot)
         if resolved is not self:
-            return resolved.leader_path(problem, leg, q, rng, stop)
+            return resolved.leader_path(problem, leg, q, rng, stop, goal)
         s = self.settings
         robot = problem.robot
-        goal = problem.goal(leg)
+        goal = problem.goal(leg) if goal is None else goal
         p_tip, _ = robot.tip(q)
         F0 = robot.fk(q)
         base = F0[0, :3, 3]
@@ -545,8 +333,6 @@ class FollowLeader(LegPlanner):
     ) -> tuple[Status, str, list[Array], int]:
         """Descend to each sub-goal along the leader's path in turn (:meth:`subgoals`); a
         sub-goal the descent stalls before is passed over, two in a row end the tracking."""
-        from plannerlab.problem.goals import GoalRegion
-
         s = self.settings
         path = [np.array(q0)]
         iterations = 0
@@ -573,6 +359,39 @@ class FollowLeader(LegPlanner):
                 return st, reason, path, iterations
             stalls = 0
         return Status.SOLVED, f"followed {len(goals)} sub-goals", path, iterations
+
+    def track(
+        self,
+        ctx: PlanningContext,
+        q0: Array,
+        goal: GoalRegion,
+        rng: np.random.Generator | None,
+        used: int = 0,
+        leader: TipPath | None = None,
+    ) -> Track:
+        """:func:`plannerlab.planners.leader_moves.track` with this planner."""
+        return leader_moves.track(self, ctx, q0, goal, rng, used, leader)
+
+    def sees_approach(self, ctx: PlanningContext, q: Array) -> bool:
+        """Whether the straight line from the tip of ``q`` to the leg goal's approach
+        point keeps the leader's clearance from the scene (the retract has got the tip
+        out)."""
+        s = self.settings
+        goal, robot = ctx.goal, ctx.robot
+        p_tip, _ = robot.tip(q)
+        approach = goal.p_world_m - s.approach_m * goal.n_world
+        clearance = (
+            float(np.asarray(robot.link_radii_m)[-1])
+            + ctx.problem.safety_margin_m
+            + s.extra_clearance_m
+        )
+        n = max(2, int(np.ceil(np.linalg.norm(approach - p_tip) / 0.1)) + 1)
+        line = p_tip + np.linspace(0.0, 1.0, n)[:, None] * (approach - p_tip)
+        return bool(scene_distance_m(ctx.scene, line).min() >= clearance)
+
+    def retract(self, ctx: PlanningContext, q0: Array, used: int = 0) -> Track:
+        """:func:`plannerlab.planners.leader_moves.retract` with this planner."""
+        return leader_moves.retract(self, ctx, q0, used)
 
     def plan(self, ctx: PlanningContext, rng: np.random.Generator) -> PlanResult:
         """Plan the leader's path, follow it, finish with the leg's descent."""
@@ -604,7 +423,29 @@ class FollowLeader(LegPlanner):
         draw_rng = rng if s.random_grid else None
         attempts = 1 + (s.max_replans if s.random_grid else 0)
         reason = ""
-        for attempt in range(attempts):
+        retracted = ""
+
+        def retract_from_start() -> PlanResult | None:
+            """The path reset to the start, then the tip drawn back along its own body."""
+            nonlocal retracted
+            del path[1:]
+            tr = self.retract(ctx, q0, leg_path.iterations)
+            leg_path.iterations += tr.iterations
+            leg_path.add(tr.states)
+            retracted = tr.reason
+            log.append({"attempt": "retract", "retract": tr.reason})
+            if tr.status is Status.BUDGET_EXHAUSTED:
+                return done(tr.status, tr.reason)
+            return None
+
+        for attempt in range(attempts + (1 if s.retract else 0)):
+            if attempt == attempts:
+                # one more try: from the start, the tip drawn back along its own body
+                if retracted or tracker.exhausted(leg_path.iterations) is not None:
+                    break
+                out = retract_from_start()
+                if out is not None:
+                    return out
             q = np.array(path[-1])
             if goal.contains(robot, q):
                 return done(Status.SOLVED, "in the goal region")
@@ -614,6 +455,22 @@ class FollowLeader(LegPlanner):
                 return tracker.exhausted(used) is not None
 
             leader = self.leader_path(problem, leg, q, draw_rng, stop)
+            if (
+                s.retract
+                and not retracted
+                and attempt == 0
+                and leader is not None
+                and crosses_body(robot, q0, leader)
+                and not self.sees_approach(ctx, q0)
+            ):
+                # the leader leads the tip back through its own body: retract first
+                out = retract_from_start()
+                if out is not None:
+                    return out
+                q = np.array(path[-1])
+                if goal.contains(robot, q):
+                    return done(Status.SOLVED, f"{retracted}; in the goal region")
+                leader = self.leader_path(problem, leg, q, draw_rng, stop)
             if tracker.exhausted(leg_path.iterations) is not None:
                 return done(Status.BUDGET_EXHAUSTED, str(tracker.exhausted(leg_path.iterations)))
             entry: dict = {
@@ -645,7 +502,8 @@ class FollowLeader(LegPlanner):
             leg_path.add(seg2)
             entry["finish"] = st2.value
             if st2 is Status.SOLVED:
-                return done(st2, f"followed the leader ({reason}); {reason2}")
+                first = f"{retracted}; " if retracted else ""
+                return done(st2, f"{first}followed the leader ({reason}); {reason2}")
             if st2 is not Status.LOCAL_MINIMUM:
                 return done(st2, reason2)
             leg_path.minima += 1

@@ -73,7 +73,18 @@ PLANNERS = (
     "ompl.kpiece1",
     "ompl.prm",
     "ompl.rrtstar",
+    "native.rrtconnect",
+    "native.rrtconnect+leader",
 )
+
+
+def deterministic(planner: str) -> bool:
+    """A planner that ignores its seed (the registry's ``uses_rng``): its seeds are one
+    run, so the study runs it on one seed and its cells read "k/1 (one run)"."""
+    from plannerlab.planners import REGISTRY
+
+    entry = REGISTRY.get(planner)
+    return entry is not None and not entry.uses_rng
 
 
 def planner_order(name: str) -> int:
@@ -180,7 +191,9 @@ def table(rs: list[dict[str, Any]]) -> str:
     for r in rs:
         fails = ", ".join(f"{k} {v}" for k, v in sorted(r["failures"].items())) or "–"
         lines.append(
-            f"| {r['problem']} | `{r['planner']}` | {r['n']} | {r['solved']} | {r['clean']} | "
+            f"| {r['problem']} | `{r['planner']}` | "
+            f"{r['n']}{' (one run)' if deterministic(r['planner']) else ''} | "
+            f"{r['solved']} | {r['clean']} | "
             f"{fmt(r['t50'])} / {fmt(r['t95'])} | {fmt(r['first50'])} | "
             f"{fmt(r['c50'])} / {fmt(r['c95'])} | "
             f"{r['minima']} / {r['escaped']} | {fmt(r['from_stall'])} / {fmt(r['from_start'])} | "
@@ -200,7 +213,8 @@ def headline(rs: list[dict[str, Any]], problems: tuple[str, ...]) -> str:
         cells = []
         for p in present:
             r = cell.get((p, pl))
-            cells.append(f"{r['clean']}/{r['n']}" if r else "–")
+            one = " (one run)" if r and deterministic(pl) else ""
+            cells.append(f"{r['clean']}/{r['n']}{one}" if r else "–")
         out += f"| `{pl}` | " + " | ".join(cells) + " |\n"
     return out
 

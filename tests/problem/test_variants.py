@@ -12,7 +12,16 @@ from conftest import PROBLEMS
 
 from plannerlab.collision.fcl_checker import CollisionChecker
 from plannerlab.problem.catalog import list_problems, load_problem
-from plannerlab.variants import MODULES_RANGE, RHO_M, draw_spec, generate, make_variant
+from plannerlab.record.leg import Status
+from plannerlab.variants import (
+    MODULES_RANGE,
+    ORDERS,
+    RHO_M,
+    VariantError,
+    draw_spec,
+    generate,
+    make_variant,
+)
 
 #: a seed whose first draw is kept (in under a second of IK)
 SEED_KEPT_FIRST = 5
@@ -20,10 +29,40 @@ SEED_KEPT_FIRST = 5
 VARIANTS = sorted((PROBLEMS / "variants").glob("*.toml"))
 
 
-def test_twenty_variants_are_committed_and_not_in_the_catalogue():
-    assert len(VARIANTS) == 20
+def test_forty_variants_are_committed_and_not_in_the_catalogue():
+    assert len(VARIANTS) == 40
     listed = {p.resolve() for p in list_problems()}
     assert not listed & {p.resolve() for p in VARIANTS}
+
+
+def test_the_committed_kinds_and_their_orders():
+    """v00-v19 visit A-E in the paper's order; v20-v39 end on the far wall, left to
+    right (v20, v22, ...) and right to left (v21, v23, ...)."""
+    for path in VARIANTS:
+        index = int(path.stem[-2:])
+        order = tuple(g.name for g in load_problem(path).goals)
+        kind = "paper" if index < 20 else ("far_ltr", "far_rtl")[index % 2]
+        assert order == ORDERS[kind], path.stem
+
+
+def test_far_kinds_end_on_the_far_wall_far_from_the_window():
+    for path in VARIANTS[20:]:
+        problem = load_problem(path)
+        boxes = {o.name: o for o in problem.scene.obstacles}
+        far = boxes["wall_far"]
+        far_y = float(far.T_world_obstacle[1, 3] - far.size_m[1] / 2)
+        last = problem.goals[-2]
+        assert last.name in ("B", "D")
+        assert last.p_world_m[1] == pytest.approx(far_y - RHO_M, abs=1e-5)
+        enter = problem.goals[0]
+        assert float(np.linalg.norm(last.p_world_m - enter.p_world_m)) > 3.0
+
+
+def test_an_unknown_kind_is_refused_by_name():
+    with pytest.raises(VariantError, match="--kind"):
+        draw_spec(0, np.random.default_rng(0), "backwards")
+    with pytest.raises(VariantError, match="--kind"):
+        generate(1, np.random.default_rng(0), kinds=("paper", "sideways"))
 
 
 @pytest.mark.parametrize("path", VARIANTS, ids=lambda p: p.stem)
@@ -96,7 +135,6 @@ def test_a_committed_variant_is_solved_and_executed_end_to_end():
     the best gradient-based planner with default settings does all seven legs within
     20 000 checks per leg, every path valid at a quarter of joint_step, and PyBullet
     executes every leg without contact with the tip in every goal region."""
-    from plannerlab.record.leg import Status
     from plannerlab.run.pipeline import execute_plan, solve_legs
 
     problem = load_problem(PROBLEMS / "variants" / "armz_inspection_v00.toml")
@@ -110,6 +148,28 @@ def test_a_committed_variant_is_solved_and_executed_end_to_end():
         assert checker.check_path(r.path, problem.joint_step / 4).valid, r.goal
     executions = execute_plan(plan, problem)
     for e in executions:
+        assert e.path_valid, e.goal
+        assert not e.contacts, (e.goal, e.contacts)
+        assert e.goal_reached, (e.goal, e.final_pos_err_m, e.final_angle_err_deg)
+
+
+def test_a_far_ended_variant_is_solved_and_executed_end_to_end():
+    """``armz_inspection_v20`` (far_ltr: A, B, C, E, D, ending in the far corner, then
+    leave from there): gradient.follow_leader with default settings plans all seven legs
+    within 20 000 checks per leg, every path valid at a quarter of joint_step, and
+    PyBullet executes every leg without contact with the tip in every goal region."""
+    from plannerlab.run.pipeline import execute_plan, solve_legs
+
+    problem = load_problem(PROBLEMS / "variants" / "armz_inspection_v20.toml")
+    budget = problem.budget.replace(max_collision_checks=20_000, time_limit_s=None)
+    plan = solve_legs(problem, "gradient.follow_leader", 0, budget=budget)
+    assert [r.goal for r in plan.legs] == list(ORDERS["far_ltr"])
+    checker = CollisionChecker(problem.robot, problem.scene)
+    for r in plan.legs:
+        assert r.status is Status.SOLVED, f"{r.goal}: {r.reason}"
+        assert r.collision_checks <= 20_000
+        assert checker.check_path(r.path, problem.joint_step / 4).valid, r.goal
+    for e in execute_plan(plan, problem):
         assert e.path_valid, e.goal
         assert not e.contacts, (e.goal, e.contacts)
         assert e.goal_reached, (e.goal, e.final_pos_err_m, e.final_angle_err_deg)

@@ -1,0 +1,146 @@
+"""Follow-the-leader's moves, reusable by other planners: the tracking from one state into
+any tip goal region (:func:`track`, the body states it passes through), and the retract
+for leaving from deep inside (:func:`retract`: the tip drawn back along the start's own
+body until it sees the goal's approach point), with
+:func:`crosses_body`, which says when the leader's path runs back through the body.
+The planner itself is :class:`~plannerlab.planners.follow_leader.FollowLeader`."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from plannerlab.planners.base import Status
+from plannerlab.planners.context import PlanningContext
+from plannerlab.problem.goals import GoalRegion
+from plannerlab.robots.base import Array
+
+#: a :class:`~plannerlab.planners.follow_leader.FollowLeader` (its tracking descent, its
+#: settings, its leader's path) and a :class:`~plannerlab.planners.leader_grid.TipPath`:
+#: typed loosely so that this module and the planner's form no import cycle
+FollowLeader = Any
+TipPath = Any
+
+
+@dataclass(frozen=True)
+class Track:
+    """Follow-the-leader from one state into one goal region (:meth:`FollowLeader.track`).
+
+    Attributes:
+        leader: the leader's path (None: none found).
+        status: how the tracking and the final descent ended (SOLVED: in the region).
+        reason: in words.
+        states: the body states passed through, in order (consecutive ones are accepted
+            steps of the descent: collision-free at the descent's resolution).
+        iterations: descent iterations used.
+    """
+
+    leader: TipPath | None
+    status: Status
+    reason: str
+    states: list[Array]
+    iterations: int
+
+
+def crosses_body(robot: Any, q: Array, leader: TipPath, step_m: float = 0.1) -> bool:
+    """Whether the leader's path from the tip of ``q`` runs back through the body of
+    ``q``: a point of the path inside the capsule of a module more than a third of the
+    body behind the tip. (Near the tip every path touches the body: the tip turns.)
+    The voxel grid knows the scene, not the body: deep in a room, the way out for the
+    tip leads back through the window its own body fills."""
+    F = robot.fk(q)
+    faces = F[:, :3, 3]
+    radii = np.asarray(robot.link_radii_m, dtype=float)
+    n_links = len(faces) - 1
+    behind = n_links - int(np.ceil(n_links / 3.0))  # links 0 .. behind-1
+    if behind < 1:
+        return False
+    pts, arc = leader.points_m, leader.arc_m
+    s_all = np.arange(0.0, float(arc[-1]), step_m)
+    p = np.stack([np.interp(s_all, arc, pts[:, k]) for k in range(3)], axis=1)  # (m, 3)
+    a, ab = faces[:behind], faces[1 : behind + 1] - faces[:behind]
+    t = np.einsum("mkd,kd->mk", p[:, None, :] - a[None], ab) / np.maximum(
+        np.einsum("kd,kd->k", ab, ab), 1e-12
+    )
+    closest = a[None] + np.clip(t, 0.0, 1.0)[..., None] * ab[None]
+    d = np.linalg.norm(p[:, None, :] - closest, axis=2)  # (m, behind)
+    r = np.resize(radii, behind) if len(radii) < behind else radii[:behind]
+    return bool(np.any(d < r[None, :]))
+
+
+def track(
+    fl: FollowLeader,
+    ctx: PlanningContext,
+    q0: Array,
+    goal: GoalRegion,
+    rng: np.random.Generator | None,
+    used: int = 0,
+    leader: TipPath | None = None,
+) -> Track:
+    """Follow-the-leader from ``q0`` into ``goal`` (any tip goal region): the leader's
+    path from ``q0``'s tip (randomised with ``rng``, None: the deterministic grid), the
+    tracking descent along it, then the descent into ``goal`` itself (no approach
+    point). The body states it passed through come back whatever the outcome: the
+    reusable part of follow-the-leader (guide states of a sampling planner, the
+    backward branches). ``used``: iterations the leg has used already; ``leader``:
+    the leader's path when the caller has it already."""
+    tracker = ctx.tracker
+
+    def stop() -> bool:
+        return tracker.exhausted(used) is not None
+
+    if leader is None:
+        leader = fl.leader_path(ctx.problem, ctx.leg, q0, rng, stop, goal=goal)
+    states = [np.array(q0, dtype=float)]
+    if leader is None:
+        why = tracker.exhausted(used) or "no path for the tip through free workspace"
+        status = Status.BUDGET_EXHAUSTED if tracker.exhausted(used) else Status.FAILED
+        return Track(None, status, why, states, 0)
+    st, reason, seg, it = fl._follow(ctx, q0, leader, used)
+    states.extend(seg[1:])
+    if st is Status.BUDGET_EXHAUSTED:
+        return Track(leader, st, reason, states, it)
+    st2, reason2, seg2, _, it2 = fl._track.descend(ctx, states[-1], goal, used + it)
+    states.extend(seg2[1:])
+    return Track(leader, st2, f"{reason}; {reason2}", states, it + it2)
+
+
+def retract(fl: FollowLeader, ctx: PlanningContext, q0: Array, used: int = 0) -> Track:
+    """The tip drawn back along the start's own body: sub-goals at the body's faces
+    from the tip's towards the base's (each looking along the body, within the
+    sub-goal tolerances), tracked by the descent, until the tip sees the leg goal's
+    approach point (``fl.sees_approach``); a sub-goal the descent stalls before is
+    passed over, two in a row end it. What got the body in gets it out: the
+    body lies on the curve its tip came in by, so the tip backs out along it while the
+    modules outside take up the length; the leader's path forwards would lead the tip
+    back through the window its own body fills (measured on the far-ended variants:
+    the tracking stalls at sub-goal 2)."""
+    s = fl.settings
+    F = ctx.robot.fk(q0)
+    faces, normals = F[:, :3, 3], F[:, :3, 2]
+    states = [np.array(q0, dtype=float)]
+    it = 0
+    stalls = 0
+    reached = 0
+    status, reason = Status.LOCAL_MINIMUM, "no face of the body reached"
+    for k in range(len(faces) - 2, 0, -1):
+        sub = GoalRegion(
+            f"face{k}", faces[k], normals[k], s.subgoal_pos_tol_m, s.subgoal_angle_tol_deg
+        )
+        st, why, seg, _, i = fl._track.descend(ctx, states[-1], sub, used + it)
+        it += i
+        states.extend(seg[1:])
+        if st is Status.BUDGET_EXHAUSTED:
+            return Track(None, st, why, states, it)
+        if st is Status.SOLVED:
+            reached, stalls = reached + 1, 0
+            status, reason = Status.SOLVED, f"retracted to face {k}"
+            if fl.sees_approach(ctx, states[-1]):
+                break
+            continue
+        stalls += 1
+        if stalls >= 2:
+            break
+    return Track(None, status, f"{reason} ({reached} faces reached)", states, it)
