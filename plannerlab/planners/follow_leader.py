@@ -369,14 +369,16 @@ class FollowLeader(LegPlanner):
         used: int = 0,
         leader: TipPath | None = None,
     ) -> Track:
-        """:func:`plannerlab.planners.leader_moves.track` with this planner."""
-        return leader_moves.track(self, ctx, q0, goal, rng, used, leader)
+        """:func:`plannerlab.planners.leader_moves.track` with this planner (its derived
+        distances set for the leg's robot)."""
+        fl = self.for_robot(ctx.robot)
+        return leader_moves.track(fl, ctx, q0, goal, rng, used, leader)
 
     def sees_approach(self, ctx: PlanningContext, q: Array) -> bool:
         """Whether the straight line from the tip of ``q`` to the leg goal's approach
         point keeps the leader's clearance from the scene (the retract has got the tip
         out)."""
-        s = self.settings
+        s = self.for_robot(ctx.robot).settings
         goal, robot = ctx.goal, ctx.robot
         p_tip, _ = robot.tip(q)
         approach = goal.p_world_m - s.approach_m * goal.n_world
@@ -390,8 +392,9 @@ class FollowLeader(LegPlanner):
         return bool(scene_distance_m(ctx.scene, line).min() >= clearance)
 
     def retract(self, ctx: PlanningContext, q0: Array, used: int = 0) -> Track:
-        """:func:`plannerlab.planners.leader_moves.retract` with this planner."""
-        return leader_moves.retract(self, ctx, q0, used)
+        """:func:`plannerlab.planners.leader_moves.retract` with this planner (its derived
+        distances set for the leg's robot)."""
+        return leader_moves.retract(self.for_robot(ctx.robot), ctx, q0, used)
 
     def plan(self, ctx: PlanningContext, rng: np.random.Generator) -> PlanResult:
         """Plan the leader's path, follow it, finish with the leg's descent."""

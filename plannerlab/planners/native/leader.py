@@ -61,7 +61,6 @@ from plannerlab.planners.native.solve import (
     K_views,
     NativeSolve,
     space_extent,
-    writable_model,
 )
 from plannerlab.robots.base import Array, wrap_to_pi
 
@@ -194,6 +193,7 @@ def build_guidance(
     """The guidance of one leg (see the module docstring), or the result when the budget
     ran out or no goal state was found."""
     s = settings
+    leader = leader.for_robot(ctx.robot)  # its distances derived for this robot
     robot, tracker, goal = ctx.robot, ctx.tracker, ctx.goal
     dof = robot.dof
     q0 = solve.q0
@@ -307,7 +307,7 @@ class LeaderSolve(NativeSolve):
         q0 = self.q0
         if self.ctx.start_problem is not None:
             return self.result(Status.INVALID_START, self.ctx.start_problem, q0[None])
-        model = writable_model(self.checker.model)
+        model = self.checker.model
         self.run.progress.note(float(self.goal.distance(self.robot, q0)))
         t0, c0 = self.tracker.elapsed_s, self.tracker.checks_used
         g = build_guidance(self.leader, self.lsettings, self, self.ctx, self.rng)
