@@ -135,11 +135,16 @@ def _settings_rows(settings: Any, prefix: str = "") -> list[dict[str, Any]]:
             rows += _settings_rows(value, key + ".")
             continue
         doc = docs.get(f.name, "")
+        derived = value is None and "derived" in doc  # set from the robot's size at plan time
         rows.append(
             {
                 "key": key,
-                "default": value if isinstance(value, int | float | str | bool) else repr(value),
-                "type": type(value).__name__,
+                "default": "derived"
+                if derived
+                else value
+                if isinstance(value, int | float | str | bool)
+                else repr(value),
+                "type": "float" if derived else type(value).__name__,
                 "unit": _unit(f.name, doc),
                 "doc": doc,
             }

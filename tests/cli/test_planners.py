@@ -40,8 +40,10 @@ def test_one_planner_shows_its_settings_as_one_json_document(capsys):
     assert info["settings_class"].endswith("ClearanceSettings")
     # the defaults of this planner (its registry entry sets the escape)
     assert settings["escape"]["default"] == "detour"
-    assert settings["margin_m"]["default"] == 0.3 and settings["margin_m"]["unit"] == "m"
-    assert "distance below which a pair costs" in settings["margin_m"]["doc"]
+    # derived from the robot's size when the leg is planned; the doc gives Arm-Z's value
+    assert settings["margin_m"]["default"] == "derived" and settings["margin_m"]["unit"] == "m"
+    assert "0.3 on Arm-Z" in settings["margin_m"]["doc"]
+    assert "the distance below which a pair of links" in settings["margin_m"]["doc"]
     assert settings["max_step_rad"]["unit"] == "rad"
     assert settings["r1"]["doc"] == settings["r2"]["doc"] != ""  # "r1, r2: ..." entry
 
