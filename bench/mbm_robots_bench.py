@@ -16,11 +16,11 @@ with the same log skips the problems already there, so it can be stopped and res
     PYTHONPATH=. .venv/bin/python bench/mbm_robots_bench.py --report /tmp/mbm/ur5.jsonl
 
 Each problem: one ``solve`` of its leg with the planner's defaults (seed = the problem's
-index), then the path re-checked by plannerlab's checker (compiled core, no margin) with
-edges cut so that no joint moves more than ``--recheck-step`` (default 0.0025 rad, an eighth
-of the imported ``joint_step``), its ends compared with the start and the goal. A problem
-counts solved only if its path passes. For every problem not solved the log says why, and
-whether its start and goal states are valid in the spherized model.
+index in name order), then the path re-checked by plannerlab's checker (compiled core, no
+margin) with edges cut so that no joint moves more than ``--recheck-step`` (default 0.0025
+rad, an eighth of the imported ``joint_step``), its ends compared with the start and the
+goal. A problem counts solved only if its path passes. For every problem not solved the log
+says why, and whether its start and goal states are valid in the spherized model.
 
 The report prints solved counts per scenario, the median and 95th percentile of the
 planning time (the leg's ``time_s``) and the whole call, the statuses, and the failures;
@@ -82,19 +82,38 @@ def run(args: argparse.Namespace) -> None:
         files = [f for group in per for f in group]
     if not files:
         sys.exit(f"no imported MotionBenchMaker problem files in {args.folder}")
+    if args.reverse:
+        files = files[::-1]
     done: set[str] = set()
-    if args.log.is_file():
-        for line in args.log.read_text().splitlines():
-            if line.startswith("{"):
-                done.add(json.loads(line)["name"])
+    for log_path in [args.log, *args.skip_logged]:
+        if log_path.is_file():
+            for line in log_path.read_text().splitlines():
+                if line.startswith("{"):
+                    done.add(json.loads(line)["name"])
     todo = [(i, f) for i, f in enumerate(files) if f.stem not in done]
     print(f"{len(files)} problems, {len(done)} done, {len(todo)} to go", flush=True)
     planner = make_planner(args.planner, {})
     budget = Budget(time_limit_s=args.time_limit)
     warm = parse_problem(files[0])
     planner.solve(warm, 0, budget, np.random.default_rng(10**6))  # untimed warm-up
+    index = {f: i for i, f in enumerate(sorted(files))}
+
+    def logged_elsewhere() -> set[str]:
+        names: set[str] = set()
+        for log_path in args.skip_logged:
+            if log_path.is_file():
+                names |= {
+                    json.loads(s)["name"]
+                    for s in log_path.read_text().splitlines()
+                    if s.startswith("{")
+                }
+        return names
+
     with args.log.open("a") as log:
-        for i, f in todo:
+        for _, f in todo:
+            if f.stem in logged_elsewhere():  # the other process got there first
+                continue
+            i = index[f]
             p = parse_problem(f)
             t0, c0 = time.perf_counter(), time.process_time()
             r = planner.solve(p, 0, budget, np.random.default_rng(i))
@@ -103,6 +122,7 @@ def run(args: argparse.Namespace) -> None:
             why = recheck(p, r.path, args.recheck_step) if solved else ""
             rec: dict[str, Any] = {
                 "name": p.name,
+                "seed": i,
                 "planner": args.planner,
                 "status": r.status.name,
                 "solved": solved and not why,
@@ -172,6 +192,14 @@ def main() -> None:
     ap.add_argument("--planner", default="ompl.rrtconnect")
     ap.add_argument("--per-scenario", type=int, default=100)
     ap.add_argument("--interleave", action="store_true", help="round-robin over scenarios")
+    ap.add_argument("--reverse", action="store_true", help="last problem first")
+    ap.add_argument(
+        "--skip-logged",
+        type=Path,
+        nargs="*",
+        default=[],
+        help="also skip the problems of these logs (a second process from the other end)",
+    )
     ap.add_argument("--time-limit", type=float, default=10.0, help="per problem [s]")
     ap.add_argument("--recheck-step", type=float, default=0.0025, help="[rad]")
     ap.add_argument("--report", type=Path, nargs="*", help="summarise these logs")

@@ -34,7 +34,9 @@ loaded with ``useFixedBase`` and ``URDF_USE_SELF_COLLISION``, each obstacle a co
 shape; every path cut so that no joint moves more than ``--referee-step`` (0.005 rad);
 ``getClosestPoints(robot, obstacle, 0.0)`` at every state; a negative distance is a
 penetration and the path is not counted solved. Robot against scene only (self-collision
-is not refereed). The paths' ends are compared with the start and goal.
+is not refereed). The paths' ends are compared with the start and goal. PyBullet collides
+each link's convex hull; at the deepest state of a path it refuses, python-fcl on the mesh
+triangles gives a second opinion (intersect, or how far apart), printed beside it.
 
     PYTHONPATH=. .venv/bin/python bench/peers_mesh_bench.py [--n 5] [--time-limit 10]
         [--plannerlab-geometry spherized|mesh] [--peers ~/.cache/plannerlab-peers]
@@ -330,7 +332,7 @@ class Referee:
         for a, b in zip(P[:-1], P[1:], strict=True):
             n = max(1, math.ceil(float(np.max(np.abs(b - a))) / step_rad))
             states += [a + (b - a) * (k / n) for k in range(1, n + 1)]
-        worst, where = 0.0, ""
+        worst, where, self.worst_q = 0.0, "", None
         for i, q in enumerate(states):
             self.c.resetJointStatesMultiDof(self.robot, self.joints, [[float(v)] for v in q])
             self.c.performCollisionDetection()
@@ -340,7 +342,68 @@ class Referee:
                         worst = float(pt[8])
                         link = self.link_names.get(pt[3], "?")
                         where = f"state {i}/{len(states) - 1}: {link} x obstacle {k}"
+                        self.worst_q = q
         return worst, len(states), where
+
+
+class TriangleReferee:
+    """A second opinion at one state: python-fcl on the mesh triangles themselves (BVH
+    models of the derived URDF's collision meshes, placed by ``yourdfpy``'s forward
+    kinematics), where PyBullet collides each link's convex hull. Whether a link and an
+    obstacle intersect, else their distance."""
+
+    def __init__(self, urdf: Path, joint_names: list[str]) -> None:
+        import fcl
+        import numpy as np
+        import trimesh
+        import yourdfpy
+
+        self.fcl = fcl
+        self.model = yourdfpy.URDF.load(
+            str(urdf), build_scene_graph=True, load_meshes=False, load_collision_meshes=False
+        )
+        self.joint_names = joint_names
+        self.links: list[tuple[str, Any, Any]] = []  # link, T_link_mesh, BVH
+        for link in self.model.robot.links:
+            for col in link.collisions:
+                if col.geometry.mesh is None:
+                    continue
+                mesh = trimesh.load(
+                    str(Path(urdf).parent / col.geometry.mesh.filename), force="mesh"
+                )
+                bvh = fcl.BVHModel()
+                bvh.beginModel(len(mesh.vertices), len(mesh.faces))
+                bvh.addSubModel(np.asarray(mesh.vertices), np.asarray(mesh.faces))
+                bvh.endModel()
+                T = np.eye(4) if col.origin is None else np.asarray(col.origin)
+                self.links.append((link.name, T, bvh))
+
+    def at(self, q: Any, obstacles: list[dict[str, Any]]) -> tuple[float, str]:
+        """(smallest distance [m], 0 when some pair intersects; which pair)."""
+        import numpy as np
+
+        fcl = self.fcl
+        self.model.update_cfg(dict(zip(self.joint_names, map(float, q), strict=True)))
+        obs = []
+        for o in obstacles:
+            if o["type"] == "box":
+                g = fcl.Box(*o["size"])
+            elif o["type"] == "cylinder":
+                g = fcl.Cylinder(o["size"][0], o["size"][1])
+            else:
+                g = fcl.Sphere(o["size"][0])
+            obs.append(fcl.CollisionObject(g, fcl.Transform(np.array(o["R"]), np.array(o["p"]))))
+        best, where = math.inf, ""
+        for name, T_lm, bvh in self.links:
+            T = self.model.get_transform(name) @ T_lm
+            a = fcl.CollisionObject(bvh, fcl.Transform(T[:3, :3], T[:3, 3]))
+            for k, b in enumerate(obs):
+                if fcl.collide(a, b, fcl.CollisionRequest(), fcl.CollisionResult()):
+                    return 0.0, f"{name} x obstacle {k} intersect"
+                d = fcl.distance(a, b, fcl.DistanceRequest(), fcl.DistanceResult())
+                if d < best:
+                    best, where = d, f"{name} x obstacle {k}"
+        return best, where
 
 
 # ---------------------------------------------------------------------- the run
@@ -511,6 +574,7 @@ def main() -> None:
         print(f"done: {which}", flush=True)
 
     referee = Referee(urdf, joint_names)
+    triangles = TriangleReferee(urdf, joint_names)
     by_name = {s["name"]: s for s in spec["problems"]}
     goal_tol = {p.name: p.goal(0).tol_rad for p in problems}
     for res in results.values():
@@ -530,10 +594,15 @@ def main() -> None:
                 r["referee_states"] = n
                 if d < 0:
                     r["referee"] = f"penetrates {-d * 1e3:.1f} mm ({where})"
+                    t_d, t_where = triangles.at(referee.worst_q, s["obstacles"])
+                    r["triangles"] = (
+                        f"{t_where}" if t_d == 0.0 else f"{t_d * 1e3:.2f} mm apart ({t_where})"
+                    )
     load1 = os.getloadavg()[0]
     # one table
     base = results["plannerlab ompl.rrtconnect"]
-    base_ok = [r for r in base["runs"] if r["solved"] and not r["referee"]]
+    # times: the medians over every path a planner returned (refereed or not)
+    base_ok = [r for r in base["runs"] if r["solved"]]
     base_plan = float(np.median([r["plan_s"] for r in base_ok])) if base_ok else float("nan")
     base_whole = float(np.median([r["whole_s"] for r in base_ok])) if base_ok else float("nan")
     print(
@@ -541,25 +610,30 @@ def main() -> None:
     )
     print(
         "| planner | version | solved, refereed on meshes | failed the referee "
-        "| median planning ms | planning / plannerlab | median whole call ms | whole / plannerlab |"
+        "| of which triangles intersect (FCL) | median planning ms (paths returned) "
+        "| planning / plannerlab | median whole call ms | whole / plannerlab |"
     )
-    print("|" + "---|" * 8)
+    print("|" + "---|" * 9)
     for label, res in results.items():
         if "error" in res:
-            print(f"| {label} | - | not run: {res['error'][-300:]} | | | | | |")
+            print(f"| {label} | - | not run: {res['error'][-300:]} | | | | | | |")
             continue
         runs = res["runs"]
         ok = [r for r in runs if r["solved"] and not r["referee"]]
         bad = [r for r in runs if r["solved"] and r["referee"]]
-        mp = float(np.median([r["plan_s"] for r in ok])) if ok else float("nan")
-        mw = float(np.median([r["whole_s"] for r in ok])) if ok else float("nan")
+        claimed = [r for r in runs if r["solved"]]
+        mp = float(np.median([r["plan_s"] for r in claimed])) if claimed else float("nan")
+        mw = float(np.median([r["whole_s"] for r in claimed])) if claimed else float("nan")
         print(
             f"| {label} | {res['version']} | {len(ok)}/{len(runs)} | {len(bad)} | "
+            f"{sum('intersect' in r.get('triangles', '') for r in bad)} | "
             f"{mp * 1e3:.1f} | {mp / base_plan:.2f} | {mw * 1e3:.1f} | {mw / base_whole:.2f} |"
         )
     for label, res in results.items():
         for r in res.get("runs", []):
             extra = f" referee: {r['referee']}" if r.get("referee") else ""
+            if r.get("triangles"):
+                extra += f"; FCL on the triangles there: {r['triangles']}"
             n = r.get("referee_states", 0)
             print(
                 f"  {label}: {r['name']}: {r['status']}, planning {r['plan_s'] * 1e3:.1f} ms, "
