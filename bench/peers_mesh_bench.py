@@ -475,6 +475,18 @@ def main() -> None:
     ap.add_argument("--time-limit", type=float, default=10.0, help="per problem [s]")
     ap.add_argument("--referee-step", type=float, default=0.005, help="[rad]")
     ap.add_argument("--plannerlab-geometry", choices=("spherized", "mesh"), default="spherized")
+    ap.add_argument(
+        "--cover-excess-m",
+        type=float,
+        default=None,
+        help="with --plannerlab-geometry mesh: [robot] cover_excess_m of the problem files",
+    )
+    ap.add_argument(
+        "--cover-max-spheres",
+        type=int,
+        default=None,
+        help="with --plannerlab-geometry mesh: [robot] cover_max_spheres of the problem files",
+    )
     ap.add_argument("--peers", type=Path, default=Path.home() / ".cache" / "plannerlab-peers")
     ap.add_argument("--json", type=Path, default=None, help="write everything here")
     ap.add_argument("--worker", nargs=2, help=argparse.SUPPRESS)
@@ -506,16 +518,16 @@ def main() -> None:
     problems = []
     for scene, request in pairs:
         out = tmp / f"{args.scenario}_{scene.stem.removeprefix('scene')}.toml"
-        out.write_text(
-            mbm.problem_toml(
-                scene,
-                request,
-                out_path=out,
-                urdf=plannerlab_urdf,
-                srdf=got.srdf,
-                tip_link="panda_hand",
-            )
+        text = mbm.problem_toml(
+            scene, request, out_path=out, urdf=plannerlab_urdf, srdf=got.srdf, tip_link="panda_hand"
         )
+        extra = ""  # the mesh covers' [robot] keys
+        if args.cover_excess_m is not None:
+            extra += f"cover_excess_m = {args.cover_excess_m!r}\n"
+        if args.cover_max_spheres is not None:
+            extra += f"cover_max_spheres = {args.cover_max_spheres}\n"
+        text = text.replace('tip_link = "panda_hand"\n', f'tip_link = "panda_hand"\n{extra}')
+        out.write_text(text)
         problems.append(parse_problem(out))
     joint_names = list(problems[0].robot.joint_names)
     rrt_range = 0.2 * float(
