@@ -16,19 +16,21 @@ def cmd_import_mbm(args: argparse.Namespace, console: Console) -> int:
     from plannerlab.errors import PlannerlabError
 
     urdf, srdf = args.urdf, args.srdf
+    robot = mbm.mbm_robot(args.robot)
+    tip_link = args.tip_link or robot.tip_link
     sources: list[Path] = list(args.source)
     if args.fetch:
-        got = mbm.fetch_vamp_panda(args.cache)
+        got = mbm.fetch_vamp(robot.name, args.cache)
         console.print(
-            f"vamp-planner 0.6.4 (Apache-2.0, licence {escape(str(got.licence))}): Panda URDF "
-            f"{escape(str(got.urdf))}, SRDF {escape(str(got.srdf))}, problems in "
-            f"{escape(str(got.problems))}",
+            f"vamp-planner 0.6.4 (Apache-2.0, licence {escape(str(got.licence))}): "
+            f"{robot.name} URDF {escape(str(got.urdf))}, SRDF {escape(str(got.srdf))}, "
+            f"problems in {escape(str(got.problems))}",
             highlight=False,
         )
         urdf = urdf or got.urdf
         srdf = srdf or got.srdf
         if not sources:
-            sources = [got.problems / f"{s}_panda" for s in mbm.MBM_SCENARIOS]
+            sources = got.scenario_folders()
     if not sources:
         if args.fetch:
             return 0
@@ -36,7 +38,7 @@ def cmd_import_mbm(args: argparse.Namespace, console: Console) -> int:
             "import mbm: give scenario folders or scene+request files, or --fetch"
         )
     if urdf is None:
-        raise PlannerlabError("import mbm: --urdf is needed (or --fetch for the Panda's)")
+        raise PlannerlabError("import mbm: --urdf is needed (or --fetch for the robot's)")
     pairs: list[tuple[Path, Path, str]] = []
     files = [s for s in sources if not s.is_dir()]
     if files:
@@ -50,7 +52,7 @@ def cmd_import_mbm(args: argparse.Namespace, console: Console) -> int:
         found = mbm.problem_pairs(folder)
         if not found:
             raise PlannerlabError(f"{folder}: no sceneNNNN.yaml + requestNNNN.yaml pairs")
-        scenario = folder.name.removesuffix("_panda")
+        scenario = folder.name.removesuffix(f"_{robot.name}")
         for scene, request in found[: args.limit]:
             pairs.append((scene, request, f"{scenario}_{scene.stem.removeprefix('scene')}"))
     out: Path = args.out
@@ -65,7 +67,7 @@ def cmd_import_mbm(args: argparse.Namespace, console: Console) -> int:
             out_path=target,
             urdf=Path(urdf),
             srdf=Path(srdf) if srdf else None,
-            tip_link=args.tip_link,
+            tip_link=tip_link,
             name=name,
             safety_margin_m=args.margin_m,
             joint_step_rad=args.joint_step,
@@ -94,7 +96,8 @@ def add_parser(sub: Any) -> None:
             "MotionBenchMaker problems (MoveIt scene + request YAML, joint goals) -> plannerlab "
             "problem files for a URDF robot. SOURCE: scenario folders of sceneNNNN.yaml + "
             "requestNNNN.yaml pairs, or one scene file and one request file. --fetch gets "
-            "the Panda set, URDF and SRDF from the vamp-planner 0.6.4 source distribution "
+            "the --robot's set (panda, ur5, fetch), URDF and SRDF from the vamp-planner "
+            "0.6.4 source distribution "
             "(pip download) into a cache and says where."
         ),
     )
@@ -102,7 +105,15 @@ def add_parser(sub: Any) -> None:
     m.add_argument("--out", type=Path, default=Path("problems/mbm"), help="folder to write to")
     m.add_argument("--urdf", type=Path, default=None, help="the robot's URDF")
     m.add_argument("--srdf", type=Path, default=None, help="the robot's SRDF (optional)")
-    m.add_argument("--tip-link", default="panda_hand", help="URDF link carrying the tip")
+    m.add_argument(
+        "--robot",
+        default="panda",
+        help="the MotionBenchMaker robot: panda, ur5 or fetch (what --fetch gets; the "
+        "default tip link; the suffix taken off scenario folder names)",
+    )
+    m.add_argument(
+        "--tip-link", default=None, help="URDF link carrying the tip (default: the robot's)"
+    )
     m.add_argument("--name", default=None, help="problem name (one scene + request)")
     m.add_argument("--limit", type=int, default=None, help="at most N problems per folder")
     m.add_argument(
@@ -121,7 +132,7 @@ def add_parser(sub: Any) -> None:
     m.add_argument(
         "--fetch",
         action="store_true",
-        help="download the Panda set (vamp-planner 0.6.4 sdist, pip) into --cache first",
+        help="download the --robot's set (vamp-planner 0.6.4 sdist, pip) into --cache first",
     )
     m.add_argument(
         "--cache",

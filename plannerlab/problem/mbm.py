@@ -14,10 +14,15 @@ cylinder's ``[height, radius]`` along its local z, a sphere's ``[radius]``; orie
 quaternions ``[x, y, z, w]``; an object may have a ``pose`` of its own, to which its
 ``primitive_poses`` are relative.
 
-:func:`fetch_vamp_panda` gets the Panda set (7 scenarios × 100 problems), its spherized
+:func:`fetch_vamp` gets one robot's set (7 scenarios × 100 problems), its spherized
 URDF and SRDF from the ``vamp-planner`` 0.6.4 source distribution through pip into a
 cache folder outside the repository (Apache-2.0; nothing of it is committed but the
-Panda URDF, SRDF and licence in ``problems/urdf/panda``).
+Panda URDF, SRDF and licence in ``problems/urdf/panda``). :data:`MBM_ROBOTS` names the
+robots: the Panda (7 arm joints), the UR5 with its Robotiq gripper (6 arm joints) and
+the Fetch (group ``arm_with_torso``: the torso's prismatic lift and 7 arm joints; its
+base, head and gripper fingers are fixed joints of VAMP's spherized URDF, at the values
+MotionBenchMaker's start states give them). A request's planning group must be the
+robot's: its goal constrains exactly the robot's joints.
 """
 
 from __future__ import annotations
@@ -38,11 +43,11 @@ import numpy as np
 from plannerlab.errors import PlannerlabError
 from plannerlab.robots.base import Array, matrix_to_rpy
 
-#: the source distribution that ships the Panda set, and what it holds
+#: the source distribution that ships the MotionBenchMaker sets, and what it holds
 VAMP_REQUIREMENT = "vamp-planner==0.6.4"
 VAMP_SDIST = "vamp_planner-0.6.4.tar.gz"
 VAMP_ROOT = "vamp_planner-0.6.4"
-#: MotionBenchMaker's Panda scenarios (each a folder ``<name>_panda`` of 100 problems)
+#: MotionBenchMaker's scenarios (for each robot a folder ``<name>_<robot>`` of 100 problems)
 MBM_SCENARIOS = (
     "bookshelf_small",
     "bookshelf_tall",
@@ -58,6 +63,11 @@ MBM_SCENARIOS = (
 DEFAULT_JOINT_STEP_RAD = 0.02
 #: the goal tolerance when the request gives none [rad]
 DEFAULT_JOINT_TOL_RAD = 1e-3
+#: how far outside its URDF limits a start or goal joint value is clipped back into them
+#: [rad or m]: the Fetch's roll joints are limited to ±3.14159 and 132 of its goals (12
+#: starts) sit at ±π, 2.7e-6 beyond; farther out a state is left as it is (and refused
+#: by the problem loader)
+LIMIT_SLACK = 1e-5
 
 
 class MbmFileError(PlannerlabError):
@@ -74,19 +84,66 @@ def default_cache() -> Path:
 
 
 @dataclass(frozen=True)
-class VampPanda:
-    """Where :func:`fetch_vamp_panda` put the Panda set."""
+class MbmRobot:
+    """One robot of the MotionBenchMaker sets in the vamp-planner distribution."""
 
-    folder: Path  #: ``resources/panda`` of the distribution
+    name: str  #: ``resources/<name>`` of the distribution; its scenario folders end ``_<name>``
+    urdf: str  #: the spherized URDF's file name (spheres only: every link a checker can use)
+    srdf: str  #: the SRDF's file name (its ``disable_collisions`` pairs)
+    tip_link: str  #: the planning group's tip link
+    group: str  #: the MoveIt planning group of the requests (``group_name``)
+
+
+#: the robots :func:`fetch_vamp` knows, by name (tip links: the groups' tips in the SRDFs;
+#: the Fetch's ``arm_with_torso`` has no chain there, its arm ends at ``gripper_link``)
+MBM_ROBOTS: dict[str, MbmRobot] = {
+    "panda": MbmRobot("panda", "panda_spherized.urdf", "panda.srdf", "panda_hand", "panda_arm"),
+    "ur5": MbmRobot("ur5", "ur5_spherized.urdf", "ur5.srdf", "ee_link", "manipulator"),
+    "fetch": MbmRobot(
+        "fetch", "fetch_spherized.urdf", "fetch.srdf", "gripper_link", "arm_with_torso"
+    ),
+}
+
+
+@dataclass(frozen=True)
+class VampRobot:
+    """Where :func:`fetch_vamp` put one robot's set."""
+
+    folder: Path  #: ``resources/<robot>`` of the distribution
     urdf: Path
     srdf: Path
-    problems: Path  #: the folder of the ``<scenario>_panda`` folders
+    problems: Path  #: the folder of the ``<scenario>_<robot>`` folders
     licence: Path
+    robot: MbmRobot = MBM_ROBOTS["panda"]
+
+    def scenario_folders(self) -> list[Path]:
+        """The robot's scenario folders, in :data:`MBM_SCENARIOS` order."""
+        return [self.problems / f"{s}_{self.robot.name}" for s in MBM_SCENARIOS]
 
 
-def fetch_vamp_panda(cache: Path | None = None) -> VampPanda:
-    """Download (``pip download --no-deps vamp-planner==0.6.4``, once) and unpack the
-    Panda set into ``cache`` (default :func:`default_cache`)."""
+#: the former name of :class:`VampRobot`
+VampPanda = VampRobot
+
+
+def mbm_robot(name: str) -> MbmRobot:
+    """The robot of :data:`MBM_ROBOTS` called ``name`` (a clear error otherwise)."""
+    if name not in MBM_ROBOTS:
+        raise PlannerlabError(
+            f"MotionBenchMaker robot: one of {', '.join(MBM_ROBOTS)}, got {name!r}"
+        )
+    return MBM_ROBOTS[name]
+
+
+def fetch_vamp_panda(cache: Path | None = None) -> VampRobot:
+    """:func:`fetch_vamp` for the Panda."""
+    return fetch_vamp("panda", cache)
+
+
+def fetch_vamp(robot: str = "panda", cache: Path | None = None) -> VampRobot:
+    """Download (``pip download --no-deps vamp-planner==0.6.4``, once) and unpack one
+    robot's set (``panda``, ``ur5`` or ``fetch``) into ``cache`` (default
+    :func:`default_cache`)."""
+    rob = mbm_robot(robot)
     cache = default_cache() if cache is None else Path(cache)
     cache.mkdir(parents=True, exist_ok=True)
     sdist = cache / VAMP_SDIST
@@ -98,26 +155,27 @@ def fetch_vamp_panda(cache: Path | None = None) -> VampPanda:
                 f"{' '.join(cmd)} failed (exit {done.returncode}): {done.stderr.strip()[-400:]}"
             )
     root = cache / VAMP_ROOT
-    panda = root / "resources" / "panda"
-    if not (panda / "panda_spherized.urdf").is_file():
+    folder = root / "resources" / rob.name
+    if not (folder / rob.urdf).is_file() or not (root / "LICENSE.txt").is_file():
         with tarfile.open(sdist) as tar:
             wanted = [
                 m
                 for m in tar.getmembers()
-                if m.name.startswith(f"{VAMP_ROOT}/resources/panda/")
+                if m.name.startswith(f"{VAMP_ROOT}/resources/{rob.name}/")
                 or m.name == f"{VAMP_ROOT}/LICENSE.txt"
             ]
             tar.extractall(cache, members=wanted, filter="data")
-    problems = panda / "problems"
-    if not (problems / f"{MBM_SCENARIOS[0]}_panda").is_dir():
-        with tarfile.open(panda / "problems.tar.bz2") as tar:
-            tar.extractall(panda, filter="data")
-    return VampPanda(
-        folder=panda,
-        urdf=panda / "panda_spherized.urdf",
-        srdf=panda / "panda.srdf",
+    problems = folder / "problems"
+    if not (problems / f"{MBM_SCENARIOS[0]}_{rob.name}").is_dir():
+        with tarfile.open(folder / "problems.tar.bz2") as tar:
+            tar.extractall(folder, filter="data")
+    return VampRobot(
+        folder=folder,
+        urdf=folder / rob.urdf,
+        srdf=folder / rob.srdf,
         problems=problems,
         licence=root / "LICENSE.txt",
+        robot=rob,
     )
 
 
@@ -323,6 +381,14 @@ def request_states(
             "goal_constraints[0].joint_constraints",
             f"a constraint on every joint of the robot; missing {missing}",
         )
+    extra = [n for n in goal if n not in joint_names]
+    if extra:
+        raise MbmFileError(
+            source,
+            "goal_constraints[0].joint_constraints",
+            f"constraints on the robot's joints {list(joint_names)} only (the planning "
+            f"group must be the robot's); {extra} are not movable joints of its URDF",
+        )
     q_goal = np.array([goal[n] for n in joint_names])
     positive = [t for t in tols if t > 0]
     tol = min(positive) if positive else DEFAULT_JOINT_TOL_RAD
@@ -375,11 +441,24 @@ def problem_toml(
     obstacles = scene_obstacles(scene, scene_src)
     allowed = allowed_pairs(scene, scene_src, sorted({n.split("#")[0] for n in robot.link_names}))
     q_start, q_goal, tol = request_states(request, request_src, robot.joint_names)
+    notes = []
+    for label, q in (("start", q_start), ("goal", q_goal)):
+        lo, hi = np.asarray(robot.lower), np.asarray(robot.upper)
+        near = (q >= lo - LIMIT_SLACK) & (q <= hi + LIMIT_SLACK)
+        clipped = np.where(near, np.clip(q, lo, hi), q)
+        moved = [robot.joint_names[k] for k in np.flatnonzero(clipped != q)]
+        if moved:
+            notes.append(
+                f"# {label}: {', '.join(moved)} clipped into the URDF's limits "
+                f"(at most {np.max(np.abs(clipped - q)):.1e} beyond)"
+            )
+            q[:] = clipped
     out_dir = Path(out_path).parent
     stem = name or Path(out_path).stem
     lines = [
         f"# imported from MotionBenchMaker: {Path(scene_path).name}, {Path(request_path).name}",
         "# (plannerlab import mbm)",
+        *notes,
         "[problem]",
         f"name = {json.dumps(stem)}",
         f'description = "MotionBenchMaker {Path(scene_path).parent.name}/'
@@ -427,13 +506,18 @@ def problem_toml(
 
 
 __all__ = [
+    "MBM_ROBOTS",
     "MBM_SCENARIOS",
     "MbmFileError",
     "MbmObstacle",
+    "MbmRobot",
     "VampPanda",
+    "VampRobot",
     "allowed_pairs",
     "default_cache",
+    "fetch_vamp",
     "fetch_vamp_panda",
+    "mbm_robot",
     "problem_pairs",
     "problem_toml",
     "quaternion_matrix",
