@@ -9,12 +9,13 @@ set -euo pipefail
 cd "$(dirname "$0")"
 PY=${PYTHON:-python3}
 VENV=.venv
-stamp="$VENV/.installed-$(sha1sum pyproject.toml | cut -c1-12)"
+stamp="$VENV/.installed-$(cat pyproject.toml constraints.txt | sha1sum | cut -c1-12)"
 if [ ! -x "$VENV/bin/python" ] || [ ! -f "$stamp" ]; then
   echo "setting up $VENV (once; a few minutes on a fresh machine)" >&2
   "$PY" -m venv "$VENV"
   "$VENV/bin/python" -m pip install --quiet --upgrade pip
-  "$VENV/bin/python" -m pip install --quiet -e ".[test]"
+  # pinned versions (constraints.txt): the goldens of tests/ depend on them
+  "$VENV/bin/python" -m pip install --quiet -c constraints.txt -e ".[test]"
   rm -f "$VENV"/.installed-*
   touch "$stamp"
 fi
