@@ -114,6 +114,34 @@ def test_covers_are_cached_by_hash_and_written_atomically(tmp_path: Path) -> Non
     assert len(list((tmp_path / "covers").iterdir())) == 8
 
 
+def test_covers_shipped_beside_the_urdf_are_read_and_never_written(tmp_path: Path) -> None:
+    """A ``covers/`` folder beside the URDF (what the bundled mesh robots ship) answers a
+    cover the cache lacks: the robot loads on a new machine without computing any, and
+    with the very spheres a computed cover has; nothing is written into that folder."""
+    computed = arm(tmp_path / "a")
+    robot_dir = tmp_path / "robot"
+    shutil.copytree(DATA, robot_dir)
+    shutil.copytree(tmp_path / "a" / "covers", robot_dir / "covers")
+    shipped_files = sorted(p.name for p in (robot_dir / "covers").iterdir())
+    args = dict(mesh_paths=(robot_dir / "pkgroot",), cover_excess_m=EXCESS_M)
+    robot = UrdfChain(robot_dir / URDF.name, "tool", cover_cache_dir=tmp_path / "empty", **args)
+    assert [c.cached for c in robot.mesh_covers] == [True] * 4
+    assert np.array_equal(robot._cap_a, computed._cap_a)
+    assert np.array_equal(robot.link_radii_m, computed.link_radii_m)
+    assert not (tmp_path / "empty").exists() or not any((tmp_path / "empty").iterdir())
+    assert sorted(p.name for p in (robot_dir / "covers").iterdir()) == shipped_files
+    # another excess is not shipped: computed, into the cache only
+    other = UrdfChain(
+        robot_dir / URDF.name,
+        "tool",
+        cover_cache_dir=tmp_path / "empty",
+        **{**args, "cover_excess_m": 0.03},
+    )
+    assert [c.cached for c in other.mesh_covers] == [False] * 4
+    assert len(list((tmp_path / "empty").iterdir())) == 4
+    assert sorted(p.name for p in (robot_dir / "covers").iterdir()) == shipped_files
+
+
 def test_a_moving_link_without_geometry_is_named(
     covers: Path, caplog: pytest.LogCaptureFixture
 ) -> None:
@@ -230,3 +258,20 @@ def test_disabled_pairs_are_computed_and_kept_in_an_srdf(covers: Path) -> None:
     assert sorted(read_srdf_disabled(out)) == sorted(by)
     again = disabled_pairs(r, np.random.default_rng(0), n_states=200)
     assert again == pairs
+
+
+@pytest.mark.parametrize("problem", ["panda_mesh/table", "panda_mesh/shelf", "iiwa_mesh/table"])
+def test_the_bundled_mesh_robots_ship_every_cover(
+    problem: str, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """The bundled mesh robots load with an empty cache from their shipped covers (a
+    change of the cover's settings or algorithm must ship new ones:
+    ``XDG_CACHE_HOME=$(mktemp -d)``, load the problem, copy the cache's files into the
+    URDF's ``covers/``)."""
+    from plannerlab.problem.catalog import load_problem
+
+    monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path))
+    root = Path(__file__).resolve().parents[2]
+    robot = load_problem(root / "problems" / "urdf" / f"{problem}.toml").robot
+    assert robot.mesh_covers and all(c.cached for c in robot.mesh_covers)
+    assert not (tmp_path / "plannerlab" / "covers").exists()

@@ -357,11 +357,16 @@ def sphere_cover(
     max_spheres: int,
     where: str,
     cache_dir: Path | None,
+    shipped_dirs: tuple[Path, ...] = (),
 ) -> SphereCover:
     """The sphere cover of a mesh file (scaled), from the disk cache when there.
 
     Args:
         cache_dir: the cache folder (:func:`default_cache_dir`), or None: no cache.
+        shipped_dirs: read-only folders of covers shipped with a robot (the ``covers/``
+            folder beside its URDF: the same file names as the cache's), looked in after
+            the cache (only when caching is on); a cover computed here is written to the
+            cache only.
 
     Raises:
         MeshError: the file cannot be read, or cannot be covered within the limits.
@@ -377,9 +382,11 @@ def sphere_cover(
         h.update(file_digest(Path(path)).encode())
         h.update(np.asarray([*s, excess_m, max_spheres, COVER_VERSION], dtype=float).tobytes())
         key = Path(cache_dir) / f"{h.hexdigest()[:32]}.npz"
-        if key.is_file():
+        for found in (key, *(Path(d) / key.name for d in shipped_dirs)):
+            if not found.is_file():
+                continue
             try:
-                with np.load(key) as z:
+                with np.load(found) as z:
                     return SphereCover(
                         np.array(z["centres"]),
                         np.array(z["radii"]),
@@ -447,6 +454,8 @@ class CoverSettings:
     excess_m: float = 0.01
     max_spheres: int = 256
     cache_dir: Path | None = None
+    #: read-only folders of shipped covers (``covers/`` beside the URDF), after the cache
+    shipped_dirs: tuple[Path, ...] = ()
 
 
 # ---------------------------------------------------------------------- box covers

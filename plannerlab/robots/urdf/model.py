@@ -30,7 +30,8 @@ Every ``<collision>`` element becomes one capsule (a plannerlab "link", named
   searched as :func:`~plannerlab.robots.urdf.meshes.resolve_mesh` says): a conservative
   cover of zero-length capsules (spheres), one capsule per sphere
   (:func:`~plannerlab.robots.urdf.meshes.sphere_cover`: every vertex and a dense surface
-  sample inside, outward excess at most ``cover_excess_m``, cached on disk);
+  sample inside, outward excess at most ``cover_excess_m``, cached on disk; a
+  ``covers/`` folder beside the URDF may ship them, read-only: ``SHIPPED_COVERS``);
   :attr:`UrdfChain.mesh_covers` reports each. The simulator is given the meshes
   themselves (:meth:`UrdfChain.urdf`): verdicts are measured on the real geometry.
 
@@ -64,6 +65,9 @@ from plannerlab.robots.urdf.meshes import CoverSettings, MeshCover
 from plannerlab.robots.urdf.pairs import excluded_pairs, read_srdf_disabled
 
 MOVABLE = ("revolute", "continuous", "prismatic")
+#: the folder beside a URDF that may ship its meshes' covers (cache files, read-only): a
+#: robot bundled with its covers loads at once on a new machine
+SHIPPED_COVERS = "covers"
 _LOG = logging.getLogger(__name__)
 
 
@@ -252,7 +256,13 @@ def _capsules(
                     file = resolve_mesh(str(g.mesh.filename), path, cover.mesh_paths, where)
                     scale = np.ones(3) if g.mesh.scale is None else np.asarray(g.mesh.scale, float)
                     sc = sphere_cover(
-                        file, scale, cover.excess_m, cover.max_spheres, where, cover.cache_dir
+                        file,
+                        scale,
+                        cover.excess_m,
+                        cover.max_spheres,
+                        where,
+                        cover.cache_dir,
+                        cover.shipped_dirs,
                     )
                 except MeshError as exc:
                     raise UrdfError("urdf", str(exc)) from None
@@ -434,6 +444,7 @@ class UrdfChain:
                 if self.cover_cache_dir is not None
                 else default_cache_dir()
             ),
+            (path.resolve().parent / SHIPPED_COVERS,),
         )
         caps, covers, mesh_files = _capsules(tree, placed, path, settings)
         bare = [n for n, link in tree.links.items() if placed[n][0] > 0 and not link.collisions]
