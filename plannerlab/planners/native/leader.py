@@ -337,13 +337,8 @@ class LeaderSolve(NativeSolve):
         # the trees as the leader seeded them (the start's branches, the goal states'
         # roots with their backward branches), their edges checked in full
         na, nb = len(g.start_states), len(g.goal_states)
-        trees: list[np.ndarray] = []
-        for Q0, P0 in ((g.start_states, g.start_parents), (g.goal_states, g.goal_parents)):
-            Q, P = np.empty((rows, dof)), np.full(rows, -1, dtype=np.int64)
-            F = np.full(rows, K.CHECKED, dtype=np.int8)
-            R = np.full(rows, np.inf)
-            Q[: len(Q0)], P[: len(P0)] = Q0, P0
-            trees += [Q, P, F, R]
+        seeds = ((g.start_states, g.start_parents), (g.goal_states, g.goal_parents))
+        trees = self.new_trees(seeds, rows, dof)
         sizes = np.array([na, nb], dtype=np.int64)
         counters = np.zeros(6, dtype=np.int64)
         if g.reached_node >= 0:
@@ -352,59 +347,22 @@ class LeaderSolve(NativeSolve):
             self.iterations = g.iterations
             self.extra["nodes"] = [na, nb]
             return self._finish(trees, counters, na + nb, model, V, S, rng_state)
-        dd = np.zeros(3)
-        if getattr(self.s, "dynamic_domain", False):
-            dd[:] = (2.0 * range_rad, 0.5 * range_rad, 1e-4)
-        every = int(getattr(self.s, "lazy_every", 1))
-        buf = np.empty((4, dof))
         b = self.budget
         max_it = UNLIMITED if b.max_iterations is None else max(b.max_iterations - g.iterations, 1)
-        self._charged = 0
-        s = self.s
-
-        def call(soft: int, hard: int) -> int:
-            return int(
-                K.rrtc_run(
-                    model,
-                    V,
-                    S,
-                    trees[0],
-                    trees[1],
-                    trees[2],
-                    trees[3],
-                    trees[4],
-                    trees[5],
-                    trees[6],
-                    trees[7],
-                    sizes,
-                    counters,
-                    rng_state,
-                    self.guides,
-                    s.guide_bias,
-                    s.guide_sigma_rad,
-                    range_rad,
-                    self.step,
-                    every,
-                    dd,
-                    max_it,
-                    soft,
-                    hard,
-                    need_free,
-                    buf,
-                )
-            )
-
-        while True:
-            code = self.run_chunks(call, counters)
-            self.iterations = g.iterations + int(counters[0])
-            if code == K.FULL and len(trees[0]) < cap:
-                grown = min(cap, 4 * len(trees[0]))
-                for i, arr in enumerate(trees):
-                    bigger = np.full((grown,) + arr.shape[1:], -1, dtype=arr.dtype)
-                    bigger[: len(arr)] = arr
-                    trees[i] = bigger
-                continue
-            break
+        code = self.search(
+            model,
+            V,
+            S,
+            trees,
+            sizes,
+            counters,
+            rng_state,
+            range_rad,
+            need_free,
+            cap,
+            max_it,
+            iterations0=g.iterations,
+        )
         self.extra["planning_checks"] = int(counters[1])
         self.extra["search_iterations"] = int(counters[0])
         self.extra["nodes"] = [int(sizes[0]), int(sizes[1])]

@@ -289,6 +289,94 @@ class NativeSolve:
         return self.result(Status.BUDGET_EXHAUSTED, f"{self.name}: no path ({what}); {why}", q0)
 
     # ------------------------------------------------------------------ RRT-Connect
+    @staticmethod
+    def new_trees(
+        seeds: tuple[tuple[np.ndarray, np.ndarray | None], ...], rows: int, dof: int
+    ) -> list[np.ndarray]:
+        """The two trees' arrays (states, parents, check flags, dynamic-domain radii; 8 in
+        all) with ``rows`` rows each, seeded with (states, parents or None: roots)."""
+        trees: list[np.ndarray] = []
+        for Q0, P0 in seeds:
+            Q, P = np.empty((rows, dof)), np.full(rows, -1, dtype=np.int64)
+            F = np.full(rows, K.CHECKED, dtype=np.int8)
+            R = np.full(rows, np.inf)
+            Q[: len(Q0)] = Q0
+            if P0 is not None:
+                P[: len(P0)] = P0
+            trees += [Q, P, F, R]
+        return trees
+
+    def search(
+        self,
+        model: Any,
+        V: Any,
+        S: Any,
+        trees: list[np.ndarray],
+        sizes: np.ndarray,
+        counters: np.ndarray,
+        rng_state: np.ndarray,
+        range_rad: float,
+        need_free: int,
+        cap: int,
+        max_it: int,
+        iterations0: int = 0,
+    ) -> int:
+        """The compiled RRT-Connect on ``trees`` in chunks (:meth:`run_chunks`), the trees
+        grown (up to ``cap`` rows) when full; ``iterations`` counts from ``iterations0``.
+        Returns the kernel's last code."""
+        dof = trees[0].shape[1]
+        dd = np.zeros(3)
+        if getattr(self.s, "dynamic_domain", False):
+            dd[:] = (2.0 * range_rad, 0.5 * range_rad, 1e-4)  # VAMP's 4, 1 for its range 2
+        every = int(getattr(self.s, "lazy_every", 1))
+        buf = np.empty((4, dof))
+        self._charged = 0
+        s = self.s
+
+        def call(soft: int, hard: int) -> int:
+            return int(
+                K.rrtc_run(
+                    model,
+                    V,
+                    S,
+                    trees[0],
+                    trees[1],
+                    trees[2],
+                    trees[3],
+                    trees[4],
+                    trees[5],
+                    trees[6],
+                    trees[7],
+                    sizes,
+                    counters,
+                    rng_state,
+                    self.guides,
+                    s.guide_bias,
+                    s.guide_sigma_rad,
+                    range_rad,
+                    self.step,
+                    every,
+                    dd,
+                    max_it,
+                    soft,
+                    hard,
+                    need_free,
+                    buf,
+                )
+            )
+
+        while True:
+            code = self.run_chunks(call, counters)
+            self.iterations = iterations0 + int(counters[0])
+            if code == K.FULL and len(trees[0]) < cap:
+                grown = min(cap, 4 * len(trees[0]))
+                for i, a in enumerate(trees):
+                    bigger = np.full((grown,) + a.shape[1:], -1, dtype=a.dtype)  # rows unused
+                    bigger[: len(a)] = a
+                    trees[i] = bigger
+                continue
+            return code
+
     def rrtconnect(self) -> PlanResult:
         """RRT-Connect from the start to a tree rooted at every goal state."""
         q0 = self.q0
@@ -309,66 +397,13 @@ class NativeSolve:
         cap = max(self.tree_rows(hard0, len(G), dof), need_free + len(G) + 1)
         self.extra["tree_rows"] = cap
         rows = min(cap, max(FIRST_ROWS, need_free + len(G) + 1))
-        trees: list[np.ndarray] = []
-        for roots in (q0[None], G):
-            Q, P = np.empty((rows, dof)), np.full(rows, -1, dtype=np.int64)
-            F = np.full(rows, K.CHECKED, dtype=np.int8)
-            R = np.full(rows, np.inf)
-            Q[: len(roots)] = roots
-            trees += [Q, P, F, R]
-        dd = np.zeros(3)
-        if getattr(self.s, "dynamic_domain", False):
-            dd[:] = (2.0 * range_rad, 0.5 * range_rad, 1e-4)  # VAMP's 4, 1 for its range 2
+        trees = self.new_trees(((q0[None], None), (G, None)), rows, dof)
         sizes = np.array([1, len(G)], dtype=np.int64)
         counters = np.zeros(6, dtype=np.int64)
-        every = int(getattr(self.s, "lazy_every", 1))
-        buf = np.empty((4, dof))
         max_it = UNLIMITED if self.budget.max_iterations is None else self.budget.max_iterations
-        self._charged = 0
-
-        def call(soft: int, hard: int) -> int:
-            return int(
-                K.rrtc_run(
-                    model,
-                    V,
-                    S,
-                    trees[0],
-                    trees[1],
-                    trees[2],
-                    trees[3],
-                    trees[4],
-                    trees[5],
-                    trees[6],
-                    trees[7],
-                    sizes,
-                    counters,
-                    rng_state,
-                    self.guides,
-                    self.s.guide_bias,
-                    self.s.guide_sigma_rad,
-                    range_rad,
-                    self.step,
-                    every,
-                    dd,
-                    max_it,
-                    soft,
-                    hard,
-                    need_free,
-                    buf,
-                )
-            )
-
-        while True:
-            code = self.run_chunks(call, counters)
-            self.iterations = int(counters[0])
-            if code == K.FULL and len(trees[0]) < cap:
-                grown = min(cap, 4 * len(trees[0]))
-                for i, a in enumerate(trees):
-                    bigger = np.full((grown,) + a.shape[1:], -1, dtype=a.dtype)  # rows unused
-                    bigger[: len(a)] = a
-                    trees[i] = bigger
-                continue
-            break
+        code = self.search(
+            model, V, S, trees, sizes, counters, rng_state, range_rad, need_free, cap, max_it
+        )
         self.extra["planning_checks"] = int(counters[1])
         self.extra["nodes"] = [int(sizes[0]), int(sizes[1])]
         self.extra["paths_failing_fine_check"] = int(counters[5])
