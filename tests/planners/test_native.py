@@ -9,6 +9,7 @@ Budgets here are collision checks or iterations, never a clock.
 from __future__ import annotations
 
 import dataclasses
+import re
 from typing import Any
 
 import numpy as np
@@ -297,3 +298,16 @@ def test_bad_settings_are_refused(overrides: dict[str, Any]):
 def test_unknown_setting_lists_the_known_ones():
     with pytest.raises(UnknownNameError, match="guide_bias"):
         make_planner("native.rrtconnect", {"guide_bais": 0.1})
+
+
+@pytest.mark.parametrize(
+    "planner", ["native.rrtconnect", "native.rrtstar", "native.rrtconnect+leader"]
+)
+def test_a_budget_without_any_limit_is_refused_by_name(planner: str):
+    """A compiled search needs a limit to stop at: an empty budget is a clear error naming
+    the planner and the limits, raised before anything is planned."""
+    problem = load_problem("armz_pocket")
+    with pytest.raises(
+        PlannerlabError, match=re.escape(f"{planner}: the budget needs at least one")
+    ):
+        make_planner(planner).solve(problem, 0, Budget(), np.random.default_rng(0))

@@ -405,18 +405,7 @@ class LeaderPlanner(NativePlanner):
             self.leader.warm_up(problem, leg, q_start)
 
     def plan(self, ctx: PlanningContext, rng: np.random.Generator) -> PlanResult:
-        b = ctx.tracker.budget
-        if b.max_iterations is None and b.max_collision_checks is None and b.time_limit_s is None:
-            raise PlannerlabError(
-                f"{self.name}: the budget needs at least one limit "
-                "(max_iterations, max_collision_checks or time_limit_s)"
-            )
-        if ctx.checker is None:
-            raise PlannerlabError(f"{self.name}: needs a collision checker")
-        try:
-            ctx.checker.model  # noqa: B018 - built once, raises when it cannot be
-        except ValueError as e:
-            raise PlannerlabError(f"{self.name}: no compiled model of this problem: {e}") from e
+        self.require(ctx)
         assert self.leader is not None
         assert isinstance(self.settings, LeaderSettings)
         return LeaderSolve(self.name, self.settings, ctx, rng, self.leader).rrtconnect()

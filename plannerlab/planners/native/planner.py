@@ -96,8 +96,13 @@ class NativePlanner(LegPlanner):
         none here (plain sampling). A guided planner returns its own."""
         return np.zeros((0, ctx.robot.dof))
 
-    def plan(self, ctx: PlanningContext, rng: np.random.Generator) -> PlanResult:
-        """Plan the leg of ``ctx`` within its budget (at least one limit must be set)."""
+    def require(self, ctx: PlanningContext) -> None:
+        """What every native planner needs of its leg: a budget with at least one limit,
+        a collision checker and a compiled model of the problem.
+
+        Raises:
+            PlannerlabError: naming what is missing.
+        """
         b = ctx.tracker.budget
         if b.max_iterations is None and b.max_collision_checks is None and b.time_limit_s is None:
             raise PlannerlabError(
@@ -110,6 +115,10 @@ class NativePlanner(LegPlanner):
             ctx.checker.model  # noqa: B018 - built once, raises when it cannot be
         except ValueError as e:
             raise PlannerlabError(f"{self.name}: no compiled model of this problem: {e}") from e
+
+    def plan(self, ctx: PlanningContext, rng: np.random.Generator) -> PlanResult:
+        """Plan the leg of ``ctx`` within its budget (at least one limit must be set)."""
+        self.require(ctx)
         solve = NativeSolve(self.name, self.settings, ctx, rng, self.guide_states(ctx, rng))
         if self.algorithm == "rrtstar":
             return rrtstar(solve)
