@@ -11,6 +11,20 @@ detour, the random detour and the RRT-Connect escapes, follow-the-leader's track
 and the descent towards a goal state. Each solve runs in a fresh spawned process (OMPL's
 seed takes effect only before its first generator exists).
 
+Two roads are left out because no path of theirs holds to 1e-9 rad under any change of
+rounding, the numpy backend's own (which differs from the compiled one only by rounding)
+included; measured on main 313f4d0 against its compiled descent:
+
+* the steepest descent on ``armz_pocket`` run to its stall (2651 iterations): the paths
+  agree to 2e-10 rad for 1350 states, then part; the numpy backend stalls after 2613
+  iterations, the model's kinematics after 2632 (main's compiled one: 2651). Kept here on
+  400 iterations.
+* ``gradient.clearance+rrtconnect`` on ``armz_behind_plate`` (a golden case): the descent
+  to the stall agrees to 2e-13 rad; the RRT-Connect escape after it (OMPL, towards the
+  goal state the unchecked descent finds near the stall) takes another tree: 3221 checks
+  with the numpy backend, 3126 with the model's kinematics, 3071 with main's compiled
+  descent, each path of 927 states.
+
 Re-pin (only with the reason in the commit)::
 
     PYTHONPATH=. .venv/bin/python tests/planners/test_descent_reference.py --pin
@@ -33,11 +47,10 @@ STRIDE = 8
 #: (planner, problem, leg, check budget, iteration budget, seed, overrides)
 CASES: tuple[tuple[str, str, int, int, int, int, tuple], ...] = (
     ("gradient.clearance", "armz_pocket", 0, 20_000, 0, 0, ()),
-    ("gradient.clearance", "armz_pocket", 0, 20_000, 0, 0, (("direction", "gradient"),)),
+    ("gradient.clearance", "armz_pocket", 0, 0, 400, 0, (("direction", "gradient"),)),
     ("gradient.clearance", "armz_inspection", 3, 0, 1000, 0, ()),
     ("gradient.clearance+detour", "armz_thin_wall", 0, 20_000, 0, 0, ()),
     ("gradient.clearance+random_detour", "armz_thin_wall", 0, 20_000, 0, 0, ()),
-    ("gradient.clearance+rrtconnect", "armz_behind_plate", 0, 60_000, 0, 0, ()),
     ("gradient.follow_leader+random", "armz_thin_wall", 0, 20_000, 0, 0, ()),
     ("gradient.clearance+detour", "armz_inspection_v00_states", 4, 0, 3000, 0, ()),
 )
