@@ -119,6 +119,48 @@ def model_of_core(core: Any) -> CompiledModel:
     )
 
 
+def chain_model(robot: Any) -> CompiledModel:
+    """The model of a robot's chain alone (no scene, no margin, no checked pairs): its
+    kinematics and capsules packed as :func:`model_of_core` packs them, for a consumer
+    that needs only those (the clearance field's spheres,
+    :mod:`plannerlab.collision.spheres`) when no checker's model is at hand.
+
+    Raises:
+        ModelError: the robot gives no serial chain (``chain_data()``).
+    """
+    if not has_chain(robot):
+        raise ModelError(
+            f"robot type {getattr(robot, 'kind', type(robot).__name__)!r} gives no serial "
+            "chain (chain_data()): its kinematics cannot be compiled"
+        )
+    L = len(np.asarray(robot.link_radii_m))
+    zeros = np.zeros(L)
+    P, M, idat, perm = _pack(
+        robot,
+        zeros,
+        zeros,
+        np.ones(L, dtype=bool),
+        np.zeros((L, L), dtype=bool),
+        np.zeros(0, dtype=np.int64),
+        np.zeros((0, 3, 3)),
+        np.zeros((0, 3)),
+        np.zeros((0, 3)),
+        None,
+    )
+    dof = int(robot.dof)
+    return CompiledModel(
+        P=P,
+        M=M,
+        idat=idat,
+        lower=np.array(robot.lower, dtype=np.float64, order="C", copy=True),
+        upper=np.array(robot.upper, dtype=np.float64, order="C", copy=True),
+        continuous=np.array(robot.continuous, dtype=np.bool_, order="C", copy=True),
+        edge_weights=np.zeros(dof),
+        margin_m=0.0,
+        perm=np.array(perm, dtype=np.int64, order="C", copy=True),
+    )
+
+
 def build_model(core: Any) -> CompiledModel:
     """The model of a built core by its robot family's registered builder (the generic
     serial-chain :func:`model_of_core` unless the family names its own).
