@@ -178,32 +178,41 @@ def tip_pose(Bf, ch):
 
 
 @njit(cache=True, nogil=True, inline="always")
-def _to_state(ch, i, x, sign, out):
+def _to_state(cpl, i, x, sign, out):
     """Add ``sign · x`` (the derivative by chain joint i) into ``out`` (dof,), through the
-    coupling when there is one."""
-    if ch.cpl_start.shape[0] == 0:
+    coupling ``cpl`` (start, idx, val; empty: none)."""
+    cpl_start, cpl_idx, cpl_val = cpl
+    if cpl_start.shape[0] == 0:
         out[i] += sign * x
         return
-    for k in range(ch.cpl_start[i], ch.cpl_start[i + 1]):
-        out[ch.cpl_idx[k]] += sign * (ch.cpl_val[k // 3, k % 3] * x)
+    for k in range(cpl_start[i], cpl_start[i + 1]):
+        out[cpl_idx[k]] += sign * (cpl_val[k // 3, k % 3] * x)
 
 
-@njit(cache=True, nogil=True)
-def point_gradient(Bf, ch, body, p, n0, n1, n2, sign, out):
-    """Add ``sign · n · ∂p/∂q`` into ``out`` (dof,) for the point p (3,) on ``body``."""
+@njit(cache=True, nogil=True, inline="always")
+def point_gradient(Bf, parent, prism, cpl, body, p, n0, n1, n2, sign, out):
+    """Add ``sign · n · ∂p/∂q`` into ``out`` (dof,) for the point p (3,) on ``body``
+    (the chain's ``parent``, ``prism`` and coupling ``cpl``, :func:`kin`)."""
     b = body
     while b > 0:
         i = b - 1  # the joint that moves body b
         zx, zy, zz = Bf[b, 0, 2], Bf[b, 1, 2], Bf[b, 2, 2]
-        if ch.prism[i] != 0:
+        if prism[i] != 0:
             g = n0 * zx + n1 * zy + n2 * zz
         else:
             dx = p[0] - Bf[b, 0, 3]
             dy = p[1] - Bf[b, 1, 3]
             dz = p[2] - Bf[b, 2, 3]
             g = n0 * (zy * dz - zz * dy) + n1 * (zz * dx - zx * dz) + n2 * (zx * dy - zy * dx)
-        _to_state(ch, i, g, sign, out)
-        b = ch.parent[i]
+        _to_state(cpl, i, g, sign, out)
+        b = parent[i]
+
+
+@njit(cache=True, nogil=True, inline="always")
+def kin(ch):
+    """The arrays :func:`point_gradient` and :func:`pair_gradient` walk the chain with:
+    (parent, prism, coupling, each link's body), taken out of the chain once."""
+    return ch.parent, ch.prism, (ch.cpl_start, ch.cpl_idx, ch.cpl_val), ch.link_body
 
 
 @njit(cache=True, nogil=True)
@@ -212,29 +221,40 @@ def tip_jacobians(Bf, ch, p, n, dof):
     ``z_i × n`` for a turning joint i, ``z_i`` and 0 for a sliding one)."""
     Jp = np.zeros((3, dof))
     Jn = np.zeros((3, dof))
-    cp = np.empty(3)
-    cn = np.empty(3)
+    parent, prism, cpl, _ = kin(ch)
+    cpl_start, cpl_idx, cpl_val = cpl
+    coupled = cpl_start.shape[0] > 0
     b = ch.tip_body
     while b > 0:
         i = b - 1
         zx, zy, zz = Bf[b, 0, 2], Bf[b, 1, 2], Bf[b, 2, 2]
-        if ch.prism[i] != 0:
-            cp[0], cp[1], cp[2] = zx, zy, zz
-            cn[0], cn[1], cn[2] = 0.0, 0.0, 0.0
+        if prism[i] != 0:
+            p0, p1, p2 = zx, zy, zz
+            m0, m1, m2 = 0.0, 0.0, 0.0
         else:
             dx = p[0] - Bf[b, 0, 3]
             dy = p[1] - Bf[b, 1, 3]
             dz = p[2] - Bf[b, 2, 3]
-            cp[0] = zy * dz - zz * dy
-            cp[1] = zz * dx - zx * dz
-            cp[2] = zx * dy - zy * dx
-            cn[0] = zy * n[2] - zz * n[1]
-            cn[1] = zz * n[0] - zx * n[2]
-            cn[2] = zx * n[1] - zy * n[0]
-        for k in range(3):
-            _to_state(ch, i, cp[k], 1.0, Jp[k])
-            _to_state(ch, i, cn[k], 1.0, Jn[k])
-        b = ch.parent[i]
+            p0 = zy * dz - zz * dy
+            p1 = zz * dx - zx * dz
+            p2 = zx * dy - zy * dx
+            m0 = zy * n[2] - zz * n[1]
+            m1 = zz * n[0] - zx * n[2]
+            m2 = zx * n[1] - zy * n[0]
+        if not coupled:
+            Jp[0, i], Jp[1, i], Jp[2, i] = p0, p1, p2
+            Jn[0, i], Jn[1, i], Jn[2, i] = m0, m1, m2
+        else:
+            for k in range(cpl_start[i], cpl_start[i + 1]):
+                c = cpl_val[k // 3, k % 3]
+                j = cpl_idx[k]
+                Jp[0, j] += c * p0
+                Jp[1, j] += c * p1
+                Jp[2, j] += c * p2
+                Jn[0, j] += c * m0
+                Jn[1, j] += c * m1
+                Jn[2, j] += c * m2
+        b = parent[i]
     return Jp, Jn
 
 
@@ -399,13 +419,15 @@ def pair_spheres(
     )
 
 
-@njit(cache=True, nogil=True)
-def pair_gradient(Bf, ch, P, link, nrm, a, b, row, out):
+@njit(cache=True, nogil=True, inline="always")
+def pair_gradient(Bf, kn, P, link, nrm, a, b, row, out):
     """∇d (dof,) of one pair into ``out``: n · ∂p_a/∂q (− n · ∂p_b/∂q for a self pair;
-    b = −1: an obstacle) with p_s sphere s's centre (:func:`point_gradient`)."""
+    b = −1: an obstacle) with p_s sphere s's centre (:func:`point_gradient`; ``kn``:
+    :func:`kin` of the chain)."""
+    parent, prism, cpl, link_body = kn
     n0, n1, n2 = nrm[row, 0], nrm[row, 1], nrm[row, 2]
     for j in range(out.shape[0]):
         out[j] = 0.0
-    point_gradient(Bf, ch, ch.link_body[link[a]], P[a], n0, n1, n2, 1.0, out)
+    point_gradient(Bf, parent, prism, cpl, link_body[link[a]], P[a], n0, n1, n2, 1.0, out)
     if b >= 0:
-        point_gradient(Bf, ch, ch.link_body[link[b]], P[b], n0, n1, n2, -1.0, out)
+        point_gradient(Bf, parent, prism, cpl, link_body[link[b]], P[b], n0, n1, n2, -1.0, out)

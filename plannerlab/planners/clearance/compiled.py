@@ -1,6 +1,6 @@
 """The clearance descent's compiled inner loop (numba, cached): the clearance field of
 :mod:`plannerlab.planners.clearance` and the step of
-:class:`~plannerlab.planners.gradient_clearance.ClearanceDescent`.
+:class:`~plannerlab.planners.clearance.descent.ClearanceDescent`.
 
 One call, :func:`evaluate`, gives everything the descent asks at a state: the objective
 ``f`` and ``F = f + w · cost``, the tip's position and angle errors, every sphere pair's
@@ -37,6 +37,7 @@ from plannerlab.collision.spheres import (
     SphereChain,
     centres,
     frames,
+    kin,
     pair_gradient,
     pair_spheres,
     pairs,
@@ -44,7 +45,7 @@ from plannerlab.collision.spheres import (
     tip_jacobians,
     tip_pose,
 )
-from plannerlab.planners.clearance import ClearanceField
+from plannerlab.planners.clearance.field import ClearanceField
 from plannerlab.problem.scene import Box, Cylinder, Sphere
 from plannerlab.robots.base import Array
 
@@ -238,6 +239,7 @@ def _clearance_cost(Bf, fld, P, nrm, d, dof):
     """The clearance cost Σ (margin − d)² / margin over the pairs closer than the margin,
     its gradient (dof,), how many pairs are that close and their rows (n_close,)."""
     margin = fld.margin
+    kn, link, A_idx, B_idx = kin(fld.ch), fld.link, fld.A, fld.B
     cost = 0.0
     grad = np.zeros(dof)
     n_close = 0
@@ -255,7 +257,7 @@ def _clearance_cost(Bf, fld, P, nrm, d, dof):
             close[k] = i
             k += 1
             wgt = -2.0 * (margin - d[i]) / margin
-            pair_gradient(Bf, fld.ch, P, fld.link, nrm, fld.A[i], fld.B[i], i, gi)
+            pair_gradient(Bf, kn, P, link, nrm, A_idx[i], B_idx[i], i, gi)
             for j in range(dof):
                 grad[j] += wgt * gi[j]
     return cost, grad, n_close, close
@@ -336,13 +338,14 @@ def _with_close_pairs(A, b, pairs, grad, weight):
     the centres, the pairs' directions, how many pairs are close, their rows and the
     margin."""
     Bf, fld, P, nrm, n_close, close, margin = pairs
+    kn, link, A_idx, B_idx = kin(fld.ch), fld.link, fld.A, fld.B
     dof = b.shape[0]
     if n_close > 0:
         gi = np.empty(dof)
         dd = np.empty((n_close, dof))
         for c in range(n_close):
             i = close[c]
-            pair_gradient(Bf, fld.ch, P, fld.link, nrm, fld.A[i], fld.B[i], i, gi)
+            pair_gradient(Bf, kn, P, link, nrm, A_idx[i], B_idx[i], i, gi)
             dd[c] = gi
         k2 = weight / margin
         A = A + k2 * (dd.T @ dd)
@@ -397,6 +400,7 @@ def hold_clearance(q, direction, fld, floor_m, metric):
     Bf = frames(q, ch)
     P = centres(Bf, ch, fld.link, fld.t)
     d, nrm = _pairs_of(P, fld, floor_m)
+    kn, link, A_idx, B_idx = kin(ch), fld.link, fld.A, fld.B
     n_act = 0
     for i in range(d.shape[0]):
         if d[i] < floor_m:
@@ -408,7 +412,7 @@ def hold_clearance(q, direction, fld, floor_m, metric):
     k = 0
     for i in range(d.shape[0]):
         if d[i] < floor_m:
-            pair_gradient(Bf, ch, P, fld.link, nrm, fld.A[i], fld.B[i], i, gi)
+            pair_gradient(Bf, kn, P, link, nrm, A_idx[i], B_idx[i], i, gi)
             G[k] = gi
             k += 1
     dnorm = math.sqrt(np.sum(direction * direction))
@@ -440,6 +444,32 @@ def hold_clearance(q, direction, fld, floor_m, metric):
         lam = np.linalg.solve(K, want[idx] - Gs @ direction)
         dq = direction + Ai @ lam
     return dq
+
+
+# ---------------------------------------------------------------------- entries
+# numba types a named tuple passed from Python at every call (some 5 µs for the field,
+# the goal and the rule; plain tuples: their types by fingerprint, ~1 µs): the wrapper
+# passes plain tuples and these entries name them again, free in compiled code
+@njit(cache=True, nogil=True, inline="always")
+def _named(fld_t, goal_t, rule_t):
+    """The field, goal and rule named again from their plain tuples."""
+    fld = SphereField(SphereChain(*fld_t[0]), *fld_t[1:])
+    return fld, DescentGoal(*goal_t), StepRule(*rule_t)
+
+
+@njit(cache=True, nogil=True)
+def evaluate_at(q, fld_t, far_m, goal_t, rule_t, want_direction, d_ref, floor_m):
+    """:func:`evaluate` on the plain tuples of a :class:`SphereField`, a
+    :class:`DescentGoal` and a :class:`StepRule` (:meth:`CompiledField.evaluate`)."""
+    fld, goal, rule = _named(fld_t, goal_t, rule_t)
+    return evaluate(q, fld, far_m, goal, rule, want_direction, d_ref, floor_m)
+
+
+@njit(cache=True, nogil=True)
+def hold_at(q, direction, fld_t, floor_m, metric):
+    """:func:`hold_clearance` on the plain tuple of a :class:`SphereField`."""
+    fld = SphereField(SphereChain(*fld_t[0]), *fld_t[1:])
+    return hold_clearance(q, direction, fld, floor_m, metric)
 
 
 # ---------------------------------------------------------------------- the wrapper
@@ -534,43 +564,33 @@ class CompiledField:
             ends=ends,
             margin=self.margin_m,
         )
+        #: the field as plain tuples (see :func:`evaluate_at`)
+        self._plain = (tuple(chain), *self._field[1:])
         #: pairs at least this far apart are reported at this distance (see pairs)
         self.far_m = max(float(far_m), self.margin_m)
         self._no_ref = np.zeros(0)
         #: the last goal asked about and its arrays (fresh, writeable: one numba version;
         #: see :func:`_goal_arrays`)
-        self._goal: tuple[Any, DescentGoal | None] = (None, None)
+        self._goal: tuple[Any, tuple] = (None, ())
 
     def evaluate(
         self,
         q: Array,
         goal,
-        r1: float,
-        r2: float,
-        weight: float,
-        gauss_newton: bool,
-        damping: float,
-        goal_depth: float,
+        rule: tuple,
         want_direction: bool,
         d_ref: Array | None = None,
         floor_m: float = 0.0,
     ) -> Evaluation:
         """F, f, tip errors, clearance cost and gradient, distances and (when asked) the
-        step direction at q (dof,) towards ``goal`` (a GoalRegion); ``spacious`` against
-        the distances ``d_ref`` (see :func:`evaluate`)."""
+        step direction at q (dof,) towards ``goal`` (a GoalRegion) by the step ``rule``
+        (a :class:`StepRule`'s values, made once: :func:`step_rule`); ``spacious``
+        against the distances ``d_ref`` (see :func:`evaluate`)."""
         if goal is not self._goal[0]:
-            self._goal = (goal, _goal_arrays(goal))
-        rule = StepRule(
-            float(r1),
-            float(r2),
-            float(weight),
-            bool(gauss_newton),
-            float(damping),
-            float(goal_depth),
-        )
-        out = evaluate(
+            self._goal = (goal, tuple(_goal_arrays(goal)))
+        out = evaluate_at(
             np.array(q, dtype=float),
-            self._field,
+            self._plain,
             self.far_m,
             self._goal[1],
             rule,
@@ -599,13 +619,30 @@ class CompiledField:
         """:func:`hold_clearance` at q (dof,) for ``direction`` (dof,), projected in
         ``metric`` (dof, dof; None: the identity)."""
         dof = len(direction)
-        return hold_clearance(
+        return hold_at(
             np.array(q, dtype=float),
             np.array(direction, dtype=float),
-            self._field,
+            self._plain,
             float(floor_m),
             np.eye(dof) if metric is None else np.ascontiguousarray(metric, dtype=float),
         )
+
+
+def step_rule(
+    r1: float, r2: float, weight: float, gauss_newton: bool, damping: float, goal_depth: float
+) -> tuple:
+    """The values of a :class:`StepRule`, a plain tuple (floats and a bool: one numba
+    version; see :func:`evaluate_at`)."""
+    return tuple(
+        StepRule(
+            float(r1),
+            float(r2),
+            float(weight),
+            bool(gauss_newton),
+            float(damping),
+            float(goal_depth),
+        )
+    )
 
 
 def _goal_arrays(goal) -> DescentGoal:
@@ -641,6 +678,7 @@ def warm_up() -> None:
     core = CompiledField(ClearanceField(robot, scene, 0.3), far_m=0.3)  # type: ignore[arg-type]
     goal = GoalRegion("warm_up", np.array([1.0, 0.0, 3.0]), np.array([0.0, 0.0, 1.0]), 0.1, 10.0)
     q = np.zeros(robot.dof)
-    e = core.evaluate(q, goal, 1.0, 1.0, 0.2, True, 0.1, 0.3, True)
-    core.evaluate(q, goal, 1.0, 1.0, 0.2, True, 0.1, 0.3, True, e.distances_m, 0.03)
+    rule = step_rule(1.0, 1.0, 0.2, True, 0.1, 0.3)
+    e = core.evaluate(q, goal, rule, True)
+    core.evaluate(q, goal, rule, True, e.distances_m, 0.03)
     core.hold_clearance(q, e.direction, 0.04)
