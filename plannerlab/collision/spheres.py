@@ -54,6 +54,9 @@ class SphereChain(NamedTuple):
     tip_body: int
     tip_p: np.ndarray  # (3,) the tip point and normal in its body's folded frame
     tip_n: np.ndarray
+    #: every joint turns and hangs from the body before it, no coupling: the joints
+    #: below body b are 0 … b − 1 (the gradients' loops run straight)
+    serial: bool
 
 
 @njit(cache=True, nogil=True)
@@ -113,11 +116,16 @@ def sphere_chain(model: Any, robot: Any) -> SphereChain:
         tip_body=tip_body,
         tip_p=f(A.T @ np.asarray(p_bt, dtype=float)),
         tip_n=f(A.T @ np.asarray(n_bt, dtype=float)),
+        serial=bool(
+            len(cpl_start) == 0
+            and not np.any(prism)
+            and np.array_equal(parent, np.arange(len(parent)))
+        ),
     )
 
 
 # ---------------------------------------------------------------------- kinematics
-@njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True, inline="always")
 def frames(q, ch):
     """The body frames (nb, 3, 4) of state q (dof,): chain_valid's ``_body_frames``."""
     n = ch.parent.shape[0]
@@ -136,7 +144,7 @@ def _affine(Bf, b, x, out, k):
         out[k, a] = Bf[b, a, 0] * x[0] + Bf[b, a, 1] * x[1] + Bf[b, a, 2] * x[2] + Bf[b, a, 3]
 
 
-@njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True, inline="always")
 def link_ends(Bf, ch):
     """Each link's axis in the world: its two ends, (L, 3) each."""
     L = ch.link_body.shape[0]
@@ -148,7 +156,7 @@ def link_ends(Bf, ch):
     return Ea, Eb
 
 
-@njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True, inline="always")
 def centres(Bf, ch, link, t):
     """Sphere centres (s, 3): on link ``link[s]``, ``a + t[s] (b − a)`` of its axis."""
     Ea, Eb = link_ends(Bf, ch)
@@ -163,7 +171,7 @@ def centres(Bf, ch, link, t):
     return P
 
 
-@njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True, inline="always")
 def tip_pose(Bf, ch):
     """The tip's point p (3,) and normal n (3,) in the world."""
     b = ch.tip_body
@@ -190,9 +198,20 @@ def _to_state(cpl, i, x, sign, out):
 
 
 @njit(cache=True, nogil=True, inline="always")
-def point_gradient(Bf, parent, prism, cpl, body, p, n0, n1, n2, sign, out):
+def point_gradient(Bf, kn, body, p, n0, n1, n2, sign, out):
     """Add ``sign · n · ∂p/∂q`` into ``out`` (dof,) for the point p (3,) on ``body``
-    (the chain's ``parent``, ``prism`` and coupling ``cpl``, :func:`kin`)."""
+    (``kn``: the chain's :func:`kin`)."""
+    parent, prism, cpl, _, serial = kn
+    if serial:  # joints 0 … body − 1, each turning about its body's z
+        for i in range(body):
+            b = i + 1
+            zx, zy, zz = Bf[b, 0, 2], Bf[b, 1, 2], Bf[b, 2, 2]
+            dx = p[0] - Bf[b, 0, 3]
+            dy = p[1] - Bf[b, 1, 3]
+            dz = p[2] - Bf[b, 2, 3]
+            g = n0 * (zy * dz - zz * dy) + n1 * (zz * dx - zx * dz) + n2 * (zx * dy - zy * dx)
+            out[i] += sign * g
+        return
     b = body
     while b > 0:
         i = b - 1  # the joint that moves body b
@@ -211,17 +230,17 @@ def point_gradient(Bf, parent, prism, cpl, body, p, n0, n1, n2, sign, out):
 @njit(cache=True, nogil=True, inline="always")
 def kin(ch):
     """The arrays :func:`point_gradient` and :func:`pair_gradient` walk the chain with:
-    (parent, prism, coupling, each link's body), taken out of the chain once."""
-    return ch.parent, ch.prism, (ch.cpl_start, ch.cpl_idx, ch.cpl_val), ch.link_body
+    (parent, prism, coupling, each link's body, serial), taken out of the chain once."""
+    return ch.parent, ch.prism, (ch.cpl_start, ch.cpl_idx, ch.cpl_val), ch.link_body, ch.serial
 
 
-@njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True, inline="always")
 def tip_jacobians(Bf, ch, p, n, dof):
     """The tip's Jacobians (3, dof) each: ∂p/∂q and ∂n/∂q (``z_i × (p − o_i)`` and
     ``z_i × n`` for a turning joint i, ``z_i`` and 0 for a sliding one)."""
     Jp = np.zeros((3, dof))
     Jn = np.zeros((3, dof))
-    parent, prism, cpl, _ = kin(ch)
+    parent, prism, cpl, _, _ = kin(ch)
     cpl_start, cpl_idx, cpl_val = cpl
     coupled = cpl_start.shape[0] > 0
     b = ch.tip_body
@@ -424,10 +443,10 @@ def pair_gradient(Bf, kn, P, link, nrm, a, b, row, out):
     """∇d (dof,) of one pair into ``out``: n · ∂p_a/∂q (− n · ∂p_b/∂q for a self pair;
     b = −1: an obstacle) with p_s sphere s's centre (:func:`point_gradient`; ``kn``:
     :func:`kin` of the chain)."""
-    parent, prism, cpl, link_body = kn
+    link_body = kn[3]
     n0, n1, n2 = nrm[row, 0], nrm[row, 1], nrm[row, 2]
     for j in range(out.shape[0]):
         out[j] = 0.0
-    point_gradient(Bf, parent, prism, cpl, link_body[link[a]], P[a], n0, n1, n2, 1.0, out)
+    point_gradient(Bf, kn, link_body[link[a]], P[a], n0, n1, n2, 1.0, out)
     if b >= 0:
-        point_gradient(Bf, parent, prism, cpl, link_body[link[b]], P[b], n0, n1, n2, -1.0, out)
+        point_gradient(Bf, kn, link_body[link[b]], P[b], n0, n1, n2, -1.0, out)
