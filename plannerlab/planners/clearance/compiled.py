@@ -132,8 +132,8 @@ def evaluate(q, fld, far_m, goal, rule, want_direction, d_ref, floor_m):
     its gradient (:func:`_clearance_cost`), the spacious test (:func:`_spacious`), and
     the step direction: towards a goal state :func:`_joint_direction`, else the tip's
     Jacobians and :func:`_tip_steepest` or :func:`_tip_gauss_newton`. The steps of this
-    module are inlined into it (``inline="always"``: numba's IR), the geometry's are
-    called."""
+    module and the kinematics are inlined into it (``inline="always"``: numba's IR); the
+    pairs are called."""
     dof = q.shape[0]
     ch = fld.ch
     Bf = frames(q, ch)
