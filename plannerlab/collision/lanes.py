@@ -36,19 +36,24 @@ from plannerlab.collision.chain_pack import (
     _H_NB,
     _H_NCL,
 )
-from plannerlab.collision.chain_valid import _SCRATCH, _sphere_hit, _unpack
+from plannerlab.collision.chain_valid import _SCRATCH, _scratch, _sphere_hit, _state_ok, _unpack
 from plannerlab.collision.geometry import BOX, SPHERE, capsule_obstacle_hit, seg_seg
 
 #: lanes per call: 8 doubles fill one AVX-512 register or two AVX2 ones
 W = 8
+#: the fewest states of an edge's group tested in lanes (fewer: one by one): eight lanes
+#: cost about three one-state tests on the Panda, four and a half on Arm-Z
+#: (``bench/lanes_bench.py``, "k filled")
+LANES_MIN = 5
 
 
 @njit(cache=True, nogil=True)
 def lanes_scratch(idat):
     """Scratch of :func:`lanes_check` (made once per search): body frames (nb, 12, W),
     body, cluster and chunk ball centres, capsule ends, the lanes' joint values, masks,
-    placed flags, the scalar tests' scratch; then a group of states waiting to be tested
-    and its count (:func:`group_push`)."""
+    placed flags, the scalar tests' scratch; then a group of states waiting to be tested,
+    its count (:func:`group_push`), and the one-state test's scratch and state (a group
+    of fewer than ``LANES_MIN`` states is tested state by state)."""
     nb, L, ncl, dof = idat[_H_NB], idat[_H_L], idat[_H_NCL], idat[_H_DOF]
     nch = (nb + _CHUNK - 1) // _CHUNK
     F = np.empty((nb, 12, W))
@@ -64,7 +69,7 @@ def lanes_scratch(idat):
     w = np.zeros(_SCRATCH + 6)  # the scalar tests' scratch, then two points
     QL = np.zeros((dof, W))  # a group of states waiting to be tested (lane k: QL[:, k])
     G = np.zeros(1, dtype=np.int64)  # how many lanes of QL are filled
-    return F, C, K, X, Y, CB, T, v, Mk, done, w, QL, G
+    return F, C, K, X, Y, CB, T, v, Mk, done, w, QL, G, _scratch(idat), np.empty(dof)
 
 
 @njit(cache=True, nogil=True, inline="always")
@@ -525,15 +530,24 @@ def chain_first_bad_lanes(Q, P, M, idat):
 @njit(cache=True, nogil=True)
 def group_flush(V, SL):
     """Test the pending group of states (:func:`group_push`) and empty it: (valid, count).
-    The unfilled lanes start dead, so they cost nothing and fail nothing."""
+    The unfilled lanes start dead, so they cost nothing and fail nothing. A group of
+    fewer than ``LANES_MIN`` states is tested state by state (eight lanes cost about as
+    much as four single states), stopping at the first invalid one (count: the states
+    tested)."""
     QL, G = SL[11], SL[12]
     cnt = G[0]
-    if cnt == 0:
-        return True, 0
+    G[0] = 0
+    if cnt < LANES_MIN:
+        S, q = SL[13], SL[14]
+        for k in range(cnt):
+            for i in range(q.shape[0]):
+                q[i] = QL[i, k]
+            if not _state_ok(q, V, S):
+                return False, k + 1
+        return True, cnt
     alive = SL[8][0]
     for k in range(W):
         alive[k] = k < cnt
-    G[0] = 0
     lanes_check(QL, V, SL, alive, True)
     ok = True
     for k in range(cnt):
