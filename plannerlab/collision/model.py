@@ -49,7 +49,13 @@ from plannerlab.collision.chain_valid import (
     _state_ok,
     _unpack,
 )
-from plannerlab.collision.lanes import group_end, group_push, lanes_scratch, valid_states_lanes
+from plannerlab.collision.lanes import (
+    group_alone,
+    group_end,
+    group_push,
+    lanes_scratch,
+    valid_states_lanes,
+)
 from plannerlab.errors import PlannerlabError
 from plannerlab.robots.registry import model_builder
 
@@ -179,7 +185,9 @@ def build_model(core: Any) -> CompiledModel:
 def views(m):
     """The model's views ``V`` and a scratch ``S`` for :func:`state_ok` (made once per
     search). ``V[3]`` is the scratch of the states tested in vector lanes
-    (:mod:`plannerlab.collision.lanes`: the edges' groups)."""
+    (:mod:`plannerlab.collision.lanes`: the edges' groups); pass ``V[:3]`` to
+    :func:`state_ok` (a compiled call passes its tuples whole: the lanes' scratch would
+    add some 0.3 µs a call)."""
     ints, floats, cpl = _unpack(m.P, m.M, m.idat)
     return (ints, floats, cpl, lanes_scratch(m.idat)), _scratch(m.idat)
 
@@ -265,9 +273,11 @@ def _edge_visit(q_a, q_b, joint_step, m, V, S, d, q, limit, rec):
     # j = n first (the state the edge reaches), then j in van der Corput order over 1..n-1
     if keep:
         rec[0] = n
-    status, checks = group_push(q_a, d, n, n, V, SL, checks, limit)
+    status, checks = group_alone(q_a, d, n, n, V, SL, checks, limit)  # the end alone first
     if status >= 0:
         return status, checks
+    if n == 1:
+        return 0, checks
     step = 1
     while step < n:
         step *= 2

@@ -31,7 +31,7 @@ import math
 import numpy as np
 from numba import njit
 
-from plannerlab.collision.lanes import group_end, group_push
+from plannerlab.collision.lanes import group_alone, group_end, group_push
 from plannerlab.collision.model import edge_count, edge_delta
 
 # ---------------------------------------------------------------------- return codes
@@ -222,12 +222,12 @@ def edge_free(q_a, q_b, joint_step, m, V, S, d, q, limit, near_a_first, every=1,
         return 2, 0
     SL = V[3]
     checks = 0
-    if not fine:
-        status, checks = group_push(q_a, d, first, n, V, SL, checks, limit)
+    if not fine:  # the new end alone first (most invalid edges fail there), then groups
+        status, checks = group_alone(q_a, d, first, n, V, SL, checks, limit)
         if status >= 0:
             return status, checks
         if n == 1:
-            return group_end(V, SL, checks)
+            return 0, checks
         if near_a_first:  # then the far end, j = n
             status, checks = group_push(q_a, d, n, n, V, SL, checks, limit)
             if status >= 0:
