@@ -36,6 +36,10 @@ from plannerlab.robots.base import Array, Robot
 from plannerlab.robots.paths import densify, edge_counts
 
 
+#: :meth:`CollisionChecker.check_path` without ``stop``: no limit on a kernel call's states
+UNLIMITED_STATES = 1 << 62
+
+
 @dataclass(frozen=True)
 class PathCheck:
     """Outcome of checking a densified path.
@@ -121,6 +125,9 @@ class CollisionChecker:
         #: fewer states, the same guarantee, at most as many checks as the grid)
         self.edge_check = "advance" if advance else "grid"
         self._core: Core | None = None
+        #: (model, V, S) of the grid re-check (:meth:`_grid_model`); None: not looked at
+        #: yet, False: none
+        self._path_model: Any = None
         if use_core:
             self._core = Core(
                 robot,
@@ -512,6 +519,9 @@ class CollisionChecker:
             if self.edge_check != "advance":
                 raise ValueError("mode 'advance' needs a checker with edge_check 'advance'")
             return self._check_path_advance(path, joint_step, stop, chunk)
+        model = self._grid_model()
+        if model is not None:
+            return self._check_path_model(model, path, joint_step, stop, chunk)
         states, owners = self.densify(path, joint_step)
         step = len(states) if stop is None else max(int(chunk), 1)
         bad = None
@@ -531,6 +541,68 @@ class CollisionChecker:
             valid=False,
             states_checked=bad + 1,
             first_invalid_edge=int(owners[bad]),
+            first_invalid_state=q_bad,
+            pairs=self.colliding_pairs(q_bad),
+            backend=self.backend,
+        )
+
+    def _grid_model(self) -> Any:
+        """The compiled model that checks grid paths (:meth:`check_path`), or None (no
+        core, or a robot without a compiled model: the dense path in numpy, then)."""
+        if self._path_model is None:
+            self._path_model = False
+            if self._core is not None:
+                from plannerlab.collision.model import ModelError, views
+
+                try:
+                    model = self._core.model
+                except ModelError:
+                    pass
+                else:
+                    self._path_model = (model, *views(model))
+        return self._path_model or None
+
+    def _check_path_model(
+        self,
+        model: tuple[Any, Any, Any],
+        path: Array,
+        joint_step: float,
+        stop: Callable[[], bool] | None,
+        chunk: int,
+    ) -> PathCheck:
+        """:meth:`check_path` on the grid in the compiled model
+        (:func:`~plannerlab.collision.model_path.grid_check`): the states of
+        :meth:`densify`, in its order and counted as it counts them, ``stop`` asked before
+        each ``chunk`` of them, without making the dense path."""
+        from plannerlab.collision.model_path import GRID_INVALID, GRID_LIMIT, grid_check
+
+        P = np.ascontiguousarray(np.atleast_2d(np.asarray(path, dtype=np.float64)))
+        if P.shape[1] != self.robot.dof:
+            raise ValueError(f"path must have {self.robot.dof} joints, got shape {P.shape}")
+        if len(P) > 1:  # an edge of more than MAX_EDGE_STATES states raises as densify
+            edge_counts(P, joint_step, self.robot.continuous, self.edge_weights)
+        m, V, S = model
+        cur = np.zeros(3, dtype=np.int64)
+        d, q = np.empty(P.shape[1]), np.empty(P.shape[1])
+        limit = UNLIMITED_STATES if stop is None else max(int(chunk), 1)
+        kernel: Any = grid_check  # a numba dispatcher
+        while True:
+            if stop is not None and stop():
+                return PathCheck(
+                    valid=False, states_checked=int(cur[2]), backend=self.backend, complete=False
+                )
+            before = int(cur[2])
+            status = kernel(P, float(joint_step), m, V, S, cur, limit, d, q)
+            self.checks += int(cur[2]) - before
+            if status != GRID_LIMIT:
+                break
+        if status != GRID_INVALID:
+            return PathCheck(valid=True, states_checked=int(cur[2]), backend=self.backend)
+        q_bad = P[0].copy() if cur[1] == 0 else q.copy()
+        return PathCheck(
+            valid=False,
+            states_checked=int(cur[2]),
+            first_invalid_edge=int(cur[0]),
             first_invalid_state=q_bad,
             pairs=self.colliding_pairs(q_bad),
             backend=self.backend,

@@ -41,7 +41,6 @@ from typing import Any, NamedTuple
 import numpy as np
 from numba import njit
 
-from plannerlab.collision.chain_pack import _pack
 from plannerlab.collision.chain_valid import (
     _body_frames,
     _place_body,
@@ -87,18 +86,7 @@ def model_of_core(core: Any) -> CompiledModel:
             "consumer (native planners, the fused checks) cannot run it; give the robot a "
             "chain_data() (docs/extending.md)"
         )
-    P, M, idat, perm = _pack(
-        robot,
-        core.radii,
-        core.radii_self,
-        core.moving,
-        core.allowed,
-        core.kinds,
-        core.Rs,
-        core.cs,
-        core.hs,
-        None,
-    )
+    P, M, idat, perm = core.packed()  # the fused validity's arrays, packed once
 
     def f(a: Any, dtype: Any) -> np.ndarray:
         # a writable C-ordered copy: numba types read-only arrays (a robot's bounds may
