@@ -35,7 +35,6 @@ from plannerlab.problem.scene import Box, Cylinder, Mesh, Scene, Sphere
 from plannerlab.robots.base import Array, Robot
 from plannerlab.robots.paths import densify, edge_counts
 
-
 #: :meth:`CollisionChecker.check_path` without ``stop``: no limit on a kernel call's states
 UNLIMITED_STATES = 1 << 62
 

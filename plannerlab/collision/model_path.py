@@ -12,7 +12,6 @@ construction, at the model's speed per state.
 
 from __future__ import annotations
 
-import numpy as np
 from numba import njit
 
 from plannerlab.collision.model import edge_count, edge_delta, edge_state, state_ok
