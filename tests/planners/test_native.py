@@ -146,9 +146,9 @@ def test_a_time_limit_cuts_the_search_into_chunks(monkeypatch: pytest.MonkeyPatc
     kernel = native_solve.K.rrtc_run
 
     def counted(*args: Any) -> int:
-        before = int(args[12][1])  # counters: iterations, checks, ...
+        before = int(args[14][1])  # counters: iterations, checks, ...
         code = kernel(*args)
-        calls.append(int(args[12][1]) - before)
+        calls.append(int(args[14][1]) - before)
         return int(code)
 
     monkeypatch.setattr(native_solve, "CHUNK_MAX", 64)

@@ -180,6 +180,112 @@ def nearest(Q, n, q, continuous, any_continuous, F):
     return best_i
 
 
+# ---------------------------------------------------------------------- the trees' k-d trees
+@njit(cache=True, nogil=True)
+def split_dims(continuous):
+    """The joints a k-d tree splits on, in turn: the bounded ones (a continuous joint's
+    wrapped difference gives no bound from one side of a plane). Empty: no k-d tree."""
+    k = 0
+    for i in range(continuous.shape[0]):
+        if not continuous[i]:
+            k += 1
+    sd = np.empty(k, dtype=np.int64)
+    k = 0
+    for i in range(continuous.shape[0]):
+        if not continuous[i]:
+            sd[k] = i
+            k += 1
+    return sd
+
+
+@njit(cache=True, nogil=True)
+def kd_insert(Q, Kd, r, sd):
+    """Insert row r of Q into the k-d tree ``Kd`` (cap, 3) int64 over Q's rows (per row:
+    left child, right child, its split's position in ``sd``; -1: not in the tree). Row 0
+    is the root; a row goes left of a node when its coordinate on the node's split joint
+    is smaller than the node's, else right."""
+    Kd[r, 0] = -1
+    Kd[r, 1] = -1
+    if r == 0:
+        Kd[0, 2] = 0
+        return
+    node = 0
+    while True:
+        k = sd[Kd[node, 2]]
+        side = 0 if Q[r, k] < Q[node, k] else 1
+        nxt = Kd[node, side]
+        if nxt < 0:
+            Kd[node, side] = r
+            Kd[r, 2] = (Kd[node, 2] + 1) % sd.shape[0]
+            return
+        node = nxt
+
+
+@njit(cache=True, nogil=True)
+def kd_catch_up(Q, n, Kd, sd):
+    """Insert the rows of Q[:n] not yet in the k-d tree (in index order: row 0 first)."""
+    if sd.shape[0] == 0:
+        return
+    for r in range(n):
+        if Kd[r, 2] < 0:
+            kd_insert(Q, Kd, r, sd)
+
+
+@njit(cache=True, nogil=True)
+def kd_nearest(Q, q, continuous, F, Kd, sd, stack, bounds):
+    """:func:`nearest` over the rows in the k-d tree ``Kd`` (:func:`kd_insert`): the same
+    row, the lowest index among the live rows at the least squared distance, each row's
+    sum made as :func:`nearest` makes it (the same terms in the same order). A subtree is
+    skipped only when the squared gap to its splitting plane exceeds the best sum (in
+    floating point a row's sum is at least any of its terms, and its term on the split
+    joint at least the gap's: ties are kept). ``stack``, ``bounds`` (at least the tree's
+    depth + 2) scratch. -1 when every row is dead."""
+    best = np.inf
+    best_i = -1
+    dof = q.shape[0]
+    stack[0] = 0
+    bounds[0] = 0.0
+    top = 1
+    while top > 0:
+        top -= 1
+        node = stack[top]
+        b = bounds[top]
+        if b > best:
+            continue
+        if F[node] != DEAD:
+            acc = 0.0
+            for i in range(dof):
+                x = q[i] - Q[node, i]
+                if continuous[i]:
+                    if x >= math.pi:
+                        x -= _TWO_PI
+                    elif x < -math.pi:
+                        x += _TWO_PI
+                acc += x * x
+                if acc > best:
+                    break
+            if acc < best or (acc == best and node < best_i):
+                best = acc
+                best_i = node
+        k = sd[Kd[node, 2]]
+        diff = q[k] - Q[node, k]
+        if diff < 0.0:
+            near, far = Kd[node, 0], Kd[node, 1]
+        else:
+            near, far = Kd[node, 1], Kd[node, 0]
+        if far >= 0:
+            fb = max(b, diff * diff)
+            if fb <= best:
+                stack[top] = far
+                bounds[top] = fb
+                top += 1
+        if near >= 0:
+            stack[top] = near
+            bounds[top] = b
+            top += 1
+    return best_i
+
+
 @njit(cache=True, nogil=True)
 def steer(q_from, q_to, range_rad, continuous, d, out):
     """out = the state at most ``range_rad`` from q_from towards q_to (q_to itself, copied,
@@ -275,11 +381,13 @@ def _tree_edge(Qt, Pt, c, goal_tree, joint_step, m, V, S, buf, limit, every, fin
 
 
 @njit(cache=True, nogil=True)
-def _grow(Qt, Pt, Ft, Rt, nt, goal_tree, near, q_to, range_rad, joint_step, m, V, S, buf,
-          limit, every, dd):  # fmt: skip
-    """Grow tree (Qt, Pt, Ft, Rt) of nt nodes from node ``near`` (-1: the nearest live one)
-    towards q_to: a node at most ``range_rad`` on, added at index nt when the coarse
-    states of its edge are free (all of them with ``every`` = 1).
+def _grow(Qt, Pt, Ft, Rt, Kt, nt, goal_tree, near, q_to, range_rad, joint_step, m, V, S, buf,
+          limit, every, dd, sd, stack, bounds):  # fmt: skip
+    """Grow tree (Qt, Pt, Ft, Rt, Kt: its k-d tree, :func:`kd_insert`) of nt nodes from
+    node ``near`` (-1: the nearest live one, by the k-d tree over the joints ``sd``, or
+    by brute force when ``sd`` is empty) towards q_to: a node at most ``range_rad`` on,
+    added at index nt when the coarse states of its edge are free (all of them with
+    ``every`` = 1); the caller puts it in the k-d tree.
 
     Dynamic domain (``dd`` = (radius, min_radius, alpha) [rad, rad, 1], radius > 0; only
     for the nearest-node step): a sample farther from its nearest node than the node's
@@ -291,7 +399,10 @@ def _grow(Qt, Pt, Ft, Rt, nt, goal_tree, near, q_to, range_rad, joint_step, m, V
     hard limit came first, 4 dropped by the dynamic domain."""
     domain = near < 0 and dd[0] > 0.0
     if near < 0:
-        near = nearest(Qt, nt, q_to, m.continuous, m.continuous.any(), Ft)
+        if sd.shape[0] > 0:
+            near = kd_nearest(Qt, q_to, m.continuous, Ft, Kt, sd, stack, bounds)
+        else:
+            near = nearest(Qt, nt, q_to, m.continuous, m.continuous.any(), Ft)
         if domain and distance2(Qt[near], q_to, m.continuous) > Rt[near] * Rt[near]:
             return 4, 0, near
     Qt[nt] = Qt[near]  # the new row's parent edge, from near to the target
@@ -358,6 +469,8 @@ def rrtc_run(
     PB,
     FB,
     RB,
+    KA,
+    KB,
     sizes,
     counters,
     rng,
@@ -377,8 +490,11 @@ def rrtc_run(
     """RRT-Connect iterations until a path, a limit, or a full tree.
 
     Trees: A (QA (cap_a, dof) states, PA parents, -1 at the root: the start, FA flags,
-    RA dynamic-domain radii, inf: none) and B (the goal tree, a root per goal state);
-    ``sizes`` (2,) their node counts.
+    RA dynamic-domain radii, inf: none, KA (cap_a, 3) int64 its k-d tree, rows -1: not
+    in it yet) and B (the goal tree, a root per goal state); ``sizes`` (2,) their node
+    counts. Nearest nodes come from the k-d trees (:func:`kd_nearest`: the very node
+    :func:`nearest`'s brute force finds); rows not in them yet (the roots, seeded
+    branches) are put in when the call starts.
     ``counters`` (6,) int64 carries the search across calls: iterations, checks, the tree
     to grow next (0 A, 1 B), on a path the meeting node in A and in B (equal states), and
     the found paths whose fine check failed.
@@ -405,6 +521,12 @@ def rrtc_run(
     :data:`FULL`)."""
     q_rand = buf[0]
     no_domain = np.zeros(3)  # the connection steps have none
+    sd = split_dims(m.continuous)
+    kd_catch_up(QA, sizes[0], KA, sd)
+    kd_catch_up(QB, sizes[1], KB, sd)
+    depth = max(QA.shape[0], QB.shape[0]) + 2
+    stack = np.empty(depth, dtype=np.int64)
+    bounds = np.empty(depth)
     while True:
         if counters[0] >= max_iterations:
             return ITERATIONS
@@ -419,14 +541,17 @@ def rrtc_run(
         t = counters[2]
         counters[2] = 1 - t
         if t == 0:
-            Qt, Pt, Ft, Rt, Qo, Po, Fo, Ro = QA, PA, FA, RA, QB, PB, FB, RB
+            Qt, Pt, Ft, Rt, Kt = QA, PA, FA, RA, KA
+            Qo, Po, Fo, Ro, Ko = QB, PB, FB, RB, KB
         else:
-            Qt, Pt, Ft, Rt, Qo, Po, Fo, Ro = QB, PB, FB, RB, QA, PA, FA, RA
+            Qt, Pt, Ft, Rt, Kt = QB, PB, FB, RB, KB
+            Qo, Po, Fo, Ro, Ko = QA, PA, FA, RA, KA
         code, c, _ = _grow(
             Qt,
             Pt,
             Ft,
             Rt,
+            Kt,
             sizes[t],
             t == 1,
             -1,
@@ -440,6 +565,9 @@ def rrtc_run(
             hard_checks - counters[1],
             every,
             dd,
+            sd,
+            stack,
+            bounds,
         )
         counters[1] += c
         if code == 3:
@@ -448,6 +576,8 @@ def rrtc_run(
             continue
         new_t = sizes[t]
         sizes[t] += 1
+        if sd.shape[0] > 0:
+            kd_insert(Qt, Kt, new_t, sd)
         q_new = Qt[new_t]
         # connect the other tree to q_new: after a step, its nearest node to q_new is the
         # node just added (it lies on the segment from the previous nearest)
@@ -459,6 +589,7 @@ def rrtc_run(
                 Po,
                 Fo,
                 Ro,
+                Ko,
                 sizes[o],
                 o == 1,
                 near,
@@ -472,6 +603,9 @@ def rrtc_run(
                 hard_checks - counters[1],
                 every,
                 no_domain,
+                sd,
+                stack,
+                bounds,
             )
             counters[1] += c
             if code == 3:
@@ -480,6 +614,8 @@ def rrtc_run(
                 break
             near = sizes[o]
             sizes[o] += 1
+            if sd.shape[0] > 0:
+                kd_insert(Qo, Ko, near, sd)
             if code == 2:
                 a = new_t if t == 0 else near
                 b = near if t == 0 else new_t

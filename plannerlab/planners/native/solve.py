@@ -293,8 +293,10 @@ class NativeSolve:
     def new_trees(
         seeds: tuple[tuple[np.ndarray, np.ndarray | None], ...], rows: int, dof: int
     ) -> list[np.ndarray]:
-        """The two trees' arrays (states, parents, check flags, dynamic-domain radii; 8 in
-        all) with ``rows`` rows each, seeded with (states, parents or None: roots)."""
+        """The two trees' arrays (states, parents, check flags, dynamic-domain radii, then
+        each tree's k-d tree, rows -1: not in it yet; 10 in all: A's four, B's four, A's
+        and B's k-d trees) with ``rows`` rows each, seeded with (states, parents or None:
+        roots)."""
         trees: list[np.ndarray] = []
         for Q0, P0 in seeds:
             Q, P = np.empty((rows, dof)), np.full(rows, -1, dtype=np.int64)
@@ -304,6 +306,7 @@ class NativeSolve:
             if P0 is not None:
                 P[: len(P0)] = P0
             trees += [Q, P, F, R]
+        trees += [np.full((rows, 3), -1, dtype=np.int64) for _ in range(2)]
         return trees
 
     def search(
@@ -347,6 +350,8 @@ class NativeSolve:
                     trees[5],
                     trees[6],
                     trees[7],
+                    trees[8],
+                    trees[9],
                     sizes,
                     counters,
                     rng_state,

@@ -31,8 +31,10 @@ def warm_up(model: Any | None = None) -> None:
     guides = np.zeros((0, dof))
     F = np.ones(4, dtype=np.int8)
     radii = np.full(4, np.inf)
+    Kd = np.full((4, 3), -1, dtype=np.int64)
     K.rrtc_run(
-        model, V, S, Q, P, F, radii, Q, P, F, radii, sizes, counters, rng, guides, 0.0, 0.1,
+        model, V, S, Q, P, F, radii, Q, P, F, radii, Kd, Kd.copy(), sizes, counters, rng,
+        guides, 0.0, 0.1,
         1.0, 0.1, 8, np.zeros(3), 0, 0, 0, 1, buf,
     )  # fmt: skip
     K.tree_path(Q, P, 0, Q, P, 0, Q.copy())
