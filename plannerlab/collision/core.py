@@ -364,6 +364,11 @@ class Core:
         return self._packed
 
     @property
+    def model_built(self) -> bool:
+        """Whether :attr:`model` was built already (asking does not build it)."""
+        return self._model is not None
+
+    @property
     def model(self) -> Any:
         """The compiled robot–scene model of this core
         (:class:`~plannerlab.collision.model.CompiledModel`), built on first use and kept.

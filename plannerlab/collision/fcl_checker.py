@@ -124,8 +124,7 @@ class CollisionChecker:
         #: fewer states, the same guarantee, at most as many checks as the grid)
         self.edge_check = "advance" if advance else "grid"
         self._core: Core | None = None
-        #: (model, V, S) of the grid re-check (:meth:`_grid_model`); None: not looked at
-        #: yet, False: none
+        #: (model, V, S) of the grid re-check (:meth:`_grid_model`); None: none yet
         self._path_model: Any = None
         if use_core:
             self._core = Core(
@@ -510,7 +509,10 @@ class CollisionChecker:
         (:meth:`~plannerlab.collision.core.Core.path_advance`), at most as many as
         :meth:`densify` gives (the reserve planners keep for this check stays sound).
         ``mode`` "grid" checks the grid's states whatever ``edge_check`` says (the states a
-        compiled planner checked its edges on: its path passes by construction).
+        compiled planner checked its edges on: its path passes by construction). Once the
+        checker's compiled model is built (:attr:`model`), grid checks run in it
+        (:func:`~plannerlab.collision.model_path.grid_check`: the same states, order,
+        counts and stops, without making the dense path); before, in numpy.
         """
         if mode not in (None, "grid", "advance"):
             raise ValueError(f"mode must be None, 'grid' or 'advance', got {mode!r}")
@@ -546,19 +548,15 @@ class CollisionChecker:
         )
 
     def _grid_model(self) -> Any:
-        """The compiled model that checks grid paths (:meth:`check_path`), or None (no
-        core, or a robot without a compiled model: the dense path in numpy, then)."""
-        if self._path_model is None:
-            self._path_model = False
-            if self._core is not None:
-                from plannerlab.collision.model import ModelError, views
+        """(model, V, S) that checks grid paths (:meth:`check_path`) once the compiled
+        model is built (by a consumer that plans in it: the compiled planners build it
+        before their clock starts); None: the dense path in numpy (no model built yet, or
+        none)."""
+        if self._path_model is None and self._core is not None and self._core.model_built:
+            from plannerlab.collision.model import views
 
-                try:
-                    model = self._core.model
-                except ModelError:
-                    pass
-                else:
-                    self._path_model = (model, *views(model))
+            model = self._core.model
+            self._path_model = (model, *views(model))
         return self._path_model or None
 
     def _check_path_model(

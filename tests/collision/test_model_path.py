@@ -1,6 +1,7 @@
 """The grid re-check in the compiled model (``check_path(..., mode="grid")`` through
 :func:`plannerlab.collision.model_path.grid_check`) gives what densifying the path in
-numpy and checking its states in order gives (the checker's own road before): the
+numpy and checking its states in order gives (the checker's road until its model is
+built, and the only one without a model): the
 verdict, the states checked and counted, the first invalid edge and state, and the same
 stops between chunks; on the Panda in a MotionBenchMaker-like scene and on Arm-Z."""
 
@@ -24,9 +25,10 @@ def checkers(name: str) -> tuple[Any, CollisionChecker, CollisionChecker]:
         PROBLEMS / "urdf" / "panda" / "bookshelf_small_0001.toml" if name == "panda" else name
     )
     compiled = CollisionChecker(p.robot, p.scene, margin_m=p.safety_margin_m)
+    compiled.model  # noqa: B018 - built: its grid checks run in it
     numpy_road = CollisionChecker(p.robot, p.scene, margin_m=p.safety_margin_m)
-    numpy_road._path_model = False  # the dense path in numpy (the road without a model)
     assert compiled._grid_model() is not None
+    assert numpy_road._grid_model() is None  # no model built: the dense path in numpy
     return p, compiled, numpy_road
 
 
