@@ -47,6 +47,8 @@ RECHECK_CHUNK = 4096
 FIRST_ROWS = 4096
 #: no limit
 UNLIMITED = 1 << 62
+#: a tree's k-d tree takes this many bytes a row (:meth:`NativeSolve.new_trees`)
+KD_ROW_BYTES = 24
 
 
 class _PoolGuard:
@@ -180,10 +182,11 @@ class NativeSolve:
             q0,
         )
 
-    def tree_rows(self, hard: int, roots: int, dof: int) -> int:
-        """Rows a tree may have: the memory cap (``max_tree_mb`` for both trees) and, with
-        a check budget, the nodes its checks can add (each costs at least one check)."""
-        by_memory = int(self.s.max_tree_mb * 1e6 / 2 / (8 * dof + 8))
+    def tree_rows(self, hard: int, roots: int, dof: int, index_bytes: int = 0) -> int:
+        """Rows a tree may have: the memory cap (``max_tree_mb`` for both trees: states,
+        parents and ``index_bytes`` a row of the nearest-node index) and, with a check
+        budget, the nodes its checks can add (each costs at least one check)."""
+        by_memory = int(self.s.max_tree_mb * 1e6 / 2 / (8 * dof + 8 + index_bytes))
         return max(min(by_memory, hard + roots + 1), roots + 1)
 
     def simplify(self, P: Array, model: Any, V: Any, S: Any, rng_state: np.ndarray) -> Array:
@@ -399,7 +402,7 @@ class NativeSolve:
         self.extra["range_rad"] = range_rad
         need_free = 2 + math.ceil(space_extent(model) / range_rad)
         hard0 = self.hard_checks()
-        cap = max(self.tree_rows(hard0, len(G), dof), need_free + len(G) + 1)
+        cap = max(self.tree_rows(hard0, len(G), dof, KD_ROW_BYTES), need_free + len(G) + 1)
         self.extra["tree_rows"] = cap
         rows = min(cap, max(FIRST_ROWS, need_free + len(G) + 1))
         trees = self.new_trees(((q0[None], None), (G, None)), rows, dof)
