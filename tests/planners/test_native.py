@@ -337,7 +337,7 @@ def test_kd_tree_nearest_is_the_brute_force_nearest():
         for _ in range(30):
             q = np.round(rng.uniform(-3.2, 3.2, dof), int(rng.integers(0, 3)))
             brute = K.nearest(Q, n, q, continuous, continuous.any(), F)
-            assert K.kd_nearest(Q, q, continuous, F, Kd, sd, stack, bounds) == brute
+            assert K.kd_nearest(Q, q, continuous, F, K.DEAD, Kd, sd, stack, bounds) == brute
             compared += 1
     assert compared == 120 * 30
     # every row dead: none
@@ -347,4 +347,7 @@ def test_kd_tree_nearest_is_the_brute_force_nearest():
     sd = K.split_dims(np.zeros(2, dtype=np.bool_))
     K.kd_catch_up(Q, 4, Kd, sd)
     stack, bounds = np.empty(6, dtype=np.int64), np.empty(6)
-    assert K.kd_nearest(Q, np.ones(2), np.zeros(2, dtype=np.bool_), F, Kd, sd, stack, bounds) == -1
+    assert (
+        K.kd_nearest(Q, np.ones(2), np.zeros(2, dtype=np.bool_), F, K.DEAD, Kd, sd, stack, bounds)
+        == -1
+    )
