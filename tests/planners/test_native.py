@@ -334,10 +334,11 @@ def test_kd_tree_nearest_is_the_brute_force_nearest():
         K.kd_catch_up(Q, n, Kd, sd)
         assert (Kd[:, 2] >= 0).all()
         stack, bounds = np.empty(n + 2, dtype=np.int64), np.empty(n + 2)
+        offs = np.empty((n + 2, dof))
         for _ in range(30):
             q = np.round(rng.uniform(-3.2, 3.2, dof), int(rng.integers(0, 3)))
             brute = K.nearest(Q, n, q, continuous, continuous.any(), F)
-            assert K.kd_nearest(Q, q, continuous, F, K.DEAD, Kd, sd, stack, bounds) == brute
+            assert K.kd_nearest(Q, q, continuous, F, K.DEAD, Kd, sd, stack, bounds, offs) == brute
             compared += 1
     assert compared == 120 * 30
     # every row dead: none
@@ -346,8 +347,10 @@ def test_kd_tree_nearest_is_the_brute_force_nearest():
     Kd = np.full((4, 3), -1, dtype=np.int64)
     sd = K.split_dims(np.zeros(2, dtype=np.bool_))
     K.kd_catch_up(Q, 4, Kd, sd)
-    stack, bounds = np.empty(6, dtype=np.int64), np.empty(6)
+    stack, bounds, offs = np.empty(6, dtype=np.int64), np.empty(6), np.empty((6, 2))
     assert (
-        K.kd_nearest(Q, np.ones(2), np.zeros(2, dtype=np.bool_), F, K.DEAD, Kd, sd, stack, bounds)
+        K.kd_nearest(
+            Q, np.ones(2), np.zeros(2, dtype=np.bool_), F, K.DEAD, Kd, sd, stack, bounds, offs
+        )
         == -1
     )

@@ -2,7 +2,8 @@
 row. Rows are put in as they are added (:func:`kd_insert`: row 0 the root, the split
 joint cycling over the bounded joints); :func:`kd_nearest` finds the very row the
 brute-force scan (:func:`~plannerlab.planners.native.kernels.nearest`) finds, with the
-same sums, so a search gives the same path either way. A robot whose joints are all
+same sums, so a search gives the same path either way (``tests/planners/test_native.py``
+compares them on random trees with many ties). A robot whose joints are all
 continuous has no split joint (:func:`split_dims` is empty): its planners scan.
 """
 
@@ -14,6 +15,8 @@ import numpy as np
 from numba import njit
 
 _TWO_PI = 2.0 * math.pi
+#: a cell is skipped only when its squared distance exceeds the best sum by this factor
+CELL_MARGIN = 1.0 + 1e-9
 
 
 @njit(cache=True, nogil=True)
@@ -67,26 +70,32 @@ def kd_catch_up(Q, n, Kd, sd):
 
 
 @njit(cache=True, nogil=True)
-def kd_nearest(Q, q, continuous, F, dead, Kd, sd, stack, bounds):
+def kd_nearest(Q, q, continuous, F, dead, Kd, sd, stack, bounds, offs):
     """:func:`~plannerlab.planners.native.kernels.nearest` over the rows in the k-d tree
     ``Kd`` (:func:`kd_insert`): the same row, the lowest index among the live rows
     (``F[r] != dead``) at the least squared distance, each row's sum made as ``nearest``
-    makes it (the same terms in the same order). A subtree is
-    skipped only when the squared gap to its splitting plane exceeds the best sum (in
-    floating point a row's sum is at least any of its terms, and its term on the split
-    joint at least the gap's: ties are kept). ``stack``, ``bounds`` (at least the tree's
-    depth + 2) scratch. -1 when every row is dead."""
+    makes it (the same terms in the same order, ties to the lower index).
+
+    A subtree is skipped when its cell is farther than the best row: the cell's squared
+    distance is the sum of q's squared gaps to it on the split joints (the incremental
+    distance of Arya and Mount; ``offs`` keeps each pending cell's gaps). The test keeps a
+    relative margin of ``CELL_MARGIN`` over the best sum, far beyond the rounding of
+    these sums (a few ulps), so a cell holding a row that ties or beats the best in
+    floating point is never skipped. ``stack``, ``bounds`` (at least the tree's depth + 2)
+    and ``offs`` (as many rows, dof columns) scratch. -1 when every row is dead."""
     best = np.inf
     best_i = -1
     dof = q.shape[0]
     stack[0] = 0
     bounds[0] = 0.0
+    for i in range(dof):
+        offs[0, i] = 0.0
     top = 1
     while top > 0:
         top -= 1
         node = stack[top]
         b = bounds[top]
-        if b > best:
+        if b > best * CELL_MARGIN:
             continue
         if F[node] != dead:
             acc = 0.0
@@ -109,13 +118,22 @@ def kd_nearest(Q, q, continuous, F, dead, Kd, sd, stack, bounds):
             near, far = Kd[node, 0], Kd[node, 1]
         else:
             near, far = Kd[node, 1], Kd[node, 0]
+        # the popped cell's gaps are in offs[top]; the far cell differs on joint k only
+        gap = abs(diff)
+        fb = 0.0
         if far >= 0:
-            fb = max(b, diff * diff)
-            if fb <= best:
-                stack[top] = far
-                bounds[top] = fb
-                top += 1
-        if near >= 0:
+            for i in range(dof):
+                o = gap if i == k else offs[top, i]
+                fb += o * o
+        if far >= 0 and fb <= best * CELL_MARGIN:
+            # far at `top` (visited after near), near above it with the popped gaps
+            for i in range(dof):
+                offs[top + 1, i] = offs[top, i]
+            offs[top, k] = gap
+            stack[top] = far
+            bounds[top] = fb
+            top += 1
+        if near >= 0:  # offs[top] holds the popped cell's gaps
             stack[top] = near
             bounds[top] = b
             top += 1

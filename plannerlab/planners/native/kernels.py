@@ -277,7 +277,7 @@ def _tree_edge(Qt, Pt, c, goal_tree, joint_step, m, V, S, buf, limit, every, fin
 
 @njit(cache=True, nogil=True)
 def _grow(Qt, Pt, Ft, Rt, Kt, nt, goal_tree, near, q_to, range_rad, joint_step, m, V, S, buf,
-          limit, every, dd, sd, stack, bounds):  # fmt: skip
+          limit, every, dd, sd, stack, bounds, offs):  # fmt: skip
     """Grow tree (Qt, Pt, Ft, Rt, Kt: its k-d tree, :func:`kd_insert`) of nt nodes from
     node ``near`` (-1: the nearest live one, by the k-d tree over the joints ``sd``, or
     by brute force when ``sd`` is empty) towards q_to: a node at most ``range_rad`` on,
@@ -295,7 +295,7 @@ def _grow(Qt, Pt, Ft, Rt, Kt, nt, goal_tree, near, q_to, range_rad, joint_step, 
     domain = near < 0 and dd[0] > 0.0
     if near < 0:
         if sd.shape[0] > 0:
-            near = kd_nearest(Qt, q_to, m.continuous, Ft, DEAD, Kt, sd, stack, bounds)
+            near = kd_nearest(Qt, q_to, m.continuous, Ft, DEAD, Kt, sd, stack, bounds, offs)
         else:
             near = nearest(Qt, nt, q_to, m.continuous, m.continuous.any(), Ft)
         if domain and distance2(Qt[near], q_to, m.continuous) > Rt[near] * Rt[near]:
@@ -422,6 +422,7 @@ def rrtc_run(
     depth = max(QA.shape[0], QB.shape[0]) + 2
     stack = np.empty(depth, dtype=np.int64)
     bounds = np.empty(depth)
+    offs = np.empty((depth, QA.shape[1]))
     while True:
         if counters[0] >= max_iterations:
             return ITERATIONS
@@ -463,6 +464,7 @@ def rrtc_run(
             sd,
             stack,
             bounds,
+            offs,
         )
         counters[1] += c
         if code == 3:
@@ -501,6 +503,7 @@ def rrtc_run(
                 sd,
                 stack,
                 bounds,
+                offs,
             )
             counters[1] += c
             if code == 3:
