@@ -528,15 +528,20 @@ class ChainValidity:
         hs: np.ndarray,
         body_order: np.ndarray | None = None,
     ) -> None:
+        from plannerlab.collision import lanes  # lanes imports this module's kernels
+
         self.dof = int(robot.dof)
         self._one = (self.dof,)
+        # batches in vector lanes (the same verdicts, state by state), one state scalar
+        self._batch_valid: Any = lanes.chain_valid_lanes
+        self._batch_first_bad: Any = lanes.chain_first_bad_lanes
         self._state_valid: Any = chain_state_valid  # a numba dispatcher
         self._P, self._M, self._idat, self.perm = _pack(
             robot, radii, radii_self, moving, allowed, kinds, Rs, cs, hs, body_order
         )
         #: the kernels' arguments after the states: ``chain_state_valid(q, *args)``
         self.args = (self._P, self._M, self._idat)
-        kernels: tuple[Any, ...] = (chain_valid, chain_first_bad, chain_state_valid)
+        kernels: tuple[Any, ...] = (self._batch_valid, self._batch_first_bad, chain_state_valid)
         if not all(k.signatures for k in kernels):  # compile or load them here, not later
             q = np.clip(np.zeros(self.dof), robot.lower, robot.upper)
             self.valid(np.vstack([q, q]))
@@ -568,12 +573,12 @@ class ChainValidity:
     def valid(self, Q: Any) -> np.ndarray:
         """(k,) bool validity of Q (k, dof)."""
         Qc = self._Q(Q)
-        kernel: Any = chain_valid  # a numba dispatcher
+        kernel: Any = self._batch_valid  # a numba dispatcher
         return kernel(Qc, self._P, self._M, self._idat, np.empty(len(Qc), dtype=np.bool_))
 
     def first_invalid(self, Q: Any) -> int:
         """Index of the first invalid state of Q (k, dof) in order, -1 if all are valid."""
-        kernel: Any = chain_first_bad
+        kernel: Any = self._batch_first_bad
         return int(kernel(self._Q(Q), self._P, self._M, self._idat))
 
     def is_valid(self, q: Any) -> bool:

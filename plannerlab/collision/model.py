@@ -41,6 +41,7 @@ from typing import Any, NamedTuple
 import numpy as np
 from numba import njit
 
+from plannerlab.collision.chain_pack import _pack
 from plannerlab.collision.chain_valid import (
     _body_frames,
     _place_body,
@@ -48,6 +49,7 @@ from plannerlab.collision.chain_valid import (
     _state_ok,
     _unpack,
 )
+from plannerlab.collision.lanes import group_end, group_push, lanes_scratch, valid_states_lanes
 from plannerlab.errors import PlannerlabError
 from plannerlab.robots.registry import model_builder
 
@@ -107,6 +109,48 @@ def model_of_core(core: Any) -> CompiledModel:
     )
 
 
+def chain_model(robot: Any) -> CompiledModel:
+    """The model of a robot's chain alone (no scene, no margin, no checked pairs): its
+    kinematics and capsules packed as :func:`model_of_core` packs them, for a consumer
+    that needs only those (the clearance field's spheres,
+    :mod:`plannerlab.collision.spheres`) when no checker's model is at hand.
+
+    Raises:
+        ModelError: the robot gives no serial chain (``chain_data()``).
+    """
+    if not has_chain(robot):
+        raise ModelError(
+            f"robot type {getattr(robot, 'kind', type(robot).__name__)!r} gives no serial "
+            "chain (chain_data()): its kinematics cannot be compiled"
+        )
+    L = len(np.asarray(robot.link_radii_m))
+    zeros = np.zeros(L)
+    P, M, idat, perm = _pack(
+        robot,
+        zeros,
+        zeros,
+        np.ones(L, dtype=bool),
+        np.zeros((L, L), dtype=bool),
+        np.zeros(0, dtype=np.int64),
+        np.zeros((0, 3, 3)),
+        np.zeros((0, 3)),
+        np.zeros((0, 3)),
+        None,
+    )
+    dof = int(robot.dof)
+    return CompiledModel(
+        P=P,
+        M=M,
+        idat=idat,
+        lower=np.array(robot.lower, dtype=np.float64, order="C", copy=True),
+        upper=np.array(robot.upper, dtype=np.float64, order="C", copy=True),
+        continuous=np.array(robot.continuous, dtype=np.bool_, order="C", copy=True),
+        edge_weights=np.zeros(dof),
+        margin_m=0.0,
+        perm=np.array(perm, dtype=np.int64, order="C", copy=True),
+    )
+
+
 def build_model(core: Any) -> CompiledModel:
     """The model of a built core by its robot family's registered builder (the generic
     serial-chain :func:`model_of_core` unless the family names its own).
@@ -122,8 +166,11 @@ def build_model(core: Any) -> CompiledModel:
 # ---------------------------------------------------------------------- compiled queries
 @njit(cache=True, nogil=True)
 def views(m):
-    """The model's views and a scratch for :func:`state_ok` (made once per search)."""
-    return _unpack(m.P, m.M, m.idat), _scratch(m.idat)
+    """The model's views ``V`` and a scratch ``S`` for :func:`state_ok` (made once per
+    search). ``V[3]`` is the scratch of the states tested in vector lanes
+    (:mod:`plannerlab.collision.lanes`: the edges' groups)."""
+    ints, floats, cpl = _unpack(m.P, m.M, m.idat)
+    return (ints, floats, cpl, lanes_scratch(m.idat)), _scratch(m.idat)
 
 
 #: One state q (dof,) is valid (``V``, ``S`` from :func:`views`): chain_valid's own
@@ -155,11 +202,9 @@ def segments(Q, m, out):
 
 @njit(cache=True, nogil=True)
 def valid_states(Q, m, out):
-    """Validity of a batch Q (k, dof) -> out (k,) bool."""
-    V, S = views(m)
-    for s in range(Q.shape[0]):
-        out[s] = _state_ok(Q[s], V, S)
-    return out
+    """Validity of a batch Q (k, dof) -> out (k,) bool, in vector lanes (the verdicts of
+    :func:`state_ok`, state by state)."""
+    return valid_states_lanes(Q, m, out)
 
 
 @njit(cache=True, nogil=True)
@@ -197,41 +242,39 @@ def edge_state(q_a, d, j, n, out):
 @njit(cache=True, nogil=True, inline="always")
 def _edge_visit(q_a, q_b, joint_step, m, V, S, d, q, limit, rec):
     """:func:`edge_ok`'s loop; ``rec`` (non-empty) records the grid indices j visited, in
-    order (the test's window on the very loop the planners run)."""
+    order (the test's window on the very loop the planners run). The states go to the
+    vector lanes in groups of ``lanes.W``, in this order."""
     edge_delta(q_a, q_b, m.continuous, d)
     n = edge_count(d, joint_step, m.edge_weights)
     keep = rec.shape[0] > 0
+    SL = V[3]
     checks = 0
-    # j = n first (the state the edge reaches), then j in van der Corput order over 1..n-1
-    edge_state(q_a, d, n, n, q)
     if limit < 1:
         return 2, checks
+    # j = n first (the state the edge reaches), then j in van der Corput order over 1..n-1
     if keep:
-        rec[checks] = n
-    checks += 1
-    if not _state_ok(q, V, S):
-        return 1, checks
-    if n == 1:
-        return 0, checks
+        rec[0] = n
+    status, checks = group_push(q_a, d, n, n, V, SL, checks, limit)
+    if status >= 0:
+        return status, checks
     step = 1
     while step < n:
         step *= 2
     # visit j = step/2, step/4, 3 step/4, ... (skipping j >= n): every j in 1..n-1 once
     h = step // 2
+    at = 1
     while h >= 1:
         j = h
         while j < n:
-            if checks >= limit:
-                return 2, checks
-            edge_state(q_a, d, j, n, q)
-            if keep:
-                rec[checks] = j
-            checks += 1
-            if not _state_ok(q, V, S):
-                return 1, checks
+            if keep and at < rec.shape[0]:
+                rec[at] = j
+            at += 1
+            status, checks = group_push(q_a, d, j, n, V, SL, checks, limit)
+            if status >= 0:
+                return status, checks
             j += 2 * h
         h //= 2
-    return 0, checks
+    return group_end(V, SL, checks)
 
 
 @njit(cache=True, nogil=True)

@@ -161,7 +161,7 @@ def _entries() -> dict[str, PlannerEntry]:
         entries.append(
             PlannerEntry(
                 name,
-                "plannerlab.planners.gradient_clearance:make",
+                "plannerlab.planners.clearance.descent:make",
                 summary,
                 uses_rng=uses_rng,
                 options=_ESCAPE_RRTCONNECT,

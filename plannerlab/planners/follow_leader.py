@@ -1,7 +1,7 @@
 """Follow-the-leader: a path for the tip through free workspace, tracked by the clearance
 descent, so the body follows the tip through a window.
 
-The clearance descent (:mod:`plannerlab.planners.gradient_clearance`) pulls the tip
+The clearance descent (:mod:`plannerlab.planners.clearance.descent`) pulls the tip
 straight at the goal; in a room entered through a window it presses the tip against the
 outside of the wall, at the point nearest the goal, and stalls there (measured on
 ``armz_deep_a``: 2 m from the goal, the window 3.7 m to the side; no retract of its
@@ -19,7 +19,7 @@ follow-the-leader:
    box round the start tip, the approach point, the goal and the base (``pad_m``, within
    the arm's reach); corners are then cut where the straight line keeps the clearance.
 2. **The body follows** (:class:`FollowLeader`): the clearance descent
-   (:meth:`~plannerlab.planners.gradient_clearance.ClearanceDescent.descend`, its public
+   (:meth:`~plannerlab.planners.clearance.descent.ClearanceDescent.descend`, its public
    entry point) tracks a sub-goal that moves along the path (:meth:`FollowLeader.subgoals`):
    to the path's first corner (the tip turns there as the descent takes it), then along
    every later segment every ``stride_m``, looking along it, each within
@@ -28,7 +28,7 @@ follow-the-leader:
    the tip leads it in. A sub-goal the descent stalls before is passed over; two in a row
    end the tracking.
 3. **The finish** is the clearance descent of the leg
-   (:meth:`~plannerlab.planners.gradient_clearance.ClearanceDescent.leg_descent`) from the
+   (:meth:`~plannerlab.planners.clearance.descent.ClearanceDescent.leg_descent`) from the
    state the tracking reached (its approach point, then the goal, with its settling); if
    it stalls, the ``+detour`` variant hands the stall to the descent's own ``plan`` with
    its detour escape (a sub-solve in the leg's context). Where no leader's path exists
@@ -73,9 +73,9 @@ from plannerlab.planners.base import (
     with_overrides,
 )
 from plannerlab.planners.clearance import SetupStopped
+from plannerlab.planners.clearance.descent import ClearanceDescent, ClearanceSettings, LegPath
+from plannerlab.planners.clearance.settings import DERIVED, resolve_distances
 from plannerlab.planners.context import LegPlanner, PlanningContext
-from plannerlab.planners.descent_settings import DERIVED, resolve_distances
-from plannerlab.planners.gradient_clearance import ClearanceDescent, ClearanceSettings, LegPath
 from plannerlab.planners.leader_grid import TipPath, scene_distance_m, tip_path
 from plannerlab.planners.leader_moves import Track, crosses_body
 from plannerlab.problem.goals import GoalRegion
@@ -84,7 +84,7 @@ from plannerlab.robots.base import Array, joint_difference
 #: the default voxel is at least the reach over this (Arm-Z's 0.34 m < its 0.375 m)
 VOXELS_PER_REACH = 50.0
 #: the distance settings of :class:`FollowLeaderSettings` derived from the robot (see
-#: :mod:`~plannerlab.planners.descent_settings`): their values on Arm-Z [m]
+#: :mod:`~plannerlab.planners.clearance.settings`): their values on Arm-Z [m]
 DERIVED_DISTANCES: dict[str, float] = {
     "extra_clearance_m": 0.05,
     "centre_m": 1.5,
@@ -100,7 +100,7 @@ class FollowLeaderSettings:
     """Settings of follow-the-leader.
 
     Distances marked *derived* default to None: Arm-Z's value (given) scaled to the
-    robot's size (:mod:`~plannerlab.planners.descent_settings`: the typical link length
+    robot's size (:mod:`~plannerlab.planners.clearance.settings`: the typical link length
     over Arm-Z's module); a value set wins. The clearance descent's settings are its own
     (:class:`ClearanceSettings`), overridden as ``descent.<key>``.
 

@@ -22,7 +22,7 @@ def near_goal_finder(ctx: PlanningContext) -> NearGoal:
     else ``gradient.clearance``'s with its default settings."""
     if ctx.near_goal is not None:
         return ctx.near_goal
-    from plannerlab.planners.gradient_clearance import make as make_clearance
+    from plannerlab.planners.clearance.descent import make as make_clearance
 
     return make_clearance("gradient.clearance", {}).near_goal_state
 

@@ -15,6 +15,7 @@ from conftest import PROBLEMS
 from plannerlab.collision.core import Core
 from plannerlab.collision.fcl_checker import CollisionChecker, problem_checker
 from plannerlab.collision.kernels import valid_batch
+from plannerlab.collision.lanes import W
 from plannerlab.collision.model import (
     CompiledModel,
     ModelError,
@@ -182,6 +183,8 @@ def test_the_models_verdicts_are_fcls_on_random_and_near_contact_states(kind):
     assert len(inside) == 60
     assert _model_valid(m, inside).all() and not _model_valid(m, outside).any()
     assert fcl.valid_batch(inside).all() and not fcl.valid_batch(outside).any()
+    # the batch runs in vector lanes (collision/lanes.py): the one-state test agrees
+    assert all(state_ok(q, V, S) for q in inside) and not any(state_ok(q, V, S) for q in outside)
 
 
 def _coiled(lo, hi, n, rng, centre_rad, spread_rad):
@@ -222,6 +225,8 @@ def test_the_models_verdicts_are_fcls_on_self_colliding_states(kind):
     v = _model_valid(m, Q)
     assert np.array_equal(v, fcl.valid_batch(Q))
     assert 0.02 < (~v).mean() < 0.98  # self-colliding states are there (the scene is empty)
+    V, S = views(m)  # the lanes' verdicts are the one-state test's
+    assert [state_ok(q, V, S) for q in Q] == v.tolist()
     inside, outside = _near_contact(m, lo, hi, Q, 30, rng)
     assert len(inside) == 30
     assert fcl.valid_batch(inside).all() and not fcl.valid_batch(outside).any()
@@ -251,8 +256,11 @@ def test_edge_ok_checks_exactly_the_checkers_grid_once_each(kind):
             assert checks == n and rec[0] == n and sorted(rec[:n]) == list(range(1, n + 1))
             assert grid_ok.all()
         else:
-            assert status == 1 and not grid_ok[rec[checks - 1] - 1]
-            assert grid_ok[rec[: checks - 1] - 1].all() and len(set(rec[:checks])) == checks
+            # the states go in groups of lanes.W: the last group tested holds an invalid
+            # state, every group before it is valid
+            g0 = (checks - 1) // W * W
+            assert status == 1 and not grid_ok[rec[g0:checks] - 1].all()
+            assert grid_ok[rec[:g0] - 1].all() and len(set(rec[:checks])) == checks
         seen[status] += 1
         # its states are densify's, bit for bit, and edge_ok says what edge_visits says
         d, q = np.empty(robot.dof), np.empty(robot.dof)

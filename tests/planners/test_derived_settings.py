@@ -1,5 +1,5 @@
 """Defaults that fit the robot (issue 27, point 4): the clearance family's distances are
-derived from the robot's size (descent_settings.robot_size), so the same defaults solve a
+derived from the robot's size (clearance.settings.robot_size), so the same defaults solve a
 0.7-m six-joint arm and the 16-m Arm-Z, and on every Arm-Z they are exactly today's.
 
 The small arm is built here: six revolute joints, 0.77 m from its base to its tool,
@@ -22,7 +22,7 @@ from conftest import toy_problem
 
 from plannerlab.collision.fcl_checker import problem_checker
 from plannerlab.planners import Status, make_planner
-from plannerlab.planners.descent_settings import (
+from plannerlab.planners.clearance.settings import (
     DERIVED_DISTANCES,
     ClearanceSettings,
     robot_size,

@@ -38,7 +38,7 @@ class OMPLPlanner(LegPlanner):
         """The near goal's descent is compiled: its kernels are loaded (or compiled)
         before the tracker starts, as the checker's core is."""
         if self.settings.goal_selection != "ik":
-            from plannerlab.planners._descent_core import warm_up
+            from plannerlab.planners.clearance.compiled import warm_up
 
             warm_up()
 

@@ -211,6 +211,12 @@ class ArmZ:
         cap_b[0] = self._T_base_j1[:3, 3]
         return parent, pre, axes, prismatic, cap_body, cap_a, cap_b
 
+    def tip_data(self) -> tuple[int, Array, Array]:
+        """The tip in :meth:`chain_data`'s terms: its body (the last), and the end
+        effector's point and normal in that body's frame (face ``dof + 1 = body dof · M``:
+        ``M``'s translation and z axis)."""
+        return self.dof, self._M[:3, 3].copy(), self._M[:3, 2].copy()
+
     def link_segments(self, q: Array) -> Array:
         """Capsule axes (L, 2, 3) or (k, L, 2, 3): chord between consecutive face centres."""
         origins = self.fk(q)[..., :3, 3]  # (..., F, 3)

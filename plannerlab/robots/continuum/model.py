@@ -378,6 +378,11 @@ class ContinuumChain:
         cap_b[:, 0] = ell
         return parent, pre, axes, prismatic, cap_body, cap_a, cap_b
 
+    def tip_data(self) -> tuple[int, Array, Array]:
+        """The tip in :meth:`chain_data`'s terms: the last link's body, the link's end
+        ``(ℓ, 0, 0)`` and its tangent (x) in that body's frame."""
+        return self.n_links + 1, np.array([self.link_length_m, 0.0, 0.0]), np.array([1.0, 0, 0])
+
     def link_segments(self, q: Array) -> Array:
         """Capsule axes (n, 2, 3) or (k, n, 2, 3): link i from joint i to joint i + 1."""
         Q, single = self._as_batch(q)

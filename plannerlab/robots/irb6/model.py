@@ -376,6 +376,11 @@ class IRb6:
         coupling[4, 4] = 1.0
         return parent, pre, axes, prismatic, cap_body, cap_a, cap_b, coupling
 
+    def tip_data(self) -> tuple[int, Array, Array]:
+        """The tip in :meth:`chain_data`'s terms: the flange (body 6, :meth:`fk_station`'s
+        frame 5), its origin and approach vector (z) in its own frame."""
+        return 6, np.zeros(3), np.array([0.0, 0.0, 1.0])
+
     def link_segments(self, q: Array) -> Array:
         """Capsule axes in the world: (5, 2, 3) for q (6,), (k, 5, 2, 3) for (k, 6)."""
         T = self.fk(q)

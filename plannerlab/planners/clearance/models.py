@@ -1,17 +1,18 @@
 """The clearance descent's field and step at one state, on one of two engines (its
 ``backend`` setting): :class:`NumpyModel` (the reference, :mod:`plannerlab.planners.
-clearance` and :class:`~plannerlab.planners.descent_step.DescentStep`) or
-:class:`CompiledModel` (numba, :mod:`plannerlab.planners._descent_core`, Arm-Z only): the
-same iterates to rounding."""
+clearance.field` and :class:`~plannerlab.planners.clearance.step.DescentStep`) or
+:class:`CompiledModel` (numba, :mod:`plannerlab.planners.clearance.compiled`; the planners
+run it on Arm-Z): the same iterates to rounding."""
 
 from __future__ import annotations
 
 from functools import cached_property
+from typing import Any
 
 import numpy as np
 
-from plannerlab.planners.clearance import ClearanceField
-from plannerlab.planners.descent_step import DescentStep, joint_residual_sq
+from plannerlab.planners.clearance.field import ClearanceField
+from plannerlab.planners.clearance.step import DescentStep, joint_residual_sq
 from plannerlab.problem.goals import JointGoal
 from plannerlab.robots.base import Array
 
@@ -109,35 +110,30 @@ class NumpyModel:
 
 
 class CompiledModel:
-    """The field and the step compiled (:mod:`plannerlab.planners._descent_core`): one
+    """The field and the step compiled (:mod:`plannerlab.planners.clearance.compiled`): one
     call per state gives F, f, the tip errors, the distances and the step direction."""
 
     backend = "compiled"
 
-    def __init__(self, descent: DescentStep, field: ClearanceField) -> None:
-        from plannerlab.planners._descent_core import CompiledField
+    def __init__(
+        self, descent: DescentStep, field: ClearanceField, compiled_model: Any = None
+    ) -> None:
+        """``compiled_model``: the checker's compiled robot–scene model, whose chain the
+        field's spheres ride on (None: the robot's chain packed alone; the same arrays)."""
+        from plannerlab.planners.clearance.compiled import CompiledField, step_rule
 
         s = descent.settings
         self._settings = s
         # distances beyond both the margin and the hold's floor matter to no test of the
         # descent (the spacious test looks only below min_clearance_m)
-        self._core = CompiledField(field, far_m=max(s.margin_m, s.min_clearance_m + s.hold_band_m))
+        far_m = max(s.margin_m, s.min_clearance_m + s.hold_band_m)
+        self._core = CompiledField(field, far_m=far_m, model=compiled_model)
+        self._rule = step_rule(
+            s.r1, s.r2, s.clearance_weight, s.direction == "gauss_newton", s.damping, s.goal_depth
+        )
 
     def point(self, goal, q: Array, d_ref: Array | None = None):
-        s = self._settings
-        return self._core.evaluate(
-            q,
-            goal,
-            s.r1,
-            s.r2,
-            s.clearance_weight,
-            s.direction == "gauss_newton",
-            s.damping,
-            s.goal_depth,
-            True,
-            d_ref,
-            s.min_clearance_m,
-        )
+        return self._core.evaluate(q, goal, self._rule, True, d_ref, self._settings.min_clearance_m)
 
     def hold(self, goal, q: Array, direction: Array) -> Array:
         """The held step, projected in the metric of the step's quadratic model at q

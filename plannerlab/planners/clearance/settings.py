@@ -182,7 +182,7 @@ class ClearanceSettings:
             it the descent stalls against the clearance floor (measured on room
             variants: the leave leg stalled at iteration 7 and no retract got out).
         backend: "compiled" (the field and the step in numba,
-            :mod:`plannerlab.planners._descent_core`; Arm-Z only, other robots use numpy)
+            :mod:`plannerlab.planners.clearance.compiled`; Arm-Z only, other robots use numpy)
             or "numpy" (the reference: the same iterates to rounding, 30-50 times slower;
             `bench/descent_bench.py`).
     """

@@ -1,22 +1,22 @@
 """The clearance descent's step in numpy: its direction (steepest descent or damped
 Gauss-Newton on the tip residuals, or the joint residual towards a goal state, and the
 clearance residuals), the metric of its quadratic model, and the hold that slides a step
-along the clearance floor (see :mod:`plannerlab.planners.gradient_clearance`). The
-reference of the compiled step (:mod:`plannerlab.planners._descent_core`)."""
+along the clearance floor (see :mod:`plannerlab.planners.clearance.descent`). The
+reference of the compiled step (:mod:`plannerlab.planners.clearance.compiled`)."""
 
 from __future__ import annotations
 
 import numpy as np
 
-from plannerlab.planners.clearance import Clearance, ClearanceField
-from plannerlab.planners.descent_settings import ClearanceSettings
+from plannerlab.planners.clearance.field import Clearance, ClearanceField
+from plannerlab.planners.clearance.settings import ClearanceSettings
 from plannerlab.problem.goals import JointGoal
 from plannerlab.robots.base import Array, joint_difference
 
 
 class DescentStep:
     """The step of the clearance descent on its ``settings`` (a base of
-    :class:`~plannerlab.planners.gradient_clearance.ClearanceDescent`)."""
+    :class:`~plannerlab.planners.clearance.descent.ClearanceDescent`)."""
 
     settings: ClearanceSettings
 

@@ -1,6 +1,6 @@
 """The clearance descent's compiled inner loop (numba, cached): the clearance field of
 :mod:`plannerlab.planners.clearance` and the step of
-:class:`~plannerlab.planners.gradient_clearance.ClearanceDescent`, for an Arm-Z chain.
+:class:`~plannerlab.planners.clearance.descent.ClearanceDescent`.
 
 One call, :func:`evaluate`, gives everything the descent asks at a state: the objective
 ``f`` and ``F = f + w · cost``, the tip's position and angle errors, every sphere pair's
@@ -13,130 +13,145 @@ loops (same spheres, same pairs in the same order, same formulas), so the compil
 takes the numpy descent's steps to rounding (``tests/planners/test_descent_core.py`` holds the two
 paths to 1e-9 rad on a fixed problem).
 
-The chain's frames, the sphere centres and the pairs are in
-:mod:`plannerlab.planners._descent_geometry`. Geometry comes from a
-:class:`~plannerlab.planners.clearance.ClearanceField` (its spheres
-and pairs) and the robot's fixed chain matrices; :class:`CompiledField` packs them once.
-Only Arm-Z (analytic Jacobians) is compiled; other robots keep the numpy field.
+No geometry of its own: the chain's frames, the tip, the sphere centres, the pairs and
+their gradients are the compiled robot–scene model's kinematics
+(:mod:`plannerlab.collision.spheres` on a :class:`~plannerlab.collision.model.
+CompiledModel`). :class:`CompiledField` packs a :class:`~plannerlab.planners.clearance.
+ClearanceField`'s spheres and pairs, the scene and the chain once into one
+:class:`SphereField` (named tuples of arrays: one argument, loaded from numba's cache).
 """
 
 from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import Any, NamedTuple
 
 import numpy as np
 from numba import njit
 
-from plannerlab.planners._descent_geometry import (
+from plannerlab.collision.spheres import (
     BOX,
     CYLINDER,
     SPHERE,
-    _centres,
-    _frames,
-    _pair_gradient,
-    _pairs,
-    _tip_jacobians,
+    SphereChain,
+    centres,
+    frames,
+    kin,
+    pair_gradient,
     pair_spheres,
+    pairs,
+    sphere_chain,
+    tip_jacobians,
+    tip_pose,
 )
-from plannerlab.planners.clearance import ClearanceField
+from plannerlab.planners.clearance.field import ClearanceField
 from plannerlab.problem.scene import Box, Cylinder, Sphere
 from plannerlab.robots.base import Array
 
 
+class SphereField(NamedTuple):
+    """A :class:`ClearanceField` packed for the kernels: the chain, the spheres (each one's
+    link, place ``t`` on it and radius), the pairs (the scene's spheres, the self pairs,
+    every pair's spheres ``A``, ``B`` and :func:`~plannerlab.collision.spheres.
+    pair_spheres`' culls), the obstacles and the margin."""
+
+    ch: SphereChain
+    link: np.ndarray
+    t: np.ndarray
+    r: np.ndarray
+    scene_idx: np.ndarray
+    self_a: np.ndarray
+    self_b: np.ndarray
+    scene: tuple  # (kinds, Rs, cs, pars, bound)
+    A: np.ndarray
+    B: np.ndarray
+    lp_of_row: np.ndarray
+    lp_links: np.ndarray
+    ends: np.ndarray
+    margin: float
+
+
+class DescentGoal(NamedTuple):
+    """A goal for :func:`evaluate`: the tip target (p, n) and tolerances, or a goal state
+    (``joint``: q, its continuous joints and tolerance; empty arrays for a tip goal)."""
+
+    p: np.ndarray
+    n: np.ndarray
+    pos_tol: float
+    angle_tol_deg: float
+    joint: bool
+    q: np.ndarray
+    continuous: np.ndarray
+    tol_rad: float
+
+
+class StepRule(NamedTuple):
+    """The step's settings: objective weights, clearance weight, the rule, damping and
+    how deep into the goal region the tip residuals count."""
+
+    r1: float
+    r2: float
+    weight: float
+    gauss_newton: bool
+    damping: float
+    goal_depth: float
+
+
+@njit(cache=True, nogil=True, inline="always")
+def _pairs_of(P, fld, far_m):
+    """Every pair's distance and direction at the centres P (:func:`pairs`)."""
+    return pairs(
+        P,
+        fld.r,
+        fld.scene_idx,
+        fld.self_a,
+        fld.self_b,
+        fld.scene,
+        far_m,
+        fld.lp_of_row,
+        fld.lp_links,
+        fld.ends,
+    )
+
+
 # ---------------------------------------------------------------------- the descent
 @njit(cache=True, nogil=True)
-def evaluate(
-    q,
-    F1,
-    T0,
-    M,
-    link,
-    t,
-    r,
-    scene_idx,
-    self_a,
-    self_b,
-    kinds,
-    Rs,
-    cs,
-    pars,
-    bound,
-    A_idx,
-    B_idx,
-    lp_of_row,
-    lp_links,
-    link_ends,
-    margin,
-    far_m,
-    p_goal,
-    n_goal,
-    pos_tol,
-    angle_tol_deg,
-    r1,
-    r2,
-    weight,
-    gauss_newton,
-    damping,
-    goal_depth,
-    want_direction,
-    d_ref,
-    floor_m,
-    joint_goal,
-    q_goal,
-    continuous,
-    tol_rad,
-):
+def evaluate(q, fld, far_m, goal, rule, want_direction, d_ref, floor_m):
     """The descent's view of state q: (F, f, pos_err_m, ang_err_deg, cost, gradient (dof,),
-    distances (m,), direction (dof,); zeros unless ``want_direction``, spacious, joint_err).
-    Spacious: every pair is at least ``floor_m`` apart or no closer than in ``d_ref`` (the
-    distances at the state the step starts from; empty: True). With ``joint_goal`` the goal
-    is the state ``q_goal`` (dof,) (``continuous`` joints wrapped) with tolerance
-    ``tol_rad``: f = r1 |q − q_goal|, F = |(q − q_goal) / tol_rad|² + w · cost, the
-    Gauss-Newton residual (q_goal − q) / tol_rad, and joint_err the largest joint
-    difference (else 0).
+    distances (m,), direction (dof,); zeros unless ``want_direction``, spacious, metric,
+    joint_err). Spacious: every pair is at least ``floor_m`` apart or no closer than in
+    ``d_ref`` (the distances at the state the step starts from; empty: True). Towards a
+    goal state (``goal.joint``) with tolerance ``tol_rad``: f = r1 |q − q_goal|,
+    F = |(q − q_goal) / tol_rad|² + w · cost, the Gauss-Newton residual
+    (q_goal − q) / tol_rad, and joint_err the largest joint difference (else 0).
 
-    The steps, each its own compiled function: the chain's frames (:func:`_frames`), the
-    tip's errors (:func:`_tip_errors`) or the joint errors (:func:`_joint_errors`), the
-    sphere centres and pairs (:func:`_centres`, :func:`_pairs`), the clearance cost and its
-    gradient (:func:`_clearance_cost`), the spacious test (:func:`_spacious`), and the step
-    direction: towards a goal state :func:`_joint_direction`, else the tip's Jacobians
-    (:func:`_tip_jacobians`) and :func:`_tip_steepest` or :func:`_tip_gauss_newton`. The
-    steps of this module are inlined into it (``inline="always"``: numba's IR), the
-    geometry's are called; each is the fused kernel's former code, the same expressions in
-    the same order, so the descent takes the same iterates, to the last bit."""
+    The steps, each its own compiled function: the chain's frames and tip
+    (:func:`~plannerlab.collision.spheres.frames`, :func:`_tip_errors`) or the joint
+    errors (:func:`_joint_errors`), the sphere centres and pairs, the clearance cost and
+    its gradient (:func:`_clearance_cost`), the spacious test (:func:`_spacious`), and
+    the step direction: towards a goal state :func:`_joint_direction`, else the tip's
+    Jacobians and :func:`_tip_steepest` or :func:`_tip_gauss_newton`. The steps of this
+    module and the kinematics are inlined into it (``inline="always"``: numba's IR); the
+    pairs are called."""
     dof = q.shape[0]
-    Fr = _frames(q, F1, T0, M)
-    p, n, diff, dist, cn, ang_err_deg = _tip_errors(Fr, dof + 1, p_goal, n_goal)
+    ch = fld.ch
+    Bf = frames(q, ch)
+    p, n, diff, dist, cn, ang_err_deg = _tip_errors(Bf, ch, goal.p, goal.n)
+    r1, r2, weight = rule.r1, rule.r2, rule.weight
     f = r1 * dist + r2 * cn**2
     dq = np.zeros(dof)
     joint_err = 0.0
     e_sq = 0.0  # |dq / tol_rad|²
-    if joint_goal:
-        dq, sq, e_sq, joint_err = _joint_errors(q, q_goal, continuous, tol_rad)
+    if goal.joint:
+        dq, sq, e_sq, joint_err = _joint_errors(q, goal.q, goal.continuous, goal.tol_rad)
         f = r1 * math.sqrt(sq)
 
-    P = _centres(Fr, link, t)
-    d, nrm = _pairs(
-        P,
-        r,
-        scene_idx,
-        self_a,
-        self_b,
-        kinds,
-        Rs,
-        cs,
-        pars,
-        bound,
-        far_m,
-        A_idx,
-        B_idx,
-        lp_of_row,
-        lp_links,
-        link_ends,
-    )
-    cost, grad, n_close, close = _clearance_cost(Fr, P, link, nrm, A_idx, B_idx, d, margin)
-    if joint_goal:
+    P = centres(Bf, ch, fld.link, fld.t)
+    d, nrm = _pairs_of(P, fld, far_m)
+    margin = fld.margin
+    cost, grad, n_close, close = _clearance_cost(Bf, fld, P, nrm, d, dof)
+    if goal.joint:
         F = e_sq + weight * cost
     else:
         F = r1 * dist + r2 * cn**2 + weight * cost
@@ -145,45 +160,52 @@ def evaluate(
     metric = np.eye(dof)  # the step's quadratic model (the identity for plain gradients)
     if not want_direction:
         return F, f, dist, ang_err_deg, cost, grad, d, direction, spacious, metric, joint_err
-    pairs = (Fr, P, link, nrm, A_idx, B_idx, n_close, close, margin)  # the close pairs
-    if joint_goal:
+    close_pairs = (Bf, fld, P, nrm, n_close, close, margin)
+    if goal.joint:
         direction, metric = _joint_direction(
-            dq, joint_err, pairs, grad, weight, gauss_newton, damping, goal_depth, tol_rad
+            dq,
+            joint_err,
+            close_pairs,
+            grad,
+            weight,
+            rule.gauss_newton,
+            rule.damping,
+            rule.goal_depth,
+            goal.tol_rad,
         )
         return F, f, dist, ang_err_deg, cost, grad, d, direction, spacious, metric, joint_err
 
-    Jp, Jn = _tip_jacobians(Fr, p, n)
-    if not gauss_newton:
-        direction = _tip_steepest(diff, dist, cn, n_goal, Jp, Jn, grad, r1, r2, weight)
+    Jp, Jn = tip_jacobians(Bf, ch, p, n, dof)
+    if not rule.gauss_newton:
+        direction = _tip_steepest(diff, dist, cn, goal.n, Jp, Jn, grad, r1, r2, weight)
         return F, f, dist, ang_err_deg, cost, grad, d, direction, spacious, metric, joint_err
     direction, A = _tip_gauss_newton(
         p,
         n,
-        p_goal,
-        n_goal,
+        goal.p,
+        goal.n,
         dist,
         cn,
         Jp,
         Jn,
-        pos_tol,
-        angle_tol_deg,
-        goal_depth,
-        pairs,
+        goal.pos_tol,
+        goal.angle_tol_deg,
+        rule.goal_depth,
+        close_pairs,
         grad,
         weight,
-        damping,
+        rule.damping,
     )
     return F, f, dist, ang_err_deg, cost, grad, d, direction, spacious, A, joint_err
 
 
 # ---------------------------------------------------------------------- its steps
 @njit(cache=True, nogil=True, inline="always")
-def _tip_errors(Fr, tip, p_goal, n_goal):
-    """The tip (frame ``tip`` of the frames ``Fr``) against the tip target (p_goal,
-    n_goal): its position p (3,), axis n (3,), p − p_goal (3,), |p − p_goal| [m],
-    1 − n · n_goal and the angle between n and n_goal [deg]."""
-    p = Fr[tip, :3, 3].copy()
-    n = Fr[tip, :3, 2].copy()
+def _tip_errors(Bf, ch, p_goal, n_goal):
+    """The tip (of the body frames ``Bf``) against the tip target (p_goal, n_goal): its
+    position p (3,), normal n (3,), p − p_goal (3,), |p − p_goal| [m], 1 − n · n_goal
+    and the angle between n and n_goal [deg]."""
+    p, n = tip_pose(Bf, ch)
     diff = p - p_goal
     dist = math.sqrt(diff[0] ** 2 + diff[1] ** 2 + diff[2] ** 2)
     dot = n[0] * n_goal[0] + n[1] * n_goal[1] + n[2] * n_goal[2]
@@ -213,10 +235,11 @@ def _joint_errors(q, q_goal, continuous, tol_rad):
 
 
 @njit(cache=True, nogil=True, inline="always")
-def _clearance_cost(Fr, P, link, nrm, A_idx, B_idx, d, margin):
-    """The clearance cost Σ (margin − d)² / margin over the pairs closer than ``margin``,
+def _clearance_cost(Bf, fld, P, nrm, d, dof):
+    """The clearance cost Σ (margin − d)² / margin over the pairs closer than the margin,
     its gradient (dof,), how many pairs are that close and their rows (n_close,)."""
-    dof = Fr.shape[0] - 2
+    margin = fld.margin
+    kn, link, A_idx, B_idx = kin(fld.ch), fld.link, fld.A, fld.B
     cost = 0.0
     grad = np.zeros(dof)
     n_close = 0
@@ -234,7 +257,7 @@ def _clearance_cost(Fr, P, link, nrm, A_idx, B_idx, d, margin):
             close[k] = i
             k += 1
             wgt = -2.0 * (margin - d[i]) / margin
-            _pair_gradient(Fr, P, link, nrm, A_idx[i], B_idx[i], i, gi)
+            pair_gradient(Bf, kn, P, link, nrm, A_idx[i], B_idx[i], i, gi)
             for j in range(dof):
                 grad[j] += wgt * gi[j]
     return cost, grad, n_close, close
@@ -311,17 +334,18 @@ def _tip_gauss_newton(
 def _with_close_pairs(A, b, pairs, grad, weight):
     """The Gauss-Newton system (A, b) with one residual per close pair added:
     A + (w / margin) D^T D (a new matrix; D (n_close, dof): the close pairs' distance
-    gradients) and b − w/2 · gradient (in place). ``pairs``: the frames, the centres,
-    each sphere's link, the pairs' directions, spheres a and b, how many pairs are close,
-    their rows and the margin."""
-    Fr, P, link, nrm, A_idx, B_idx, n_close, close, margin = pairs
+    gradients) and b − w/2 · gradient (in place). ``pairs``: the body frames, the field,
+    the centres, the pairs' directions, how many pairs are close, their rows and the
+    margin."""
+    Bf, fld, P, nrm, n_close, close, margin = pairs
+    kn, link, A_idx, B_idx = kin(fld.ch), fld.link, fld.A, fld.B
     dof = b.shape[0]
     if n_close > 0:
         gi = np.empty(dof)
         dd = np.empty((n_close, dof))
         for c in range(n_close):
             i = close[c]
-            _pair_gradient(Fr, P, link, nrm, A_idx[i], B_idx[i], i, gi)
+            pair_gradient(Bf, kn, P, link, nrm, A_idx[i], B_idx[i], i, gi)
             dd[c] = gi
         k2 = weight / margin
         A = A + k2 * (dd.T @ dd)
@@ -365,57 +389,18 @@ def _joint_direction(
 
 
 @njit(cache=True, nogil=True)
-def hold_clearance(
-    q,
-    direction,
-    F1,
-    T0,
-    M,
-    link,
-    t,
-    r,
-    scene_idx,
-    self_a,
-    self_b,
-    kinds,
-    Rs,
-    cs,
-    pars,
-    bound,
-    A_idx,
-    B_idx,
-    lp_of_row,
-    lp_links,
-    link_ends,
-    floor_m,
-    metric,
-):
+def hold_clearance(q, direction, fld, floor_m, metric):
     """``ClearanceDescent._hold_clearance``: ``direction`` changed as little as possible so
     that no pair closer than ``floor_m`` comes closer (to first order, it moves away at
     0.1 of its gradient's rate); active-set projection, at most 10 rounds. "As little as
     possible" in ``metric`` (A, dof x dof, the step's quadratic model):
     ``dq = direction + A^-1 G^T lambda``."""
     dof = q.shape[0]
-    Fr = _frames(q, F1, T0, M)
-    P = _centres(Fr, link, t)
-    d, nrm = _pairs(
-        P,
-        r,
-        scene_idx,
-        self_a,
-        self_b,
-        kinds,
-        Rs,
-        cs,
-        pars,
-        bound,
-        floor_m,
-        A_idx,
-        B_idx,
-        lp_of_row,
-        lp_links,
-        link_ends,
-    )
+    ch = fld.ch
+    Bf = frames(q, ch)
+    P = centres(Bf, ch, fld.link, fld.t)
+    d, nrm = _pairs_of(P, fld, floor_m)
+    kn, link, A_idx, B_idx = kin(ch), fld.link, fld.A, fld.B
     n_act = 0
     for i in range(d.shape[0]):
         if d[i] < floor_m:
@@ -427,7 +412,7 @@ def hold_clearance(
     k = 0
     for i in range(d.shape[0]):
         if d[i] < floor_m:
-            _pair_gradient(Fr, P, link, nrm, A_idx[i], B_idx[i], i, gi)
+            pair_gradient(Bf, kn, P, link, nrm, A_idx[i], B_idx[i], i, gi)
             G[k] = gi
             k += 1
     dnorm = math.sqrt(np.sum(direction * direction))
@@ -461,6 +446,32 @@ def hold_clearance(
     return dq
 
 
+# ---------------------------------------------------------------------- entries
+# numba types a named tuple passed from Python at every call (some 5 µs for the field,
+# the goal and the rule; plain tuples: their types by fingerprint, ~1 µs): the wrapper
+# passes plain tuples and these entries name them again, free in compiled code
+@njit(cache=True, nogil=True, inline="always")
+def _named(fld_t, goal_t, rule_t):
+    """The field, goal and rule named again from their plain tuples."""
+    fld = SphereField(SphereChain(*fld_t[0]), *fld_t[1:])
+    return fld, DescentGoal(*goal_t), StepRule(*rule_t)
+
+
+@njit(cache=True, nogil=True)
+def evaluate_at(q, fld_t, far_m, goal_t, rule_t, want_direction, d_ref, floor_m):
+    """:func:`evaluate` on the plain tuples of a :class:`SphereField`, a
+    :class:`DescentGoal` and a :class:`StepRule` (:meth:`CompiledField.evaluate`)."""
+    fld, goal, rule = _named(fld_t, goal_t, rule_t)
+    return evaluate(q, fld, far_m, goal, rule, want_direction, d_ref, floor_m)
+
+
+@njit(cache=True, nogil=True)
+def hold_at(q, direction, fld_t, floor_m, metric):
+    """:func:`hold_clearance` on the plain tuple of a :class:`SphereField`."""
+    fld = SphereField(SphereChain(*fld_t[0]), *fld_t[1:])
+    return hold_clearance(q, direction, fld, floor_m, metric)
+
+
 # ---------------------------------------------------------------------- the wrapper
 @dataclass(frozen=True)
 class Evaluation:
@@ -484,27 +495,32 @@ class Evaluation:
 
 
 class CompiledField:
-    """The compiled field and step for one Arm-Z in one scene: the spheres and pairs of a
-    :class:`ClearanceField` (so both backends see the same field) and the chain's fixed
-    matrices, packed once."""
+    """The compiled field and step for one robot in one scene: the spheres and pairs of a
+    :class:`ClearanceField` (so both backends see the same field), the scene and the
+    robot's chain from the compiled robot–scene model (``model``: a checker's
+    :class:`~plannerlab.collision.model.CompiledModel`, or None: the robot's chain
+    packed alone, :func:`~plannerlab.collision.model.chain_model`), packed once.
 
-    def __init__(self, field: ClearanceField, far_m: float) -> None:
+    Raises:
+        ModelError: the robot gives no serial chain.
+        ValueError: its chain's capsules are not its links one to one, or it gives no
+            tip (``tip_data()``).
+    """
+
+    def __init__(self, field: ClearanceField, far_m: float, model: Any = None) -> None:
+        from plannerlab.collision.model import chain_model
+
         robot = field.robot
-        if getattr(robot, "kind", "") != "armz":
-            raise ValueError(f"the compiled descent needs an Arm-Z, got {robot.kind!r}")
-        # fresh (writeable, contiguous) arrays everywhere: numba compiles one version
-        T0 = np.array(robot.T_world_base, dtype=float)
-        T_base_j1: Array = np.asarray(getattr(robot, "_T_base_j1"), dtype=float)  # noqa: B009
-        M: Array = np.array(getattr(robot, "_M"), dtype=float)  # noqa: B009
-        self._chain = (np.array(T0 @ T_base_j1, dtype=float), T0, M)
-        self._spheres = (
-            np.array(field._link, dtype=np.int64),
-            np.array(field._t, dtype=float),
-            np.array(field._r, dtype=float),
-            np.array(field._scene_spheres, dtype=np.int64),
-            np.array(field._self_a, dtype=np.int64),
-            np.array(field._self_b, dtype=np.int64),
-        )
+        if not callable(getattr(robot, "tip_data", None)):
+            raise ValueError(
+                f"the compiled descent needs the robot's tip (tip_data()); "
+                f"robot {getattr(robot, 'kind', '?')!r} gives none"
+            )
+        chain = sphere_chain(chain_model(robot) if model is None else model, robot)
+        link = np.array(field._link, dtype=np.int64)
+        scene_idx = np.array(field._scene_spheres, dtype=np.int64)
+        self_a = np.array(field._self_a, dtype=np.int64)
+        self_b = np.array(field._self_b, dtype=np.int64)
         obstacles = field.scene.obstacles
         k = len(obstacles)
         kinds = np.zeros(k, dtype=np.int64)
@@ -529,59 +545,58 @@ class CompiledField:
                 bound[i] = pars[i, 0]
             else:  # pragma: no cover - scene types are closed
                 raise TypeError(f"unknown obstacle {o!r}")
-        self._scene = (kinds, Rs, cs, pars, bound)
-        self._pair_spheres = pair_spheres(
-            self._spheres[3], k, self._spheres[4], self._spheres[5], self._spheres[0]
-        )
+        A, B, lp_of_row, lp_links, ends = pair_spheres(scene_idx, k, self_a, self_b, link)
         self.margin_m = float(field.margin_m)
-        #: pairs at least this far apart are reported at this distance (see _pairs)
+        # fresh (writeable, contiguous) arrays everywhere: numba compiles one version
+        self._field = SphereField(
+            ch=chain,
+            link=link,
+            t=np.array(field._t, dtype=float),
+            r=np.array(field._r, dtype=float),
+            scene_idx=scene_idx,
+            self_a=self_a,
+            self_b=self_b,
+            scene=(kinds, Rs, cs, pars, bound),
+            A=A,
+            B=B,
+            lp_of_row=lp_of_row,
+            lp_links=lp_links,
+            ends=ends,
+            margin=self.margin_m,
+        )
+        #: the field as plain tuples (see :func:`evaluate_at`)
+        self._plain = (tuple(chain), *self._field[1:])
+        #: pairs at least this far apart are reported at this distance (see pairs)
         self.far_m = max(float(far_m), self.margin_m)
         self._no_ref = np.zeros(0)
         #: the last goal asked about and its arrays (fresh, writeable: one numba version;
         #: see :func:`_goal_arrays`)
-        self._goal: tuple = (None,)
+        self._goal: tuple[Any, tuple] = (None, ())
 
     def evaluate(
         self,
         q: Array,
         goal,
-        r1: float,
-        r2: float,
-        weight: float,
-        gauss_newton: bool,
-        damping: float,
-        goal_depth: float,
+        rule: tuple,
         want_direction: bool,
         d_ref: Array | None = None,
         floor_m: float = 0.0,
     ) -> Evaluation:
         """F, f, tip errors, clearance cost and gradient, distances and (when asked) the
-        step direction at q (dof,) towards ``goal`` (a GoalRegion); ``spacious`` against
-        the distances ``d_ref`` (see :func:`evaluate`)."""
+        step direction at q (dof,) towards ``goal`` (a GoalRegion) by the step ``rule``
+        (a :class:`StepRule`'s values, made once: :func:`step_rule`); ``spacious``
+        against the distances ``d_ref`` (see :func:`evaluate`)."""
         if goal is not self._goal[0]:
-            self._goal = _goal_arrays(goal)
-        out = evaluate(
+            self._goal = (goal, tuple(_goal_arrays(goal)))
+        out = evaluate_at(
             np.array(q, dtype=float),
-            *self._chain,
-            *self._spheres,
-            *self._scene,
-            *self._pair_spheres,
-            self.margin_m,
+            self._plain,
             self.far_m,
             self._goal[1],
-            self._goal[2],
-            float(goal.pos_tol_m),
-            float(goal.angle_tol_deg),
-            float(r1),
-            float(r2),
-            float(weight),
-            bool(gauss_newton),
-            float(damping),
-            float(goal_depth),
+            rule,
             bool(want_direction),
             self._no_ref if d_ref is None else d_ref,
             float(floor_m),
-            *self._goal[3:],
         )
         F, f, pos_err, ang_err, cost, grad, d, direction, spacious, metric, joint_err = out
         return Evaluation(
@@ -604,31 +619,48 @@ class CompiledField:
         """:func:`hold_clearance` at q (dof,) for ``direction`` (dof,), projected in
         ``metric`` (dof, dof; None: the identity)."""
         dof = len(direction)
-        return hold_clearance(
+        return hold_at(
             np.array(q, dtype=float),
             np.array(direction, dtype=float),
-            *self._chain,
-            *self._spheres,
-            *self._scene,
-            *self._pair_spheres,
+            self._plain,
             float(floor_m),
             np.eye(dof) if metric is None else np.ascontiguousarray(metric, dtype=float),
         )
 
 
-def _goal_arrays(goal) -> tuple:
-    """A goal's arguments of :func:`evaluate`, after the goal itself: the tip target
-    (p, n), then whether it is a goal state, the state, its continuous joints and its
-    tolerance (empty arrays for a tip goal: one numba version for both)."""
+def step_rule(
+    r1: float, r2: float, weight: float, gauss_newton: bool, damping: float, goal_depth: float
+) -> tuple:
+    """The values of a :class:`StepRule`, a plain tuple (floats and a bool: one numba
+    version; see :func:`evaluate_at`)."""
+    return tuple(
+        StepRule(
+            float(r1),
+            float(r2),
+            float(weight),
+            bool(gauss_newton),
+            float(damping),
+            float(goal_depth),
+        )
+    )
+
+
+def _goal_arrays(goal) -> DescentGoal:
+    """A goal as :func:`evaluate` takes it: the tip target (p, n) and tolerances, then
+    whether it is a goal state, the state, its continuous joints and its tolerance (empty
+    arrays for a tip goal: one numba version for both)."""
     from plannerlab.problem.goals import JointGoal
 
     p = np.array(goal.p_world_m, dtype=float)
     n = np.array(goal.n_world, dtype=float)
+    pos_tol, angle_tol = float(goal.pos_tol_m), float(goal.angle_tol_deg)
     if isinstance(goal, JointGoal):
         q = np.array(goal.q_rad, dtype=float)
         cont = np.array(goal.continuous, dtype=np.bool_)
-        return (goal, p, n, True, q, cont, float(goal.tol_rad))
-    return (goal, p, n, False, np.zeros(0), np.zeros(0, dtype=np.bool_), 1.0)
+        return DescentGoal(p, n, pos_tol, angle_tol, True, q, cont, float(goal.tol_rad))
+    return DescentGoal(
+        p, n, pos_tol, angle_tol, False, np.zeros(0), np.zeros(0, dtype=np.bool_), 1.0
+    )
 
 
 def warm_up() -> None:
@@ -646,6 +678,7 @@ def warm_up() -> None:
     core = CompiledField(ClearanceField(robot, scene, 0.3), far_m=0.3)  # type: ignore[arg-type]
     goal = GoalRegion("warm_up", np.array([1.0, 0.0, 3.0]), np.array([0.0, 0.0, 1.0]), 0.1, 10.0)
     q = np.zeros(robot.dof)
-    e = core.evaluate(q, goal, 1.0, 1.0, 0.2, True, 0.1, 0.3, True)
-    core.evaluate(q, goal, 1.0, 1.0, 0.2, True, 0.1, 0.3, True, e.distances_m, 0.03)
+    rule = step_rule(1.0, 1.0, 0.2, True, 0.1, 0.3)
+    e = core.evaluate(q, goal, rule, True)
+    core.evaluate(q, goal, rule, True, e.distances_m, 0.03)
     core.hold_clearance(q, e.direction, 0.04)

@@ -1,0 +1,689 @@
+"""The gradient method with a clearance term: a descent that slides along walls.
+
+The paper's objective ``f(S) = r1 |p − p_d| + r2 (1 − n·n_d)²`` (eq. 3) replaces the
+collision penalty A(S), which is flat everywhere but at contact, by a smooth clearance
+term (:mod:`plannerlab.planners.clearance`)::
+
+    F(S) = f(S) + w · Σ_pairs (m − d)² / m        over link pairs closer than m
+
+so a link that nears a wall or another link is pushed away before it touches, and the
+descent slides along the wall instead of stopping at it. Every accepted state is checked
+by the collision checker (steps are at most ``joint_step`` per joint, so the path is
+checked edge by edge at the problem's resolution).
+
+Two step rules, both on F:
+
+``direction = "gradient"``
+    Steepest descent, the paper's rule, with the step scaled so that its largest joint
+    change is the trust radius (the paper's γ∇f on a 16-m arm moves the base by radians).
+``direction = "gauss_newton"``
+    F written as a sum of squares (the tip residuals in units of the goal's tolerances,
+    one residual ``√(w/m)(m − d)`` per close pair) and a damped Gauss-Newton step on it:
+    the same minimum, a step that does not let the base joints' long lever arms dominate.
+
+The trust radius grows by 1.5 after an accepted step (up to ``joint_step``) and halves
+after a rejected one (F did not decrease or the state collides). A **stall** is declared
+when the best ``f`` has not decreased by ``stall_min_decrease`` in ``stall_window``
+iterations, or the trust radius falls below ``min_step_rad``: status ``local_minimum``
+with ``extra["q_stall"]`` and ``extra["descent_rad"]`` (joint-space distance travelled).
+
+Towards a goal state (:class:`~plannerlab.problem.goals.JointGoal`) the tip terms give
+way to the joint residual ``e = (q_goal − q) / tol_rad`` (continuous joints wrapped; its
+Jacobian ``I / tol_rad``): the Gauss-Newton step is taken on it beside the clearance
+residuals, and a step is accepted when it lowers the sum of squares that step models,
+``F = |e|² + w · cost`` (``direction = "gradient"``: the step is −∇F). Accepting on
+``r1 |q − q_goal| + w · cost`` instead, whose balance with the clearance differs from the
+step's by ``|q − q_goal| / tol_rad²``, stalled the descent where the step closed on a wall
+(measured, ``gradient.clearance+detour``: 14 of the 56 legs of room variants v00-v07
+towards their witness states solved, against 40 of 56). ``f``, which the
+stall test and the trace follow, is ``r1 |q − q_goal|`` [rad]. "Inside" and "deep" are the
+largest joint difference against ``tol_rad`` and ``goal_depth · tol_rad``, and there is
+no approach point (the goal state says how the arm comes in). Sub-goals of the escapes
+stay tip targets.
+
+Escapes from a stall (``escape`` setting): ``detour`` (sub-goals near the stall: the tip
+drawn back along its own body, ``retract_step``, ``2 retract_step``, … modules, each
+followed by the leg's descent; deterministic), ``rrtconnect`` (RRT-Connect from the stall
+to a goal state found near it, or, when the descent near the stall finds none, to goal
+states drawn by IK) and ``random_detour``, the detour with its sub-goals drawn
+from the planner's generator: each retract goes back a random ``1 … 2 retract_step``
+modules further than the last and aims at a point drawn uniformly in a ball of
+``retract_jitter_m`` round the body's face there; a detour that finds no way is drawn
+again from the same stall, up to ``max_escapes`` draws. Its seeds are different runs, so
+a success rate over seeds says how often such an escape works (the ``detour``'s seeds are
+one run repeated).
+
+The settings are in :mod:`~plannerlab.planners.clearance.settings`, the step in numpy in
+:mod:`~plannerlab.planners.clearance.step` (a base of :class:`ClearanceDescent`), the field
+and step on either engine in :mod:`~plannerlab.planners.clearance.models`; this module holds
+the descent, its escapes and :class:`LegPath`, the clearance family's result.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Mapping
+from typing import Any
+
+import numpy as np
+
+from plannerlab.collision.fcl_checker import CollisionChecker
+from plannerlab.errors import PlannerlabError
+from plannerlab.planners.base import (
+    LegRun,
+    Planner,
+    PlanResult,
+    Status,
+    with_overrides,
+)
+from plannerlab.planners.clearance.field import ClearanceField, SetupStopped
+from plannerlab.planners.clearance.models import CompiledModel, Model, NumpyModel
+from plannerlab.planners.clearance.settings import ClearanceSettings
+from plannerlab.planners.clearance.step import DescentStep
+from plannerlab.planners.context import LegPlanner, PlanningContext, plan_in
+from plannerlab.problem.goals import GoalRegion, JointGoal
+from plannerlab.robots.base import Array, joint_difference, wrap_to_pi
+from plannerlab.robots.paths import path_length
+
+
+class ClearanceDescent(DescentStep, LegPlanner):
+    """One descent of F from a start state (see the module docstring)."""
+
+    def __init__(
+        self,
+        name: str,
+        settings: ClearanceSettings,
+        escape_planner: Callable[[Mapping[str, Any]], Planner] | None = None,
+    ) -> None:
+        self.name = name
+        self.settings = settings
+        self.escape_planner = escape_planner
+        #: (problem, its model): the field of the last problem solved (see :meth:`model`)
+        self._model_cache: tuple[Any, Model] | None = None
+        #: (robot, this descent with its distances derived for it) (see :meth:`for_robot`)
+        self._resolved: tuple[Any, ClearanceDescent] | None = None
+
+    def for_robot(self, robot: Any) -> ClearanceDescent:
+        """This descent with its derived distance settings (None: ``margin_m``,
+        ``min_clearance_m``, ``approach_m``, …) set for ``robot``
+        (:meth:`ClearanceSettings.for_robot`); itself when none is left to derive. Every
+        entry point plans with it, so a solve's result records the values used."""
+        if self.settings.resolved:
+            return self
+        cached = self._resolved
+        if cached is not None and cached[0] is robot:
+            return cached[1]
+        descent = ClearanceDescent(self.name, self.settings.for_robot(robot), self.escape_planner)
+        self._resolved = (robot, descent)
+        return descent
+
+    # ------------------------------------------------------------------ pieces
+    def _settle(
+        self,
+        robot,
+        goal,
+        model: Model,
+        q: Array,
+        checker: CollisionChecker,
+        max_step: float,
+        path: list[Array],
+    ) -> int:
+        """In the goal region: descend the clearance term alone, staying within
+        ``settle_fraction`` of the tolerances, so the arm does not end a few centimetres
+        from a wall when the region leaves room (a tracking arm overshoots a little).
+        Appends the accepted states to ``path``; returns the iterations used."""
+        s = self.settings
+        c = model.point(goal, q)
+        radius = max_step
+        used = 0
+        for used in range(1, s.settle_iterations + 1):  # noqa: B007
+            g = c.gradient
+            big = float(np.max(np.abs(g), initial=0.0))
+            if c.cost <= 0.0 or big < 1e-12 or radius < s.min_step_rad:
+                break
+            q_new = wrap_to_pi(q - g * (radius / big), robot.continuous)
+            c_new = model.point(goal, q_new)
+            if (
+                c_new.cost < c.cost
+                and _within(goal, c_new, s.settle_fraction)
+                and checker.is_valid(q_new)
+            ):
+                q, c = q_new, c_new
+                path.append(q.copy())
+                radius = min(radius * 1.5, max_step)
+            else:
+                radius *= 0.5
+        return used
+
+    def backend_for(self, robot: Any) -> str:
+        """The engine the field runs on for ``robot``: "compiled" (the ``backend``
+        setting's default) on an Arm-Z, else "numpy"."""
+        if self.settings.backend == "compiled" and getattr(robot, "kind", "") == "armz":
+            return "compiled"
+        return "numpy"
+
+    def model(self, problem, stop: Callable[[], bool] | None = None, checker: Any = None) -> Model:
+        """The field and step of ``problem`` on the ``backend`` setting's engine (built
+        once per problem and kept: building the field's pair lists takes milliseconds,
+        and is bounded, :data:`~plannerlab.planners.clearance.MAX_SPHERES`). It is built
+        in the first solve's time: ``stop()`` (the leg's time limit) is asked while it is
+        built, and True raises :class:`~plannerlab.planners.clearance.SetupStopped`.
+        The compiled engine's spheres ride on the ``checker``'s compiled robot–scene
+        model when it has one (else on the robot's chain packed alone: the same
+        kinematics)."""
+        resolved = self.for_robot(problem.robot)
+        if resolved is not self:
+            return resolved.model(problem, stop, checker)
+        cached = self._model_cache
+        if cached is not None and cached[0] is problem:
+            return cached[1]
+        field = ClearanceField(problem.robot, problem.scene, self.settings.margin_m, stop=stop)
+        model: Model
+        if self.backend_for(problem.robot) == "compiled":
+            model = CompiledModel(self, field, _compiled_model(checker))
+        else:
+            model = NumpyModel(self, field)
+        self._model_cache = (problem, model)
+        return model
+
+    # ------------------------------------------------------------------ solve
+    def descend(
+        self,
+        ctx: PlanningContext,
+        q_start: Array,
+        goal=None,
+        iterations_before: int = 0,
+        *,
+        checked: bool = True,
+    ) -> tuple[Status, str, list[Array], list[float], int]:
+        """Descend from q_start in the leg's context; returns status, reason, path, f per
+        iteration, iterations.
+
+        ``goal`` overrides the leg's goal region (sub-goals of escapes). ``checked`` False:
+        the states are not checked (goal selection near q_start). ``iterations_before``:
+        iterations the leg has already used (the budget is the leg's, ``ctx.tracker``).
+        """
+        resolved = self.for_robot(ctx.robot)
+        if resolved is not self:
+            return resolved.descend(ctx, q_start, goal, iterations_before, checked=checked)
+        s = self.settings
+        problem, robot, tracker = ctx.problem, ctx.robot, ctx.tracker
+        checker = ctx.checker if checked else None
+        goal = goal if goal is not None else ctx.goal
+        model = self.model(problem, tracker.time_up, ctx.checker)
+        max_step = s.max_step_rad if s.max_step_rad > 0 else problem.joint_step / 2
+        q = np.array(q_start, dtype=float)
+        path = [q.copy()]
+        here = model.point(goal, q)
+        f_now = here.f
+        trace = [f_now]
+        best, best_iter = f_now, 0
+        radius = max_step
+        iteration = 0
+        inside_since = 0
+        d_now = here.distances_m
+        direction, F_now = here.direction, here.F
+        held = False
+        while True:
+            inside = _within(goal, here, 1.0)
+            deep = _within(goal, here, s.goal_depth)
+            stalled = iteration - best_iter >= s.stall_window or radius < s.min_step_rad
+            # inside the region the descent goes on towards goal_depth of the tolerances
+            # (an executed path then ends inside too), as long as it makes progress
+            if deep or (inside and (stalled or iteration - inside_since >= s.deepen_iterations)):
+                if checker is not None and s.settle_iterations > 0:
+                    iteration += self._settle(robot, goal, model, q, checker, max_step, path)
+                return (
+                    Status.SOLVED,
+                    f"in the goal region after {iteration} iterations",
+                    path,
+                    trace,
+                    iteration,
+                )
+            if not inside:
+                inside_since = iteration + 1
+            if stalled:
+                why = (
+                    f"best f = {best:.4g} has not improved by {s.stall_min_decrease} in "
+                    f"{s.stall_window} iterations"
+                    if radius >= s.min_step_rad
+                    else f"no step of {s.min_step_rad} rad lowers F"
+                )
+                return (
+                    Status.LOCAL_MINIMUM,
+                    f"stalled at iteration {iteration}: {why}",
+                    path,
+                    trace,
+                    iteration,
+                )
+            exhausted = tracker.exhausted(iterations_before + iteration)
+            left = tracker.checks_left()
+            if exhausted is None and left is not None and left < 1:
+                exhausted = (
+                    f"collision-check budget of {tracker.budget.max_collision_checks} used up"
+                )
+            if exhausted:
+                return Status.BUDGET_EXHAUSTED, exhausted, path, trace, iteration
+            iteration += 1
+            big = float(np.max(np.abs(direction), initial=0.0))
+            if big < 1e-12:
+                radius = 0.0
+                continue
+            step = direction * min(1.0, radius / big)
+            q_new = wrap_to_pi(q + step, robot.continuous)
+            there = model.point(goal, q_new, d_now)
+            F_new = there.F
+            # keep min_clearance_m (a tracking arm overshoots a little), unless already closer
+            d_new = there.distances_m
+            spacious = there.spacious
+            if F_new < F_now and spacious and (checker is None or checker.is_valid(q_new)):
+                d_now = d_new
+                q = q_new
+                here = there
+                path.append(q.copy())
+                radius = min(radius * 1.5, max_step)
+                direction, F_now = here.direction, here.F
+                f_now = here.f
+                held = False
+            elif not spacious and not held and s.hold_clearance:
+                # the step takes a pair below min_clearance_m: slide along it instead
+                direction = model.hold(goal, q, direction)
+                held = True
+            else:
+                radius *= 0.5
+            trace.append(f_now)
+            if f_now < best - s.stall_min_decrease:
+                best, best_iter = f_now, iteration
+
+    # ------------------------------------------------------------------ goals near q
+    def near_goal_state(self, ctx: PlanningContext, q: Array) -> Array | None:
+        """A collision-free state in the leg's goal region found by descending F from q
+        with the path left unchecked (the clearance term still steers): a goal *near* q,
+        the part of the arm that F does not need to move stays where it is. One check.
+        The goal finder (:data:`~plannerlab.planners.context.NearGoal`) this descent
+        hands its ``rrtconnect`` escape, with its own settings."""
+        resolved = self.for_robot(ctx.robot)
+        if resolved is not self:
+            return resolved.near_goal_state(ctx, q)
+        try:
+            status, _, path, _, _ = self.leg_descent(ctx, q, checked=False)
+        except SetupStopped:  # out of time while building the field: no goal found
+            return None
+        q_goal = path[-1]
+        if status is Status.SOLVED and ctx.checker.is_valid(q_goal):
+            return q_goal
+        return None
+
+    # ------------------------------------------------------------------ the leg's descent
+    def leg_descent(
+        self,
+        ctx: PlanningContext,
+        q_start: Array,
+        used: int = 0,
+        *,
+        checked: bool = True,
+    ) -> tuple[Status, str, list[Array], list[float], int]:
+        """The descent of one leg: with ``approach_m`` > 0, first to the goal's approach
+        point (the tip at ``p_d − approach_m · n_d`` with the goal's normal, within the
+        sub-goal tolerances: the tip comes in along the inspection normal), then to the
+        goal; if the approach stalls, the descent to the goal continues from there. A goal
+        state (:class:`JointGoal`) has no approach point."""
+        resolved = self.for_robot(ctx.robot)
+        if resolved is not self:
+            return resolved.leg_descent(ctx, q_start, used, checked=checked)
+        s = self.settings
+        goal = ctx.goal
+        path = [np.array(q_start)]
+        trace: list[float] = []
+        iterations = 0
+        # a goal state says how the arm comes in: no approach point
+        if (
+            s.approach_m > 0
+            and not isinstance(goal, JointGoal)
+            and not goal.contains(ctx.robot, q_start)
+        ):
+            sub = GoalRegion(
+                "approach",
+                goal.p_world_m - s.approach_m * goal.n_world,
+                goal.n_world,
+                s.subgoal_pos_tol_m,
+                s.subgoal_angle_tol_deg,
+            )
+            st, reason, seg, tr, it = self.descend(ctx, path[-1], sub, used, checked=checked)
+            iterations += it
+            path.extend(seg[1:])
+            trace.extend(tr)
+            if st not in (Status.SOLVED, Status.LOCAL_MINIMUM):
+                return st, reason, path, trace, iterations
+        st, reason, seg, tr, it = self.descend(
+            ctx, path[-1], None, used + iterations, checked=checked
+        )
+        path.extend(seg[1:])
+        trace.extend(tr)
+        return st, reason, path, trace, iterations + it
+
+    # ------------------------------------------------------------------ escapes
+    def _detour(
+        self,
+        ctx: PlanningContext,
+        q_stall: Array,
+        used: int,
+        rng: np.random.Generator | None = None,
+    ) -> tuple[list[Array], int, str]:
+        """Sub-goals near the stall: the tip drawn back along its own body, to the face
+        ``retract_step``, ``2 retract_step``, … modules behind the stall's tip (normal
+        along the body), each retract followed by the leg's descent (:meth:`leg_descent`).
+        With ``rng`` (``random_detour``) the sub-goals are drawn: each goes back a random
+        1 … ``2 retract_step`` modules further, its point uniform in a ball of
+        ``retract_jitter_m`` round the face.
+
+        Returns the kept path from q_stall (its last state is in the goal region when the
+        detour succeeded, else just [q_stall]), the iterations and how far it retracted.
+        """
+        s = self.settings
+        robot, tracker = ctx.robot, ctx.tracker
+        iterations = 0
+        # retract along the body of the stall state
+        F = robot.fk(q_stall)
+        kept = [np.array(q_stall)]
+        q = np.array(q_stall)
+        last_face = F.shape[0] - 1
+        for back in self._retract_depths(robot.dof, rng):
+            if tracker.exhausted(used + iterations) is not None:
+                break
+            face = last_face - back
+            p_sub = F[face, :3, 3]
+            if rng is not None and s.retract_jitter_m > 0:
+                p_sub = p_sub + _in_ball(rng, s.retract_jitter_m)
+            sub = GoalRegion(
+                f"retract{back}",
+                p_sub,
+                F[face, :3, 2],
+                s.subgoal_pos_tol_m,
+                s.subgoal_angle_tol_deg,
+            )
+            st, _, seg, _, it = self.descend(ctx, q, sub, used + iterations)
+            iterations += it
+            kept.extend(seg[1:])
+            q = kept[-1]
+            st2, _, seg2, _, it2 = self.leg_descent(ctx, q, used + iterations)
+            iterations += it2
+            if st2 is Status.SOLVED:
+                return kept + seg2[1:], iterations, f"retract {back} modules"
+        return [np.array(q_stall)], iterations, "none"
+
+    def _retract_depths(self, dof: int, rng: np.random.Generator | None) -> list[int]:
+        """Modules the detour's sub-goals go back, in order: every ``retract_step`` below
+        ``dof``, or (with ``rng``) random steps of 1 … ``2 retract_step``."""
+        step = self.settings.retract_step
+        if rng is None:
+            return list(range(step, dof, step))
+        depths: list[int] = []
+        back = int(rng.integers(1, 2 * step + 1))
+        while back < dof:
+            depths.append(back)
+            back += int(rng.integers(1, 2 * step + 1))
+        return depths
+
+    def _random_detours(
+        self,
+        ctx: PlanningContext,
+        q_stall: Array,
+        used: int,
+        rng: np.random.Generator,
+    ) -> tuple[list[Array], int, str]:
+        """Randomly drawn detours from the stall (:meth:`_detour` with ``rng``), drawn again
+        while none finds a way, at most ``max_escapes`` draws and within the budget."""
+        iterations = 0
+        how = "none"
+        for draw in range(1, self.settings.max_escapes + 1):
+            if ctx.tracker.exhausted(used + iterations) is not None:
+                break
+            esc, it, how = self._detour(ctx, q_stall, used + iterations, rng)
+            iterations += it
+            if len(esc) > 1:
+                return esc, iterations, f"{how} (draw {draw})"
+        return [np.array(q_stall)], iterations, how
+
+    def _rrtconnect(
+        self, ctx: PlanningContext, q_stall: Array, rng: np.random.Generator
+    ) -> tuple[list[Array], int, str]:
+        """RRT-Connect from the stall to a goal state found near it by this descent, with
+        its settings (:meth:`near_goal_state`, the sub-solve's goal finder) or, when the
+        descent from the stall ends in no collision-free goal state, to
+        ``escape_goal_samples`` goal states drawn by IK (OMPL's ``near_or_ik`` goal
+        selection), with the checks and time left, at most ``escape_checks`` checks: a
+        sub-solve in the leg's context (its checks are the leg's); its iterations count
+        in the leg's afterwards (the caller adds them)."""
+        if self.escape_planner is None:
+            raise PlannerlabError(
+                f"{self.name}: no escape planner given (make it by name, make_planner)"
+            )
+        tracker = ctx.tracker
+        sub = tracker.remaining(self.settings.escape_checks, limit_iterations=False)
+        if sub is None:
+            return [np.array(q_stall)], 0, f"not started: {tracker.exhausted() or 'no budget'}"
+        rrt = self.escape_planner(
+            {"goal_selection": "near_or_ik", "goal_samples": self.settings.escape_goal_samples}
+        )
+        r = plan_in(rrt, ctx.sub(sub, q_stall, near_goal=self.near_goal_state), rng)
+        if r.solved:
+            return list(r.path), r.iterations, "rrtconnect"
+        return [np.array(q_stall)], r.iterations, f"rrtconnect: {r.status.value}"
+
+    # ------------------------------------------------------------------ solve
+    def warm_up(self, problem, leg: int, q_start: Array) -> None:
+        """For the compiled backend on an Arm-Z, load (or compile) its kernels before the
+        leg's tracker starts, like the checker's core: a one-off cost of the process,
+        outside the limits. The problem's field is set-up, built in the solve's time
+        (:meth:`model`)."""
+        if self.backend_for(problem.robot) == "compiled":
+            from plannerlab.planners.clearance.compiled import warm_up
+
+            warm_up()
+
+    def plan(self, ctx: PlanningContext, rng: np.random.Generator) -> PlanResult:
+        """Descend F from the context's start into its leg's goal region; at a stall,
+        escape from the stall state (``escape`` setting) and descend again."""
+        resolved = self.for_robot(ctx.robot)
+        if resolved is not self:
+            return resolved.plan(ctx, rng)
+        s = self.settings
+        problem, robot, goal, tracker = ctx.problem, ctx.robot, ctx.goal, ctx.tracker
+        q0 = ctx.q_start
+        leg_path = LegPath(ctx.run(self.name, s), q0)
+        path = leg_path.path
+        trace: list[float] = []
+        escapes_log: list[dict] = []
+        descent_rad: list[float] = []
+
+        def dist(a: Array, b: Array) -> float:
+            return float(np.linalg.norm(joint_difference(a, b, robot.continuous)))
+
+        def done(status: Status, reason: str) -> PlanResult:
+            """The leg's result from the state of the loop."""
+            return leg_path.result(
+                status,
+                reason,
+                trace=trace,
+                extra={
+                    "descent_rad": descent_rad,
+                    "escapes": escapes_log,
+                    # what ran: "compiled" falls back to numpy for robots other than Arm-Z
+                    "descent_backend": self.backend_for(robot),
+                },
+            )
+
+        if ctx.start_problem is not None:
+            return done(Status.INVALID_START, ctx.start_problem)
+        leg_path.note([q0])
+        try:  # the set-up, in the leg's time
+            self.model(problem, tracker.time_up, ctx.checker)
+        except SetupStopped as exc:
+            return done(Status.BUDGET_EXHAUSTED, f"{tracker.exhausted() or 'time is up'}: {exc}")
+        q = q0
+        while True:
+            st, reason, seg, tr, it = self.leg_descent(ctx, q, leg_path.iterations)
+            leg_path.iterations += it
+            trace.extend(tr)
+            leg_path.add(seg)
+            descent_rad.append(path_length(np.array(seg), robot.continuous))
+            minima, escapes = leg_path.minima, leg_path.escapes
+            if st is not Status.LOCAL_MINIMUM:  # solved, or out of budget
+                return done(st, f"{reason}; {minima} local minima met, {escapes} escaped")
+            leg_path.minima = minima = minima + 1
+            q_stall = np.array(path[-1])
+            if s.escape == "none":
+                return done(st, reason)
+            if minima > s.max_escapes:
+                return done(st, f"{reason}; {minima} local minima met, {escapes} escaped; gave up")
+            c0 = tracker.checks_used
+            used = leg_path.iterations
+            if s.escape == "detour":
+                esc, it, how = self._detour(ctx, q_stall, used)
+            elif s.escape == "random_detour":
+                esc, it, how = self._random_detours(ctx, q_stall, used, rng)
+            else:
+                esc, it, how = self._rrtconnect(ctx, q_stall, rng)
+            leg_path.iterations += it
+            left_stall = len(esc) > 1
+            leg_path.escapes += int(left_stall)
+            escapes_log.append(
+                {
+                    "kind": s.escape,
+                    "how": how,
+                    "stall": minima,
+                    "start_from_leg_start_rad": dist(esc[0], q0),
+                    "start_from_stall_rad": dist(esc[0], q_stall),
+                    "descent_before_stall_rad": descent_rad[-1],
+                    "left_stall": left_stall,
+                    "checks": tracker.checks_used - c0,
+                }
+            )
+            if not left_stall:
+                return done(
+                    Status.LOCAL_MINIMUM,
+                    f"{reason}; the {s.escape} escape from stall {minima} failed ({how})",
+                )
+            leg_path.add(esc)
+            q = np.array(path[-1])
+            if goal.contains(robot, q):
+                return done(
+                    Status.SOLVED,
+                    f"descent stalled {minima} times; escaped from the stall by {how}",
+                )
+
+
+class LegPath:
+    """A leg's path built from segments (descents, escapes, a leader's tracking), the
+    counts the planner keeps on it, and its result: the one home of the result of the
+    clearance family (``gradient.clearance*``, ``gradient.follow_leader*``).
+
+    Progress is noted after each segment (the best goal distance it reached); the result
+    adds ``extra["path_rad"]`` (the path's joint-space length) and, at a local minimum,
+    ``extra["q_stall"]`` (the state it stalled at) to the planner's own ``extra``.
+
+    Args:
+        run: the leg's :class:`~plannerlab.planners.base.LegRun`.
+        q0: (dof,) the leg's start, the path's first state.
+    """
+
+    def __init__(self, run: LegRun, q0: Array) -> None:
+        self.run = run
+        self.path: list[Array] = [q0]
+        #: the planner's counts, reported in the result
+        self.iterations = 0
+        self.minima = 0
+        self.escapes = 0
+
+    def note(self, states: Any) -> None:
+        """Progress after a segment: the best goal distance its states reach."""
+        if len(states):
+            run = self.run
+            run.progress.note(float(np.min(run.goal.distance(run.robot, np.asarray(states)))))
+
+    def add(self, segment: Any) -> None:
+        """Append a segment that starts at the path's last state (its first state is
+        dropped) and note its progress."""
+        self.note(list(segment))
+        self.path.extend(list(segment[1:]))
+
+    def result(
+        self,
+        status: Status,
+        reason: str,
+        *,
+        trace: Any = None,
+        extra: Mapping[str, Any] | None = None,
+    ) -> PlanResult:
+        """The leg's result: the path, the counts, the planner's ``extra`` with the
+        path's length and, at a local minimum, the stall state."""
+        robot = self.run.robot
+        out: dict[str, Any] = {
+            **(extra or {}),
+            "path_rad": path_length(np.array(self.path), robot.continuous),
+        }
+        if status is Status.LOCAL_MINIMUM:
+            out["q_stall"] = np.asarray(self.path[-1], dtype=float).tolist()
+        return self.run.result(
+            status,
+            reason,
+            self.path,
+            iterations=self.iterations,
+            trace=trace,
+            local_minima=self.minima,
+            escapes=self.escapes,
+            extra=out,
+        )
+
+
+def _compiled_model(checker: Any) -> Any:
+    """The checker's compiled robot–scene model, or None when it has none (no checker,
+    an FCL-only scene, a robot without a chain)."""
+    if checker is None:
+        return None
+    try:
+        return checker.model
+    except (AttributeError, ValueError, PlannerlabError):
+        return None
+
+
+def _within(goal: GoalRegion, point, fraction: float) -> bool:
+    """Whether the state ``point`` describes is within ``fraction`` of ``goal``'s
+    tolerances: the tip's position and angle errors, or for a goal state
+    (:class:`JointGoal`) the largest joint difference."""
+    if isinstance(goal, JointGoal):
+        return bool(point.joint_err <= fraction * goal.tol_rad)
+    return bool(
+        point.pos_err_m <= fraction * goal.pos_tol_m
+        and point.ang_err_deg <= fraction * goal.angle_tol_deg
+    )
+
+
+def _in_ball(rng: np.random.Generator, radius_m: float) -> Array:
+    """A point drawn uniformly in the ball of ``radius_m`` round the origin (3,) [m]."""
+    v = rng.normal(size=3)
+    v /= max(float(np.linalg.norm(v)), 1e-12)
+    return v * radius_m * float(rng.uniform()) ** (1.0 / 3.0)
+
+
+VARIANTS: dict[str, dict[str, object]] = {
+    "gradient.clearance": {},
+    "gradient.clearance+detour": {"escape": "detour"},
+    "gradient.clearance+random_detour": {"escape": "random_detour"},
+    "gradient.clearance+rrtconnect": {"escape": "rrtconnect"},
+}
+
+
+def make(
+    name: str,
+    overrides: dict,
+    *,
+    escape_planner: Callable[[Mapping[str, Any]], Planner] | None = None,
+) -> ClearanceDescent:
+    """Registry factory for the ``gradient.clearance`` family. ``escape_planner(overrides)``
+    makes the RRT-Connect planner of the ``rrtconnect`` escape (the registry passes OMPL's,
+    so this module needs neither the registry nor ``ompl``)."""
+    if name not in VARIANTS:
+        raise PlannerlabError(f"{name} is not a clearance descent ({', '.join(VARIANTS)})")
+    base = ClearanceSettings(**VARIANTS[name])  # type: ignore[arg-type]
+    return ClearanceDescent(name, with_overrides(base, overrides, name), escape_planner)

@@ -1,0 +1,115 @@
+"""The clearance field's compiled geometry (``collision/spheres.py``) on the compiled
+robot–scene model's kinematics, for every robot family with a chain and a tip: link axes
+and the tip equal the robot's own kinematics, gradients through the chain (a coupling,
+sliding joints, folded axes) equal finite differences of them; and the model a checker
+builds gives the same chain as the robot's chain packed alone."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from plannerlab.collision.fcl_checker import CollisionChecker
+from plannerlab.collision.model import chain_model
+from plannerlab.collision.spheres import (
+    frames,
+    kin,
+    link_ends,
+    point_gradient,
+    sphere_chain,
+    tip_jacobians,
+    tip_pose,
+)
+from plannerlab.problem.catalog import load_problem
+
+PROBLEMS = [
+    "armz_pocket",  # 23 turning joints about z
+    "irb6_case1",  # a sliding joint, axes not z, a coupling
+    "continuum_case1",  # a sliding joint along x, then turns
+    "problems/urdf/panda/bookshelf_small_0001.toml",  # a URDF chain
+]
+
+
+def _states(robot, k: int, seed: int) -> np.ndarray:
+    rng = np.random.default_rng(seed)
+    lo = np.maximum(robot.lower, -np.pi)
+    hi = np.minimum(robot.upper, np.pi)
+    return lo + rng.uniform(0.05, 0.95, (k, robot.dof)) * (hi - lo)
+
+
+@pytest.fixture(scope="module", params=PROBLEMS)
+def robot(request):
+    return load_problem(request.param).robot
+
+
+def test_link_axes_and_tip_are_the_robots(robot):
+    ch = sphere_chain(chain_model(robot), robot)
+    for q in _states(robot, 10, 0):
+        Bf = frames(q, ch)
+        a, b = link_ends(Bf, ch)
+        seg = robot.link_segments(q)
+        np.testing.assert_allclose(a, seg[:, 0], atol=1e-12)
+        np.testing.assert_allclose(b, seg[:, 1], atol=1e-12)
+        p, n = tip_pose(Bf, ch)
+        p_ref, n_ref = robot.tip(q)
+        np.testing.assert_allclose(p, p_ref, atol=1e-12)
+        np.testing.assert_allclose(n, n_ref, atol=1e-12)
+
+
+def test_gradients_through_the_chain_are_the_derivatives(robot):
+    """n · ∂p/∂q of a point on each link (its axis' midpoint) and the tip's Jacobians
+    against central differences of the robot's own kinematics."""
+    ch = sphere_chain(chain_model(robot), robot)
+    kn = kin(ch)
+    rng = np.random.default_rng(1)
+    h = 1e-6
+    for q in _states(robot, 3, 2):
+        Bf = frames(q, ch)
+        a, b = link_ends(Bf, ch)
+        mid = (a + b) / 2.0
+        n = rng.normal(size=(len(mid), 3))
+        n /= np.linalg.norm(n, axis=1, keepdims=True)
+        E = np.eye(robot.dof) * h
+        seg_p = robot.link_segments(q[None] + E)
+        seg_m = robot.link_segments(q[None] - E)
+        d_mid = ((seg_p[..., 0, :] + seg_p[..., 1, :]) - (seg_m[..., 0, :] + seg_m[..., 1, :])) / (
+            4.0 * h
+        )  # (dof, L, 3)
+        for l in range(len(mid)):
+            out = np.zeros(robot.dof)
+            point_gradient(Bf, kn, kn[3][l], mid[l], *n[l], 1.0, out)
+            np.testing.assert_allclose(out, d_mid[:, l] @ n[l], atol=1e-6)
+        p, nt = tip_pose(Bf, ch)
+        Jp, Jn = tip_jacobians(Bf, ch, p, nt, robot.dof)
+        tp, tn = robot.tip(q[None] + E)
+        tm, tnm = robot.tip(q[None] - E)
+        np.testing.assert_allclose(Jp, ((tp - tm) / (2 * h)).T, atol=1e-6)
+        np.testing.assert_allclose(Jn, ((tn - tnm) / (2 * h)).T, atol=1e-6)
+
+
+def test_a_checkers_model_gives_the_chain_packed_alone():
+    """The descent's spheres ride on the checker's model when there is one, else on the
+    robot's chain packed alone: the same arrays, so the same paths."""
+    problem = load_problem("armz_pocket")
+    checker = CollisionChecker(problem.robot, problem.scene, margin_m=0.05)
+    a = sphere_chain(checker.model, problem.robot)
+    b = sphere_chain(chain_model(problem.robot), problem.robot)
+    for name, x, y in zip(a._fields, a, b, strict=True):
+        assert np.array_equal(np.asarray(x), np.asarray(y)), name
+
+
+def test_a_chain_whose_capsules_are_not_its_links_is_refused():
+    robot = load_problem("armz_pocket").robot
+
+    class Split:
+        """Arm-Z with one link more than its chain has capsules."""
+
+        def __getattr__(self, name):
+            return getattr(robot, name)
+
+        @property
+        def link_radii_m(self):
+            return np.append(robot.link_radii_m, 0.1)
+
+    with pytest.raises(ValueError, match="one capsule per link"):
+        sphere_chain(chain_model(robot), Split())
