@@ -364,6 +364,12 @@ class Core:
         return self._packed
 
     @property
+    def fused(self) -> bool:
+        """Whether a chain's states are answered by its fused validity (``ChainValidity``,
+        in vector lanes)."""
+        return self._fused is not None
+
+    @property
     def model_built(self) -> bool:
         """Whether :attr:`model` was built already (asking does not build it)."""
         return self._model is not None

@@ -18,7 +18,7 @@ import numpy as np
 from numba import njit
 
 from plannerlab.collision.lanes import LANES_MIN, W, lanes_check
-from plannerlab.collision.model import edge_count, edge_delta, state_ok
+from plannerlab.collision.model import edge_count, edge_delta, state_ok, views
 
 #: :func:`grid_check`'s return codes: every state is valid / the cursor's state is
 #: invalid / ``limit`` states were checked and at least one is left
@@ -38,7 +38,7 @@ def _lane_state(path, e, j, d, n, QL, k):
         QL[i, k] = path[e, i] + t * d[i]
 
 
-@njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True, inline="always")
 def _flush(QL, cnt, V, SL, alive, S, q):
     """Test lanes 0..cnt-1 of QL: the first invalid lane, or -1. A group of fewer than
     ``LANES_MIN`` states is tested state by state (as ``lanes.group_flush``)."""
@@ -59,12 +59,13 @@ def _flush(QL, cnt, V, SL, alive, S, q):
 
 
 @njit(cache=True, nogil=True)
-def grid_check(path, joint_step, m, V, S, cur, limit, d, q):
+def grid_check(path, joint_step, m, cur, limit, d, q):
     """Check the grid states of ``path`` (k, dof) in order from the cursor ``cur`` (3,)
     int64 (edge e, state j of that edge: 0 is ``path[0]``, which only edge 0 has, 1..n
     the edge's grid states; states checked so far), at most ``limit`` of them, ``lanes.W``
-    at a time in vector lanes (the verdicts of the one-state test; ``V``, ``S``: the
-    model's views, :func:`~plannerlab.collision.model.views`).
+    at a time in vector lanes (the verdicts of the one-state test). The model's views are
+    made here: passed in, their fifty-odd arrays would cost numba's dispatcher about
+    0.1 ms a call to type.
 
     The order is ``densify``'s: ``path[0]``, then per edge e its states j = 1..n (``n``:
     :func:`edge_count` of the edge, ``q = path[e] + t d``, ``t = j / n``, exactly 1 at
@@ -75,6 +76,7 @@ def grid_check(path, joint_step, m, V, S, cur, limit, d, q):
     Returns :data:`GRID_VALID`, :data:`GRID_INVALID` or :data:`GRID_LIMIT` (the cursor at
     the next state to check)."""
     k_rows = path.shape[0]
+    V, S = views(m)
     SL = V[3]
     QL = SL[11]
     alive = SL[8][0]

@@ -48,7 +48,7 @@ def warm_up(model: Any | None = None) -> None:
         1.0, 0, 0, 0, buf, np.empty(4, dtype=np.int64), np.empty(4), np.empty(4, dtype=np.int64),
     )  # fmt: skip
     R.chain(Q, P, 0, Q.copy())
-    grid_check(Q[:1], 0.1, model, V, S, np.zeros(3, dtype=np.int64), 0, buf[0], buf[1])
+    grid_check(Q[:1], 0.1, model, np.zeros(3, dtype=np.int64), 0, buf[0], buf[1])
 
 
 def _tiny_model() -> Any:
