@@ -38,7 +38,8 @@ from typing import Any
 
 import numpy as np
 
-from plannerlab.collision.chain_valid import ChainValidity, chain_first_bad
+from plannerlab.collision.chain_check import ChainValidity
+from plannerlab.collision.chain_valid import chain_first_bad
 from plannerlab.collision.core import chain_first_invalid, edge_states
 from plannerlab.collision.fcl_checker import CollisionChecker
 from plannerlab.problem.load import Budget, parse_problem

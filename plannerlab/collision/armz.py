@@ -1,15 +1,14 @@
-"""Arm-Z's compiled kinematics and the core's checks with them fused in (numba,
+"""Arm-Z's compiled kinematics and the conservative advancement of its paths (numba,
 ``cache=True``).
 
 Arm-Z's chain ``H_i = RotZ(θ_i) · Trans(0, δy, δz) · RotX(ζ)`` (see
 :class:`~plannerlab.robots.armz.model.ArmZ`): its frames (:func:`armz_frames`), capsule
 axes (:func:`armz_segments`, and with the joints' axes :func:`armz_segments_axes`) for a
-batch of states; the first invalid state of a batch or an edge with no kinematics past the
-first hit (:func:`armz_first_invalid`, :func:`armz_edge_first_invalid`); and a whole path
-checked by conservative advancement with the bounds taken at the configuration
-(:func:`armz_advance_dt`, :func:`armz_path_advance`: see
+batch of states; and a whole path checked by conservative advancement with the bounds
+taken at the configuration (:func:`armz_advance_dt`, :func:`armz_path_advance`: see
 :mod:`plannerlab.collision.core`). The generic kernels they call are in
-:mod:`plannerlab.collision.kernels`.
+:mod:`plannerlab.collision.kernels`. Its states' validity is the compiled model's, as for
+every chain (:mod:`plannerlab.collision.chain_valid`, :mod:`plannerlab.collision.lanes`).
 """
 
 from __future__ import annotations
@@ -23,7 +22,6 @@ from plannerlab.collision.geometry import capsule_obstacle, seg_seg
 from plannerlab.collision.kernels import (
     box_gap,
     edge_rates,
-    edge_states,
     link_boxes,
     scratch,
     state_hits,
@@ -121,74 +119,6 @@ def armz_segments_axes(q, T0, T1, M, seg, z):
             R[i, 2] = g0 * M[0, 2] + g1 * M[1, 2] + g2 * M[2, 2]
     for i in range(3):
         seg[dof, 1, i] = p[i]
-
-
-@njit(cache=True, nogil=True)
-def armz_first_invalid(
-    Q, T0, T1, M, radii, radii_self, moving, allowed, tree, kinds, Rs, cs, hs, olo, ohi
-):
-    """As :func:`first_invalid` with Arm-Z kinematics fused in: no FK past the first hit."""
-    k, dof = Q.shape
-    L = dof + 1
-    seg = np.empty((1, L, 2, 3))
-    buf = scratch(L)
-    pairs = np.empty((1, 3), dtype=np.int64)
-    for s in range(k):
-        armz_segments(Q[s : s + 1], T0, T1, M, seg)
-        if state_hits(
-            seg[0],
-            radii,
-            radii_self,
-            moving,
-            allowed,
-            tree,
-            kinds,
-            Rs,
-            cs,
-            hs,
-            olo,
-            ohi,
-            buf,
-            True,
-            pairs,
-        ):
-            return s
-    return -1
-
-
-@njit(cache=True, nogil=True)
-def armz_edge_first_invalid(
-    q_a,
-    q_b,
-    joint_step,
-    continuous,
-    limit,
-    cap,
-    weights,
-    T0,
-    T1,
-    M,
-    radii,
-    radii_self,
-    moving,
-    allowed,
-    tree,
-    kinds,
-    Rs,
-    cs,
-    hs,
-    olo,
-    ohi,
-):
-    """An Arm-Z edge checked in order, interpolation and kinematics fused in: (n, first bad
-    index among the first min(n, limit) states or -1)."""
-    n, Q = edge_states(q_a, q_b, joint_step, continuous, limit, cap, weights)
-    if n > cap:
-        return n, -1
-    bad = armz_first_invalid(
-        Q, T0, T1, M, radii, radii_self, moving, allowed, tree, kinds, Rs, cs, hs, olo, ohi
-    )
-    return n, bad
 
 
 @njit(cache=True, nogil=True)

@@ -6,10 +6,14 @@ how far is every pair of shapes (:meth:`Core.pair_distances`, for clearance-awar
 optimisation). Everything on the hot path is one numba call over the whole batch (``cache=
 True``: compiled once per machine into ``__pycache__``, loaded in later processes):
 
-* **Kinematics.** Arm-Z's chain ``H_i = RotZ(θ_i) · Trans(0, δy, δz) · RotX(ζ)`` is compiled
-  (:mod:`plannerlab.collision.armz`), and so is a URDF chain's
-  (:mod:`plannerlab.collision.chain`); other robots give their segments through their own
-  numpy ``link_segments``.
+* **One road for every chain.** A robot that gives its serial chain (Arm-Z, IRb-6, the
+  continuum chain, URDF chains) has its states, batches and edges tested by the compiled
+  model's fused test (:mod:`plannerlab.collision.chain_valid`; batches in vector lanes,
+  :mod:`plannerlab.collision.lanes`), the test the native planners certify their edges
+  with, so a path they return passes the re-check bit for bit. Arm-Z keeps its own
+  compiled kinematics (:mod:`plannerlab.collision.armz`) only for the conservative
+  advancement below; other robots give their segments through their own numpy
+  ``link_segments``.
 * **Broad phase.** Per state, world-aligned boxes of every capsule and a bounding-box tree
   over the chain's consecutive links (:func:`~plannerlab.collision.kernels.chain_tree`:
   topology built once, boxes refit per state), traversed against each obstacle and
@@ -97,15 +101,14 @@ from typing import Any
 import numpy as np
 
 from plannerlab.collision.armz import (
-    armz_edge_first_invalid,
-    armz_first_invalid,
     armz_frames,
     armz_path_advance,
     armz_segments,
 )
 from plannerlab.collision.chain import chain_arrays, chain_parts, chain_segments
+from plannerlab.collision.chain_check import ChainValidity
 from plannerlab.collision.chain_pack import _pack
-from plannerlab.collision.chain_valid import ChainValidity, chain_state_valid
+from plannerlab.collision.chain_valid import chain_state_valid
 from plannerlab.collision.geometry import BOX, CYLINDER, SPHERE
 from plannerlab.collision.kernels import (
     advance_dt,
@@ -282,9 +285,13 @@ class Core:
         self._chain: Any = None
         #: its validity in one fused call per query (collision/chain_valid.py)
         self._fused: ChainValidity | None = None
-        if not self._armz and callable(getattr(robot, "chain_data", None)):
-            self._chain = chain_arrays(robot)
+        if callable(getattr(robot, "chain_data", None)):
+            # every chain's validity (Arm-Z's too) takes the fused test, the compiled
+            # model's own (its batches in vector lanes): the verdicts the native
+            # planners certify edges with are the re-check's, bit for bit
             self._fused = ChainValidity.of(self)
+            if not self._armz:
+                self._chain = chain_arrays(robot)
         if modules is not None:
             T0 = np.ascontiguousarray(robot.T_world_base, dtype=np.float64)
             self._T0 = T0
@@ -315,7 +322,7 @@ class Core:
         empty cache, about 11 s) or loading from its cache (about 0.5 s per process) happens
         here, when the checker is built, and not inside a planner's time limit."""
         kernels: tuple[Any, ...] = (
-            (armz_frames, armz_segments, armz_first_invalid, armz_edge_first_invalid)
+            (armz_frames, armz_segments, edge_states)
             + ((armz_path_advance,) if self._rates is not None else ())
             if self._armz
             else (first_invalid, edge_states, chain_segments, chain_first_invalid)
@@ -448,8 +455,6 @@ class Core:
             Qc = self._Q(q)
         if len(Qc) != 1:
             raise ValueError(f"q must be one state ({self.robot.dof},), got shape {np.shape(q)}")
-        if self._armz:
-            return armz_first_invalid(Qc, self._T0, self._T1, self._M, *self._geo) < 0
         if self._fused is not None:
             kernel: Any = chain_state_valid  # a numba dispatcher
             return bool(kernel(Qc[0], *self._fused.args))
@@ -458,8 +463,6 @@ class Core:
     def first_invalid(self, Q: Array) -> int:
         """Index of the first invalid state of Q (k, dof) in order, -1 if all are valid."""
         Qc = self._Q(Q)
-        if self._armz:
-            return int(armz_first_invalid(Qc, self._T0, self._T1, self._M, *self._geo))
         if self._fused is not None:
             return self._fused.first_invalid(Qc)
         return int(first_invalid(self.segments(Qc), *self._geo))
@@ -481,31 +484,14 @@ class Core:
         step = float(joint_step)
         require_joint_step(step)
         lim = _NO_LIMIT if limit is None else max(int(limit), 0)
-        if self._armz:
-            n, bad = armz_edge_first_invalid(
-                qa,
-                qb,
-                step,
-                self._continuous,
-                lim,
-                MAX_EDGE_STATES,
-                self.edge_weights,
-                self._T0,
-                self._T1,
-                self._M,
-                *self._geo,
-            )
-        else:
-            n, Q = edge_states(
-                qa, qb, step, self._continuous, lim, MAX_EDGE_STATES, self.edge_weights
-            )
-            bad = (
-                -1
-                if n > MAX_EDGE_STATES or len(Q) == 0
-                else self._fused.first_invalid(Q)
-                if self._fused is not None
-                else first_invalid(self.segments(Q), *self._geo)
-            )
+        n, Q = edge_states(qa, qb, step, self._continuous, lim, MAX_EDGE_STATES, self.edge_weights)
+        bad = (
+            -1
+            if n > MAX_EDGE_STATES or len(Q) == 0
+            else self._fused.first_invalid(Q)
+            if self._fused is not None
+            else first_invalid(self.segments(Q), *self._geo)
+        )
         if n > MAX_EDGE_STATES:
             span = float(np.max(np.abs(joint_difference(qb, qa, self._continuous))))
             raise edge_too_long(span, step, max(n, edge_steps(qa, qb, step, self._continuous)))

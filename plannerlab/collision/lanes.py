@@ -299,35 +299,19 @@ def _apart_lanes(A, i, B, j, r, src, dst):
     return any_live
 
 
-@njit(cache=True, nogil=True)
-def lanes_check(QL, V, SL, alive, stop):
-    """Test the W states QL (dof, W) (lane k: QL[:, k]) of the lanes set in ``alive`` (W,)
-    bool; a lane whose state collides is cleared from ``alive``. ``stop``: end at the
-    first lane that collides (an edge fails with it). Returns whether every lane that
-    was alive still is.
-
-    The culls of ``chain_valid._state_ok`` in its order (the scene body by body, then the
-    link pairs by chunk, body and cluster), each skipped only when clear in every live
-    lane."""
+@njit(cache=True, nogil=True, inline="always")
+def _scene_lanes(V, SL, alive, stop):
+    """:func:`lanes_check`'s scene: body by body (in ``order``) and obstacle by obstacle,
+    the body's ball, each cluster's ball, then its capsules. False when the test is over
+    (a lane collided and ``stop``, or no lane is left)."""
     nw = alive.shape[0]  # W, read at run time: loops over it vectorize
-    (parent, prism, body_cl, cl_start, order, kinds, issph, moving, allowed, any_cl) = V[0][:10]
-    groups, cgroups = V[0][10], V[0][11]
-    (T0, pre, cap_a, cap_b, rad, rads, bc, br, brs, cl_c, cl_r, cl_rs, Rs, cs, hs) = V[1][:15]
-    olo, ohi = V[1][15], V[1][16]
-    F, C, K, X, Y, CB, T, v, Mk, done, w = SL[:11]
-    _joint_values(QL, V[2], v)
-    _frames_lanes(v, T0, parent, prism, pre, F, T)
-    nb = bc.shape[0]
-    for b in range(nb):
-        x, y, z = bc[b, 0], bc[b, 1], bc[b, 2]
-        for a in range(3):
-            ra = 4 * a
-            for k in range(nw):
-                C[b, a, k] = (
-                    F[b, ra, k] * x + F[b, ra + 1, k] * y + F[b, ra + 2, k] * z + F[b, ra + 3, k]
-                )
-        done[b] = 0
+    body_cl, cl_start, order, kinds, issph, moving = V[0][2:8]
+    cap_a, cap_b, rad = V[1][2], V[1][3], V[1][4]
+    br, cl_c, cl_r = V[1][7], V[1][9], V[1][10]
+    Rs, cs, hs, olo, ohi = V[1][12], V[1][13], V[1][14], V[1][15], V[1][16]
+    F, C, K, X, Y, Mk, done, w = SL[0], SL[1], SL[2], SL[3], SL[4], SL[8], SL[9], SL[10]
     m1, m2, m3 = Mk[1], Mk[2], Mk[3]
+    nb = br.shape[0]
     n_obs = kinds.shape[0]
     for kk in range(nb):
         b = order[kk]
@@ -368,6 +352,21 @@ def lanes_check(QL, V, SL, alive, stop):
                                        issph, moving, rad, X, Y, m3, Mk[4], alive, stop,
                                        w):  # fmt: skip
                     return False
+    return True
+
+
+@njit(cache=True, nogil=True, inline="always")
+def _pairs_lanes(V, SL, alive, stop):
+    """:func:`lanes_check`'s link pairs: by chunk of bodies, body pair, cluster pair, then
+    the checked pairs. Returns whether every lane that was alive still is."""
+    nw = alive.shape[0]  # W, read at run time: loops over it vectorize
+    body_cl, cl_start, issph, allowed, any_cl = V[0][2], V[0][3], V[0][6], V[0][8], V[0][9]
+    groups, cgroups = V[0][10], V[0][11]
+    cap_a, cap_b, rads, bc = V[1][2], V[1][3], V[1][5], V[1][6]
+    brs, cl_c, cl_rs = V[1][8], V[1][9], V[1][11]
+    F, C, K, X, Y, CB, Mk, done, w = SL[0], SL[1], SL[2], SL[3], SL[4], SL[5], SL[8], SL[9], SL[10]
+    m1, m2, m3 = Mk[1], Mk[2], Mk[3]
+    nb = bc.shape[0]
     ncl = K.shape[0]
     L = X.shape[0]
     if cgroups.shape[0] > 0:
@@ -469,6 +468,37 @@ def lanes_check(QL, V, SL, alive, stop):
         if not alive[k]:
             return False
     return True
+
+
+@njit(cache=True, nogil=True)
+def lanes_check(QL, V, SL, alive, stop):
+    """Test the W states QL (dof, W) (lane k: QL[:, k]) of the lanes set in ``alive`` (W,)
+    bool; a lane whose state collides is cleared from ``alive``. ``stop``: end at the
+    first lane that collides (an edge fails with it). Returns whether every lane that
+    was alive still is.
+
+    The culls of ``chain_valid._state_ok`` in its order (the scene body by body, then the
+    link pairs by chunk, body and cluster), each skipped only when clear in every live
+    lane."""
+    nw = alive.shape[0]  # W, read at run time: loops over it vectorize
+    (parent, prism) = V[0][:2]
+    T0, pre, bc = V[1][0], V[1][1], V[1][6]
+    F, C, T, v, done = SL[0], SL[1], SL[6], SL[7], SL[9]
+    _joint_values(QL, V[2], v)
+    _frames_lanes(v, T0, parent, prism, pre, F, T)
+    nb = bc.shape[0]
+    for b in range(nb):
+        x, y, z = bc[b, 0], bc[b, 1], bc[b, 2]
+        for a in range(3):
+            ra = 4 * a
+            for k in range(nw):
+                C[b, a, k] = (
+                    F[b, ra, k] * x + F[b, ra + 1, k] * y + F[b, ra + 2, k] * z + F[b, ra + 3, k]
+                )
+        done[b] = 0
+    if not _scene_lanes(V, SL, alive, stop):
+        return False
+    return _pairs_lanes(V, SL, alive, stop)
 
 
 @njit(cache=True, nogil=True)

@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 from conftest import ROOT
 
-from plannerlab.collision.chain_valid import ChainValidity
+from plannerlab.collision.chain_check import ChainValidity
 from plannerlab.collision.core import Core
 from plannerlab.collision.fcl_checker import CollisionChecker
 from plannerlab.problem.load import Problem, parse_problem

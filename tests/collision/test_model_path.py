@@ -25,10 +25,10 @@ def checkers(name: str) -> tuple[Any, CollisionChecker, CollisionChecker]:
         PROBLEMS / "urdf" / "panda" / "bookshelf_small_0001.toml" if name == "panda" else name
     )
     compiled = CollisionChecker(p.robot, p.scene, margin_m=p.safety_margin_m)
-    compiled.model  # noqa: B018 - built: Arm-Z's grid checks run in it
+    compiled.model  # noqa: B018 - built: an unfused core's grid checks run in it
     numpy_road = CollisionChecker(p.robot, p.scene, margin_m=p.safety_margin_m)
     assert numpy_road._grid_model() is None  # no model built: the dense path in numpy
-    if name == "panda":  # a fused chain keeps the numpy road: the kernel is put in here
+    if compiled._core.fused:  # a fused chain keeps the numpy road: the kernel is put in here
         assert compiled._grid_model() is None
         compiled._path_model = compiled.model
     assert compiled._grid_model() is not None
