@@ -107,6 +107,7 @@ from plannerlab.collision.armz import (
 )
 from plannerlab.collision.chain import chain_arrays, chain_parts, chain_segments
 from plannerlab.collision.chain_check import ChainValidity
+from plannerlab.collision.chain_pack import _pack
 from plannerlab.collision.chain_valid import chain_state_valid
 from plannerlab.collision.geometry import BOX, CYLINDER, SPHERE
 from plannerlab.collision.kernels import (
@@ -312,6 +313,8 @@ class Core:
             )
         #: the compiled robot–scene model (:attr:`model`), built on first use
         self._model: Any = None
+        #: the packed arrays (:meth:`packed`) when no fused validity holds them
+        self._packed: tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray] | None = None
         self._warm_up()
 
     def _warm_up(self) -> None:
@@ -343,6 +346,40 @@ class Core:
             q1 = q.copy()
             q1[0] += 0.5 if q[0] + 0.5 <= self.robot.upper[0] else -0.5
             self.path_advance(np.vstack([q, q1]), 1, 0.05, None)
+
+    def packed(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """The chain, capsules, checked pairs and scene packed for the compiled state test
+        (:func:`~plannerlab.collision.chain_pack._pack`: ``P``, ``M``, ``idat``, ``perm``,
+        bodies in the default order), packed once per core: the fused validity's own
+        arrays when it has them (the model then shares them), else packed here and kept.
+        """
+        if self._fused is not None:
+            return (*self._fused.args, self._fused.perm)
+        if self._packed is None:
+            self._packed = _pack(
+                self.robot,
+                self.radii,
+                self.radii_self,
+                self.moving,
+                self.allowed,
+                self.kinds,
+                self.Rs,
+                self.cs,
+                self.hs,
+                None,
+            )
+        return self._packed
+
+    @property
+    def fused(self) -> bool:
+        """Whether a chain's states are answered by its fused validity (``ChainValidity``,
+        in vector lanes)."""
+        return self._fused is not None
+
+    @property
+    def model_built(self) -> bool:
+        """Whether :attr:`model` was built already (asking does not build it)."""
+        return self._model is not None
 
     @property
     def model(self) -> Any:

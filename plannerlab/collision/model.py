@@ -94,18 +94,7 @@ def model_of_core(core: Any) -> CompiledModel:
             "consumer (native planners, the fused checks) cannot run it; give the robot a "
             "chain_data() (docs/extending.md)"
         )
-    P, M, idat, perm = _pack(
-        robot,
-        core.radii,
-        core.radii_self,
-        core.moving,
-        core.allowed,
-        core.kinds,
-        core.Rs,
-        core.cs,
-        core.hs,
-        None,
-    )
+    P, M, idat, perm = core.packed()  # the fused validity's arrays, packed once
 
     def f(a: Any, dtype: Any) -> np.ndarray:
         # a writable C-ordered copy: numba types read-only arrays (a robot's bounds may

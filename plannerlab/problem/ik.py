@@ -122,8 +122,13 @@ def solve_ik(
     ang_scale = 1.0 / np.deg2rad(goal.angle_tol_deg)
     lam2 = damping**2
     iterations = 0
+    # a robot that gives tip and Jacobian from one forward kinematics (the same numbers)
+    both = getattr(robot, "tip_and_jacobian", None)
     for iterations in range(1, max_iterations + 1):  # noqa: B007 - count survives the loop
-        p, n = robot.tip(q)
+        if both is not None:
+            p, n, J_p, J_n = both(q)
+        else:
+            p, n = robot.tip(q)
         pos_e, ang_e = goal.errors_from_tip(p, n)
         if (
             pos_e <= target_fraction * goal.pos_tol_m
@@ -132,7 +137,8 @@ def solve_ik(
             iterations -= 1
             break
         e = np.concatenate([(goal.p_world_m - p) * pos_scale, (goal.n_world - n) * ang_scale])
-        J_p, J_n = robot.tip_jacobian(q)
+        if both is None:
+            J_p, J_n = robot.tip_jacobian(q)
         J = np.vstack([J_p * pos_scale, J_n * ang_scale])  # (6, dof)
         dq = J.T @ np.linalg.solve(J @ J.T + lam2 * np.eye(6), e)
         biggest = float(np.max(np.abs(dq), initial=0.0))

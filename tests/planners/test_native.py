@@ -149,9 +149,9 @@ def test_a_time_limit_cuts_the_search_into_chunks(monkeypatch: pytest.MonkeyPatc
     kernel = native_solve.K.rrtc_run
 
     def counted(*args: Any) -> int:
-        before = int(args[12][1])  # counters: iterations, checks, ...
+        before = int(args[14][1])  # counters: iterations, checks, ...
         code = kernel(*args)
-        calls.append(int(args[12][1]) - before)
+        calls.append(int(args[14][1]) - before)
         return int(code)
 
     monkeypatch.setattr(native_solve, "CHUNK_MAX", 64)
@@ -314,3 +314,46 @@ def test_a_budget_without_any_limit_is_refused_by_name(planner: str):
         PlannerlabError, match=re.escape(f"{planner}: the budget needs at least one")
     ):
         make_planner(planner).solve(problem, 0, Budget(), np.random.default_rng(0))
+
+
+def test_kd_tree_nearest_is_the_brute_force_nearest():
+    """The k-d trees' nearest node (kernels.kd_nearest) is the brute-force scan's
+    (kernels.nearest) on random trees: 1-8 joints, some continuous, dead rows, and
+    coordinates rounded to few decimals so that many distances tie (the lowest index
+    wins in both)."""
+    K = native_solve.K
+    rng = np.random.default_rng(3)
+    compared = 0
+    for _ in range(120):
+        dof = int(rng.integers(1, 9))
+        n = int(rng.integers(1, 300))
+        continuous = rng.random(dof) < 0.3
+        continuous[0] = False
+        Q = np.round(rng.uniform(-3.0, 3.0, (n, dof)), int(rng.integers(0, 3)))
+        F = np.where(rng.random(n) < 0.1, K.DEAD, K.CHECKED).astype(np.int8)
+        sd = K.split_dims(continuous)
+        assert list(sd) == list(np.flatnonzero(~continuous))
+        Kd = np.full((n, 3), -1, dtype=np.int64)
+        K.kd_catch_up(Q, n, Kd, sd)
+        assert (Kd[:, 2] >= 0).all()
+        stack, bounds = np.empty(n + 2, dtype=np.int64), np.empty(n + 2)
+        offs = np.empty((n + 2, dof))
+        for _ in range(30):
+            q = np.round(rng.uniform(-3.2, 3.2, dof), int(rng.integers(0, 3)))
+            brute = K.nearest(Q, n, q, continuous, continuous.any(), F)
+            assert K.kd_nearest(Q, q, continuous, F, K.DEAD, Kd, sd, stack, bounds, offs) == brute
+            compared += 1
+    assert compared == 120 * 30
+    # every row dead: none
+    F = np.full(4, K.DEAD, dtype=np.int8)
+    Q = np.zeros((4, 2))
+    Kd = np.full((4, 3), -1, dtype=np.int64)
+    sd = K.split_dims(np.zeros(2, dtype=np.bool_))
+    K.kd_catch_up(Q, 4, Kd, sd)
+    stack, bounds, offs = np.empty(6, dtype=np.int64), np.empty(6), np.empty((6, 2))
+    assert (
+        K.kd_nearest(
+            Q, np.ones(2), np.zeros(2, dtype=np.bool_), F, K.DEAD, Kd, sd, stack, bounds, offs
+        )
+        == -1
+    )

@@ -108,3 +108,19 @@ def test_urdf_names_every_joint_and_frame():
         assert f'name="{name}"' in text
     assert 'mass value="1.0"' in text and 'effort="100.0"' in text
     assert 'ixx="0.25"' in text and 'izz="0.5"' in text
+
+
+@settings(max_examples=30, deadline=None)
+@given(angles)
+def test_tip_and_jacobian_is_tip_and_tip_jacobian_bit_for_bit(q):
+    """One forward kinematics for both (what the numeric IK calls each step): the very
+    numbers of ``tip`` and of the Jacobian made with ``np.cross``."""
+    p, n, J_p, J_n = ROBOT.tip_and_jacobian(q)
+    p_ref, n_ref = ROBOT.tip(q)
+    F = ROBOT.fk(q)
+    z, o = F[1:-1, :3, 2], F[1:-1, :3, 3]
+    assert np.array_equal(p, p_ref) and np.array_equal(n, n_ref)
+    assert np.array_equal(J_p, np.cross(z, F[-1, :3, 3] - o).T)
+    assert np.array_equal(J_n, np.cross(z, F[-1, :3, 2]).T)
+    J_p2, J_n2 = ROBOT.tip_jacobian(q)
+    assert np.array_equal(J_p2, J_p) and np.array_equal(J_n2, J_n)

@@ -33,6 +33,7 @@ from numba import njit
 
 from plannerlab.collision.lanes import group_alone, group_end, group_push
 from plannerlab.collision.model import edge_count, edge_delta
+from plannerlab.planners.native.kdtree import kd_catch_up, kd_insert, kd_nearest, split_dims
 
 # ---------------------------------------------------------------------- return codes
 #: the chunk's soft limit (checks or iterations of this call) was reached: call again
@@ -270,11 +271,13 @@ def _tree_edge(Qt, Pt, c, goal_tree, joint_step, m, V, S, buf, limit, every, fin
 
 
 @njit(cache=True, nogil=True)
-def _grow(Qt, Pt, Ft, Rt, nt, goal_tree, near, q_to, range_rad, joint_step, m, V, S, buf,
-          limit, every, dd):  # fmt: skip
-    """Grow tree (Qt, Pt, Ft, Rt) of nt nodes from node ``near`` (-1: the nearest live one)
-    towards q_to: a node at most ``range_rad`` on, added at index nt when the coarse
-    states of its edge are free (all of them with ``every`` = 1).
+def _grow(Qt, Pt, Ft, Rt, Kt, nt, goal_tree, near, q_to, range_rad, joint_step, m, V, S, buf,
+          limit, every, dd, sd, stack, bounds, offs):  # fmt: skip
+    """Grow tree (Qt, Pt, Ft, Rt, Kt: its k-d tree, :func:`kd_insert`) of nt nodes from
+    node ``near`` (-1: the nearest live one, by the k-d tree over the joints ``sd``, or
+    by brute force when ``sd`` is empty) towards q_to: a node at most ``range_rad`` on,
+    added at index nt when the coarse states of its edge are free (all of them with
+    ``every`` = 1); the caller puts it in the k-d tree.
 
     Dynamic domain (``dd`` = (radius, min_radius, alpha) [rad, rad, 1], radius > 0; only
     for the nearest-node step): a sample farther from its nearest node than the node's
@@ -286,7 +289,10 @@ def _grow(Qt, Pt, Ft, Rt, nt, goal_tree, near, q_to, range_rad, joint_step, m, V
     hard limit came first, 4 dropped by the dynamic domain."""
     domain = near < 0 and dd[0] > 0.0
     if near < 0:
-        near = nearest(Qt, nt, q_to, m.continuous, m.continuous.any(), Ft)
+        if sd.shape[0] > 0:
+            near = kd_nearest(Qt, q_to, m.continuous, Ft, DEAD, Kt, sd, stack, bounds, offs)
+        else:
+            near = nearest(Qt, nt, q_to, m.continuous, m.continuous.any(), Ft)
         if domain and distance2(Qt[near], q_to, m.continuous) > Rt[near] * Rt[near]:
             return 4, 0, near
     Qt[nt] = Qt[near]  # the new row's parent edge, from near to the target
@@ -353,6 +359,8 @@ def rrtc_run(
     PB,
     FB,
     RB,
+    KA,
+    KB,
     sizes,
     counters,
     rng,
@@ -372,8 +380,11 @@ def rrtc_run(
     """RRT-Connect iterations until a path, a limit, or a full tree.
 
     Trees: A (QA (cap_a, dof) states, PA parents, -1 at the root: the start, FA flags,
-    RA dynamic-domain radii, inf: none) and B (the goal tree, a root per goal state);
-    ``sizes`` (2,) their node counts.
+    RA dynamic-domain radii, inf: none, KA (cap_a, 3) int64 its k-d tree, rows -1: not
+    in it yet) and B (the goal tree, a root per goal state); ``sizes`` (2,) their node
+    counts. Nearest nodes come from the k-d trees (:func:`kd_nearest`: the very node
+    :func:`nearest`'s brute force finds); rows not in them yet (the roots, seeded
+    branches) are put in when the call starts.
     ``counters`` (6,) int64 carries the search across calls: iterations, checks, the tree
     to grow next (0 A, 1 B), on a path the meeting node in A and in B (equal states), and
     the found paths whose fine check failed.
@@ -400,6 +411,13 @@ def rrtc_run(
     :data:`FULL`)."""
     q_rand = buf[0]
     no_domain = np.zeros(3)  # the connection steps have none
+    sd = split_dims(m.continuous)
+    kd_catch_up(QA, sizes[0], KA, sd)
+    kd_catch_up(QB, sizes[1], KB, sd)
+    depth = max(QA.shape[0], QB.shape[0]) + 2
+    stack = np.empty(depth, dtype=np.int64)
+    bounds = np.empty(depth)
+    offs = np.empty((depth, QA.shape[1]))
     while True:
         if counters[0] >= max_iterations:
             return ITERATIONS
@@ -414,14 +432,17 @@ def rrtc_run(
         t = counters[2]
         counters[2] = 1 - t
         if t == 0:
-            Qt, Pt, Ft, Rt, Qo, Po, Fo, Ro = QA, PA, FA, RA, QB, PB, FB, RB
+            Qt, Pt, Ft, Rt, Kt = QA, PA, FA, RA, KA
+            Qo, Po, Fo, Ro, Ko = QB, PB, FB, RB, KB
         else:
-            Qt, Pt, Ft, Rt, Qo, Po, Fo, Ro = QB, PB, FB, RB, QA, PA, FA, RA
+            Qt, Pt, Ft, Rt, Kt = QB, PB, FB, RB, KB
+            Qo, Po, Fo, Ro, Ko = QA, PA, FA, RA, KA
         code, c, _ = _grow(
             Qt,
             Pt,
             Ft,
             Rt,
+            Kt,
             sizes[t],
             t == 1,
             -1,
@@ -435,6 +456,10 @@ def rrtc_run(
             hard_checks - counters[1],
             every,
             dd,
+            sd,
+            stack,
+            bounds,
+            offs,
         )
         counters[1] += c
         if code == 3:
@@ -443,6 +468,8 @@ def rrtc_run(
             continue
         new_t = sizes[t]
         sizes[t] += 1
+        if sd.shape[0] > 0:
+            kd_insert(Qt, Kt, new_t, sd)
         q_new = Qt[new_t]
         # connect the other tree to q_new: after a step, its nearest node to q_new is the
         # node just added (it lies on the segment from the previous nearest)
@@ -454,6 +481,7 @@ def rrtc_run(
                 Po,
                 Fo,
                 Ro,
+                Ko,
                 sizes[o],
                 o == 1,
                 near,
@@ -467,6 +495,10 @@ def rrtc_run(
                 hard_checks - counters[1],
                 every,
                 no_domain,
+                sd,
+                stack,
+                bounds,
+                offs,
             )
             counters[1] += c
             if code == 3:
@@ -475,6 +507,8 @@ def rrtc_run(
                 break
             near = sizes[o]
             sizes[o] += 1
+            if sd.shape[0] > 0:
+                kd_insert(Qo, Ko, near, sd)
             if code == 2:
                 a = new_t if t == 0 else near
                 b = near if t == 0 else new_t

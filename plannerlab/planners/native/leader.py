@@ -57,6 +57,7 @@ from plannerlab.planners.native.planner import NativePlanner, _check_settings
 from plannerlab.planners.native.settings import RRTConnectSettings
 from plannerlab.planners.native.solve import (
     FIRST_ROWS,
+    KD_ROW_BYTES,
     UNLIMITED,
     K_views,
     NativeSolve,
@@ -331,7 +332,7 @@ class LeaderSolve(NativeSolve):
         need_free = 2 + math.ceil(space_extent(model) / range_rad)
         seeded = max(len(g.start_states), len(g.goal_states))
         hard0 = self.hard_checks()
-        cap = max(self.tree_rows(hard0, seeded, dof), need_free + seeded + 1)
+        cap = max(self.tree_rows(hard0, seeded, dof, KD_ROW_BYTES), need_free + seeded + 1)
         self.extra["tree_rows"] = cap
         rows = min(cap, max(FIRST_ROWS, need_free + seeded + 1))
         # the trees as the leader seeded them (the start's branches, the goal states'

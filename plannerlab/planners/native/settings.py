@@ -26,7 +26,8 @@ class NativeSettings:
             dropping the waypoints whose neighbours see each other), within the budget.
         shortcut_tries: random shortcuts tried (0: four per waypoint of the found path,
             at least 32).
-        max_tree_mb: the trees' memory at most [MB] (states and parents); a search that
+        max_tree_mb: the trees' memory at most [MB] (states, parents and the k-d trees of
+            RRT-Connect's nearest nodes); a search that
             fills it stops with ``budget_exhausted`` and says so.
         guide_bias: probability that a sample is a guide state (``guides`` of the
             kernel: a state drawn uniformly from them) perturbed by Gaussian noise

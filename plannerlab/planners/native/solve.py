@@ -47,6 +47,8 @@ RECHECK_CHUNK = 4096
 FIRST_ROWS = 4096
 #: no limit
 UNLIMITED = 1 << 62
+#: a tree's k-d tree takes this many bytes a row (:meth:`NativeSolve.new_trees`)
+KD_ROW_BYTES = 24
 
 
 class _PoolGuard:
@@ -180,10 +182,11 @@ class NativeSolve:
             q0,
         )
 
-    def tree_rows(self, hard: int, roots: int, dof: int) -> int:
-        """Rows a tree may have: the memory cap (``max_tree_mb`` for both trees) and, with
-        a check budget, the nodes its checks can add (each costs at least one check)."""
-        by_memory = int(self.s.max_tree_mb * 1e6 / 2 / (8 * dof + 8))
+    def tree_rows(self, hard: int, roots: int, dof: int, index_bytes: int = 0) -> int:
+        """Rows a tree may have: the memory cap (``max_tree_mb`` for both trees: states,
+        parents and ``index_bytes`` a row of the nearest-node index) and, with a check
+        budget, the nodes its checks can add (each costs at least one check)."""
+        by_memory = int(self.s.max_tree_mb * 1e6 / 2 / (8 * dof + 8 + index_bytes))
         return max(min(by_memory, hard + roots + 1), roots + 1)
 
     def simplify(self, P: Array, model: Any, V: Any, S: Any, rng_state: np.ndarray) -> Array:
@@ -293,8 +296,10 @@ class NativeSolve:
     def new_trees(
         seeds: tuple[tuple[np.ndarray, np.ndarray | None], ...], rows: int, dof: int
     ) -> list[np.ndarray]:
-        """The two trees' arrays (states, parents, check flags, dynamic-domain radii; 8 in
-        all) with ``rows`` rows each, seeded with (states, parents or None: roots)."""
+        """The two trees' arrays (states, parents, check flags, dynamic-domain radii, then
+        each tree's k-d tree, rows -1: not in it yet; 10 in all: A's four, B's four, A's
+        and B's k-d trees) with ``rows`` rows each, seeded with (states, parents or None:
+        roots)."""
         trees: list[np.ndarray] = []
         for Q0, P0 in seeds:
             Q, P = np.empty((rows, dof)), np.full(rows, -1, dtype=np.int64)
@@ -304,6 +309,7 @@ class NativeSolve:
             if P0 is not None:
                 P[: len(P0)] = P0
             trees += [Q, P, F, R]
+        trees += [np.full((rows, 3), -1, dtype=np.int64) for _ in range(2)]
         return trees
 
     def search(
@@ -347,6 +353,8 @@ class NativeSolve:
                     trees[5],
                     trees[6],
                     trees[7],
+                    trees[8],
+                    trees[9],
                     sizes,
                     counters,
                     rng_state,
@@ -394,7 +402,7 @@ class NativeSolve:
         self.extra["range_rad"] = range_rad
         need_free = 2 + math.ceil(space_extent(model) / range_rad)
         hard0 = self.hard_checks()
-        cap = max(self.tree_rows(hard0, len(G), dof), need_free + len(G) + 1)
+        cap = max(self.tree_rows(hard0, len(G), dof, KD_ROW_BYTES), need_free + len(G) + 1)
         self.extra["tree_rows"] = cap
         rows = min(cap, max(FIRST_ROWS, need_free + len(G) + 1))
         trees = self.new_trees(((q0[None], None), (G, None)), rows, dof)

@@ -12,10 +12,11 @@ def warm_up(model: Any | None = None) -> None:
     """Run every kernel entry point once, doing no work of note (``model``: a compiled
     model to run them on; default: a two-joint chain in an empty room)."""
     from plannerlab.collision.model import views
+    from plannerlab.collision.model_path import grid_check
     from plannerlab.planners.native import kernels as K
     from plannerlab.planners.native import rrtstar as R
 
-    entries = (views, K.rrtc_run, K.tree_path, K.shortcut_run, R.rrtstar_run, R.chain)
+    entries = (views, K.rrtc_run, K.tree_path, K.shortcut_run, R.rrtstar_run, R.chain, grid_check)
     if model is None and all(getattr(f, "signatures", True) for f in entries):
         return  # loaded in this process already
     if model is None:
@@ -31,8 +32,10 @@ def warm_up(model: Any | None = None) -> None:
     guides = np.zeros((0, dof))
     F = np.ones(4, dtype=np.int8)
     radii = np.full(4, np.inf)
+    Kd = np.full((4, 3), -1, dtype=np.int64)
     K.rrtc_run(
-        model, V, S, Q, P, F, radii, Q, P, F, radii, sizes, counters, rng, guides, 0.0, 0.1,
+        model, V, S, Q, P, F, radii, Q, P, F, radii, Kd, Kd.copy(), sizes, counters, rng,
+        guides, 0.0, 0.1,
         1.0, 0.1, 8, np.zeros(3), 0, 0, 0, 1, buf,
     )  # fmt: skip
     K.tree_path(Q, P, 0, Q, P, 0, Q.copy())
@@ -45,6 +48,7 @@ def warm_up(model: Any | None = None) -> None:
         1.0, 0, 0, 0, buf, np.empty(4, dtype=np.int64), np.empty(4), np.empty(4, dtype=np.int64),
     )  # fmt: skip
     R.chain(Q, P, 0, Q.copy())
+    grid_check(Q[:1], 0.1, model, np.zeros(3, dtype=np.int64), 0, buf[0], buf[1])
 
 
 def _tiny_model() -> Any:

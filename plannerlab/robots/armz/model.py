@@ -35,6 +35,17 @@ import numpy as np
 from plannerlab.robots.base import Array, rot_x, rot_z, trans, urdf_origin
 
 
+def _cross(a: Array, b: Array) -> Array:
+    """``np.cross(a, b)`` of rows a (k, 3) and b (k, 3) or (3,), written out (the same
+    products and differences, without np.cross's general-axis set-up)."""
+    b = np.broadcast_to(b, a.shape)
+    out = np.empty(a.shape)
+    out[:, 0] = a[:, 1] * b[:, 2] - a[:, 2] * b[:, 1]
+    out[:, 1] = a[:, 2] * b[:, 0] - a[:, 0] * b[:, 2]
+    out[:, 2] = a[:, 0] * b[:, 1] - a[:, 1] * b[:, 0]
+    return out
+
+
 @dataclass(frozen=True, eq=False)
 class ArmZ:
     """The Arm-Z chain.
@@ -163,14 +174,18 @@ class ArmZ:
         Joint i turns about the z axis of frame i (its bottom face) through that frame's
         origin, so ``dp/dθ_i = z_i × (p − o_i)`` and ``dn/dθ_i = z_i × n``.
         """
+        return self.tip_and_jacobian(q)[2:]
+
+    def tip_and_jacobian(self, q: Array) -> tuple[Array, Array, Array, Array]:
+        """:meth:`tip` and :meth:`tip_jacobian` at one q from one forward kinematics
+        (the same numbers): ``p_world`` (3,), ``n_world`` (3,), ``dp/dq``, ``dn/dq``
+        (3, dof)."""
         F = self.fk(np.asarray(q, dtype=float).reshape(self.dof))
         p = F[-1, :3, 3]
         n = F[-1, :3, 2]
         z = F[1:-1, :3, 2]  # (dof, 3) joint axes
         o = F[1:-1, :3, 3]  # (dof, 3) points on them
-        J_p = np.cross(z, p - o).T
-        J_n = np.cross(z, n).T
-        return J_p, J_n
+        return p.copy(), n.copy(), _cross(z, p - o).T, _cross(z, n).T
 
     def chain_data(self) -> tuple[Any, ...]:
         """The chain as plain arrays for the compiled robot-scene model
