@@ -66,12 +66,7 @@ def main() -> None:
     timed(K, "shortcut_run", "  shortcut_run (kernel)")
     timed(S.NativeSolve, "checked", "re-check and result")
     timed(FC.CollisionChecker, "check_path", "  check_path")
-    try:
-        import plannerlab.collision.model_path as MP
-
-        timed(MP, "grid_check", "    grid_check (kernel)")
-    except ImportError:  # an older checkout: the re-check in numpy and the core
-        timed(FC.CollisionChecker, "first_invalid", "    first_invalid (core)")
+    timed(FC.CollisionChecker, "first_invalid", "    first_invalid (core)")
     timed(FC.CollisionChecker, "densify", "    densify (numpy road)")
     timed(S.NativeSolve, "result", "  result")
     if args.what == "mbm":

@@ -371,17 +371,6 @@ class Core:
         return self._packed
 
     @property
-    def fused(self) -> bool:
-        """Whether a chain's states are answered by its fused validity (``ChainValidity``,
-        in vector lanes)."""
-        return self._fused is not None
-
-    @property
-    def model_built(self) -> bool:
-        """Whether :attr:`model` was built already (asking does not build it)."""
-        return self._model is not None
-
-    @property
     def model(self) -> Any:
         """The compiled robot–scene model of this core
         (:class:`~plannerlab.collision.model.CompiledModel`), built on first use and kept.

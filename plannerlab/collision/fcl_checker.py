@@ -124,8 +124,6 @@ class CollisionChecker:
         #: fewer states, the same guarantee, at most as many checks as the grid)
         self.edge_check = "advance" if advance else "grid"
         self._core: Core | None = None
-        #: the model of the grid re-check (:meth:`_grid_model`); None: none yet
-        self._path_model: Any = None
         if use_core:
             self._core = Core(
                 robot,
@@ -509,10 +507,7 @@ class CollisionChecker:
         (:meth:`~plannerlab.collision.core.Core.path_advance`), at most as many as
         :meth:`densify` gives (the reserve planners keep for this check stays sound).
         ``mode`` "grid" checks the grid's states whatever ``edge_check`` says (the states a
-        compiled planner checked its edges on: its path passes by construction). Once the
-        checker's compiled model is built (:attr:`model`), grid checks run in it
-        (:func:`~plannerlab.collision.model_path.grid_check`: the same states, order,
-        counts and stops, without making the dense path); before, in numpy.
+        compiled planner checked its edges on: its path passes by construction).
         """
         if mode not in (None, "grid", "advance"):
             raise ValueError(f"mode must be None, 'grid' or 'advance', got {mode!r}")
@@ -520,9 +515,6 @@ class CollisionChecker:
             if self.edge_check != "advance":
                 raise ValueError("mode 'advance' needs a checker with edge_check 'advance'")
             return self._check_path_advance(path, joint_step, stop, chunk)
-        model = self._grid_model()
-        if model is not None:
-            return self._check_path_model(model, path, joint_step, stop, chunk)
         states, owners = self.densify(path, joint_step)
         step = len(states) if stop is None else max(int(chunk), 1)
         bad = None
@@ -542,64 +534,6 @@ class CollisionChecker:
             valid=False,
             states_checked=bad + 1,
             first_invalid_edge=int(owners[bad]),
-            first_invalid_state=q_bad,
-            pairs=self.colliding_pairs(q_bad),
-            backend=self.backend,
-        )
-
-    def _grid_model(self) -> Any:
-        """The compiled model that checks grid paths (:meth:`check_path`): once it is
-        built (by a consumer that plans in it: the compiled planners build it before their
-        clock starts), for a core without a fused chain validity (Arm-Z: its own kernel
-        and ``densify`` in numpy take about twice as long). A fused chain keeps the numpy
-        road, whose batches run in the lanes with four arguments a call (measured faster
-        than ``grid_check`` on the Panda, 0.41 against 0.51 ms for 653 states). None: the
-        numpy road."""
-        core = self._core
-        if self._path_model is None and core is not None and core.model_built and not core.fused:
-            self._path_model = core.model
-        return self._path_model
-
-    def _check_path_model(
-        self,
-        model: Any,
-        path: Array,
-        joint_step: float,
-        stop: Callable[[], bool] | None,
-        chunk: int,
-    ) -> PathCheck:
-        """:meth:`check_path` on the grid in the compiled model
-        (:func:`~plannerlab.collision.model_path.grid_check`): the states of
-        :meth:`densify`, in its order and counted as it counts them, ``stop`` asked before
-        each ``chunk`` of them, without making the dense path."""
-        from plannerlab.collision.model_path import GRID_INVALID, GRID_LIMIT, grid_check
-
-        P = np.ascontiguousarray(np.atleast_2d(np.asarray(path, dtype=np.float64)))
-        if P.shape[1] != self.robot.dof:
-            raise ValueError(f"path must have {self.robot.dof} joints, got shape {P.shape}")
-        if len(P) > 1:  # an edge of more than MAX_EDGE_STATES states raises as densify
-            edge_counts(P, joint_step, self.robot.continuous, self.edge_weights)
-        cur = np.zeros(3, dtype=np.int64)
-        d, q = np.empty(P.shape[1]), np.empty(P.shape[1])
-        limit = UNLIMITED_STATES if stop is None else max(int(chunk), 1)
-        kernel: Any = grid_check  # a numba dispatcher
-        while True:
-            if stop is not None and stop():
-                return PathCheck(
-                    valid=False, states_checked=int(cur[2]), backend=self.backend, complete=False
-                )
-            before = int(cur[2])
-            status = kernel(P, float(joint_step), model, cur, limit, d, q)
-            self.checks += int(cur[2]) - before
-            if status != GRID_LIMIT:
-                break
-        if status != GRID_INVALID:
-            return PathCheck(valid=True, states_checked=int(cur[2]), backend=self.backend)
-        q_bad = P[0].copy() if cur[1] == 0 else q.copy()
-        return PathCheck(
-            valid=False,
-            states_checked=int(cur[2]),
-            first_invalid_edge=int(cur[0]),
             first_invalid_state=q_bad,
             pairs=self.colliding_pairs(q_bad),
             backend=self.backend,

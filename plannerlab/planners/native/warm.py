@@ -12,11 +12,10 @@ def warm_up(model: Any | None = None) -> None:
     """Run every kernel entry point once, doing no work of note (``model``: a compiled
     model to run them on; default: a two-joint chain in an empty room)."""
     from plannerlab.collision.model import views
-    from plannerlab.collision.model_path import grid_check
     from plannerlab.planners.native import kernels as K
     from plannerlab.planners.native import rrtstar as R
 
-    entries = (views, K.rrtc_run, K.tree_path, K.shortcut_run, R.rrtstar_run, R.chain, grid_check)
+    entries = (views, K.rrtc_run, K.tree_path, K.shortcut_run, R.rrtstar_run, R.chain)
     if model is None and all(getattr(f, "signatures", True) for f in entries):
         return  # loaded in this process already
     if model is None:
@@ -48,7 +47,6 @@ def warm_up(model: Any | None = None) -> None:
         1.0, 0, 0, 0, buf, np.empty(4, dtype=np.int64), np.empty(4), np.empty(4, dtype=np.int64),
     )  # fmt: skip
     R.chain(Q, P, 0, Q.copy())
-    grid_check(Q[:1], 0.1, model, np.zeros(3, dtype=np.int64), 0, buf[0], buf[1])
 
 
 def _tiny_model() -> Any:
