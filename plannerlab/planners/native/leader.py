@@ -48,9 +48,9 @@ import numpy as np
 
 from plannerlab.errors import PlannerlabError
 from plannerlab.planners.base import PlanResult, Status, with_overrides
+from plannerlab.planners.clearance.descent import ClearanceSettings
 from plannerlab.planners.context import PlanningContext
 from plannerlab.planners.follow_leader import FollowLeader, FollowLeaderSettings
-from plannerlab.planners.gradient_clearance import ClearanceSettings
 from plannerlab.planners.leader_moves import Track, crosses_body
 from plannerlab.planners.native import kernels as K
 from plannerlab.planners.native.planner import NativePlanner, _check_settings
