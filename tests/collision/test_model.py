@@ -256,9 +256,9 @@ def test_edge_ok_checks_exactly_the_checkers_grid_once_each(kind):
             assert checks == n and rec[0] == n and sorted(rec[:n]) == list(range(1, n + 1))
             assert grid_ok.all()
         else:
-            # the states go in groups of lanes.W: the last group tested holds an invalid
-            # state, every group before it is valid
-            g0 = (checks - 1) // W * W
+            # the end state goes alone, the others in groups of lanes.W: the last group
+            # tested holds an invalid state, every state before it is valid
+            g0 = 0 if checks == 1 else 1 + (checks - 2) // W * W
             assert status == 1 and not grid_ok[rec[g0:checks] - 1].all()
             assert grid_ok[rec[:g0] - 1].all() and len(set(rec[:checks])) == checks
         seen[status] += 1
