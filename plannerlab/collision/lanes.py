@@ -12,13 +12,21 @@ capsules (not spheres) and cylinders against spheres fall back to the scalar tes
 the one-state test :func:`plannerlab.collision.chain_valid._state_ok`, in the same order
 (the kinematics, the ball centres, the obstacle and pair tests); the culls are the same
 conservative balls. A lane's verdict is therefore the one-state verdict of its state
-(``tests/collision/test_lanes.py`` holds them equal on random, near-contact and
-self-colliding states of every family). An edge checked in lanes therefore passes or fails
-exactly as it does state by state, and the re-check (which may run either) agrees.
+(``tests/collision/test_model.py`` holds them equal, and both equal to FCL's, on random,
+near-contact and self-colliding states of every family). An edge checked in lanes
+therefore passes or fails exactly as it does state by state, and the re-check (which may
+run either) agrees.
 
-Two uses: :func:`lanes_all_ok` (an edge: stop at the first lane that collides, since one
-invalid state fails the edge) and :func:`valid_states_lanes` (a batch: every lane's
-verdict).
+Two uses: edges (:func:`group_push`, :func:`group_alone`, :func:`group_end`: an edge's
+states in groups, stopping at the first lane that collides, since one invalid state fails
+the edge) and batches (:func:`valid_states_lanes`, :func:`chain_valid_lanes`,
+:func:`chain_first_bad_lanes`: every lane's verdict).
+
+Numba vectorizes a loop over the lanes only when their count is read at run time (``nw``
+below): a loop of a constant count is unrolled and left scalar, the arrays possibly
+aliasing. Eight lanes cost about as much as three (Panda) to four and a half (Arm-Z)
+one-state tests, whether one lane or eight is filled (``bench/lanes_bench.py``): the
+culls' control flow and each small loop's alias check, not arithmetic.
 """
 
 from __future__ import annotations
@@ -562,8 +570,8 @@ def group_flush(V, SL):
     """Test the pending group of states (:func:`group_push`) and empty it: (valid, count).
     The unfilled lanes start dead, so they cost nothing and fail nothing. A group of
     fewer than ``LANES_MIN`` states is tested state by state (eight lanes cost about as
-    much as four single states), stopping at the first invalid one (count: the states
-    tested)."""
+    much as three to four and a half single states), stopping at the first invalid one
+    (count: the states tested)."""
     QL, G = SL[11], SL[12]
     cnt = G[0]
     G[0] = 0
