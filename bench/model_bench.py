@@ -49,7 +49,6 @@ PANDA = "problems/urdf/panda/bookshelf_small_0001.toml"
 def _one_by_one(Q, m):
     """Each state through ``state_ok`` on its own (a compiled planner's sample check)."""
     V, S = views(m)
-    V = V[:3]  # the views without the lanes' scratch (a call passes its tuples whole)
     n = 0
     for s in range(Q.shape[0]):
         n += state_ok(Q[s], V, S)

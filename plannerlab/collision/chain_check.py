@@ -11,7 +11,7 @@ import numpy as np
 
 from plannerlab.collision.chain_pack import _pack
 from plannerlab.collision.chain_valid import _F64, chain_points, chain_state_valid
-from plannerlab.collision.lanes import chain_first_bad_lanes, chain_valid_lanes
+from plannerlab.collision.lanes import chain_batch_lanes
 
 
 class ChainValidity:
@@ -41,15 +41,14 @@ class ChainValidity:
         self.dof = int(robot.dof)
         self._one = (self.dof,)
         # batches in vector lanes (the same verdicts, state by state), one state scalar
-        self._batch_valid: Any = chain_valid_lanes
-        self._batch_first_bad: Any = chain_first_bad_lanes
+        self._batch: Any = chain_batch_lanes  # a numba dispatcher
         self._state_valid: Any = chain_state_valid  # a numba dispatcher
         self._P, self._M, self._idat, self.perm = _pack(
             robot, radii, radii_self, moving, allowed, kinds, Rs, cs, hs, body_order
         )
         #: the kernels' arguments after the states: ``chain_state_valid(q, *args)``
         self.args = (self._P, self._M, self._idat)
-        kernels: tuple[Any, ...] = (self._batch_valid, self._batch_first_bad, chain_state_valid)
+        kernels: tuple[Any, ...] = (self._batch, chain_state_valid)
         if not all(k.signatures for k in kernels):  # compile or load them here, not later
             q = np.clip(np.zeros(self.dof), robot.lower, robot.upper)
             self.valid(np.vstack([q, q]))
@@ -81,13 +80,15 @@ class ChainValidity:
     def valid(self, Q: Any) -> np.ndarray:
         """(k,) bool validity of Q (k, dof)."""
         Qc = self._Q(Q)
-        kernel: Any = self._batch_valid  # a numba dispatcher
-        return kernel(Qc, self._P, self._M, self._idat, np.empty(len(Qc), dtype=np.bool_))
+        out = np.empty(len(Qc), dtype=np.bool_)
+        self._batch(Qc, self._P, self._M, self._idat, out, False)
+        return out
 
     def first_invalid(self, Q: Any) -> int:
         """Index of the first invalid state of Q (k, dof) in order, -1 if all are valid."""
-        kernel: Any = self._batch_first_bad
-        return int(kernel(self._Q(Q), self._P, self._M, self._idat))
+        Qc = self._Q(Q)
+        out = np.empty(len(Qc), dtype=np.bool_)
+        return int(self._batch(Qc, self._P, self._M, self._idat, out, True))
 
     def is_valid(self, q: Any) -> bool:
         """Validity of one state q (dof,): a float64 array of that shape goes straight to

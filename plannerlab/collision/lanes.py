@@ -17,10 +17,13 @@ near-contact and self-colliding states of every family). An edge checked in lane
 therefore passes or fails exactly as it does state by state, and the re-check (which may
 run either) agrees.
 
-Two uses: edges (:func:`group_push`, :func:`group_alone`, :func:`group_end`: an edge's
-states in groups, stopping at the first lane that collides, since one invalid state fails
-the edge) and batches (:func:`valid_states_lanes`, :func:`chain_valid_lanes`,
-:func:`chain_first_bad_lanes`: every lane's verdict).
+Its use: batches (:func:`valid_states_lanes`, :func:`chain_valid_lanes`,
+:func:`chain_first_bad_lanes`: every lane's verdict), so the re-check, the OMPL planners'
+edges (each edge one batch) and the executor's checks. The compiled planners' edges stay
+one state at a time: they are checked lazily, the end state and a few coarse states, too
+few to fill the lanes, and every kernel that calls the lanes compiles them again into its
+own module (the native kernels took 175 s to compile cold with their edges in lanes,
+against 46 s).
 
 Numba vectorizes a loop over the lanes only when their count is read at run time (``nw``
 below): a loop of a constant count is unrolled and left scalar, the arrays possibly
@@ -32,6 +35,7 @@ culls' control flow and each small loop's alias check, not arithmetic.
 from __future__ import annotations
 
 import math
+from typing import Any
 
 import numpy as np
 from numba import njit
@@ -44,24 +48,18 @@ from plannerlab.collision.chain_pack import (
     _H_NB,
     _H_NCL,
 )
-from plannerlab.collision.chain_valid import _SCRATCH, _scratch, _sphere_hit, _state_ok, _unpack
+from plannerlab.collision.chain_valid import _SCRATCH, _sphere_hit, _unpack
 from plannerlab.collision.geometry import BOX, SPHERE, capsule_obstacle_hit, seg_seg
 
 #: lanes per call: 8 doubles fill one AVX-512 register or two AVX2 ones
 W = 8
-#: the fewest states of an edge's group tested in lanes (fewer: one by one): eight lanes
-#: cost about three one-state tests on the Panda, four and a half on Arm-Z
-#: (``bench/lanes_bench.py``, "k filled")
-LANES_MIN = 5
 
 
 @njit(cache=True, nogil=True)
 def lanes_scratch(idat):
     """Scratch of :func:`lanes_check` (made once per search): body frames (nb, 12, W),
     body, cluster and chunk ball centres, capsule ends, the lanes' joint values, masks,
-    placed flags, the scalar tests' scratch; then a group of states waiting to be tested,
-    its count (:func:`group_push`), and the one-state test's scratch and state (a group
-    of fewer than ``LANES_MIN`` states is tested state by state)."""
+    placed flags, the scalar tests' scratch; then the states being tested."""
     nb, L, ncl, dof = idat[_H_NB], idat[_H_L], idat[_H_NCL], idat[_H_DOF]
     nch = (nb + _CHUNK - 1) // _CHUNK
     F = np.empty((nb, 12, W))
@@ -75,9 +73,8 @@ def lanes_scratch(idat):
     Mk = np.zeros((8, W), dtype=np.bool_)  # masks: alive, then one per cull level
     done = np.zeros(nb, dtype=np.int64)  # placed bodies; done[-1]... see _group
     w = np.zeros(_SCRATCH + 6)  # the scalar tests' scratch, then two points
-    QL = np.zeros((dof, W))  # a group of states waiting to be tested (lane k: QL[:, k])
-    G = np.zeros(1, dtype=np.int64)  # how many lanes of QL are filled
-    return F, C, K, X, Y, CB, T, v, Mk, done, w, QL, G, _scratch(idat), np.empty(dof)
+    QL = np.zeros((dof, W))  # the states being tested (lane k: QL[:, k])
+    return F, C, K, X, Y, CB, T, v, Mk, done, w, QL
 
 
 @njit(cache=True, nogil=True, inline="always")
@@ -531,7 +528,7 @@ def _batch(Q, V, SL, out, first_only):
             for i in range(dof):
                 QL[i, k] = Q[src, i]
             alive[k] = k < cnt
-        lanes_check(QL, V[:3], SL[:11], alive, False)  # no more than it reads: a call
+        lanes_check(QL, V, SL[:11], alive, False)  # what it reads: a call copies its tuples
         bad = -1
         for k in range(cnt):
             out[s0 + k] = alive[k]
@@ -543,91 +540,18 @@ def _batch(Q, V, SL, out, first_only):
 
 
 @njit(cache=True, nogil=True)
-def valid_states_lanes(Q, m, out):
-    """Validity of a batch Q (k, dof) -> out (k,) bool, W states at a time."""
-    V, SL = lanes_views(m)
-    _batch(Q, V, SL, out, False)
+def chain_batch_lanes(Q, P, M, idat, out, first_only):
+    """Validity of a batch Q (k, dof) into out (k,) bool, W states at a time, on the
+    packed chain (``chain_pack._pack``'s arrays, a model's ``P, M, idat``); with
+    ``first_only`` it stops after the first group holding an invalid state. Returns the
+    first invalid index, or -1. The one compiled entry of the lanes: every kernel that
+    calls them compiles them again into its own module (about 20 s cold each)."""
+    return _batch(Q, _unpack(P, M, idat), lanes_scratch(idat), out, first_only)
+
+
+def valid_states_lanes(Q: np.ndarray, m: Any, out: np.ndarray) -> np.ndarray:
+    """Validity of a batch Q (k, dof) -> out (k,) bool of a compiled model, W states at a
+    time (:func:`chain_batch_lanes`)."""
+    kernel: Any = chain_batch_lanes  # a numba dispatcher
+    kernel(Q, m.P, m.M, m.idat, out, False)
     return out
-
-
-@njit(cache=True, nogil=True)
-def chain_valid_lanes(Q, P, M, idat, out):
-    """``chain_valid.chain_valid`` (the packed arrays), W states at a time."""
-    _batch(Q, _unpack(P, M, idat), lanes_scratch(idat), out, False)
-    return out
-
-
-@njit(cache=True, nogil=True)
-def chain_first_bad_lanes(Q, P, M, idat):
-    """``chain_valid.chain_first_bad``, W states at a time: the first invalid index or -1."""
-    out = np.empty(Q.shape[0], dtype=np.bool_)
-    return _batch(Q, _unpack(P, M, idat), lanes_scratch(idat), out, True)
-
-
-# ---------------------------------------------------------------------- edges in groups
-@njit(cache=True, nogil=True)
-def group_flush(V, SL):
-    """Test the pending group of states (:func:`group_push`) and empty it: (valid, count).
-    The unfilled lanes start dead, so they cost nothing and fail nothing. A group of
-    fewer than ``LANES_MIN`` states is tested state by state (eight lanes cost about as
-    much as three to four and a half single states), stopping at the first invalid one
-    (count: the states tested)."""
-    QL, G = SL[11], SL[12]
-    cnt = G[0]
-    G[0] = 0
-    if cnt < LANES_MIN:
-        S, q = SL[13], SL[14]
-        for k in range(cnt):
-            for i in range(q.shape[0]):
-                q[i] = QL[i, k]
-            if not _state_ok(q, V[:3], S):  # the views alone: a call passes its tuples
-                return False, k + 1
-        return True, cnt
-    alive = SL[8][0]
-    for k in range(W):
-        alive[k] = k < cnt
-    lanes_check(QL, V[:3], SL[:11], alive, True)
-    ok = True
-    for k in range(cnt):
-        ok &= alive[k]
-    return ok, cnt
-
-
-@njit(cache=True, nogil=True)
-def group_push(q_a, d, j, n, V, SL, checks, limit):
-    """Add grid state j (1..n) of edge ``q_a + t d`` (``model.edge_state``'s floats) to the
-    pending group, testing the group when it is full or when the check ``limit`` would
-    be passed (the states before the limit are tested, none after it). Returns (status,
-    checks): -1 go on, 1 a state of the tested group is invalid, 2 the limit came first.
-    A tested group counts as many checks as states."""
-    QL, G = SL[11], SL[12]
-    if checks + G[0] >= limit:
-        ok, c = group_flush(V, SL)
-        return (2 if ok else 1), checks + c
-    t = 1.0 if j == n else j * (1.0 / n)
-    k = G[0]
-    for i in range(q_a.shape[0]):
-        QL[i, k] = q_a[i] + t * d[i]
-    G[0] = k + 1
-    if k + 1 == W:
-        ok, c = group_flush(V, SL)
-        return -1 if ok else 1, checks + c
-    return -1, checks
-
-
-@njit(cache=True, nogil=True)
-def group_alone(q_a, d, j, n, V, SL, checks, limit):
-    """:func:`group_push`, then the group tested at once: an edge's first state goes alone
-    (most invalid edges fail on it, and one state costs a third of eight lanes)."""
-    status, checks = group_push(q_a, d, j, n, V, SL, checks, limit)
-    if status >= 0:
-        return status, checks
-    ok, c = group_flush(V, SL)
-    return (-1 if ok else 1), checks + c
-
-
-@njit(cache=True, nogil=True)
-def group_end(V, SL, checks):
-    """The edge's last, partial group: (status, checks), status 0 every state valid, 1 not."""
-    ok, c = group_flush(V, SL)
-    return 0 if ok else 1, checks + c

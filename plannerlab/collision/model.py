@@ -49,13 +49,7 @@ from plannerlab.collision.chain_valid import (
     _state_ok,
     _unpack,
 )
-from plannerlab.collision.lanes import (
-    group_alone,
-    group_end,
-    group_push,
-    lanes_scratch,
-    valid_states_lanes,
-)
+from plannerlab.collision.lanes import valid_states_lanes
 from plannerlab.errors import PlannerlabError
 from plannerlab.robots.registry import model_builder
 
@@ -172,13 +166,8 @@ def build_model(core: Any) -> CompiledModel:
 # ---------------------------------------------------------------------- compiled queries
 @njit(cache=True, nogil=True)
 def views(m):
-    """The model's views ``V`` and a scratch ``S`` for :func:`state_ok` (made once per
-    search). ``V[3]`` is the scratch of the states tested in vector lanes
-    (:mod:`plannerlab.collision.lanes`: the edges' groups); pass ``V[:3]`` to
-    :func:`state_ok` (a compiled call passes its tuples whole: the lanes' scratch would
-    add some 0.3 µs a call)."""
-    ints, floats, cpl = _unpack(m.P, m.M, m.idat)
-    return (ints, floats, cpl, lanes_scratch(m.idat)), _scratch(m.idat)
+    """The model's views and a scratch for :func:`state_ok` (made once per search)."""
+    return _unpack(m.P, m.M, m.idat), _scratch(m.idat)
 
 
 #: One state q (dof,) is valid (``V``, ``S`` from :func:`views`): chain_valid's own
@@ -208,8 +197,7 @@ def segments(Q, m, out):
     return out
 
 
-@njit(cache=True, nogil=True)
-def valid_states(Q, m, out):
+def valid_states(Q: np.ndarray, m: CompiledModel, out: np.ndarray) -> np.ndarray:
     """Validity of a batch Q (k, dof) -> out (k,) bool, in vector lanes (the verdicts of
     :func:`state_ok`, state by state)."""
     return valid_states_lanes(Q, m, out)
@@ -250,21 +238,20 @@ def edge_state(q_a, d, j, n, out):
 @njit(cache=True, nogil=True, inline="always")
 def _edge_visit(q_a, q_b, joint_step, m, V, S, d, q, limit, rec):
     """:func:`edge_ok`'s loop; ``rec`` (non-empty) records the grid indices j visited, in
-    order (the test's window on the very loop the planners run). The states go to the
-    vector lanes in groups of ``lanes.W``, in this order."""
+    order (the test's window on the very loop the planners run)."""
     edge_delta(q_a, q_b, m.continuous, d)
     n = edge_count(d, joint_step, m.edge_weights)
     keep = rec.shape[0] > 0
-    SL = V[3]
     checks = 0
+    # j = n first (the state the edge reaches), then j in van der Corput order over 1..n-1
+    edge_state(q_a, d, n, n, q)
     if limit < 1:
         return 2, checks
-    # j = n first (the state the edge reaches), then j in van der Corput order over 1..n-1
     if keep:
-        rec[0] = n
-    status, checks = group_alone(q_a, d, n, n, V, SL, checks, limit)  # the end alone first
-    if status >= 0:
-        return status, checks
+        rec[checks] = n
+    checks += 1
+    if not _state_ok(q, V, S):
+        return 1, checks
     if n == 1:
         return 0, checks
     step = 1
@@ -272,19 +259,20 @@ def _edge_visit(q_a, q_b, joint_step, m, V, S, d, q, limit, rec):
         step *= 2
     # visit j = step/2, step/4, 3 step/4, ... (skipping j >= n): every j in 1..n-1 once
     h = step // 2
-    at = 1
     while h >= 1:
         j = h
         while j < n:
-            if keep and at < rec.shape[0]:
-                rec[at] = j
-            at += 1
-            status, checks = group_push(q_a, d, j, n, V, SL, checks, limit)
-            if status >= 0:
-                return status, checks
+            if checks >= limit:
+                return 2, checks
+            edge_state(q_a, d, j, n, q)
+            if keep:
+                rec[checks] = j
+            checks += 1
+            if not _state_ok(q, V, S):
+                return 1, checks
             j += 2 * h
         h //= 2
-    return group_end(V, SL, checks)
+    return 0, checks
 
 
 @njit(cache=True, nogil=True)

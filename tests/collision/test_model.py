@@ -15,7 +15,6 @@ from conftest import PROBLEMS
 from plannerlab.collision.core import Core
 from plannerlab.collision.fcl_checker import CollisionChecker, problem_checker
 from plannerlab.collision.kernels import valid_batch
-from plannerlab.collision.lanes import W
 from plannerlab.collision.model import (
     CompiledModel,
     ModelError,
@@ -256,11 +255,8 @@ def test_edge_ok_checks_exactly_the_checkers_grid_once_each(kind):
             assert checks == n and rec[0] == n and sorted(rec[:n]) == list(range(1, n + 1))
             assert grid_ok.all()
         else:
-            # the end state goes alone, the others in groups of lanes.W: the last group
-            # tested holds an invalid state, every state before it is valid
-            g0 = 0 if checks == 1 else 1 + (checks - 2) // W * W
-            assert status == 1 and not grid_ok[rec[g0:checks] - 1].all()
-            assert grid_ok[rec[:g0] - 1].all() and len(set(rec[:checks])) == checks
+            assert status == 1 and not grid_ok[rec[checks - 1] - 1]
+            assert grid_ok[rec[: checks - 1] - 1].all() and len(set(rec[:checks])) == checks
         seen[status] += 1
         # its states are densify's, bit for bit, and edge_ok says what edge_visits says
         d, q = np.empty(robot.dof), np.empty(robot.dof)

@@ -31,8 +31,7 @@ import math
 import numpy as np
 from numba import njit
 
-from plannerlab.collision.lanes import group_alone, group_end, group_push
-from plannerlab.collision.model import edge_count, edge_delta
+from plannerlab.collision.model import edge_count, edge_delta, edge_state, state_ok
 from plannerlab.planners.native.kdtree import kd_catch_up, kd_insert, kd_nearest, split_dims
 
 # ---------------------------------------------------------------------- return codes
@@ -221,18 +220,21 @@ def edge_free(q_a, q_b, joint_step, m, V, S, d, q, limit, near_a_first, every=1,
     first = 1 if near_a_first else n
     if limit <= 0:
         return 2, 0
-    SL = V[3]
     checks = 0
-    if not fine:  # the new end alone first (most invalid edges fail there), then groups
-        status, checks = group_alone(q_a, d, first, n, V, SL, checks, limit)
-        if status >= 0:
-            return status, checks
+    if not fine:
+        edge_state(q_a, d, first, n, q)
+        checks += 1
+        if not state_ok(q, V, S):
+            return 1, checks
         if n == 1:
             return 0, checks
         if near_a_first:  # then the far end, j = n
-            status, checks = group_push(q_a, d, n, n, V, SL, checks, limit)
-            if status >= 0:
-                return status, checks
+            if checks >= limit:
+                return 2, checks
+            edge_state(q_a, d, n, n, q)
+            checks += 1
+            if not state_ok(q, V, S):
+                return 1, checks
     step = 1
     while step < n:
         step *= 2
@@ -242,12 +244,15 @@ def edge_free(q_a, q_b, joint_step, m, V, S, d, q, limit, near_a_first, every=1,
         j = h
         while j < n:
             if not (fine and near_a_first and j == 1) and not (not fine and j == first):
-                status, checks = group_push(q_a, d, j, n, V, SL, checks, limit)
-                if status >= 0:
-                    return status, checks
+                if checks >= limit:
+                    return 2, checks
+                edge_state(q_a, d, j, n, q)
+                checks += 1
+                if not state_ok(q, V, S):
+                    return 1, checks
             j += 2 * h
         h //= 2
-    return group_end(V, SL, checks)
+    return 0, checks
 
 
 @njit(cache=True, nogil=True)
