@@ -113,3 +113,14 @@ def test_a_chain_whose_capsules_are_not_its_links_is_refused():
 
     with pytest.raises(ValueError, match="one capsule per link"):
         sphere_chain(chain_model(robot), Split())
+
+
+def test_a_model_of_another_chain_is_refused_by_name():
+    """The sphere field needs the model's capsules to be the robot's links one to one: a
+    model of a six-module Arm-Z given with a 24-module one is refused, naming the robot
+    and both counts."""
+    from plannerlab.robots.armz.model import ArmZ
+
+    short, long = ArmZ(n_modules=6), ArmZ(n_modules=24)
+    with pytest.raises(ValueError, match=r"'armz'.*capsules for 24 links"):
+        sphere_chain(chain_model(short), long)
