@@ -89,7 +89,7 @@ def main(argv: list[str]) -> int:
     from plannerlab.collision.fcl_checker import problem_checker
     from plannerlab.planners import make_planner
     from plannerlab.planners.clearance import ClearanceField
-    from plannerlab.planners.leader_grid import grid_voxel_m, grid_voxels
+    from plannerlab.planners.follow_leader.grid import grid_voxel_m, grid_voxels
     from plannerlab.problem.catalog import load_problem
     from plannerlab.problem.load import Budget
 

@@ -128,8 +128,8 @@ if TYPE_CHECKING:
     from plannerlab.run.pipeline import execute_results, legs_from_spec
     from plannerlab.run.plan_check import check_plan, read_checked_plan, read_plan
     from plannerlab.run.planner_info import planner_catalog, planner_info
-    from plannerlab.variants import VariantError, write_variants
-    from plannerlab.variants import generate as generate_variants
+    from plannerlab.problem.variants import VariantError, write_variants
+    from plannerlab.problem.variants import generate as generate_variants
 
 #: what the command line needs beyond the road above (``cli/`` is this API's first
 #: client: it imports nothing else of plannerlab but ``record``); a name without an
@@ -170,9 +170,9 @@ _EXPORTS |= {
     "run_continuum_case": "plannerlab.comparison.continuum:run_case",
     "continuum_case_name": "plannerlab.comparison.continuum:case_name",
     # Arm-Z variants, the IRb-6's analytic IK
-    "generate_variants": "plannerlab.variants:generate",
-    "write_variants": "plannerlab.variants:write_variants",
-    "VariantError": "plannerlab.variants:VariantError",
+    "generate_variants": "plannerlab.problem.variants:generate",
+    "write_variants": "plannerlab.problem.variants:write_variants",
+    "VariantError": "plannerlab.problem.variants:VariantError",
     "irb6_ik": "plannerlab.robots.irb6.report:irb6_ik",
 }
 __all__ += [

@@ -11,7 +11,7 @@ planner) and writes the kept variants as problem files (``<out>/armz_inspection_
 each written atomically). A draw without a witness for some goal is dropped (reported on
 stderr) and the next draw is taken. The same seed gives the same files.
 
-Argument parsing and printing only; the generator is :mod:`plannerlab.variants`.
+Argument parsing and printing only; the generator is :mod:`plannerlab.problem.variants`.
 """
 
 from __future__ import annotations

@@ -191,7 +191,7 @@ def _entries() -> dict[str, PlannerEntry]:
         entries.append(
             PlannerEntry(
                 name,
-                "plannerlab.planners.follow_leader:make",
+                "plannerlab.planners.follow_leader.planner:make",
                 summary,
                 uses_rng=uses_rng,
                 options=_ESCAPE_RRTCONNECT,

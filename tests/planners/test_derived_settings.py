@@ -27,8 +27,8 @@ from plannerlab.planners.clearance.settings import (
     ClearanceSettings,
     robot_size,
 )
-from plannerlab.planners.follow_leader import DERIVED_DISTANCES as LEADER_DISTANCES
-from plannerlab.planners.follow_leader import FollowLeaderSettings
+from plannerlab.planners.follow_leader.planner import DERIVED_DISTANCES as LEADER_DISTANCES
+from plannerlab.planners.follow_leader.planner import FollowLeaderSettings
 from plannerlab.problem.catalog import load_problem
 from plannerlab.problem.load import Budget, Problem
 from plannerlab.robots.armz.model import ArmZ

@@ -9,7 +9,7 @@ import pytest
 from plannerlab.collision.fcl_checker import problem_checker
 from plannerlab.planners import make_planner
 from plannerlab.planners.base import Status
-from plannerlab.planners.leader_grid import grid_distance_m, scene_distance_m
+from plannerlab.planners.follow_leader.grid import grid_distance_m, scene_distance_m
 from plannerlab.problem.catalog import load_problem
 from plannerlab.problem.load import Budget
 

@@ -1,5 +1,5 @@
 """``native.rrtconnect+leader`` (planners/native/leader.py) and follow-the-leader's
-reverse plan (planners/follow_leader.py): golden values on fixed seeds with check budgets
+reverse plan (planners/follow_leader/): golden values on fixed seeds with check budgets
 (no clock), seeds that differ, and leaving a room from its far wall."""
 
 from __future__ import annotations

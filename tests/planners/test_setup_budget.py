@@ -19,7 +19,7 @@ from test_planner_contract import CHECK_S, LOOP_CHECKS, LOOP_READS, timed_solve
 from plannerlab.errors import PlannerlabError
 from plannerlab.planners import REGISTRY, Status, make_planner
 from plannerlab.planners.clearance import MAX_SPHERES, ClearanceField, SetupStopped
-from plannerlab.planners.leader_grid import grid_voxel_m, grid_voxels
+from plannerlab.planners.follow_leader.grid import grid_voxel_m, grid_voxels
 from plannerlab.problem.catalog import load_problem
 from plannerlab.problem.load import Budget, Problem
 

@@ -1,4 +1,4 @@
-"""Variants of the paper's task (``plannerlab.variants``): the generator is deterministic,
+"""Variants of the paper's task (``plannerlab.problem.variants``): the generator is deterministic,
 every committed variant's witnesses are collision-free with their stated clearance and
 inside their goals, and one variant is solved and executed end to end."""
 
@@ -13,7 +13,7 @@ from conftest import PROBLEMS
 from plannerlab.collision.fcl_checker import CollisionChecker
 from plannerlab.problem.catalog import list_problems, load_problem
 from plannerlab.record.leg import Status
-from plannerlab.variants import (
+from plannerlab.problem.variants import (
     MODULES_RANGE,
     ORDERS,
     RHO_M,

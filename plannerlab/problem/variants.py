@@ -515,7 +515,7 @@ def _header(spec: VariantSpec, name: str, command: str, min_clearance_m: float) 
     r = spec.room
     return (
         f"{name}: a variant of the Arm-Z paper's task (problems/armz_inspection.toml) in a room\n"
-        f"it was not developed on, made by plannerlab.variants:\n"
+        f"it was not developed on, made by plannerlab.problem.variants:\n"
         f"    {command}\n"
         f"Drawn: room scaled x{spec.scale:.4f} about the base, shifted "
         f"[{', '.join(f'{v:.3f}' for v in spec.shift_m)}] m, "
@@ -553,7 +553,7 @@ def make_variant(
         return found
     states, clear = found
     doc["witness"] = {
-        "note": "one collision-free state per goal, in leg order (plannerlab.variants)",
+        "note": "one collision-free state per goal, in leg order (plannerlab.problem.variants)",
         "min_clearance_m": min_clearance_m,
         "goal_states_rad": [[round(float(v), 6) for v in q] for q in states],
     }

@@ -18,7 +18,7 @@ from plannerlab.problem.goals import GoalRegion
 from plannerlab.robots.base import Array
 
 #: a :class:`~plannerlab.planners.follow_leader.FollowLeader` (its tracking descent, its
-#: settings, its leader's path) and a :class:`~plannerlab.planners.leader_grid.TipPath`:
+#: settings, its leader's path) and a :class:`~plannerlab.planners.follow_leader.grid.TipPath`:
 #: typed loosely so that this module and the planner's form no import cycle
 FollowLeader = Any
 TipPath = Any

@@ -64,7 +64,7 @@ from typing import Any
 import numpy as np
 
 from plannerlab.errors import PlannerlabError
-from plannerlab.planners import leader_moves
+from plannerlab.planners.follow_leader import moves as leader_moves
 from plannerlab.planners.base import (
     Planner,
     PlanResult,
@@ -76,8 +76,8 @@ from plannerlab.planners.clearance import SetupStopped
 from plannerlab.planners.clearance.descent import ClearanceDescent, ClearanceSettings, LegPath
 from plannerlab.planners.clearance.settings import DERIVED, resolve_distances
 from plannerlab.planners.context import LegPlanner, PlanningContext
-from plannerlab.planners.leader_grid import TipPath, scene_distance_m, tip_path
-from plannerlab.planners.leader_moves import Track, crosses_body
+from plannerlab.planners.follow_leader.grid import TipPath, scene_distance_m, tip_path
+from plannerlab.planners.follow_leader.moves import Track, crosses_body
 from plannerlab.problem.goals import GoalRegion
 from plannerlab.robots.base import Array, joint_difference
 
@@ -369,7 +369,7 @@ class FollowLeader(LegPlanner):
         used: int = 0,
         leader: TipPath | None = None,
     ) -> Track:
-        """:func:`plannerlab.planners.leader_moves.track` with this planner (its derived
+        """:func:`plannerlab.planners.follow_leader.moves.track` with this planner (its derived
         distances set for the leg's robot)."""
         fl = self.for_robot(ctx.robot)
         return leader_moves.track(fl, ctx, q0, goal, rng, used, leader)
@@ -392,7 +392,7 @@ class FollowLeader(LegPlanner):
         return bool(scene_distance_m(ctx.scene, line).min() >= clearance)
 
     def retract(self, ctx: PlanningContext, q0: Array, used: int = 0) -> Track:
-        """:func:`plannerlab.planners.leader_moves.retract` with this planner (its derived
+        """:func:`plannerlab.planners.follow_leader.moves.retract` with this planner (its derived
         distances set for the leg's robot)."""
         return leader_moves.retract(self.for_robot(ctx.robot), ctx, q0, used)
 
