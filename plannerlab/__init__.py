@@ -124,12 +124,12 @@ if TYPE_CHECKING:
     from plannerlab.problem import mbm
     from plannerlab.problem.catalog import problem_catalog, problem_origin, resolve_problem_path
     from plannerlab.problem.load import parse_problem
+    from plannerlab.problem.variants import VariantError, write_variants
+    from plannerlab.problem.variants import generate as generate_variants
     from plannerlab.robots.irb6.report import irb6_ik
     from plannerlab.run.pipeline import execute_results, legs_from_spec
     from plannerlab.run.plan_check import check_plan, read_checked_plan, read_plan
     from plannerlab.run.planner_info import planner_catalog, planner_info
-    from plannerlab.problem.variants import VariantError, write_variants
-    from plannerlab.problem.variants import generate as generate_variants
 
 #: what the command line needs beyond the road above (``cli/`` is this API's first
 #: client: it imports nothing else of plannerlab but ``record``); a name without an

@@ -108,10 +108,64 @@ def write_problem(directory: Path, text: str | bytes, name: str = "p.toml") -> P
 
 
 def path_digest(path: np.ndarray) -> str:
-    """First 16 hex digits of the SHA-256 of a path rounded to 1e-6 rad (float noise below
-    that does not change it): the golden value of a fixed-seed regression."""
+    """First 16 hex digits of the SHA-256 of a path rounded to 1e-6 rad: for comparing two
+    runs *on this machine* (the same seed must give the same path). Never a golden value:
+    a value on the rounding edge flips the digest with a float's last bit, and compiled code
+    runs the host CPU's instructions; goldens use :func:`assert_golden_path`."""
     rounded = np.round(np.asarray(path, dtype=np.float64), 6) + 0.0  # + 0.0: no -0.0
     return hashlib.sha256(np.ascontiguousarray(rounded).tobytes()).hexdigest()[:16]
+
+
+#: golden paths of the fixed-seed regressions: per case, the path's shape and up to
+#: GOLDEN_SAMPLES of its states (evenly spaced, the first and the last included)
+GOLDEN_PATHS = ROOT / "tests" / "data" / "golden_paths.json"
+GOLDEN_SAMPLES = 33
+#: how far [rad] a golden path's sampled states may move: far above a float's last bits
+#: (1e-16 .. 1e-11 rad between CPUs and compilers), far below any change of behaviour
+GOLDEN_ATOL_RAD = 1e-6
+
+
+def path_fingerprint(path: np.ndarray) -> dict:
+    """A path's golden form: its shape and a few of its states (JSON-ready)."""
+    P = np.atleast_2d(np.asarray(path, dtype=np.float64))
+    n = len(P)
+    idx = np.unique(np.linspace(0, n - 1, min(n, GOLDEN_SAMPLES)).round().astype(int)) if n else []
+    states = np.round(P[idx], 9) + 0.0  # 1e-9 rad: far below the tolerance; no -0.0
+    return {"shape": [int(n), int(P.shape[1]) if P.ndim == 2 else 0], "states": states.tolist()}
+
+
+def _golden_paths() -> dict:
+    import json
+
+    if GOLDEN_PATHS.exists():
+        return json.loads(GOLDEN_PATHS.read_text(encoding="utf-8"))
+    return {}
+
+
+def assert_golden_path(key: str, fingerprint: dict) -> None:
+    """The path (its :func:`path_fingerprint`) is the one pinned under ``key``: the same
+    number of states and every sampled state within ``GOLDEN_ATOL_RAD``. With
+    ``PLANNERLAB_REPIN_PATHS=1`` the fingerprint is written instead (re-pin only with the
+    reason in the commit)."""
+    import json
+
+    if os.environ.get("PLANNERLAB_REPIN_PATHS") == "1":
+        table = _golden_paths()
+        table[key] = fingerprint
+        GOLDEN_PATHS.parent.mkdir(parents=True, exist_ok=True)
+        GOLDEN_PATHS.write_text(
+            json.dumps(table, indent=1, sort_keys=True) + "\n", encoding="utf-8"
+        )
+        return
+    table = _golden_paths()
+    assert key in table, f"no golden path {key!r}: run with PLANNERLAB_REPIN_PATHS=1 once"
+    want = table[key]
+    assert fingerprint["shape"] == want["shape"], (key, fingerprint["shape"], want["shape"])
+    got_s, want_s = np.asarray(fingerprint["states"]), np.asarray(want["states"])
+    assert got_s.shape == want_s.shape, key
+    if got_s.size:
+        worst = float(np.max(np.abs(got_s - want_s)))
+        assert worst <= GOLDEN_ATOL_RAD, f"{key}: a sampled state moved {worst:.3g} rad"
 
 
 @pytest.fixture

@@ -9,8 +9,12 @@ one's path, test_joint_goal_descent the Panda's goal-state checks.
 
 Each solve runs in a fresh spawned process: OMPL's seed takes effect only before its first
 generator exists. Pinned: status, collision checks, iterations, local minima met and
-escaped, and the path's digest (rounded to 1e-6 rad, conftest.path_digest). A change that
+escaped, and the path (its shape and 33 of its states within 1e-6 rad:
+``conftest.assert_golden_path``, pinned in ``tests/data/golden_paths.json``). A change that
 moves one of them changes what the planner does: re-pin only with the reason in the commit.
+The paths were pinned as SHA-256 digests of the path rounded to 1e-6 rad until a digest
+flipped with a float's last bit on another CPU (a joint value on the rounding edge): a
+golden must not depend on the last bits of a float.
 
 The hybrids' checks were 14 378 and 24 694 before each leg got one planning context: their
 sub-solves (each descent after the first, each RRT-Connect escape) checked their start,
@@ -47,48 +51,18 @@ import multiprocessing as mp
 import pytest
 
 #: (planner, problem, check budget, seed) -> (status, checks, iterations, minima,
-#: escapes, path digest)
+#: escapes); the paths in tests/data/golden_paths.json (``goldens/<planner>/<problem>``)
 GOLDEN = {
-    ("ompl.rrtconnect", "toy", 20_000, 5): ("solved", 945, 1, 0, 0, "329421407dad09f6"),
-    ("ompl.kpiece1", "toy", 20_000, 5): ("solved", 1168, 18, 0, 0, "b39b50323c865506"),
-    ("gradient.follow_leader", "toy", 20_000, 5): ("solved", 564, 587, 0, 0, "61d72f1330090571"),
-    ("gradient+rrtconnect", "armz_pocket", 30_000, 3): (
-        "solved",
-        11919,
-        131,
-        2,
-        2,
-        "625be33c04fa1282",
-    ),
-    ("gradient.multistart", "armz_pocket", 30_000, 3): (
-        # restarts checked in metres: fewer of them are clear, the budget runs out first
-        "budget_exhausted",
-        30003,
-        1076,
-        7,
-        7,
-        "482129b54811cde8",
-    ),
-    ("ompl.prm", "toy", 20_000, 5): ("solved", 17925, 72, 0, 0, "429e64a7746baed4"),
-    ("ompl.prmstar", "toy", 20_000, 5): ("solved", 20000, 76, 0, 0, "bf38396b893ee331"),
-    ("ompl.rrtconnect", "toy_joint", 20_000, 5): ("solved", 600, 1, 0, 0, "5e54a2caaa73d393"),
-    ("gradient.clearance", "armz_pocket", 20_000, 0): (
-        "solved",
-        323,
-        341,
-        0,
-        0,
-        "b9ba13985f6b9eab",
-    ),
-    ("gradient.clearance", "toy_joint", 20_000, 5): ("solved", 39, 39, 0, 0, "d7e910ea840010e6"),
-    ("gradient.clearance+detour", "armz_thin_wall", 20_000, 0): (
-        "solved",
-        487,
-        574,
-        1,
-        1,
-        "a422fbc4367b408b",
-    ),
+    ("ompl.rrtconnect", "toy", 20_000, 5): ("solved", 945, 1, 0, 0),
+    ("ompl.kpiece1", "toy", 20_000, 5): ("solved", 1168, 18, 0, 0),
+    ("gradient.follow_leader", "toy", 20_000, 5): ("solved", 564, 587, 0, 0),
+    ("gradient+rrtconnect", "armz_pocket", 30_000, 3): ("solved", 11919, 131, 2, 2),
+    ("ompl.prm", "toy", 20_000, 5): ("solved", 17925, 72, 0, 0),
+    ("ompl.prmstar", "toy", 20_000, 5): ("solved", 20000, 76, 0, 0),
+    ("ompl.rrtconnect", "toy_joint", 20_000, 5): ("solved", 600, 1, 0, 0),
+    ("gradient.clearance", "armz_pocket", 20_000, 0): ("solved", 323, 341, 0, 0),
+    ("gradient.clearance", "toy_joint", 20_000, 5): ("solved", 39, 39, 0, 0),
+    ("gradient.clearance+detour", "armz_thin_wall", 20_000, 0): ("solved", 487, 574, 1, 1),
     ("gradient.clearance+random_detour", "armz_thin_wall", 20_000, 0): (
         # was e490ba083476c424: see "Re-pinned when the descent's kinematics" above
         "solved",
@@ -96,27 +70,36 @@ GOLDEN = {
         607,
         1,
         1,
-        "07c5ded7c45cde4a",
+    ),
+    ("gradient.follow_leader+random", "armz_thin_wall", 20_000, 0): ("solved", 409, 427, 0, 0),
+    ("chord_arc", "continuum_case1", 20_000, 0): ("solved", 576, 18, 0, 0),
+}
+
+#: cases that amplify a float's last bit into another search (a finite-difference gradient
+#: into restarts that end at the budget; a descent's stall into an RRT-Connect escape whose
+#: goal is found by another descent): the same machine gives the same values, another CPU
+#: moves checks and iterations by a fraction of a percent (measured: 30 003 / 1 076 on one
+#: machine, 30 013 / 1 074 on an AVX-512 EPYC; 3 126 and 3 130 checks). Pinned: status,
+#: minima and escapes exactly, checks and iterations within CHAOTIC_REL of the value.
+CHAOTIC = {
+    ("gradient.multistart", "armz_pocket", 30_000, 3): (
+        # restarts checked in metres: fewer of them are clear, the budget runs out first
+        "budget_exhausted",
+        30003,
+        1076,
+        7,
+        7,
     ),
     ("gradient.clearance+rrtconnect", "armz_behind_plate", 60_000, 0): (
-        # was 3071 checks, 425bdabf890f3091: see "Re-pinned when the descent's kinematics"
+        # was 3071 checks: see "Re-pinned when the descent's kinematics" above
         "solved",
         3126,
         244,
         1,
         1,
-        "c3541f68bb44a837",
     ),
-    ("gradient.follow_leader+random", "armz_thin_wall", 20_000, 0): (
-        "solved",
-        409,
-        427,
-        0,
-        0,
-        "7fd21662fad47124",
-    ),
-    ("chord_arc", "continuum_case1", 20_000, 0): ("solved", 576, 18, 0, 0, "72a33f66dc3b20ff"),
 }
+CHAOTIC_REL = 0.02
 
 
 def _problem(name: str):
@@ -149,7 +132,7 @@ def _problem(name: str):
 
 def _solve(case: tuple[str, str, int, int]) -> tuple:
     """Spawned worker: one leg-0 solve, OMPL seeded by it (a fresh process)."""
-    from conftest import path_digest
+    from conftest import path_fingerprint
 
     from plannerlab.planners import make_planner
     from plannerlab.problem.load import Budget
@@ -164,18 +147,30 @@ def _solve(case: tuple[str, str, int, int]) -> tuple:
         r.iterations,
         r.local_minima,
         r.escapes,
-        path_digest(r.path),
+        path_fingerprint(r.path),
     )
 
 
 @pytest.fixture(scope="module")
 def solved() -> dict:
     ctx = mp.get_context("spawn")
-    cases = sorted(GOLDEN)
+    cases = sorted(GOLDEN) + sorted(CHAOTIC)
     with ctx.Pool(2, maxtasksperchild=1) as pool:
         return dict(zip(cases, pool.map(_solve, cases), strict=True))
 
 
 @pytest.mark.parametrize("case", sorted(GOLDEN), ids=lambda c: f"{c[0]}-{c[1]}")
 def test_golden_values(solved, case):
-    assert solved[case] == GOLDEN[case]
+    from conftest import assert_golden_path
+
+    assert solved[case][:5] == GOLDEN[case]
+    assert_golden_path(f"goldens/{case[0]}/{case[1]}/{case[2]}/{case[3]}", solved[case][5])
+
+
+@pytest.mark.parametrize("case", sorted(CHAOTIC), ids=lambda c: f"{c[0]}-{c[1]}")
+def test_chaotic_golden_values(solved, case):
+    status, checks, iterations, minima, escapes = solved[case][:5]
+    want = CHAOTIC[case]
+    assert (status, minima, escapes) == (want[0], want[3], want[4])
+    assert abs(checks - want[1]) <= CHAOTIC_REL * want[1], (checks, want[1])
+    assert abs(iterations - want[2]) <= CHAOTIC_REL * want[2], (iterations, want[2])

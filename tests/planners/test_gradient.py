@@ -6,7 +6,7 @@ import dataclasses
 
 import numpy as np
 import pytest
-from conftest import colliding_state, path_digest, small_armz_problem
+from conftest import assert_golden_path, colliding_state, path_fingerprint, small_armz_problem
 
 from plannerlab.collision.fcl_checker import CollisionChecker
 from plannerlab.errors import PlannerlabError, UnknownNameError
@@ -88,7 +88,7 @@ def test_pocket_stalls_at_the_pinned_iteration_and_path():
     a = make_planner("gradient").solve(problem, 0, problem.budget, np.random.default_rng(0))
     assert a.status is Status.LOCAL_MINIMUM
     assert (a.iterations, a.extra["stall_iteration"], len(a.path)) == (61, 61, 62)
-    assert path_digest(a.path) == "aea7e8cd10bd02ea"
+    assert_golden_path("gradient/armz_pocket", path_fingerprint(a.path))
     assert a.local_minima == 1
     # the stall is real: far from the goal, and f flat over the stall window
     assert a.pos_err_m > 1.0
@@ -118,7 +118,7 @@ def test_inspection_leg_stalls_at_the_pinned_iteration_and_path():
     budget = problem.budget.replace(max_iterations=150)
     r = make_planner("gradient").solve(problem, 0, budget, np.random.default_rng(0))
     assert (r.status, r.iterations, len(r.path)) == (Status.LOCAL_MINIMUM, 73, 74)
-    assert path_digest(r.path) == "4b672d5cc99932b1"
+    assert_golden_path("gradient/armz_inspection/enter", path_fingerprint(r.path))
 
 
 def test_descent_keeps_bounded_joints_inside_their_limits():

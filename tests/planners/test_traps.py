@@ -12,7 +12,7 @@ import dataclasses
 
 import numpy as np
 import pytest
-from conftest import assert_witness_solves, path_digest
+from conftest import assert_golden_path, assert_witness_solves, path_fingerprint
 
 from plannerlab.planners import make_planner
 from plannerlab.planners.base import Status
@@ -59,20 +59,16 @@ def test_faithful_gradient_stalls_far_from_the_goal(trap):
     np.testing.assert_allclose(an.path[-1], r.path[-1], atol=1e-4)
 
 
-#: golden values of the analytic variant (seed 0; it ignores its generator):
-#: (stall iteration, digest of the path)
-STALLS = {
-    "armz_pocket": (61, "aea7e8cd10bd02ea"),
-    "armz_window": (62, "c8787a785bde3682"),
-    "armz_cavity": (62, "1722a37cf1067b1a"),
-    "armz_thin_wall": (62, "70a2f0ba2aa47b8a"),
-}
+#: golden values of the analytic variant (seed 0; it ignores its generator): the stall
+#: iteration; the path in tests/data/golden_paths.json (``traps/<problem>``)
+STALLS = {"armz_pocket": 61, "armz_window": 62, "armz_cavity": 62, "armz_thin_wall": 62}
 
 
 def test_stall_is_pinned(trap):
     r = solve(trap, "gradient.analytic")
     assert r.status is Status.LOCAL_MINIMUM
-    assert (r.extra["stall_iteration"], path_digest(r.path)) == STALLS[trap.name]
+    assert r.extra["stall_iteration"] == STALLS[trap.name]
+    assert_golden_path(f"traps/{trap.name}", path_fingerprint(r.path))
 
 
 def test_without_the_trap_the_gradient_reaches_the_goal(trap):

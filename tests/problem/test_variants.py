@@ -12,7 +12,6 @@ from conftest import PROBLEMS
 
 from plannerlab.collision.fcl_checker import CollisionChecker
 from plannerlab.problem.catalog import list_problems, load_problem
-from plannerlab.record.leg import Status
 from plannerlab.problem.variants import (
     MODULES_RANGE,
     ORDERS,
@@ -22,6 +21,7 @@ from plannerlab.problem.variants import (
     generate,
     make_variant,
 )
+from plannerlab.record.leg import Status
 
 #: a seed whose first draw is kept (in under a second of IK)
 SEED_KEPT_FIRST = 5

@@ -64,7 +64,6 @@ from typing import Any
 import numpy as np
 
 from plannerlab.errors import PlannerlabError
-from plannerlab.planners.follow_leader import moves as leader_moves
 from plannerlab.planners.base import (
     Planner,
     PlanResult,
@@ -76,6 +75,7 @@ from plannerlab.planners.clearance import SetupStopped
 from plannerlab.planners.clearance.descent import ClearanceDescent, ClearanceSettings, LegPath
 from plannerlab.planners.clearance.settings import DERIVED, resolve_distances
 from plannerlab.planners.context import LegPlanner, PlanningContext
+from plannerlab.planners.follow_leader import moves as leader_moves
 from plannerlab.planners.follow_leader.grid import TipPath, scene_distance_m, tip_path
 from plannerlab.planners.follow_leader.moves import Track, crosses_body
 from plannerlab.problem.goals import GoalRegion

@@ -50,8 +50,8 @@ from plannerlab.errors import PlannerlabError
 from plannerlab.planners.base import PlanResult, Status, with_overrides
 from plannerlab.planners.clearance.descent import ClearanceSettings
 from plannerlab.planners.context import PlanningContext
-from plannerlab.planners.follow_leader.planner import FollowLeader, FollowLeaderSettings
 from plannerlab.planners.follow_leader.moves import Track, crosses_body
+from plannerlab.planners.follow_leader.planner import FollowLeader, FollowLeaderSettings
 from plannerlab.planners.native import kernels as K
 from plannerlab.planners.native.planner import NativePlanner, _check_settings
 from plannerlab.planners.native.settings import RRTConnectSettings
