@@ -142,6 +142,19 @@ def _golden_paths() -> dict:
     return {}
 
 
+def _golden_text(table: dict) -> str:
+    """The golden paths as JSON, one sampled state a line (readable diffs)."""
+    import json
+
+    rows = []
+    for key in sorted(table):
+        fp = table[key]
+        states = ",\n    ".join(json.dumps(s) for s in fp["states"])
+        shape = json.dumps(fp["shape"])
+        rows.append(f'  {json.dumps(key)}: {{"shape": {shape}, "states": [\n    {states}\n  ]}}')
+    return "{\n" + ",\n".join(rows) + "\n}\n"
+
+
 def assert_golden_path(key: str, fingerprint: dict) -> None:
     """The path (its :func:`path_fingerprint`) is the one pinned under ``key``: the same
     number of states and every sampled state within ``GOLDEN_ATOL_RAD``. With
@@ -153,9 +166,7 @@ def assert_golden_path(key: str, fingerprint: dict) -> None:
         table = _golden_paths()
         table[key] = fingerprint
         GOLDEN_PATHS.parent.mkdir(parents=True, exist_ok=True)
-        GOLDEN_PATHS.write_text(
-            json.dumps(table, indent=1, sort_keys=True) + "\n", encoding="utf-8"
-        )
+        GOLDEN_PATHS.write_text(_golden_text(table), encoding="utf-8")
         return
     table = _golden_paths()
     assert key in table, f"no golden path {key!r}: run with PLANNERLAB_REPIN_PATHS=1 once"
