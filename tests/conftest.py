@@ -160,7 +160,6 @@ def assert_golden_path(key: str, fingerprint: dict) -> None:
     number of states and every sampled state within ``GOLDEN_ATOL_RAD``. With
     ``PLANNERLAB_REPIN_PATHS=1`` the fingerprint is written instead (re-pin only with the
     reason in the commit)."""
-    import json
 
     if os.environ.get("PLANNERLAB_REPIN_PATHS") == "1":
         table = _golden_paths()
