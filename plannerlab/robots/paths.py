@@ -125,6 +125,48 @@ def path_length(path: Array, continuous: np.ndarray) -> float:
     return float(np.sum(np.linalg.norm(d, axis=1)))
 
 
+#: states of the resampled path on which :func:`roughness` measures turning
+ROUGHNESS_SAMPLES = 200
+
+
+def roughness(path: Array, continuous: np.ndarray, n_samples: int = ROUGHNESS_SAMPLES) -> float:
+    """How much a joint-space path turns [rad²]: the sum of the squared turning angles of
+    the path resampled at ``n_samples`` states of equal joint-space arc length (the first
+    and last state included; continuous joints the short way round). A straight path has
+    0; a path that doubles back on itself adds π² at the turn. It does not depend on how
+    many waypoints a planner returns or how it spaces them, only on the path's shape, so
+    planners are compared on it (the ``smoothness`` of ``docs/comparison.md``: lower is
+    smoother). A path with fewer than two distinct states has 0.
+
+    Args:
+        path: (m, dof) states [rad or m].
+        continuous: (dof,) bool, joints that wrap.
+        n_samples: states of the resampled path (at least 3).
+    """
+    if n_samples < 3:
+        raise ValueError(f"roughness needs at least 3 samples, got {n_samples}")
+    P = np.atleast_2d(np.asarray(path, dtype=float))
+    if len(P) < 2:
+        return 0.0
+    steps = joint_difference(P[1:], P[:-1], continuous)  # (m - 1, dof), unwrapped
+    seg = np.linalg.norm(steps, axis=1)
+    keep = seg > 1e-12  # repeated states carry no direction
+    steps, seg = steps[keep], seg[keep]
+    if len(seg) == 0:
+        return 0.0
+    s = np.concatenate([[0.0], np.cumsum(seg)])
+    U = P[0] + np.concatenate([np.zeros((1, P.shape[1])), np.cumsum(steps, axis=0)])
+    t = np.linspace(0.0, s[-1], n_samples)
+    R = np.column_stack([np.interp(t, s, U[:, j]) for j in range(U.shape[1])])
+    d = np.diff(R, axis=0)
+    n = np.linalg.norm(d, axis=1)
+    a, b, na, nb = d[:-1], d[1:], n[:-1], n[1:]
+    ok = (na > 0.0) & (nb > 0.0)
+    cos = np.einsum("ij,ij->i", a[ok], b[ok]) / (na[ok] * nb[ok])
+    turn = np.arccos(np.clip(cos, -1.0, 1.0))
+    return float(np.sum(turn**2))
+
+
 def _on_segment(a: Array, b: Array, inner: Array, tol_rad: float) -> Array:
     """For each row of ``inner`` (k, dof): within ``tol_rad`` of segment a–b, between a and b."""
     ab = b - a
