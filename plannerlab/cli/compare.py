@@ -64,6 +64,7 @@ from plannerlab.cli.tables import (
     print_summary_tables,
 )
 from plannerlab.errors import PlannerlabError
+from plannerlab.record.trial import DIED_STATUS, ERROR_STATUS
 
 DEFAULT_OUT = Path("results") / "compare"
 
@@ -260,15 +261,11 @@ def cmd_compare(args: argparse.Namespace, console: Console) -> int:
 
     task = progress.add_task(f"compare {name}", total=len(trials), detail="")
 
-    def on_done(rec: dict[str, Any], skipped: bool) -> None:
+    def on_done(rec: Any, skipped: bool) -> None:
         counts["skipped" if skipped else "ran"] += 1
-        if rec.get("status") in (pl.ERROR_STATUS, pl.TIMEOUT_STATUS):
+        if not rec.ran:
             counts["errors"] += 1
-        last = (
-            ""
-            if skipped
-            else (f" · last: {escape(rec['planner'])} s{rec['seed']} {rec.get('status')}")
-        )
+        last = "" if skipped else f" · last: {escape(rec.planner)} s{rec.seed} {rec.status}"
         progress.update(task, advance=1, detail=detail() + last)
 
     try:
@@ -294,9 +291,7 @@ def cmd_compare(args: argparse.Namespace, console: Console) -> int:
         "seeds_spec": args.seeds,
         "ran": run.ran,
         "skipped": run.skipped,
-        "errors": sum(
-            1 for r in records if r.get("status") in (pl.ERROR_STATUS, pl.TIMEOUT_STATUS)
-        ),
+        "errors": sum(1 for r in records if not r.ran),
         "started_at": started.isoformat(timespec="seconds"),
         "wall_s": wall_s,
         "store": str(store.path),
@@ -318,19 +313,25 @@ def cmd_compare(args: argparse.Namespace, console: Console) -> int:
                         "skipped": run.skipped,
                         "errors": meta["errors"],
                         "wall_s": wall_s,
-                        "summary": rows,
+                        "summary": [r.to_dict() for r in rows],
                     }
                 )
             )
         )
         return 0
     _print_tables(console, rows, columns)
-    errors = [r for r in records if r.get("status") == pl.ERROR_STATUS]
+    errors = [r for r in records if r.status == ERROR_STATUS]
     if errors:
         console.print(
             f"[red]{len(errors)} trial(s) raised[/red] (rerun them with "
-            f"--retry-errors), e.g. {escape(errors[0]['key'])}: "
-            f"{escape(str(errors[0].get('error')))}",
+            f"--retry-errors), e.g. {escape(errors[0].key)}: {escape(str(errors[0].error))}",
+            highlight=False,
+        )
+    died = [r for r in records if r.status == DIED_STATUS]
+    if died:
+        console.print(
+            f"[red]{len(died)} trial process(es) died[/red] (the next run of this command "
+            f"tries them again), e.g. {escape(died[0].key)}: {escape(str(died[0].error))}",
             highlight=False,
         )
     console.print(
@@ -344,11 +345,9 @@ def cmd_compare(args: argparse.Namespace, console: Console) -> int:
     return 0
 
 
-def _print_tables(console: Console, rows: list[dict[str, Any]], columns: list[str]) -> None:
-    for problem in dict.fromkeys(r["problem"] for r in rows):
-        print_summary_tables(
-            console, problem, [r for r in rows if r["problem"] == problem], columns
-        )
+def _print_tables(console: Console, rows: list[Any], columns: list[str]) -> None:
+    for problem in dict.fromkeys(r.problem for r in rows):
+        print_summary_tables(console, problem, [r for r in rows if r.problem == problem], columns)
     console.print(
         f"[dim]{escape(column_notes(columns))}. Medians over the trials that ran; times and "
         "checks summed over legs. All columns: --wide, report.md, summary.csv.[/dim]",

@@ -8,14 +8,16 @@ terminal the command runs in (stderr's), else :data:`PIPE_WIDTH` columns.
 
 ``compare`` prints a compact table by default (:data:`COMPACT_COLUMNS`: planner, solved
 with its 95 % interval, median time, median checks, local minima met/escaped, executed
-cleanly) that fits 80 columns; ``--wide`` shows :data:`WIDE_COLUMNS`, ``--columns a,b``
-picks from :data:`SUMMARY_COLUMNS`.
+cleanly) that fits 80 columns; ``--wide`` shows :data:`WIDE_COLUMNS` (path length with
+its smoothness and its clearance along the path beside it, tip errors beside their
+tolerances, …), ``--columns a,b`` picks from :data:`SUMMARY_COLUMNS`. A row is a
+:class:`~plannerlab.comparison.statistics.SummaryRow`, read by attribute.
 """
 
 from __future__ import annotations
 
 import os
-from collections.abc import Callable, Mapping, Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from typing import Any, Literal, TextIO
 
@@ -25,7 +27,7 @@ from rich.markup import escape
 from rich.table import Table
 
 from plannerlab.errors import UnknownNameError
-from plannerlab.record.cells import fmt, mm
+from plannerlab.record.cells import err_of_tol, fmt, mm
 
 #: width of piped output when neither COLUMNS nor a terminal says otherwise
 PIPE_WIDTH = 100
@@ -98,7 +100,7 @@ class SummaryColumn:
 
     header: str
     kind: Kind
-    cell: Callable[[Mapping[str, Any]], str]
+    cell: Callable[[Any], str]
     help: str
     executed: bool = False  #: only meaningful when the comparison executed its plans
 
@@ -107,21 +109,21 @@ def _pct(x: Any) -> str:
     return "-" if x is None or x != x else f"{100 * x:.0f}"
 
 
-def _solved(r: Mapping[str, Any]) -> str:
-    return f"{r['successes']}/{r['n']}" + (f" ({r['errors']} err)" if r["errors"] else "")
+def _solved(r: Any) -> str:
+    return f"{r.successes}/{r.n}" + (f" ({r.errors} err)" if r.errors else "")
 
 
-def _solved_ci(r: Mapping[str, Any]) -> str:
+def _solved_ci(r: Any) -> str:
     # errors are listed under the table (and counted by ``solved_n``)
-    if r.get("deterministic") is True:
-        return f"{r['successes']}/{r['n']} [{ONE_TRIAL}]"
-    return f"{r['successes']}/{r['n']} [{_pct(r['ci95_low'])}-{_pct(r['ci95_high'])}%]"
+    if r.deterministic:
+        return f"{r.successes}/{r.n} [{ONE_TRIAL}]"
+    return f"{r.successes}/{r.n} [{_pct(r.ci95_low)}-{_pct(r.ci95_high)}%]"
 
 
-def _success_ci(r: Mapping[str, Any]) -> str:
-    if r.get("deterministic") is True:
-        return f"{_pct(r['success_rate'])}% [{DETERMINISTIC}]"
-    return f"{_pct(r['success_rate'])}% [{_pct(r['ci95_low'])}, {_pct(r['ci95_high'])}]"
+def _success_ci(r: Any) -> str:
+    if r.deterministic:
+        return f"{_pct(r.success_rate)}% [{DETERMINISTIC}]"
+    return f"{_pct(r.success_rate)}% [{_pct(r.ci95_low)}, {_pct(r.ci95_high)}]"
 
 
 #: what stands where the interval would be when every seed ran the same trial (the
@@ -135,12 +137,12 @@ _DETERMINISTIC_HELP = (
 )
 
 
-def _exec_ok(r: Mapping[str, Any]) -> str:
-    return f"{r['exec_successes']}/{r['executed']}" if r.get("executed") else "-"
+def _exec_ok(r: Any) -> str:
+    return f"{r.exec_successes}/{r.executed}" if r.executed else "-"
 
 
 SUMMARY_COLUMNS: dict[str, SummaryColumn] = {
-    "planner": SummaryColumn("planner", "name", lambda r: str(r["planner"]), "registry name"),
+    "planner": SummaryColumn("planner", "name", lambda r: str(r.planner), "registry name"),
     "solved": SummaryColumn(
         "solved\n[95% CI]",
         "num",
@@ -156,36 +158,57 @@ SUMMARY_COLUMNS: dict[str, SummaryColumn] = {
         "success rate with the Wilson 95 % interval" + _DETERMINISTIC_HELP,
     ),
     "time": SummaryColumn(
-        "time s\nmedian", "num", lambda r: fmt(r["time_median_s"]), "planning time, median [s]"
+        "time s\nmedian", "num", lambda r: fmt(r.time_median_s), "planning time, median [s]"
     ),
     "time_p75_p95": SummaryColumn(
         "time s\np75 / p95",
         "num",
-        lambda r: f"{fmt(r['time_p75_s'])} / {fmt(r['time_p95_s'])}",
+        lambda r: f"{fmt(r.time_p75_s)} / {fmt(r.time_p95_s)}",
         "planning time, 75th / 95th percentile [s]",
     ),
     "path": SummaryColumn(
         "path\nrad",
         "num",
-        lambda r: fmt(r["path_length_median"]),
+        lambda r: fmt(r.path_length_median),
         "joint-space path length, median over solved trials [rad]",
     ),
+    "smoothness": SummaryColumn(
+        "smooth-\nness rad²",
+        "num",
+        lambda r: fmt(r.smoothness_median_rad2),
+        "the path's roughness: squared turning angles of each leg's path resampled at 200 "
+        "states of equal joint-space arc length, summed over legs, median over solved "
+        "trials [rad²]; lower is smoother",
+    ),
+    "path_clearance": SummaryColumn(
+        "path clear.\nmin mm",
+        "num",
+        lambda r: fmt(mm(r.path_clearance_min_m)),
+        "smallest clearance along the whole planned path (every state of the final "
+        "re-check's grid, true geometry, to the scene and between links), over solved "
+        "trials [mm]",
+    ),
     "pos_err": SummaryColumn(
-        "pos err\nm", "num", lambda r: fmt(r["pos_err_median_m"]), "final tip position error [m]"
+        "pos err\n/ tol m",
+        "num",
+        lambda r: err_of_tol(r.pos_err_median_m, r.pos_tol_m),
+        "final tip position error of the last leg, median over solved trials, beside the "
+        "goal's position tolerance [m]",
     ),
     "ang_err": SummaryColumn(
-        "ang err\n°",
+        "ang err\n/ tol °",
         "num",
-        lambda r: fmt(r["angle_err_median_deg"]),
-        "final tip angle error [deg]",
+        lambda r: err_of_tol(r.angle_err_median_deg, r.angle_tol_deg),
+        "final tip angle error of the last leg, median over solved trials, beside the "
+        "goal's angle tolerance [deg]",
     ),
     "checks": SummaryColumn(
-        "checks\nmedian", "num", lambda r: fmt(r["checks_median"]), "collision checks, median"
+        "checks\nmedian", "num", lambda r: fmt(r.checks_median), "collision checks, median"
     ),
     "minima": SummaryColumn(
         "minima\nmet/esc",
         "num",
-        lambda r: f"{r['local_minima']}/{r['escapes']}",
+        lambda r: f"{r.local_minima}/{r.escapes}",
         "local minima met / escaped, totals",
     ),
     "exec_ok": SummaryColumn(
@@ -199,22 +222,22 @@ SUMMARY_COLUMNS: dict[str, SummaryColumn] = {
     "deviation": SummaryColumn(
         "deviation\nmm",
         "num",
-        lambda r: fmt(mm(r.get("exec_deviation_median_m"))),
+        lambda r: fmt(mm(r.exec_deviation_median_m)),
         "largest deviation of the robot's collision geometry from the plan in "
         "PyBullet, median [mm]",
         executed=True,
     ),
     "clearance": SummaryColumn(
-        "clearance\nmm",
+        "sim clear.\nmm",
         "num",
-        lambda r: fmt(mm(r.get("exec_clearance_min_m"))),
+        lambda r: fmt(mm(r.exec_clearance_min_m)),
         "smallest simulated clearance (PyBullet's closest points) over the executions [mm]",
         executed=True,
     ),
     "track_err": SummaryColumn(
         "track\nerr rad",
         "num",
-        lambda r: fmt(r["exec_track_err_median_rad"]),
+        lambda r: fmt(r.exec_track_err_median_rad),
         "largest joint tracking error in PyBullet, median [rad] (informational)",
         executed=True,
     ),
@@ -229,6 +252,8 @@ WIDE_COLUMNS = (
     "time",
     "time_p75_p95",
     "path",
+    "smoothness",
+    "path_clearance",
     "pos_err",
     "ang_err",
     "checks",
@@ -253,7 +278,7 @@ def pick_columns(spec: str | None, wide: bool, executed: bool) -> list[str]:
     return [k for k in keys if executed or not SUMMARY_COLUMNS[k].executed]
 
 
-def summary_table(problem: str, rows: Sequence[Mapping[str, Any]], keys: Sequence[str]) -> Table:
+def summary_table(problem: str, rows: Sequence[Any], keys: Sequence[str]) -> Table:
     """``compare``'s table for one problem."""
     cols = [SUMMARY_COLUMNS[k] for k in keys]
     t = table(problem, [(c.header, c.kind) for c in cols], compact=True)
@@ -261,9 +286,7 @@ def summary_table(problem: str, rows: Sequence[Mapping[str, Any]], keys: Sequenc
         cells = [escape(c.cell(r)) for c in cols]
         if "solved" in keys or "solved_n" in keys:
             i = keys.index("solved") if "solved" in keys else keys.index("solved_n")
-            style = (
-                "green" if r["success_rate"] >= 0.95 else "red" if r["successes"] == 0 else "yellow"
-            )
+            style = "green" if r.success_rate >= 0.95 else "red" if r.successes == 0 else "yellow"
             cells[i] = f"[{style}]{cells[i]}[/{style}]"
         t.add_row(*cells)
     return t
@@ -293,7 +316,7 @@ def fitted_groups(
 
 
 def print_summary_tables(
-    console: Console, problem: str, rows: Sequence[Mapping[str, Any]], keys: Sequence[str]
+    console: Console, problem: str, rows: Sequence[Any], keys: Sequence[str]
 ) -> None:
     """``compare``'s table(s) for one problem, split by columns where too wide."""
     for group in fitted_groups(console, keys, lambda ks: summary_table(problem, rows, ks)):

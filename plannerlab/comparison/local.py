@@ -41,6 +41,7 @@ from pathlib import Path
 from typing import Any
 
 from plannerlab.errors import PlannerlabError
+from plannerlab.record.trial import TrialRecord
 
 #: modules the fork server imports before forking trials (no OMPL object is created)
 PRELOAD_MODULES: tuple[str, ...] = (
@@ -65,14 +66,44 @@ _TRIAL_MODULES = tuple(m for m in PRELOAD_MODULES if m.startswith("plannerlab.")
 START_METHODS = ("forkserver", "spawn")
 #: characters of a trial process's captured output kept in its record
 OUTPUT_TAIL_CHARS = 2000
+#: lines of a trial process's captured output kept in its record (at most
+#: :data:`OUTPUT_TAIL_CHARS` characters)
+OUTPUT_TAIL_LINES = 20
 
 
-def _tail(path: Path, chars: int = OUTPUT_TAIL_CHARS) -> str:
+def _tail(path: Path, chars: int = OUTPUT_TAIL_CHARS, lines: int = OUTPUT_TAIL_LINES) -> str:
+    """The last ``lines`` whole lines of a file, at most ``chars`` characters."""
     try:
-        text = path.read_text(encoding="utf-8", errors="replace")
+        with open(path, "rb") as fh:
+            size = fh.seek(0, os.SEEK_END)
+            fh.seek(max(size - 4 * chars, 0))
+            text = fh.read().decode("utf-8", errors="replace")
     except OSError:
         return ""
-    return text[-chars:]
+    kept = text.splitlines()[-lines:]
+    while kept and len("\n".join(kept)) > chars:
+        kept = kept[1:]
+    return "\n".join(kept) if kept else text[-chars:]
+
+
+def death(exitcode: int | None, output: str) -> dict[str, Any]:
+    """Why a trial's process ended without reporting, as a record's fields: ``error`` in
+    words, ``exit_code`` or ``signal`` (by name), ``output`` (the end of its stdout and
+    stderr)."""
+    out: dict[str, Any] = {"output": output}
+    if exitcode is not None and exitcode < 0:
+        try:
+            name = signal.Signals(-exitcode).name
+        except ValueError:
+            name = f"signal {-exitcode}"
+        out["signal"] = name
+        how = f"killed by {name}"
+    else:
+        out["exit_code"] = exitcode
+        how = f"exit code {exitcode}"
+    last = output.strip().splitlines()[-1] if output.strip() else "nothing on stdout or stderr"
+    out["error"] = f"trial process died ({how}) before reporting a result: {last}"
+    return out
 
 
 @contextlib.contextmanager
@@ -130,7 +161,7 @@ def _child_main(
     conn: Connection,
     out_path: str,
     launched_at: float,
-    run: Callable[[Any], dict[str, Any]],
+    run: Callable[[Any], TrialRecord],
 ) -> None:
     """Entry point of a trial's process: ``run(trial)`` and send the record to the parent."""
     import sys
@@ -144,13 +175,9 @@ def _child_main(
         _import_trial_modules()
         startup_s = time.time() - launched_at
         rec = run(trial)
-        rec["startup_s"] = startup_s
         sys.stdout.flush()
         sys.stderr.flush()
-        output = _tail(Path(out_path))
-        if output:
-            rec["output"] = output
-        conn.send(rec)
+        conn.send(rec.replace(startup_s=startup_s, output=_tail(Path(out_path))))
     finally:
         conn.close()
 
@@ -180,7 +207,7 @@ class LocalBackend:
     def __init__(
         self,
         work_dir: str | Path,
-        run: Callable[[Any], dict[str, Any]],
+        run: Callable[[Any], TrialRecord],
         start_method: str = "forkserver",
     ) -> None:
         self._run = run
@@ -215,9 +242,12 @@ class LocalBackend:
         send.close()  # the child holds the only write end now
         return recv
 
-    def wait(self, handles: list[Any], timeout_s: float) -> list[tuple[Any, dict | None, str]]:
+    def wait(
+        self, handles: list[Any], timeout_s: float
+    ) -> list[tuple[Any, TrialRecord | None, dict[str, Any]]]:
         """Handles that finished within ``timeout_s``: ``(handle, record or None, why)``
-        (None when the process died before reporting; ``why`` then says how)."""
+        (None when the process died before reporting; ``why`` then says how, as the
+        record's fields: :func:`death`)."""
         done = []
         for conn in wait(handles, timeout=timeout_s):
             run = self._running.pop(conn)  # type: ignore[call-overload]
@@ -227,14 +257,9 @@ class LocalBackend:
                 rec = None
             run.conn.close()
             run.proc.join(timeout=30)
-            why = ""
+            why: dict[str, Any] = {}
             if rec is None:
-                why = (
-                    f"trial process died (exit code {run.proc.exitcode}) before reporting a result"
-                )
-                output = _tail(run.out)
-                if output:
-                    why += "\n" + output
+                why = death(run.proc.exitcode, _tail(run.out))
             run.out.unlink(missing_ok=True)
             done.append((conn, rec, why))
         return done
@@ -253,7 +278,7 @@ class LocalBackend:
         run.conn.close()
         run.out.unlink(missing_ok=True)
 
-    def salvage(self) -> list[dict]:
+    def salvage(self) -> list[TrialRecord]:
         """Stop the running children and return the records they had already sent
         (after an interrupt)."""
         for run in self._running.values():
@@ -267,7 +292,7 @@ class LocalBackend:
             with contextlib.suppress(Exception):
                 if conn.poll(0):
                     rec = conn.recv()
-                    if isinstance(rec, dict) and "key" in rec:
+                    if isinstance(rec, TrialRecord):
                         out.append(rec)
         return out
 
@@ -279,4 +304,4 @@ class LocalBackend:
             self.work_dir.rmdir()
 
 
-__all__ = ["PRELOAD_MODULES", "START_METHODS", "LocalBackend"]
+__all__ = ["PRELOAD_MODULES", "START_METHODS", "LocalBackend", "death"]

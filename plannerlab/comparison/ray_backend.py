@@ -31,17 +31,16 @@ from collections.abc import Callable
 from typing import Any
 
 from plannerlab.errors import PlannerlabError
+from plannerlab.record.trial import TrialRecord
 
 
-def _ray_trial(trial: Any, launched_at: float, run: Callable[[Any], dict[str, Any]]) -> dict:
+def _ray_trial(trial: Any, launched_at: float, run: Callable[[Any], TrialRecord]) -> TrialRecord:
     """The Ray task: ``run(trial)`` in this (fresh) worker process."""
     from plannerlab.comparison.local import _import_trial_modules
 
     _import_trial_modules()
     startup_s = time.time() - launched_at
-    rec = run(trial)
-    rec["startup_s"] = startup_s
-    return rec
+    return run(trial).replace(startup_s=startup_s)
 
 
 class RayBackend:
@@ -61,7 +60,7 @@ class RayBackend:
 
     def __init__(
         self,
-        run: Callable[[Any], dict[str, Any]],
+        run: Callable[[Any], TrialRecord],
         address: str | None = None,
         num_cpus: int | None = None,
     ) -> None:
@@ -96,20 +95,23 @@ class RayBackend:
         self._trials[ref] = trial
         return ref
 
-    def wait(self, handles: list[Any], timeout_s: float) -> list[tuple[Any, dict | None, str]]:
-        """Handles that finished within ``timeout_s``: ``(handle, record or None, why)``."""
+    def wait(
+        self, handles: list[Any], timeout_s: float
+    ) -> list[tuple[Any, TrialRecord | None, dict[str, Any]]]:
+        """Handles that finished within ``timeout_s``: ``(handle, record or None, why)``
+        (``why``: the fields of a died trial's record)."""
         ray = self._ray
         if not handles:
             return []
         ready, _ = ray.wait(handles, num_returns=len(handles), timeout=timeout_s)
-        done = []
+        done: list[tuple[Any, TrialRecord | None, dict[str, Any]]] = []
         for ref in ready:
             self._trials.pop(ref, None)
             try:
-                done.append((ref, ray.get(ref), ""))
+                done.append((ref, ray.get(ref), {}))
             except Exception as exc:  # the worker died, or the task could not run
                 last = traceback.format_exception_only(type(exc), exc)[-1].strip()
-                done.append((ref, None, f"Ray task failed: {last}"))
+                done.append((ref, None, {"error": f"Ray task failed: {last}"}))
         return done
 
     def kill(self, handle: Any) -> None:
@@ -117,7 +119,7 @@ class RayBackend:
         if self._trials.pop(handle, None) is not None:
             self._ray.cancel(handle, force=True)
 
-    def salvage(self) -> list[dict]:
+    def salvage(self) -> list[TrialRecord]:
         """Records of tasks that already finished; the others are cancelled."""
         out = []
         handles = list(self._trials)

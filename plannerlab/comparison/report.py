@@ -61,18 +61,31 @@ from collections.abc import Iterable, Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
-from plannerlab.comparison.statistics import SUMMARY_COLUMNS
-from plannerlab.comparison.trial import ERROR_STATUS, TOTAL_KEYS
-from plannerlab.record.cells import fmt, mm
+from plannerlab.comparison.statistics import SUMMARY_COLUMNS, SummaryRow
+from plannerlab.record.cells import err_of_tol, fmt, mm
 from plannerlab.record.files import write_json_atomic, write_text_atomic
 from plannerlab.record.leg import Status
+from plannerlab.record.trial import (
+    DIED_STATUS,
+    ERROR_STATUS,
+    TIMEOUT_STATUS,
+    ExecutionRecord,
+    LegRecord,
+    TrialRecord,
+)
 
 #: values of the ``status ENUM`` run property (index = stored value): the planner statuses
 #: in :class:`Status` order, with ``error`` (the trial raised) at index 8, where it stood
 #: before statuses were added to :class:`Status`; those follow it, so that a stored index
 #: keeps its meaning
 _STATUSES = [s.value for s in Status]
-STATUS_ENUM: tuple[str, ...] = (*_STATUSES[:8], ERROR_STATUS, *_STATUSES[8:])
+STATUS_ENUM: tuple[str, ...] = (
+    *_STATUSES[:8],
+    ERROR_STATUS,
+    *_STATUSES[8:],
+    TIMEOUT_STATUS,
+    DIED_STATUS,
+)
 
 TRIAL_COLUMNS = (
     "key",
@@ -89,8 +102,12 @@ TRIAL_COLUMNS = (
     "collision_checks",
     "fk_calls",
     "path_length",
+    "smoothness_rad2",
+    "path_clearance_m",
     "final_pos_err_m",
+    "final_pos_tol_m",
     "final_angle_err_deg",
+    "final_angle_tol_deg",
     "local_minima",
     "escapes",
     "exec_success",
@@ -102,6 +119,8 @@ TRIAL_COLUMNS = (
     "exec_final_pos_err_m",
     "exec_final_angle_err_deg",
     "wall_s",
+    "exit_code",
+    "signal",
     "budget",
     "settings",
 )
@@ -119,10 +138,15 @@ LEG_COLUMNS = (
     "collision_checks",
     "fk_calls",
     "pos_err_m",
+    "pos_tol_m",
     "angle_err_deg",
+    "angle_tol_deg",
+    "tip_state",
     "local_minima",
     "escapes",
     "path_length",
+    "smoothness_rad2",
+    "path_clearance_m",
     "path_points",
     "extra_lengths",
     "exec_success",
@@ -191,52 +215,68 @@ def _csv(columns: Sequence[str], rows: Iterable[Mapping[str, Any]]) -> str:
     return buf.getvalue()
 
 
-def _exec_legs(rec: Mapping[str, Any]) -> dict[int, Mapping[str, Any]]:
-    ex = rec.get("execution") or {}
-    return {int(e["leg"]): e for e in ex.get("legs", []) if e.get("leg") is not None}
+def _exec_cells(e: ExecutionRecord | None, prefix: str = "exec_") -> dict[str, Any]:
+    if e is None:
+        return {}
+    return {
+        f"{prefix}success": e.success,
+        f"{prefix}path_valid": e.path_valid,
+        f"{prefix}max_deviation_m": e.max_deviation_m,
+        f"{prefix}min_clearance_m": e.min_clearance_m,
+        f"{prefix}max_track_err_rad": e.max_track_err_rad,
+        f"{prefix}contacts": e.contact_count,
+        f"{prefix}final_pos_err_m": e.final_pos_err_m,
+        f"{prefix}final_angle_err_deg": e.final_angle_err_deg,
+    }
 
 
-def trial_rows(records: Iterable[Mapping[str, Any]]) -> list[dict[str, Any]]:
-    """One flat row per trial (keys :data:`TRIAL_COLUMNS`)."""
+def trial_rows(records: Iterable[TrialRecord]) -> list[dict[str, Any]]:
+    """One flat row per trial (keys :data:`TRIAL_COLUMNS`). The final tip errors are
+    those of a successful trial's last leg (a failed trial's last state is no result:
+    its legs are in ``legs.csv``)."""
     rows = []
     for r in records:
-        tot = r.get("totals") or {}
-        ex = r.get("execution") or {}
-        legs = r.get("legs_run") or []
+        last = r.last_leg if r.success else None
+        ex = r.exec_last
         rows.append(
             {
-                "key": r["key"],
-                "problem": r["problem"],
-                "planner": r["planner"],
-                "seed": r["seed"],
-                "status": r.get("status"),
-                "success": bool(r.get("success")),
-                "error": r.get("error"),
-                "legs": len(legs),
-                "legs_solved": sum(1 for x in legs if x["status"] == "solved"),
-                **{k: tot.get(k) for k in TOTAL_KEYS},
-                "final_pos_err_m": r.get("final_pos_err_m"),
-                "final_angle_err_deg": r.get("final_angle_err_deg"),
-                "exec_success": ex.get("success"),
-                "exec_path_valid": ex.get("path_valid"),
-                "exec_max_deviation_m": ex.get("max_deviation_m"),
-                "exec_min_clearance_m": ex.get("min_clearance_m"),
-                "exec_max_track_err_rad": ex.get("max_track_err_rad"),
-                "exec_contacts": ex.get("contacts"),
-                "exec_final_pos_err_m": ex.get("final_pos_err_m"),
-                "exec_final_angle_err_deg": ex.get("final_angle_err_deg"),
-                "wall_s": r.get("wall_s"),
-                "budget": r.get("budget_used") or r.get("budget"),
-                "settings": r.get("settings"),
+                "key": r.key,
+                "problem": r.problem,
+                "planner": r.planner,
+                "seed": r.seed,
+                "status": r.status,
+                "success": r.success,
+                "error": r.error,
+                "legs": len(r.legs_run),
+                "legs_solved": r.legs_solved,
+                "time_s": r.time_s if r.ran else None,
+                "iterations": r.iterations,
+                "collision_checks": r.collision_checks,
+                "fk_calls": r.fk_calls,
+                "path_length": r.path_length,
+                "smoothness_rad2": r.roughness_rad2,
+                "path_clearance_m": r.path_clearance_m,
+                "final_pos_err_m": last.pos_err_m if last else None,
+                "final_pos_tol_m": last.pos_tol_m if last else None,
+                "final_angle_err_deg": last.angle_err_deg if last else None,
+                "final_angle_tol_deg": last.angle_tol_deg if last else None,
+                "local_minima": r.local_minima,
+                "escapes": r.escapes,
+                **_exec_cells(ex),
+                "exec_success": r.exec_success,
+                "exec_path_valid": r.exec_path_valid,
+                "exec_max_deviation_m": r.exec_max_deviation_m,
+                "exec_min_clearance_m": r.exec_min_clearance_m,
+                "exec_max_track_err_rad": r.exec_max_track_err_rad,
+                "exec_contacts": r.exec_contacts,
+                "wall_s": r.wall_s,
+                "exit_code": r.exit_code,
+                "signal": r.signal,
+                "budget": r.budget_used or r.budget,
+                "settings": r.settings,
             }
         )
     return rows
-
-
-def _n_contacts(contacts: Any) -> int | None:
-    """Contacts of an executed leg: its list of contact records (a count in stores written
-    before the trial legs were Execution records)."""
-    return len(contacts) if isinstance(contacts, list) else contacts
 
 
 def _lengths(extra: Mapping[str, Any]) -> dict[str, Any]:
@@ -249,75 +289,98 @@ def _lengths(extra: Mapping[str, Any]) -> dict[str, Any]:
     }
 
 
-def leg_rows(records: Iterable[Mapping[str, Any]]) -> list[dict[str, Any]]:
-    """One flat row per leg of every trial (keys :data:`LEG_COLUMNS`)."""
+def tip_state(leg: LegRecord) -> str:
+    """What a leg's tip errors describe: ``goal`` (a solved leg's last state),
+    ``best reached`` (the state it ended at, as close as it got or stalled there), or
+    ``none`` (it planned nothing or gave up: its errors are blank)."""
+    if leg.solved:
+        return "goal"
+    return "best reached" if leg.reached_best else "none"
+
+
+def leg_rows(records: Iterable[TrialRecord]) -> list[dict[str, Any]]:
+    """One flat row per leg of every trial (keys :data:`LEG_COLUMNS`). A leg that has no
+    best state (:func:`tip_state` ``none``) has blank tip errors: its reason says why."""
     rows = []
     for r in records:
-        exl = _exec_legs(r)
-        for x in r.get("legs_run") or []:
-            e = exl.get(int(x["leg"]), {})
+        executed = {e.leg: e for e in r.executions or ()}
+        for x in r.legs_run:
+            e = executed.get(x.leg)
+            has_tip = x.reached_best
             rows.append(
                 {
-                    "key": r["key"],
-                    "problem": r["problem"],
-                    "planner": r["planner"],
-                    "seed": r["seed"],
-                    **{k: x.get(k) for k in LEG_COLUMNS if k in x},
-                    "path_points": x.get("path_points"),
-                    "extra_lengths": _lengths(x.get("extra") or {}),
-                    "exec_success": e.get("success"),
-                    "exec_path_valid": e.get("path_valid"),
-                    "exec_max_deviation_m": e.get("max_deviation_m"),
-                    "exec_min_clearance_m": e.get("min_clearance_m"),
-                    "exec_max_track_err_rad": e.get("max_track_err_rad"),
-                    "exec_contacts": _n_contacts(e.get("contacts")),
-                    "exec_final_pos_err_m": e.get("final_pos_err_m"),
-                    "exec_final_angle_err_deg": e.get("final_angle_err_deg"),
-                    "exec_reason": e.get("reason"),
+                    "key": r.key,
+                    "problem": r.problem,
+                    "planner": r.planner,
+                    "seed": r.seed,
+                    "leg": x.leg,
+                    "goal": x.goal,
+                    "status": x.status.value,
+                    "time_s": x.time_s,
+                    "iterations": x.iterations,
+                    "collision_checks": x.collision_checks,
+                    "fk_calls": x.fk_calls,
+                    "pos_err_m": x.pos_err_m if has_tip else None,
+                    "pos_tol_m": x.pos_tol_m,
+                    "angle_err_deg": x.angle_err_deg if has_tip else None,
+                    "angle_tol_deg": x.angle_tol_deg,
+                    "tip_state": tip_state(x),
+                    "local_minima": x.local_minima,
+                    "escapes": x.escapes,
+                    "path_length": x.path_length,
+                    "smoothness_rad2": x.roughness_rad2,
+                    "path_clearance_m": x.path_clearance_m,
+                    "path_points": x.path_points,
+                    "extra_lengths": _lengths(x.extra),
+                    **_exec_cells(e),
+                    "reason": x.reason,
+                    "exec_reason": e.reason if e else None,
                 }
             )
     return rows
 
 
-def trials_csv(records: Iterable[Mapping[str, Any]]) -> str:
+def trials_csv(records: Iterable[TrialRecord]) -> str:
     return _csv(TRIAL_COLUMNS, trial_rows(records))
 
 
-def legs_csv(records: Iterable[Mapping[str, Any]]) -> str:
+def legs_csv(records: Iterable[TrialRecord]) -> str:
     return _csv(LEG_COLUMNS, leg_rows(records))
 
 
-def summary_csv(rows: Iterable[Mapping[str, Any]]) -> str:
-    return _csv(SUMMARY_COLUMNS, rows)
+def summary_csv(rows: Iterable[SummaryRow]) -> str:
+    return _csv(SUMMARY_COLUMNS, (r.to_dict() for r in rows))
 
 
 # ---------------------------------------------------------------------- Markdown
-def summary_cells(row: Mapping[str, Any], executed: bool) -> list[str]:
+def summary_cells(row: SummaryRow, executed: bool) -> list[str]:
     """The cells of one planner's line in a per-problem table (see :data:`TABLE_HEADERS`)."""
     cells = [
-        str(row["planner"]),
-        f"{row['successes']}/{row['n']}" + (f" ({row['errors']} err)" if row["errors"] else ""),
+        row.planner,
+        f"{row.successes}/{row.n}" + (f" ({row.errors} err)" if row.errors else ""),
         (
-            f"{fmt(100 * row['success_rate'], 3)}% [deterministic: {row['n']} seeds, one trial]"
-            if row.get("deterministic") is True
-            else f"{fmt(100 * row['success_rate'], 3)}% [{fmt(100 * row['ci95_low'], 3)}, "
-            f"{fmt(100 * row['ci95_high'], 3)}]"
+            f"{fmt(100 * row.success_rate, 3)}% [deterministic: {row.n} seeds, one trial]"
+            if row.deterministic
+            else f"{fmt(100 * row.success_rate, 3)}% [{fmt(100 * row.ci95_low, 3)}, "
+            f"{fmt(100 * row.ci95_high, 3)}]"
         ),
-        f"{fmt(row['time_median_s'])} / {fmt(row['time_p75_s'])} / {fmt(row['time_p95_s'])}",
-        fmt(row["path_length_median"]),
-        fmt(row["pos_err_median_m"]),
-        fmt(row["angle_err_median_deg"]),
-        fmt(row["checks_median"]),
-        f"{row['local_minima']} / {row['escapes']}",
+        f"{fmt(row.time_median_s)} / {fmt(row.time_p75_s)} / {fmt(row.time_p95_s)}",
+        fmt(row.path_length_median),
+        fmt(row.smoothness_median_rad2),
+        fmt(mm(row.path_clearance_min_m)),
+        err_of_tol(row.pos_err_median_m, row.pos_tol_m),
+        err_of_tol(row.angle_err_median_deg, row.angle_tol_deg),
+        fmt(row.checks_median),
+        f"{row.local_minima} / {row.escapes}",
     ]
     if executed:
-        rate = row["exec_success_rate"]
+        rate = row.exec_success_rate
         cells += [
-            f"{row['exec_successes']}/{row['executed']}"
-            + (f" ({fmt(100 * rate)}%)" if row["executed"] else ""),
-            fmt(mm(row.get("exec_deviation_median_m"))),
-            fmt(mm(row.get("exec_clearance_min_m"))),
-            fmt(row["exec_track_err_median_rad"]),
+            f"{row.exec_successes}/{row.executed}"
+            + (f" ({fmt(100 * rate)}%)" if row.executed else ""),
+            fmt(mm(row.exec_deviation_median_m)),
+            fmt(mm(row.exec_clearance_min_m)),
+            fmt(row.exec_track_err_median_rad),
         ]
     return cells
 
@@ -328,8 +391,10 @@ TABLE_HEADERS = (
     "success % [95% CI]",
     "time s med / p75 / p95",
     "path len rad",
-    "pos err m",
-    "ang err °",
+    "smoothness rad²",
+    "path clearance mm",
+    "pos err / tol m",
+    "ang err / tol °",
     "checks",
     "minima met / escaped",
 )
@@ -341,8 +406,14 @@ TABLE_NOTES = (
     "(same statuses, path hashes, counts, tip errors and execution verdict), so the seeds "
     "are one run and no interval is given. time: planning time summed over legs, over trials "
     "that ran (median / 75th / 95th percentile). path len: joint-space length summed "
-    "over legs, median over solved trials. pos/ang err: final tip error of the last "
-    "leg, median over trials that ran. checks: collision checks per trial, median. "
+    "over legs, median over solved trials; smoothness: the paths' roughness (squared "
+    "turning angles of each leg's path resampled at 200 states of equal joint-space arc "
+    "length, summed over legs; lower is smoother), median over solved trials; path "
+    "clearance: the smallest clearance along the whole planned paths (every state of the "
+    "final re-check's grid, true geometry, scene and links) over solved trials. pos/ang "
+    "err / tol: the last leg's final tip error, median over solved trials, beside that "
+    "leg's goal tolerance (a failed trial's last state is no result; see legs.csv). "
+    "checks: collision checks per trial, median. "
     "minima met / escaped: totals over trials. PyBullet ok: of the trials whose plan "
     "solved (only those are executed, solved legs up to the first failure), executions "
     "with a valid FCL re-check, no contact, simulated clearance >= 0, deviation within "
@@ -375,31 +446,29 @@ def _md_table(headers: Sequence[str], rows: Iterable[Sequence[str]]) -> str:
     return "\n".join(lines)
 
 
-def _finished_span(records: Sequence[Mapping[str, Any]]) -> str:
-    times = sorted(str(r["finished_at"]) for r in records if r.get("finished_at"))
+def _finished_span(records: Sequence[TrialRecord]) -> str:
+    times = sorted(r.finished_at for r in records if r.finished_at)
     return f"{times[0]} to {times[-1]}" if times else "-"
 
 
 def markdown(
-    rows: Sequence[Mapping[str, Any]], records: Sequence[Mapping[str, Any]], meta: Mapping[str, Any]
+    rows: Sequence[SummaryRow], records: Sequence[TrialRecord], meta: Mapping[str, Any]
 ) -> str:
     """The report: a table per problem, the command, seeds, budget, versions, machine."""
     executed = bool(meta.get("execute"))
     out = [f"# Comparison `{meta.get('name', '')}`", ""]
     out += ["Command:", "", "```", str(meta.get("command", "")), "```", ""]
-    problems = list(dict.fromkeys(str(r["problem"]) for r in rows))
+    problems = list(dict.fromkeys(r.problem for r in rows))
     headers = TABLE_HEADERS + (EXEC_HEADERS if executed else ())
     for p in problems:
         out += [f"## {p}", ""]
-        out.append(
-            _md_table(headers, [summary_cells(r, executed) for r in rows if r["problem"] == p])
-        )
+        out.append(_md_table(headers, [summary_cells(r, executed) for r in rows if r.problem == p]))
         out.append("")
     out += [TABLE_NOTES, "", BUDGET_NOTE, ""]
-    errors = [r for r in records if r.get("status") == ERROR_STATUS]
+    errors = [r for r in records if not r.ran]
     if errors:
         out += ["## Errors", ""]
-        out += [f"- `{r['key']}`: {r.get('error')}" for r in errors]
+        out += [f"- `{r.key}` ({r.status}): {r.error}" for r in errors]
         out.append("")
     out += ["## Set-up", ""]
     setup = [
@@ -418,14 +487,14 @@ def markdown(
         ),
         ("jobs", meta.get("jobs", "")),
         ("trials finished", _finished_span(records)),
-        ("trial processes, total s", fmt(sum(float(r.get("wall_s") or 0.0) for r in records))),
+        ("trial processes, total s", fmt(sum(r.wall_s or 0.0 for r in records))),
         ("this invocation started", meta.get("started_at", "")),
         ("this invocation's wall time s", fmt(meta.get("wall_s"))),
         ("trial store", meta.get("store", "")),
     ]
     out.append(_md_table(("item", "value"), [(k, str(v)) for k, v in setup]))
     out += ["", "## Versions", ""]
-    seen = {json.dumps(r.get("versions"), sort_keys=True) for r in records if r.get("versions")}
+    seen = {json.dumps(r.versions, sort_keys=True) for r in records if r.versions}
     if len(seen) > 1:
         out += [
             f"**The trials ran under {len(seen)} different sets of versions** (the store "
@@ -468,6 +537,8 @@ _RUN_PROPERTIES: tuple[tuple[str, str], ...] = (
     ("execution contacts", "INTEGER"),
     ("execution max deviation", "REAL"),
     ("execution min clearance", "REAL"),
+    ("smoothness", "REAL"),
+    ("path clearance", "REAL"),
 )
 
 
@@ -482,25 +553,25 @@ _PROGRESS_PROPERTIES: tuple[tuple[str, str], ...] = (
 )
 
 
-def _run_progress(r: Mapping[str, Any]) -> list[list[Any]]:
+def _run_progress(r: TrialRecord) -> list[list[Any]]:
     """A trial's progress rows (see :data:`_PROGRESS_PROPERTIES`), times strictly
     increasing (OMPL's table keys progress on (run, time))."""
     rows: list[list[Any]] = []
     t_off = 0.0
     c_off = 0
-    for leg in r.get("legs_run") or []:
-        for t, checks, dist, cost in leg.get("progress") or []:
+    for leg in r.legs_run:
+        for t, checks, dist, cost in leg.progress:
             if t is None:
                 continue
             time_s = t_off + float(t)
             c = None if checks is None else c_off + int(checks)
-            row = [time_s, dist, cost, c, int(leg["leg"])]
+            row = [time_s, dist, cost, c, leg.leg]
             if rows and time_s <= rows[-1][0]:
                 rows[-1] = [rows[-1][0], *row[1:]]  # same instant: the later values
             else:
                 rows.append(row)
-        t_off += float(leg.get("time_s") or 0.0)
-        c_off += int(leg.get("collision_checks") or 0)
+        t_off += leg.time_s
+        c_off += leg.collision_checks
     return rows
 
 
@@ -514,34 +585,34 @@ def _log_value(v: Any) -> str:
     return str(v)
 
 
-def _run_values(r: Mapping[str, Any]) -> list[str]:
-    tot = r.get("totals") or {}
-    ex = r.get("execution")
-    legs = r.get("legs_run") or []
-    status = str(r.get("status"))
-    ok = bool(r.get("success"))
+def _run_values(r: TrialRecord) -> list[str]:
+    status = r.status
+    ok = r.success
+    last = r.last_leg if ok else None
     values: list[Any] = [
-        int(r["seed"]),
-        tot.get("time_s"),
+        r.seed,
+        r.time_s if r.ran else None,
         ok,
         STATUS_ENUM.index(status) if status in STATUS_ENUM else STATUS_ENUM.index("failed"),
         status == "approximate",
-        sum(1 for x in legs if x["status"] == "solved"),
-        tot.get("iterations"),
-        tot.get("collision_checks"),
-        tot.get("fk_calls"),
-        tot.get("path_length") if ok else None,
-        tot.get("path_length"),
-        r.get("final_pos_err_m"),
-        r.get("final_angle_err_deg"),
-        tot.get("local_minima"),
-        tot.get("escapes"),
-        r.get("wall_s"),
-        ex.get("success") if ex else None,
-        ex.get("max_track_err_rad") if ex else None,
-        ex.get("contacts") if ex else None,
-        ex.get("max_deviation_m") if ex else None,
-        ex.get("min_clearance_m") if ex else None,
+        r.legs_solved,
+        r.iterations,
+        r.collision_checks,
+        r.fk_calls,
+        r.path_length if ok else None,
+        r.path_length,
+        last.pos_err_m if last else None,
+        last.angle_err_deg if last else None,
+        r.local_minima,
+        r.escapes,
+        r.wall_s,
+        r.exec_success,
+        r.exec_max_track_err_rad,
+        r.exec_contacts,
+        r.exec_max_deviation_m,
+        r.exec_min_clearance_m,
+        r.roughness_rad2 if ok else None,
+        r.path_clearance_m if ok else None,
     ]
     return [_log_value(v) for v in values]
 
@@ -550,11 +621,11 @@ def _one_line(s: str) -> str:
     return " ".join(str(s).split())
 
 
-def ompl_log(problem: str, records: Sequence[Mapping[str, Any]], meta: Mapping[str, Any]) -> str:
+def ompl_log(problem: str, records: Sequence[TrialRecord], meta: Mapping[str, Any]) -> str:
     """One OMPL benchmark log (one experiment) for the records of ``problem``."""
-    recs = [r for r in records if r["problem"] == problem]
-    planners = list(dict.fromkeys(str(r["planner"]) for r in recs))
-    by_planner = {p: [r for r in recs if r["planner"] == p] for p in planners}
+    recs = [r for r in records if r.problem == problem]
+    planners = list(dict.fromkeys(r.planner for r in recs))
+    by_planner = {p: [r for r in recs if r.planner == p] for p in planners}
     versions = meta.get("versions") or {}
     machine = meta.get("machine") or {}
     budget = (meta.get("budgets_used") or {}).get(problem, {})
@@ -566,7 +637,7 @@ def ompl_log(problem: str, records: Sequence[Mapping[str, Any]], meta: Mapping[s
     ]
     exp_props = [(n, t, v) for n, t, v in exp_props if v is not None]
     time_limit = budget.get("time_limit_s")
-    seeds = sorted({int(r["seed"]) for r in recs})
+    seeds = sorted({r.seed for r in recs})
     lines = [
         f"plannerlab version {versions.get('plannerlab', '0')}",
         f"Experiment {'_'.join(problem.split()) or 'problem'}",
@@ -576,7 +647,7 @@ def ompl_log(problem: str, records: Sequence[Mapping[str, Any]], meta: Mapping[s
         f"Starting at {str(meta.get('started_at', '')).replace('T', ' ')}",
         "<<<|",
         f"command: {_one_line(meta.get('command', ''))}",
-        f"problem file: {recs[0].get('problem_file', '') if recs else ''}",
+        f"problem file: {recs[0].problem_file if recs else ''}",
         f"seeds: {meta.get('seeds_spec', '')} (each run's seed is its 'seed' property)",
         f"budget: {json.dumps(budget, sort_keys=True)}",
         f"legs: {meta.get('legs') or 'all'}",
@@ -593,7 +664,7 @@ def ompl_log(problem: str, records: Sequence[Mapping[str, Any]], meta: Mapping[s
     counts = {len(v) for v in by_planner.values()}
     if len(counts) == 1:
         lines.append(f"{counts.pop()} runs per planner")
-    total = sum(float(r.get("wall_s") or 0.0) for r in recs)
+    total = float(sum(r.wall_s or 0.0 for r in recs))
     lines += [
         f"{total!r} seconds spent to collect the data",
         "1 enum type",
@@ -602,9 +673,7 @@ def ompl_log(problem: str, records: Sequence[Mapping[str, Any]], meta: Mapping[s
     ]
     for p in planners:
         runs = by_planner[p]
-        settings: dict[str, Any] = next(
-            (r["settings_used"] for r in runs if r.get("settings_used")), {}
-        )
+        settings: dict[str, Any] = next((r.settings_used for r in runs if r.settings_used), {})
         common = [f"{k} = {_one_line(json.dumps(v))}" for k, v in sorted(settings.items())]
         lines += [p, f"{len(common)} common properties", *common]
         lines.append(f"{len(_RUN_PROPERTIES)} properties for each run")
@@ -635,8 +704,8 @@ def log_paths(folder: str | Path, name: str, problems: Sequence[str]) -> dict[st
 def write_reports(
     folder: str | Path,
     name: str,
-    records: Sequence[Mapping[str, Any]],
-    rows: Sequence[Mapping[str, Any]],
+    records: Sequence[TrialRecord],
+    rows: Sequence[SummaryRow],
     meta: Mapping[str, Any],
 ) -> list[Path]:
     """Write CSVs, Markdown, metadata and OMPL logs atomically into ``folder``.
@@ -653,7 +722,7 @@ def write_reports(
         write_text_atomic(folder / "report.md", markdown(rows, records, meta)),
         write_json_atomic(folder / "meta.json", meta),
     ]
-    problems = list(dict.fromkeys(str(r["problem"]) for r in records))
+    problems = list(dict.fromkeys(r.problem for r in records))
     for problem, path in log_paths(folder, name, problems).items():
         files.append(write_text_atomic(path, ompl_log(problem, records, meta)))
     return files
@@ -676,6 +745,7 @@ __all__ = [
     "ompl_log",
     "summary_cells",
     "summary_csv",
+    "tip_state",
     "trial_rows",
     "trials_csv",
     "write_reports",

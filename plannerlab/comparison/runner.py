@@ -36,7 +36,8 @@ Decisions:
   runs of the same grid under different budgets without mixing them.
 * **Errors.** A trial that raises is recorded with status ``error`` and the exception's
   last line (never kills the run); it and a ``timeout`` are "finished" for resuming
-  unless ``retry_errors``.
+  unless ``retry_errors``. A trial that ``died`` is never finished: its record says why
+  (in the store, and in this run's records), and the next run tries it again.
 """
 
 from __future__ import annotations
@@ -51,14 +52,16 @@ from typing import Any
 from plannerlab.comparison.spec import BACKENDS, ComparisonSpec
 from plannerlab.comparison.store import TrialStore
 from plannerlab.comparison.trial import (
+    DIED_STATUS,
     ERROR_STATUS,
     TIMEOUT_STATUS,
     Scalar,
     Trial,
-    _error_record,
+    error_record,
     run_trial,
 )
 from plannerlab.errors import PlannerlabError
+from plannerlab.record.trial import TrialRecord
 
 LOGGER = logging.getLogger(__name__)
 
@@ -74,19 +77,26 @@ class ComparisonRun:
         missing: trials without a record (only after an interruption).
     """
 
-    records: list[dict[str, Any]]
+    records: list[TrialRecord]
     ran: int
     skipped: int
     missing: list[Trial] = field(default_factory=list)
 
 
-def _timeout_record(trial: Trial, limit_s: float, elapsed_s: float) -> dict[str, Any]:
-    rec = _error_record(
-        trial, f"killed after {elapsed_s:.1f} s: past the per-trial limit of {limit_s:g} s"
+def _timeout_record(trial: Trial, limit_s: float, elapsed_s: float) -> TrialRecord:
+    return error_record(
+        trial,
+        f"killed after {elapsed_s:.1f} s: past the per-trial limit of {limit_s:g} s",
+        TIMEOUT_STATUS,
+        wall_s=elapsed_s,
     )
-    rec["status"] = TIMEOUT_STATUS
-    rec["wall_s"] = elapsed_s
-    return rec
+
+
+def _died_record(trial: Trial, why: dict[str, Any], elapsed_s: float) -> TrialRecord:
+    """A trial whose process ended without reporting: why, from the backend."""
+    fields = dict(why)
+    error = str(fields.pop("error", "") or "trial process died before reporting a result")
+    return error_record(trial, error, DIED_STATUS, wall_s=elapsed_s, **fields)
 
 
 def make_backend(name: str, work_dir: str | Path, *, address: str | None = None) -> Any:
@@ -113,7 +123,7 @@ def run_comparison(
     trials: Sequence[Trial],
     store: TrialStore | str | Path,
     jobs: int = 1,
-    on_done: Callable[[dict[str, Any], bool], None] | None = None,
+    on_done: Callable[[TrialRecord, bool], None] | None = None,
     *,
     retry_errors: bool = False,
     poll_s: float = 0.5,
@@ -129,7 +139,7 @@ def run_comparison(
         on_done: called in this process as ``on_done(record, skipped)`` for every trial
             already in the store (``skipped=True``, first) and every trial as it finishes.
         retry_errors: rerun trials whose stored record has status ``error`` or
-            ``timeout``.
+            ``timeout`` (a trial that ``died`` is always run again).
         poll_s: how often to look at the running trials [s] (responsiveness, and the
             resolution of the time limit).
         trial_timeout_s: wall-clock limit per trial [s], or a function of the trial
@@ -153,12 +163,12 @@ def run_comparison(
     for t in trials:
         unique.setdefault(t.key, t)
     stored = store.load()
-    results: dict[str, dict[str, Any]] = {}
+    results: dict[str, TrialRecord] = {}
     todo: list[Trial] = []
-    retry = (ERROR_STATUS, TIMEOUT_STATUS)
+    retry = (DIED_STATUS, ERROR_STATUS, TIMEOUT_STATUS) if retry_errors else (DIED_STATUS,)
     for key, t in unique.items():
         rec = stored.get(key)
-        if rec is not None and not (retry_errors and rec.get("status") in retry):
+        if rec is not None and rec.status not in retry:
             results[key] = rec
         else:
             todo.append(t)
@@ -182,10 +192,10 @@ def run_comparison(
             if own_backend:
                 backend = make_backend("local", store.path.parent / ".running")
 
-            def finish(rec: dict[str, Any]) -> None:
+            def finish(rec: TrialRecord) -> None:
                 nonlocal ran
                 append(rec)
-                results[rec["key"]] = rec
+                results[rec.key] = rec
                 ran += 1
                 if on_done is not None:
                     on_done(rec, False)
@@ -199,8 +209,9 @@ def run_comparison(
                         handle = backend.start(trial)
                         running[handle] = (trial, started, limit_of(trial))
                     for handle, rec, why in backend.wait(list(running), poll_s):
-                        trial, _started, _limit = running.pop(handle)
-                        finish(rec if rec is not None else _error_record(trial, why))
+                        trial, started, _limit = running.pop(handle)
+                        elapsed = time.monotonic() - started
+                        finish(rec if rec is not None else _died_record(trial, why, elapsed))
                     now = time.monotonic()
                     for handle, (trial, started, limit) in list(running.items()):
                         if limit is not None and now - started > limit:
@@ -209,7 +220,7 @@ def run_comparison(
                             finish(_timeout_record(trial, limit, now - started))
             except KeyboardInterrupt:
                 for rec in backend.salvage():  # sent but not yet read
-                    if rec.get("key") in unique and rec["key"] not in results:
+                    if rec.key in unique and rec.key not in results:
                         finish(rec)
                 raise
             finally:
@@ -226,7 +237,7 @@ def run_comparison(
 def run_spec(
     spec: ComparisonSpec,
     store: TrialStore | str | Path,
-    on_done: Callable[[dict[str, Any], bool], None] | None = None,
+    on_done: Callable[[TrialRecord, bool], None] | None = None,
 ) -> ComparisonRun:
     """Run a checked specification's trials on its backend, resuming from ``store``.
 
@@ -266,7 +277,7 @@ def compare(
     address: str | None = None,
     trial_timeout_s: float | None = None,
     retry_errors: bool = False,
-    on_done: Callable[[dict[str, Any], bool], None] | None = None,
+    on_done: Callable[[TrialRecord, bool], None] | None = None,
 ) -> ComparisonRun:
     """Every planner on every problem with every seed, each trial in its own process,
     resumable from ``store``: what ``plannerlab compare`` runs, with the same checks

@@ -19,6 +19,7 @@ from typing import Any
 from plannerlab.comparison.trial import Scalar, Trial
 from plannerlab.errors import PlannerlabError
 from plannerlab.problem.load import Budget, Problem
+from plannerlab.record.trial import TrialRecord
 from plannerlab.run.pipeline import legs_from_spec
 
 #: the backends a comparison runs on, by name
@@ -223,15 +224,11 @@ class ComparisonSpec:
             self.budget_used(problem).time_limit_s, n_legs, trial.execute
         )
 
-    def sort_key(self, rec: Mapping[str, Any]) -> tuple[int, int, int]:
+    def sort_key(self, rec: TrialRecord) -> tuple[int, int, int]:
         """Records in the specification's order: problem, planner, seed."""
         order_p = {n: i for i, n in enumerate(self.problem_names)}
         order_pl = {n: i for i, n in enumerate(self.planners)}
-        return (
-            order_p.get(rec["problem"], 1 << 30),
-            order_pl.get(rec["planner"], 1 << 30),
-            int(rec["seed"]),
-        )
+        return (order_p.get(rec.problem, 1 << 30), order_pl.get(rec.planner, 1 << 30), rec.seed)
 
     def to_dict(self) -> dict[str, Any]:
         """The specification as data (a report's metadata)."""

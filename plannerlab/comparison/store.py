@@ -1,19 +1,18 @@
-"""The trial store: one JSON line per finished trial, appended by one writer, read back to
-resume an interrupted comparison."""
+"""The trial store: one JSON line per finished trial (a
+:class:`~plannerlab.record.trial.TrialRecord` with its schema version), appended by one
+writer, read back to resume an interrupted comparison."""
 
 from __future__ import annotations
 
 import contextlib
 import hashlib
-import json
 import logging
 import os
-from collections.abc import Callable, Iterator, Mapping, Sequence
+from collections.abc import Callable, Iterator, Sequence
 from pathlib import Path
-from typing import Any
 
 from plannerlab.errors import PlannerlabError
-from plannerlab.record.codec import dumps
+from plannerlab.record.trial import NotJSONError, TrialRecord, decode_trial, encode_trial
 
 LOGGER = logging.getLogger(__name__)
 
@@ -25,15 +24,22 @@ class TrialStore:
     Every line is flushed and fsynced when written. On reading, a line that is not valid
     JSON is ignored: the last one may be half-written by a kill (it is cut off before the
     next append, so new lines never glue onto it); any other is logged. A key that occurs
-    twice keeps its last record.
+    twice keeps its last record. Lines of the previous schema version are read and
+    converted; a line of another version is refused, naming the file and line
+    (:class:`~plannerlab.record.trial.StoreFormatError`).
     """
 
     def __init__(self, path: str | Path) -> None:
         self.path = Path(path)
 
-    def load(self) -> dict[str, dict[str, Any]]:
-        """Records by trial key."""
-        out: dict[str, dict[str, Any]] = {}
+    def load(self) -> dict[str, TrialRecord]:
+        """Records by trial key.
+
+        Raises:
+            StoreFormatError: a line of a schema version this plannerlab does not read.
+            PlannerlabError: a JSON line that is not a trial record.
+        """
+        out: dict[str, TrialRecord] = {}
         if not self.path.exists():
             return out
         lines = self.path.read_bytes().split(b"\n")
@@ -41,13 +47,13 @@ class TrialStore:
             if not line.strip():
                 continue
             try:
-                rec = json.loads(line)
-            except (json.JSONDecodeError, UnicodeDecodeError):
+                line.decode("utf-8")
+                rec = decode_trial(line, f"{self.path}: line {i + 1}")
+            except (UnicodeDecodeError, NotJSONError):
                 if i < len(lines) - 1:
                     LOGGER.warning("%s: line %d is not JSON; ignored", self.path, i + 1)
                 continue
-            if isinstance(rec, dict) and "key" in rec:
-                out[str(rec["key"])] = rec
+            out[rec.key] = rec
         return out
 
     def _cut_partial_tail(self) -> None:
@@ -69,7 +75,7 @@ class TrialStore:
             os.fsync(fh.fileno())
 
     @contextlib.contextmanager
-    def writer(self) -> Iterator[Callable[[Mapping[str, Any]], None]]:
+    def writer(self) -> Iterator[Callable[[TrialRecord], None]]:
         """Exclusive appender: ``with store.writer() as append: append(record)``.
 
         Raises:
@@ -90,8 +96,8 @@ class TrialStore:
             self._cut_partial_tail()
             with open(self.path, "a", encoding="utf-8") as fh:
 
-                def append(rec: Mapping[str, Any]) -> None:
-                    fh.write(dumps(rec) + "\n")
+                def append(rec: TrialRecord) -> None:
+                    fh.write(encode_trial(rec).decode("utf-8") + "\n")
                     fh.flush()
                     os.fsync(fh.fileno())
 

@@ -7,7 +7,6 @@ from __future__ import annotations
 import hashlib
 import json
 import logging
-import math
 import os
 import time
 import traceback
@@ -17,20 +16,33 @@ from datetime import UTC, datetime
 from pathlib import Path
 from typing import Any
 
-import numpy as np
-
 from plannerlab.errors import PlannerlabError
-from plannerlab.record.codec import to_data
-from plannerlab.record.execution import Execution
-from plannerlab.record.leg import PlanResult, Status
+from plannerlab.record.leg import Status
+from plannerlab.record.trial import (
+    DIED_STATUS,
+    ERROR_STATUS,
+    TIMEOUT_STATUS,
+    TRIAL_FORMAT,
+    ExecutionRecord,
+    LegRecord,
+    TrialRecord,
+)
 
 LOGGER = logging.getLogger(__name__)
 
-RECORD_FORMAT = "plannerlab.trial/1"
-#: statuses of a trial record: the planner statuses plus "error" (the trial raised)
-ERROR_STATUS = "error"
-#: status of a trial killed for running past its wall-clock limit
-TIMEOUT_STATUS = "timeout"
+#: kept for readers of the old name
+RECORD_FORMAT = TRIAL_FORMAT
+__all__ = [
+    "DIED_STATUS",
+    "ERROR_STATUS",
+    "MAX_SEEDS",
+    "RECORD_FORMAT",
+    "TIMEOUT_STATUS",
+    "Trial",
+    "error_record",
+    "parse_seeds",
+    "run_trial",
+]
 
 Scalar = int | float | str | bool | None
 
@@ -174,93 +186,34 @@ def _seed_ompl(seed: int) -> bool:
     return True
 
 
-#: most progress rows a leg record keeps (evenly picked, the first and last always)
-MAX_PROGRESS_ROWS = 200
-
-
-def _thinned(rows: np.ndarray, most: int = MAX_PROGRESS_ROWS) -> np.ndarray:
-    rows = np.asarray(rows, dtype=float).reshape(-1, 4)
-    if len(rows) <= most:
-        return rows
-    return rows[np.unique(np.linspace(0, len(rows) - 1, most).round().astype(int))]
-
-
-def _leg_record(r: PlanResult, continuous: np.ndarray) -> dict[str, Any]:
-    """The leg's :class:`PlanResult` record without its path and trace (a store holds
-    hundreds of legs; ``path_sha256`` identifies the path), plus its joint-space length."""
-    from plannerlab.robots.paths import path_length
-
-    return {
-        **r.to_dict(include_path=False),
-        "path_length": to_data(path_length(r.path, continuous)),
-        "progress": to_data(_thinned(r.progress)),
-    }
-
-
-def _execution_record(executions: Sequence[Execution]) -> dict[str, Any]:
-    """The trial's executions: each leg's :class:`Execution` record without its
-    per-waypoint log, and the verdict over the legs."""
-    legs = [e.to_dict(include_log=False) for e in executions]
-    last = executions[-1] if executions else None
-    return {
-        "success": bool(executions) and all(e.success for e in executions),
-        "path_valid": all(e.path_valid is not False for e in executions),
-        "max_track_err_rad": to_data(max((e.max_track_err_rad for e in executions), default=0.0)),
-        "max_deviation_m": to_data(
-            max((e.max_deviation_m for e in executions), default=math.nan)
-            if all(math.isfinite(e.max_deviation_m) for e in executions)
-            else math.nan
-        ),
-        "min_clearance_m": to_data(
-            min(
-                (e.min_clearance_m for e in executions if math.isfinite(e.min_clearance_m)),
-                default=math.nan,
-            )
-        ),
-        "contacts": sum(len(e.unexpected_contacts) for e in executions),
-        "final_pos_err_m": to_data(last.final_pos_err_m) if last else None,
-        "final_angle_err_deg": to_data(last.final_angle_err_deg) if last else None,
-        "legs": legs,
-    }
-
-
-def _trial_status(legs: Sequence[Mapping[str, Any]]) -> str:
+def _trial_status(legs: Sequence[LegRecord]) -> str:
     for leg in legs:
-        if leg["status"] != Status.SOLVED:
-            return str(leg["status"])
+        if leg.status is not Status.SOLVED:
+            return str(leg.status.value)
     return Status.SOLVED.value if legs else Status.FAILED.value
 
 
-#: per-leg numbers summed into a trial's ``totals``
-TOTAL_KEYS = (
-    "time_s",
-    "iterations",
-    "collision_checks",
-    "fk_calls",
-    "path_length",
-    "local_minima",
-    "escapes",
-)
+def _base(trial: Trial) -> dict[str, Any]:
+    d = trial.to_dict()
+    d["legs"] = None if trial.legs is None else tuple(trial.legs)
+    return {"format": TRIAL_FORMAT, "key": trial.key, **d}
 
 
-def run_trial(trial: Trial) -> dict[str, Any]:
-    """Run one trial and return its record (plain JSON-able data). Never raises
-    (except KeyboardInterrupt/SystemExit): an exception becomes status ``error``.
+def run_trial(trial: Trial) -> TrialRecord:
+    """Run one trial and return its record. Never raises (except KeyboardInterrupt/
+    SystemExit): an exception becomes status ``error``.
 
     Meant to run in a fresh process: OMPL is seeded first, before any OMPL object exists.
-    The legs are solved in order and the trial stops at the first leg that is not solved
-    (the task has failed there; ``legs_run`` shows how far it got).
+    The problem file is parsed once, the planner built once and one collision checker
+    serves the solve, the path measurements and the execution's re-check. The legs are
+    solved in order and the trial stops at the first leg that is not solved (the task has
+    failed there; ``legs_run`` shows how far it got).
     """
     t0 = time.perf_counter()
     ompl_seeded = _seed_ompl(trial.seed)  # first: before any OMPL object exists
     from plannerlab.record.files import versions
 
-    rec: dict[str, Any] = {
-        "format": RECORD_FORMAT,
-        "key": trial.key,
-        **trial.to_dict(),
-        "ompl_seeded": ompl_seeded,
-    }
+    fields: dict[str, Any] = {**_base(trial), "ompl_seeded": ompl_seeded}
     try:
         from plannerlab.problem.catalog import load_problem
         from plannerlab.run.pipeline import SharedChecker, solve_legs
@@ -280,61 +233,46 @@ def run_trial(trial: Trial) -> dict[str, Any]:
             stop_on_failure=True,  # a task fails at its first failed leg
             shared=shared,
         )
-        legs = [_leg_record(r, problem.robot.continuous) for r in plan.legs]
-        rec["budget_used"] = budget.to_dict()
-        rec["settings_used"] = dict(plan.legs[0].settings) if plan.legs else {}
-        rec["legs_run"] = legs
-        rec["status"] = _trial_status(legs)
-        rec["success"] = bool(legs) and all(x["status"] == "solved" for x in legs)
-        rec["error"] = None
-        rec["totals"] = {k: to_data(sum((x[k] or 0) for x in legs)) for k in TOTAL_KEYS}
-        rec["final_pos_err_m"] = legs[-1]["pos_err_m"] if legs else None
-        rec["final_angle_err_deg"] = legs[-1]["angle_err_deg"] if legs else None
-        rec["execution"] = None
+        legs = tuple(LegRecord.of(r, problem.robot.continuous) for r in plan.legs)
+        fields.update(
+            budget_used=budget.to_dict(),
+            settings_used=dict(plan.legs[0].settings) if plan.legs else {},
+            legs_run=legs,
+            status=_trial_status(legs),
+            success=bool(legs) and all(x.solved for x in legs),
+        )
         # Execution runs what the planner claims: the solved legs up to the first that is
         # not solved. A failed plan's path (thousands of flailing descent steps, say) is
         # not executed; ``executed_legs`` says how many legs were.
         solved_prefix = 0
         while solved_prefix < len(plan.legs) and plan.legs[solved_prefix].solved:
             solved_prefix += 1
-        rec["executed_legs"] = solved_prefix if trial.execute else 0
+        fields["executed_legs"] = solved_prefix if trial.execute else 0
         if trial.execute and solved_prefix:
             from plannerlab.run.pipeline import execute_results
 
             executions = execute_results(problem, plan.legs[:solved_prefix], shared=shared)
-            rec["execution"] = _execution_record(executions)
+            fields["executions"] = tuple(ExecutionRecord.of(e) for e in executions)
     except Exception as exc:  # a crashing trial is a record, never the end of the run
         last = traceback.format_exception_only(type(exc), exc)[-1].strip()
         LOGGER.debug("trial %s raised", trial.key, exc_info=True)
-        rec.update(
-            status=ERROR_STATUS,
-            success=False,
-            error=last,
-            legs_run=[],
-            totals={},
-            execution=None,
-            final_pos_err_m=None,
-            final_angle_err_deg=None,
-        )
-    rec["versions"] = versions()
-    rec["pid"] = os.getpid()
-    rec["wall_s"] = time.perf_counter() - t0
-    rec["finished_at"] = datetime.now(UTC).isoformat(timespec="seconds")
-    return rec
+        fields.update(status=ERROR_STATUS, success=False, error=last, legs_run=(), executions=None)
+    fields["versions"] = versions()
+    fields["pid"] = os.getpid()
+    fields["wall_s"] = time.perf_counter() - t0
+    fields["finished_at"] = datetime.now(UTC).isoformat(timespec="seconds")
+    return TrialRecord(**fields)
 
 
-def _error_record(trial: Trial, error: str) -> dict[str, Any]:
-    return {
-        "format": RECORD_FORMAT,
-        "key": trial.key,
-        **trial.to_dict(),
-        "status": ERROR_STATUS,
-        "success": False,
-        "error": error,
-        "legs_run": [],
-        "totals": {},
-        "execution": None,
-        "final_pos_err_m": None,
-        "final_angle_err_deg": None,
-        "finished_at": datetime.now(UTC).isoformat(timespec="seconds"),
-    }
+def error_record(trial: Trial, error: str, status: str = ERROR_STATUS, **more: Any) -> TrialRecord:
+    """The record of a trial that did not report (it died, timed out, or could not run):
+    ``status`` with ``error`` saying why; ``more``: the other fields known (``exit_code``,
+    ``signal``, ``output``, ``wall_s``)."""
+    return TrialRecord(
+        **_base(trial),
+        status=status,
+        success=False,
+        error=error,
+        finished_at=datetime.now(UTC).isoformat(timespec="seconds"),
+        **more,
+    )

@@ -23,3 +23,13 @@ def fmt(x: Any, digits: int = 3) -> str:
             return "-"
         return f"{x:.{digits}g}" if abs(x) < 1e3 else f"{x:.0f}"
     return str(x)
+
+
+def err_of_tol(err: Any, tol: Any, digits: int = 3) -> str:
+    """A tip error beside its tolerance, ``"0.0976 / 0.1"`` ("-" without an error; the
+    error alone when the tolerance is unknown)."""
+    if err is None or (isinstance(err, float) and not math.isfinite(err)):
+        return "-"
+    if tol is None or (isinstance(tol, float) and not math.isfinite(tol)):
+        return fmt(float(err), digits)
+    return f"{fmt(float(err), digits)} / {fmt(float(tol), digits)}"

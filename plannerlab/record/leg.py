@@ -48,7 +48,16 @@ def settings_dict(settings: Any) -> dict[str, Any]:
 PROGRESS_COLUMNS = ("time_s", "collision_checks", "best_goal_dist", "best_cost")
 
 #: float fields of :class:`PlanResult` (``null`` in a file reads back as NaN)
-_FLOAT_FIELDS = ("time_s", "pos_err_m", "angle_err_deg", "min_clearance_m")
+_FLOAT_FIELDS = (
+    "time_s",
+    "pos_err_m",
+    "angle_err_deg",
+    "min_clearance_m",
+    "pos_tol_m",
+    "angle_tol_deg",
+    "path_clearance_m",
+    "roughness_rad2",
+)
 
 
 @dataclass(frozen=True, eq=False)
@@ -80,6 +89,17 @@ class PlanResult:
         seed: the trial's seed (None if not seeded by a trial).
         settings: the planner's settings as data.
         extra: planner-specific numbers (path length before/after simplification, …).
+        pos_tol_m, angle_tol_deg: the goal's tolerances the tip errors are judged against
+            (NaN when not recorded); set by :func:`plannerlab.run.pipeline.solve_legs`.
+        path_clearance_m: smallest clearance along the whole path [m]: every state of the
+            final re-check's grid (``joint_step / 4``, the checker's edge cuts), the true
+            capsules (no margin) to the scene and between checked link pairs, in one
+            compiled call; measured by :func:`~plannerlab.run.pipeline.solve_legs` after
+            the solve (outside the planner's clock) for a solved leg (NaN otherwise, and
+            for a contact-permitting plan, which touches by design).
+        roughness_rad2: how much the path turns [rad²]
+            (:func:`~plannerlab.robots.paths.roughness`; lower is smoother), set with
+            ``path_clearance_m``.
         contact_plan: a contact-permitting plan's record of its contacts (the continuum's
             ``chord_arc``: :class:`~plannerlab.record.contact_plan.ContactPlan`), which the
             executor, the figures and the CLI read; None for every other planner. A leg
@@ -100,6 +120,10 @@ class PlanResult:
     pos_err_m: float = math.nan
     angle_err_deg: float = math.nan
     min_clearance_m: float = math.nan
+    pos_tol_m: float = math.nan
+    angle_tol_deg: float = math.nan
+    path_clearance_m: float = math.nan
+    roughness_rad2: float = math.nan
     trace: Array = field(default_factory=lambda: np.zeros(0))
     progress: Array = field(default_factory=lambda: np.zeros((0, 4)))
     local_minima: int = 0

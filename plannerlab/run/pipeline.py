@@ -29,7 +29,7 @@ import numpy as np
 
 from plannerlab.errors import PlanFileError, PlannerlabError, ProblemError
 from plannerlab.planners import get_entry, make_planner
-from plannerlab.planners.base import LegRun, start_collision
+from plannerlab.planners.base import LegRun, planned_clearance_m, start_collision
 from plannerlab.planners.context import PlanningContext
 from plannerlab.problem.goals import unreachable_reason
 from plannerlab.problem.load import Budget, Problem
@@ -37,7 +37,11 @@ from plannerlab.record.execution import Execution
 from plannerlab.record.files import versions
 from plannerlab.record.leg import PlanResult, Status
 from plannerlab.record.plan import Plan, file_sha256
-from plannerlab.robots.paths import waypoints
+from plannerlab.robots.paths import edge_counts, roughness, waypoints
+
+#: most grid states measured in one compiled call (a long path is measured in pieces of
+#: whole edges, so its grid never has to fit in memory at once)
+CLEARANCE_CHUNK = 8192
 
 
 class SharedChecker:
@@ -63,6 +67,43 @@ def canonical_result(r: PlanResult) -> PlanResult:
     its waypoints (``r`` itself when nothing drops)."""
     path = waypoints(r.path)
     return r if len(path) == len(r.path) else r.replace(path=path)
+
+
+def path_clearance_m(checker: Any, path: np.ndarray, joint_step: float) -> float:
+    """Smallest clearance [m] along the whole of ``path``: every state of the grid the final
+    re-check checks (``checker.densify`` at ``joint_step``), true capsules (the checker's
+    margin added back), to the scene and between checked link pairs, in compiled calls of
+    at most :data:`CLEARANCE_CHUNK` states. Not counted as collision checks (a measurement
+    of the result)."""
+    P = np.atleast_2d(np.asarray(path, dtype=float))
+    if len(P) < 2:
+        return planned_clearance_m(checker, P)
+    _, n = edge_counts(P, joint_step, checker.robot.continuous, checker.edge_weights)
+    best, start, count = np.inf, 0, 0
+    for i, k in enumerate(n):
+        count += int(k)
+        if count >= CLEARANCE_CHUNK or i == len(n) - 1:
+            dense, _ = checker.densify(P[start : i + 2], joint_step)
+            best = min(best, planned_clearance_m(checker, dense))
+            start, count = i + 1, 0
+    return float(best)
+
+
+def measured(problem: Problem, r: PlanResult, checker: Any | None) -> PlanResult:
+    """``r`` with its goal's tolerances and, when it solved, its path's quality: roughness
+    (:func:`~plannerlab.robots.paths.roughness`) and the smallest clearance along the
+    whole path (:func:`path_clearance_m` at the final re-check's ``joint_step / 4``; not
+    for a contact plan, which touches by design, nor without a checker). Measured after
+    the solve: outside the planner's clock and its counts."""
+    goal = problem.goal(r.leg)
+    changes: dict[str, Any] = {"pos_tol_m": goal.pos_tol_m, "angle_tol_deg": goal.angle_tol_deg}
+    if r.solved:
+        changes["roughness_rad2"] = roughness(r.path, problem.robot.continuous)
+        if checker is not None and r.contact_plan is None and hasattr(checker, "densify"):
+            changes["path_clearance_m"] = path_clearance_m(
+                checker, r.path, problem.joint_step / 4.0
+            )
+    return r.replace(**changes)
 
 
 def leg_rng(seed: int, leg: int) -> np.random.Generator:
@@ -197,6 +238,9 @@ def solve_legs(
                     problem, leg, budget, leg_rng(seed, leg), q_start=q, stepper=stepper
                 )
             r = canonical_result(r.replace(seed=seed))
+            if r.solved and checker is None and r.contact_plan is None:
+                checker = (shared or SharedChecker(problem)).get()  # to measure the path
+            r = measured(problem, r, checker)
             results.append(r)
             if on_leg is not None:
                 on_leg(r)
