@@ -27,6 +27,7 @@ from plannerlab.comparison.store import TrialStore
 from plannerlab.comparison.trial import ERROR_STATUS, Trial, parse_seeds, run_trial
 from plannerlab.errors import PlannerlabError
 from plannerlab.problem.catalog import resolve_problem_path
+from plannerlab.record.trial import DIED_STATUS, TrialRecord
 
 try:
     import plannerlab.planners.ompl  # noqa: F401
@@ -60,8 +61,10 @@ def _lines(path: Path) -> list[dict]:
     return [json.loads(x) for x in path.read_text().splitlines() if x.strip()]
 
 
-def _deterministic(rec: dict) -> list[dict]:
+def _deterministic(rec: dict | TrialRecord) -> list[dict]:
     """A record's per-leg results without the clocks (progress rows without their time)."""
+    if isinstance(rec, TrialRecord):
+        rec = rec.to_dict()
     return [
         {
             **{k: v for k, v in leg.items() if k not in ("time_s", "progress")},
@@ -147,7 +150,7 @@ def test_deleted_line_reruns_only_that_trial(comparison: dict, tmp_path: Path) -
         _trials(),
         store,
         jobs=2,
-        on_done=lambda r, skipped: None if skipped else fresh.append(r["key"]),
+        on_done=lambda r, skipped: None if skipped else fresh.append(r.key),
     )
     assert (run.ran, run.skipped) == (1, len(_trials()) - 1)
     assert fresh == [gone["key"]]
@@ -281,34 +284,32 @@ def test_same_seed_same_results_in_fresh_processes(comparison: dict, tmp_path: P
     run = run_comparison(pick, tmp_path / "again.jsonl", jobs=2)
     assert run.ran == len(pick)
     for rec in run.records:
-        old = first[rec["key"]]
-        assert rec["pid"] != old["pid"]
-        assert _deterministic(rec) == _deterministic(old), rec["key"]
+        old = first[rec.key]
+        assert rec.pid != old["pid"]
+        assert _deterministic(rec) == _deterministic(old), rec.key
 
 
 def test_same_seeds_same_table_whatever_jobs(comparison: dict, tmp_path: Path) -> None:
     """The module comparison ran with --jobs 2 in children forked from the fork server;
     one job at a time gives the same per-trial results and the same table, and OMPL's
     seed took effect in every child (different seeds, different paths)."""
-    first = {r["key"]: r for r in _lines(comparison["store"])}
+    first = TrialStore(comparison["store"]).load()
     run = run_comparison(_trials(), tmp_path / "one.jsonl", jobs=1)
     assert run.ran == len(first)
     for rec in run.records:
-        assert _deterministic(rec) == _deterministic(first[rec["key"]]), rec["key"]
-        assert rec["startup_s"] >= 0.0
+        assert _deterministic(rec) == _deterministic(first[rec.key]), rec.key
+        assert rec.startup_s is not None and rec.startup_s >= 0.0
 
-    def table(records: list[dict]) -> list[dict]:
+    def table(records: list[TrialRecord]) -> list[dict]:
         return [
-            {k: v for k, v in row.items() if not k.startswith("time_")}
+            {k: v for k, v in row.to_dict().items() if not k.startswith("time_")}
             for row in summarise(records)
         ]
 
-    assert table(run.records) == table([first[r["key"]] for r in run.records])
+    assert table(run.records) == table([first[r.key] for r in run.records])
     if HAVE_OMPL:
         hashes = {
-            r["seed"]: r["legs_run"][0]["path_sha256"]
-            for r in run.records
-            if r["planner"] == "ompl.rrtconnect"
+            r.seed: r.legs_run[0].path_sha256 for r in run.records if r.planner == "ompl.rrtconnect"
         }
         assert len(set(hashes.values())) == len(SEEDS), hashes
 
@@ -318,27 +319,29 @@ def test_a_planner_whose_seeds_are_one_trial_is_marked_and_gets_no_interval(
 ) -> None:
     """The gradient methods ignore their generator: their three seeds are one trial, so
     the row says deterministic and has no interval; RRT-Connect's seeds differ."""
-    records = _lines(comparison["store"])
-    rows = {r["planner"]: r for r in summarise(records)}
+    import msgspec
+
+    records = list(TrialStore(comparison["store"]).load().values())
+    rows = {r.planner: r for r in summarise(records)}
     for name in ("gradient", "gradient.analytic"):
         row = rows[name]
-        assert row["deterministic"] is True and row["distinct_trials"] == 1, name
-        assert math.isnan(row["ci95_low"]) and math.isnan(row["ci95_high"])
+        assert row.deterministic is True and row.distinct_trials == 1, name
+        assert math.isnan(row.ci95_low) and math.isnan(row.ci95_high)
     if HAVE_OMPL:
         row = rows["ompl.rrtconnect"]
-        assert row["deterministic"] is False and row["distinct_trials"] == len(SEEDS)
-        assert (row["ci95_low"], row["ci95_high"]) == wilson_interval(row["successes"], row["n"])
+        assert row.deterministic is False and row.distinct_trials == len(SEEDS)
+        assert (row.ci95_low, row.ci95_high) == wilson_interval(row.successes, row.n)
     report = (comparison["folder"] / "report.md").read_text(encoding="utf-8")
     assert report.count(f"[deterministic: {len(SEEDS)} seeds, one trial]") == 2
     # a trial that did something else (another path) is another trial: the interval is back
-    grad = [r for r in records if r["planner"] == "gradient"]
-    leg0 = {**grad[0]["legs_run"][0], "path_sha256": "0" * 16}
-    (row,) = summarise([{**grad[0], "legs_run": [leg0]}, *grad[1:]])
-    assert row["deterministic"] is False and row["distinct_trials"] == 2
-    assert (row["ci95_low"], row["ci95_high"]) == wilson_interval(row["successes"], row["n"])
+    grad = [r for r in records if r.planner == "gradient"]
+    leg0 = msgspec.structs.replace(grad[0].legs_run[0], path_sha256="0" * 16)
+    (row,) = summarise([grad[0].replace(legs_run=(leg0,)), *grad[1:]])
+    assert row.deterministic is False and row.distinct_trials == 2
+    assert (row.ci95_low, row.ci95_high) == wilson_interval(row.successes, row.n)
     # one trial alone is not called deterministic (nothing to compare it with)
     (row,) = summarise(grad[:1])
-    assert row["deterministic"] is False and row["distinct_trials"] == 1
+    assert row.deterministic is False and row.distinct_trials == 1
 
 
 def test_fork_server_children_match_spawned_interpreters(comparison: dict, tmp_path: Path) -> None:
@@ -354,7 +357,7 @@ def test_fork_server_children_match_spawned_interpreters(comparison: dict, tmp_p
         backend.close()
     assert run.ran == len(pick)
     for rec in run.records:
-        assert _deterministic(rec) == _deterministic(first[rec["key"]]), rec["key"]
+        assert _deterministic(rec) == _deterministic(first[rec.key]), rec.key
 
 
 def test_a_trial_past_its_time_limit_is_killed_and_recorded(tmp_path: Path) -> None:
@@ -374,12 +377,12 @@ def test_a_trial_past_its_time_limit_is_killed_and_recorded(tmp_path: Path) -> N
         trial_timeout_s=lambda t: 0.2 if t.key == slow.key else None,
     )
     assert time.monotonic() - t0 < 60
-    recs = {r["key"]: r for r in run.records}
-    assert recs[slow.key]["status"] == TIMEOUT_STATUS and not recs[slow.key]["success"]
-    assert "per-trial limit of 0.2 s" in recs[slow.key]["error"]
-    assert recs[quick.key]["status"] not in (TIMEOUT_STATUS, ERROR_STATUS)
-    rows = {r["planner"]: r for r in summarise(run.records)}
-    assert rows["gradient"]["errors"] == 1 and rows["gradient"]["successes"] == 0
+    recs = {r.key: r for r in run.records}
+    assert recs[slow.key].status == TIMEOUT_STATUS and not recs[slow.key].success
+    assert "per-trial limit of 0.2 s" in str(recs[slow.key].error)
+    assert recs[quick.key].status not in (TIMEOUT_STATUS, ERROR_STATUS)
+    rows = {r.planner: r for r in summarise(run.records)}
+    assert rows["gradient"].errors == 1 and rows["gradient"].successes == 0
     # a timeout is finished for resuming
     again = run_comparison([slow, quick], tmp_path / "s.jsonl", jobs=1)
     assert again.ran == 0 and again.skipped == 2
@@ -479,30 +482,35 @@ def test_a_raising_trial_is_recorded_and_execution_summarised(tmp_path: Path) ->
         PROBLEM, path, "gradient.analytic", 0, budget={"max_collision_checks": 100}, execute=True
     )
     run = run_comparison([bad, ok, stalled], tmp_path / "s.jsonl", jobs=2)
-    recs = {r["key"]: r for r in run.records}
-    assert recs[bad.key]["status"] == ERROR_STATUS
-    assert "missing.toml" in recs[bad.key]["error"]
-    assert recs[ok.key]["success"], recs[ok.key]["legs_run"]
-    ex = recs[ok.key]["execution"]
-    assert ex is not None and set(ex) >= {"success", "max_track_err_rad", "contacts"}
+    recs = {r.key: r for r in run.records}
+    assert recs[bad.key].status == ERROR_STATUS
+    assert "missing.toml" in str(recs[bad.key].error)
+    good = recs[ok.key]
+    assert good.success, good.legs_run
+    assert good.executions is not None and good.exec_success is not None
     # the verdict's numbers in metres, per trial and per leg
-    assert 0.0 <= ex["max_deviation_m"] <= 0.01 and ex["min_clearance_m"] > 0.0
-    assert all(leg["max_deviation_limit_m"] == 0.01 for leg in ex["legs"])
-    assert len(ex["legs"]) == len(recs[ok.key]["legs_run"]) == recs[ok.key]["executed_legs"]
+    assert 0.0 <= good.exec_max_deviation_m <= 0.01 and good.exec_min_clearance_m > 0.0
+    assert all(e.max_deviation_limit_m == 0.01 for e in good.executions)
+    assert len(good.executions) == len(good.legs_run) == good.executed_legs
+    # the path's quality, measured densely after the solve, and the goal's tolerances
+    (leg,) = good.legs_run
+    assert leg.path_clearance_m is not None and 0.0 < leg.path_clearance_m <= leg.min_clearance_m
+    assert leg.roughness_rad2 is not None and leg.roughness_rad2 >= 0.0
+    assert leg.pos_tol_m is not None and leg.pos_err_m <= leg.pos_tol_m
     # a plan that did not solve its leg is not executed
-    assert recs[stalled.key]["execution"] is None and recs[stalled.key]["executed_legs"] == 0
-    rows = {r["planner"]: r for r in summarise(run.records)}
-    assert rows["gradient"]["errors"] == 1 and rows["ompl.rrtconnect"]["errors"] == 0
-    assert rows["ompl.rrtconnect"]["executed"] == 1
-    assert math.isfinite(rows["ompl.rrtconnect"]["exec_track_err_median_rad"])
-    assert 0.0 <= rows["ompl.rrtconnect"]["exec_deviation_median_m"] <= 0.01
-    assert rows["ompl.rrtconnect"]["exec_clearance_min_m"] > 0.0
-    assert rows["gradient.analytic"]["executed"] == 0
+    assert recs[stalled.key].executions is None and recs[stalled.key].executed_legs == 0
+    rows = {r.planner: r for r in summarise(run.records)}
+    assert rows["gradient"].errors == 1 and rows["ompl.rrtconnect"].errors == 0
+    assert rows["ompl.rrtconnect"].executed == 1
+    assert math.isfinite(rows["ompl.rrtconnect"].exec_track_err_median_rad)
+    assert 0.0 <= rows["ompl.rrtconnect"].exec_deviation_median_m <= 0.01
+    assert rows["ompl.rrtconnect"].exec_clearance_min_m > 0.0
+    assert rows["gradient.analytic"].executed == 0
 
 
 def test_a_trial_whose_process_dies_is_recorded(tmp_path: Path) -> None:
-    """A hard crash (here SIGKILL) of one trial's process is that trial's error record;
-    the trial beside it is unaffected."""
+    """A hard crash (here SIGKILL) of one trial's process is that trial's ``died`` record,
+    with the signal; the trial beside it is unaffected."""
     import multiprocessing
     import threading
 
@@ -531,11 +539,49 @@ def test_a_trial_whose_process_dies_is_recorded(tmp_path: Path) -> None:
     th.start()
     run = run_comparison([victim, other], tmp_path / "s.jsonl", jobs=2)
     th.join(timeout=5)
-    recs = {r["key"]: r for r in run.records}
+    recs = {r.key: r for r in run.records}
     assert killed
-    assert recs[victim.key]["status"] == ERROR_STATUS
-    assert "died" in recs[victim.key]["error"]
-    assert recs[other.key]["status"] != ERROR_STATUS
+    assert recs[victim.key].status == DIED_STATUS
+    assert recs[victim.key].signal == "SIGKILL" and recs[victim.key].exit_code is None
+    assert "died (killed by SIGKILL)" in str(recs[victim.key].error)
+    assert recs[other.key].status not in (ERROR_STATUS, DIED_STATUS)
+
+
+def _dies_loudly(trial: Trial) -> TrialRecord:
+    """A trial's process that writes to stderr and exits (code 3) without reporting."""
+    for i in range(30):
+        print(f"line {i} of a dying trial", file=sys.stderr)
+    sys.stderr.flush()
+    os._exit(3)
+
+
+def test_a_died_trial_says_why_and_is_run_again_next_time(tmp_path: Path) -> None:
+    """A trial whose process really exits without reporting (code 3, after writing to
+    stderr) is recorded as died, with the exit code and the last lines of its output; the
+    next run of the same comparison runs it again (no --retry-errors needed), and its
+    new record replaces the old one."""
+    from plannerlab.comparison.local import OUTPUT_TAIL_LINES, LocalBackend
+
+    path = resolve_problem_path(PROBLEM).resolve()
+    trial = Trial.make(PROBLEM, path, "gradient.analytic", 0, budget={"max_collision_checks": 100})
+    store = tmp_path / "s.jsonl"
+    dying = LocalBackend(tmp_path / "running", _dies_loudly, start_method="spawn")
+    try:
+        run = run_comparison([trial], store, backend=dying)
+    finally:
+        dying.close()
+    (rec,) = run.records
+    assert (rec.status, rec.exit_code, rec.signal) == (DIED_STATUS, 3, None)
+    assert "died (exit code 3)" in str(rec.error) and "line 29 of a dying trial" in str(rec.error)
+    lines = rec.output.splitlines()
+    assert len(lines) == OUTPUT_TAIL_LINES and lines[-1] == "line 29 of a dying trial"
+    assert TrialStore(store).load()[trial.key].status == DIED_STATUS  # in the store
+    again = run_comparison([trial], store)
+    assert (again.ran, again.skipped) == (1, 0)
+    (rec,) = again.records
+    assert rec.status != DIED_STATUS and rec.error is None
+    assert TrialStore(store).load()[trial.key] == rec
+    assert run_comparison([trial], store).skipped == 1  # finished now
 
 
 def test_interrupted_compare_resumes(tmp_path: Path) -> None:
@@ -638,11 +684,14 @@ def test_cli_parses_the_issue_example() -> None:
 @pytest.mark.skipif(os.name != "posix", reason="the store lock uses fcntl")
 def test_store_is_locked_while_written(tmp_path: Path) -> None:
     store = TrialStore(tmp_path / "s.jsonl")
+    rec = TrialRecord(
+        key="k", problem="p", problem_file="p.toml", planner="x", seed=0, status="solved"
+    )
     with store.writer() as append:
-        append({"key": "k", "x": 1})
+        append(rec)
         with pytest.raises(PlannerlabError, match="in use"), store.writer():
             pass
-    assert TrialStore(tmp_path / "s.jsonl").load() == {"k": {"key": "k", "x": 1}}
+    assert TrialStore(tmp_path / "s.jsonl").load() == {"k": rec}
 
 
 def test_the_api_checks_a_comparison_as_the_cli_does(tmp_path: Path) -> None:
