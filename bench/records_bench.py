@@ -138,18 +138,18 @@ def main() -> None:
     t_ms_r = best(lambda: [decode_trial(b) for b in ms_lines], args.repeat)
     t_dc_r = best(lambda: [dc_decode(s) for s in dc_lines], args.repeat)
     load = os.getloadavg()
-    print(
-        f"{len(recs)} trial records from the stores under results/ (python {sys.version.split()[0]})"
-    )
-    print(
-        f"machine load (1, 5, 15 min): {load[0]:.2f} {load[1]:.2f} {load[2]:.2f} on {os.cpu_count()} CPUs"
-    )
+    py = sys.version.split()[0]
+    print(f"{len(recs)} trial records from the stores under results/ (python {py})")
+    print(f"machine load (1, 5, 15 min): {load[0]:.2f} {load[1]:.2f} {load[2]:.2f}", end="")
+    print(f" on {os.cpu_count()} CPUs")
+    rows = [
+        ("store size [kB]", ms_bytes / 1e3, dc_bytes / 1e3),
+        ("write all [ms]", 1e3 * t_ms_w, 1e3 * t_dc_w),
+        ("read all [ms]", 1e3 * t_ms_r, 1e3 * t_dc_r),
+    ]
     print(f"{'':24}{'msgspec':>12}{'dataclasses':>14}{'ratio dc/ms':>13}")
-    print(
-        f"{'store size [kB]':24}{ms_bytes / 1e3:12.1f}{dc_bytes / 1e3:14.1f}{dc_bytes / ms_bytes:13.2f}"
-    )
-    print(f"{'write all [ms]':24}{1e3 * t_ms_w:12.1f}{1e3 * t_dc_w:14.1f}{t_dc_w / t_ms_w:13.2f}")
-    print(f"{'read all [ms]':24}{1e3 * t_ms_r:12.1f}{1e3 * t_dc_r:14.1f}{t_dc_r / t_ms_r:13.2f}")
+    for name, ms, dc in rows:
+        print(f"{name:24}{ms:12.1f}{dc:14.1f}{dc / ms:13.2f}")
 
 
 if __name__ == "__main__":

@@ -436,8 +436,10 @@ def decode_trial(line: bytes | str, where: str = "<record>") -> TrialRecord:
     """
     try:
         return _DECODER.decode(line)
-    except msgspec.ValidationError as exc:
+    except msgspec.ValidationError as exc:  # another version, or not a trial record
         first = exc
+    except msgspec.DecodeError as exc:
+        raise NotJSONError(f"{where}: not JSON ({exc})") from None
     try:
         data = msgspec.json.decode(line)
     except msgspec.DecodeError as exc:
