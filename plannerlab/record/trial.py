@@ -403,7 +403,7 @@ class TrialRecord(msgspec.Struct, frozen=True, kw_only=True):
 
     def to_dict(self) -> dict[str, Any]:
         """The record as plain JSON-able data (what a store line holds)."""
-        out: dict[str, Any] = msgspec.to_builtins(self)
+        out: dict[str, Any] = msgspec.json.decode(msgspec.json.encode(self))
         return out
 
 
@@ -434,8 +434,11 @@ def decode_trial(line: bytes | str, where: str = "<record>") -> TrialRecord:
         PlannerlabError: a line that is not a trial record (the field and what was
             expected).
     """
+    first: Exception | None = None
     try:
-        return _DECODER.decode(line)
+        rec = _DECODER.decode(line)
+        if rec.format == TRIAL_FORMAT:
+            return rec
     except msgspec.ValidationError as exc:  # another version, or not a trial record
         first = exc
     except msgspec.DecodeError as exc:

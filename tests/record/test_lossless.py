@@ -15,6 +15,7 @@ import json
 from pathlib import Path
 from typing import Any
 
+import msgspec
 import numpy as np
 import pytest
 from conftest import plannerlab
@@ -22,6 +23,7 @@ from conftest import plannerlab
 import plannerlab as pl
 from plannerlab.record.codec import dumps, loads
 from plannerlab.record.plan import ExecutionFile, Plan, execution_path
+from plannerlab.record.trial import ExecutionRecord, LegRecord, TrialRecord
 from plannerlab.robots.paths import waypoints
 from plannerlab.run.pipeline import canonical_result, execute_results, leg_rng
 
@@ -96,20 +98,34 @@ def test_execute_of_the_cli_plan_file_and_compare_execute_agree_with_the_api(
     file_plan = Plan.load(plan_file)
     exec_file = ExecutionFile.load(execution_path(plan_file))
     assert json.loads(executed.stdout) == exec_file.to_dict()
-    (trial,) = [json.loads(x) for x in (tmp_path / "runs" / "c" / "trials.jsonl").open()]
+    (trial,) = pl.TrialStore(tmp_path / "runs" / "c" / "trials.jsonl").load().values()
+    assert isinstance(trial, TrialRecord)
     api_plan, api_exec = api["plan"], api["executions"]
 
     # the same verdict, field by field: the execution file (its log too) and the trial
     assert [_verdict(e, include_log=True) for e in exec_file.executions] == [
         _verdict(e, include_log=True) for e in api_exec
     ]
-    assert [_verdict(x) for x in trial["execution"]["legs"]] == [_verdict(e) for e in api_exec]
-    # the same path on every road: the file's, the trial's (its hash) and the API's
+    assert trial.executions is not None
+    untimed = [msgspec.structs.replace(x, wall_time_s=None) for x in trial.executions]
+    assert untimed == [
+        msgspec.structs.replace(ExecutionRecord.of(e), wall_time_s=None) for e in api_exec
+    ]
+    # the same legs (clocks aside), the same path on every road: the file's, the trial's
+    # (its hash) and the API's
+    continuous = api["problem"].robot.continuous
+    assert [msgspec.structs.replace(x, time_s=0.0, progress=()) for x in trial.legs_run] == [
+        msgspec.structs.replace(LegRecord.of(r, continuous), time_s=0.0, progress=())
+        for r in api_plan.legs
+    ]
     assert [r.path.tobytes() for r in file_plan.legs] == [r.path.tobytes() for r in api_plan.legs]
-    assert [x["path_sha256"] for x in trial["legs_run"]] == [r.path_sha256() for r in api_plan.legs]
-    assert [x["path_points"] for x in trial["legs_run"]] == [len(r.path) for r in api_plan.legs]
-
-    assert trial["execution"]["success"] == all(e.success for e in api_exec)
+    assert [x.path_sha256 for x in trial.legs_run] == [r.path_sha256() for r in api_plan.legs]
+    assert [x.path_points for x in trial.legs_run] == [len(r.path) for r in api_plan.legs]
+    # the path's quality is the plan file's too
+    assert [x.path_clearance_m for x in trial.legs_run] == [
+        r.path_clearance_m for r in file_plan.legs
+    ]
+    assert trial.exec_success == all(e.success for e in api_exec)
 
 
 def test_waypoints_are_a_fixed_point_and_survive_json() -> None:
