@@ -14,7 +14,10 @@ What the page shows (``plannerlab view PLAN.json``, :func:`plannerlab.view`):
   normal's angle tolerance); a leg selector;
 * the link nearest the scene coloured by its clearance (red touching, green at
   :data:`CLEAR_AT_M` or more), with its distance in the side panel;
-* the contacts an execution recorded, marked where they happened.
+* the contacts an execution recorded, marked where they happened;
+* each leg's planned path in the side panel: its length, smoothness and the smallest
+  clearance along the whole path, from its record (:func:`~plannerlab.plot.view_scene.
+  path_quality`).
 
 The frames are made from records only (:func:`leg_motions`): the plan's path densified at
 the problem's joint step, or, for an executed leg, each logged sample's commanded and
@@ -476,6 +479,7 @@ class Viewer:
                 lines.append(f"leg {m.leg} '{m.goal}': {m.status}; {m.verdict}")
             else:
                 lines.append(f"leg {m.leg} '{m.goal}': {m.status}; not executed")
+            lines.append(m.quality)
             self.info.content = "  \n".join(lines)
 
     # ------------------------------------------------------------------- playing

@@ -19,7 +19,7 @@ import numpy as np
 from plannerlab.problem.load import Problem
 from plannerlab.problem.scene import Box, Cylinder, Sphere
 from plannerlab.robots.base import Array
-from plannerlab.robots.paths import densify
+from plannerlab.robots.paths import densify, path_length, roughness
 
 PLANNED_RGB = (31, 119, 180)
 EXECUTED_RGB = (255, 127, 14)
@@ -55,6 +55,7 @@ class LegMotion:
         tips_planned, tips_executed: (m, 3) tip traces in the world [m] (None: not
             executed).
         contacts: the execution's contact records (empty when none or not executed).
+        quality: the planned path's quality in words (:func:`path_quality`).
     """
 
     leg: int
@@ -67,6 +68,7 @@ class LegMotion:
     tips_planned: Array
     tips_executed: Array | None
     contacts: tuple[Any, ...] = ()
+    quality: str = ""
 
     @property
     def frames(self) -> int:
@@ -90,6 +92,25 @@ def _verdict(e: Any) -> str:
     if not e.success and e.reason:
         parts.append(e.reason)
     return ", ".join(parts)
+
+
+def path_quality(problem: Problem, r: Any) -> str:
+    """A leg's planned path in words, from its record: its joint-space length, its
+    smoothness (roughness, :func:`~plannerlab.robots.paths.roughness`: lower is smoother;
+    computed from the path when the record has none) and the smallest clearance along the
+    whole path (``path_clearance_m``, measured when it was planned; "not measured" for a
+    leg that did not solve, a contact plan, or a plan file written before it was)."""
+    path = np.atleast_2d(np.asarray(r.path, dtype=float))
+    cont = problem.robot.continuous
+    rough = getattr(r, "roughness_rad2", math.nan)
+    if not math.isfinite(rough):
+        rough = roughness(path, cont)
+    clear = getattr(r, "path_clearance_m", math.nan)
+    clear_text = f"{clear * 1000:.1f} mm" if math.isfinite(clear) else "not measured"
+    return (
+        f"path: length {path_length(path, cont):.3g} rad, smoothness {rough:.3g} rad² "
+        f"(roughness, lower is smoother), clearance along the whole path {clear_text}"
+    )
 
 
 def leg_motions(
@@ -128,6 +149,7 @@ def leg_motions(
                     np.atleast_2d(robot.tip(dense)[0]),
                     tips_e,
                     tuple(e.contacts),
+                    path_quality(problem, r),
                 )
             )
         else:
@@ -143,6 +165,7 @@ def leg_motions(
                     None,
                     np.atleast_2d(robot.tip(dense)[0]),
                     None,
+                    quality=path_quality(problem, r),
                 )
             )
     return out
@@ -436,6 +459,7 @@ __all__ = [
     "camera_pose",
     "capsule_batch",
     "clearance_rgb",
+    "path_quality",
     "cone_mesh",
     "leg_motions",
     "matrix_to_wxyz",

@@ -96,6 +96,15 @@ def test_the_timeline_densifies_the_plan_and_keeps_its_ends():
     np.testing.assert_allclose(m.q_planned[-1], plan.legs[0].path[-1])
     assert len(m.tips_planned) > 5  # the trace keeps every densified state
     assert m.t_s[0] == 0.0 and m.t_s[-1] == 1.0
+    # the panel's path quality: a straight two-state path has roughness 0; its clearance
+    # along the path is not in this hand-made record
+    assert (
+        "smoothness 0 rad²" in m.quality
+        and "clearance along the whole path not measured" in m.quality
+    )
+    measured = plan.legs[0].replace(path_clearance_m=0.0123, roughness_rad2=0.25)
+    (m,) = leg_motions(problem, [measured], (), max_frames=5)
+    assert "smoothness 0.25 rad²" in m.quality and "whole path 12.3 mm" in m.quality
 
 
 @pytest.mark.parametrize("name", ["armz_pocket", "irb6_case1", "continuum_case1"])
@@ -120,6 +129,7 @@ def test_a_viewer_draws_every_robot_family(name):
         viewer.slider.value = viewer.legs[0].frames - 1
         assert not np.allclose(before, links.batched_positions)
         assert "nearest link" in viewer.info.content
+        assert "clearance along the whole path" in viewer.info.content
 
 
 def test_a_port_in_use_is_an_error(tmp_path, capsys):
