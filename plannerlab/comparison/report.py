@@ -52,16 +52,19 @@ shows as a drop of the best goal distance.
 from __future__ import annotations
 
 import csv
+import dataclasses
 import io
 import json
 import math
 import os
 import platform
 from collections.abc import Iterable, Mapping, Sequence
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
 from plannerlab.comparison.statistics import SUMMARY_COLUMNS, SummaryRow
+from plannerlab.problem.load import Budget
 from plannerlab.record.cells import err_of_tol, fmt, mm
 from plannerlab.record.files import write_json_atomic, write_text_atomic
 from plannerlab.record.leg import Status
@@ -160,6 +163,66 @@ LEG_COLUMNS = (
     "reason",
     "exec_reason",
 )
+
+
+# ---------------------------------------------------------------------- metadata
+@dataclass(frozen=True)
+class ReportMeta:
+    """What a report says about its comparison besides the records (``meta.json``).
+
+    Build it with :meth:`of` from the mapping ``plannerlab compare`` writes (any subset of
+    these keys; others are kept in ``meta.json`` and not read here).
+
+    Attributes:
+        name, command: the comparison's name and the command that reproduces it.
+        problems, planners, seeds: what was compared; ``seeds_spec`` as given.
+        budget: the budget overrides; ``budgets_used``: per problem, the budget its
+            trials ran with (a :class:`~plannerlab.problem.load.Budget`).
+        settings: per planner, the settings overrides; ``legs``: the legs asked for.
+        execute, jobs: executed in PyBullet; trials run at once.
+        trials, ran, skipped, errors: trials asked for, run now, reused from the store,
+            and those that did not run to their end.
+        started_at, wall_s, store: this invocation's start, wall time [s] and the store.
+        versions, machine: package versions and the machine (:func:`machine_info`).
+    """
+
+    name: str = ""
+    command: str = ""
+    problems: tuple[str, ...] = ()
+    planners: tuple[str, ...] = ()
+    seeds: tuple[int, ...] = ()
+    seeds_spec: str = ""
+    budget: Mapping[str, Any] = field(default_factory=dict)
+    budgets_used: Mapping[str, Budget] = field(default_factory=dict)
+    settings: Mapping[str, Any] = field(default_factory=dict)
+    legs: str | None = None
+    execute: bool = False
+    jobs: int | str = ""
+    trials: int | None = None
+    ran: int | str = "?"
+    skipped: int | str = "?"
+    errors: int = 0
+    started_at: str = ""
+    wall_s: float | None = None
+    store: str = ""
+    versions: Mapping[str, str] = field(default_factory=dict)
+    machine: Mapping[str, Any] = field(default_factory=dict)
+
+    @classmethod
+    def of(cls, meta: Mapping[str, Any] | ReportMeta) -> ReportMeta:
+        """The metadata from a mapping (its keys among the fields)."""
+        if isinstance(meta, ReportMeta):
+            return meta
+        known = {f.name for f in dataclasses.fields(cls)}
+        values = {k: v for k, v in meta.items() if k in known and v is not None}
+        for k in ("problems", "planners", "seeds"):
+            if k in values:
+                values[k] = tuple(values[k])
+        budgets = values.pop("budgets_used", {})
+        values["budgets_used"] = {
+            p: b if isinstance(b, Budget) else Budget().replace(**b) for p, b in budgets.items()
+        }
+        return cls(**values)
 
 
 # ---------------------------------------------------------------------- machine
@@ -452,17 +515,21 @@ def _finished_span(records: Sequence[TrialRecord]) -> str:
 
 
 def markdown(
-    rows: Sequence[SummaryRow], records: Sequence[TrialRecord], meta: Mapping[str, Any]
+    rows: Sequence[SummaryRow],
+    records: Sequence[TrialRecord],
+    meta: Mapping[str, Any] | ReportMeta,
 ) -> str:
     """The report: a table per problem, the command, seeds, budget, versions, machine."""
-    executed = bool(meta.get("execute"))
-    out = [f"# Comparison `{meta.get('name', '')}`", ""]
-    out += ["Command:", "", "```", str(meta.get("command", "")), "```", ""]
+    m = ReportMeta.of(meta)
+    out = [f"# Comparison `{m.name}`", ""]
+    out += ["Command:", "", "```", m.command, "```", ""]
     problems = list(dict.fromkeys(r.problem for r in rows))
-    headers = TABLE_HEADERS + (EXEC_HEADERS if executed else ())
+    headers = TABLE_HEADERS + (EXEC_HEADERS if m.execute else ())
     for p in problems:
         out += [f"## {p}", ""]
-        out.append(_md_table(headers, [summary_cells(r, executed) for r in rows if r.problem == p]))
+        out.append(
+            _md_table(headers, [summary_cells(r, m.execute) for r in rows if r.problem == p])
+        )
         out.append("")
     out += [TABLE_NOTES, "", BUDGET_NOTE, ""]
     errors = [r for r in records if not r.ran]
@@ -471,26 +538,27 @@ def markdown(
         out += [f"- `{r.key}` ({r.status}): {r.error}" for r in errors]
         out.append("")
     out += ["## Set-up", ""]
+    used = {p: b.to_dict() for p, b in m.budgets_used.items()}
     setup = [
-        ("problems", ", ".join(meta.get("problems", []))),
-        ("planners", ", ".join(meta.get("planners", []))),
-        ("seeds", meta.get("seeds_spec", "")),
-        ("budget overrides", json.dumps(meta.get("budget", {})) or "{}"),
-        ("budgets used", json.dumps(meta.get("budgets_used", {}))),
-        ("settings overrides", json.dumps(meta.get("settings", {}))),
-        ("legs", meta.get("legs") or "all"),
-        ("executed in PyBullet", "yes" if executed else "no"),
+        ("problems", ", ".join(m.problems)),
+        ("planners", ", ".join(m.planners)),
+        ("seeds", m.seeds_spec),
+        ("budget overrides", json.dumps(dict(m.budget))),
+        ("budgets used", json.dumps(used)),
+        ("settings overrides", json.dumps(dict(m.settings))),
+        ("legs", m.legs or "all"),
+        ("executed in PyBullet", "yes" if m.execute else "no"),
         (
             "trials",
-            f"{len(records)} finished of {meta.get('trials', len(records))} "
-            f"(ran {meta.get('ran', '?')}, reused {meta.get('skipped', '?')})",
+            f"{len(records)} finished of {m.trials if m.trials is not None else len(records)} "
+            f"(ran {m.ran}, reused {m.skipped})",
         ),
-        ("jobs", meta.get("jobs", "")),
+        ("jobs", m.jobs),
         ("trials finished", _finished_span(records)),
         ("trial processes, total s", fmt(sum(r.wall_s or 0.0 for r in records))),
-        ("this invocation started", meta.get("started_at", "")),
-        ("this invocation's wall time s", fmt(meta.get("wall_s"))),
-        ("trial store", meta.get("store", "")),
+        ("this invocation started", m.started_at),
+        ("this invocation's wall time s", fmt(m.wall_s)),
+        ("trial store", m.store),
     ]
     out.append(_md_table(("item", "value"), [(k, str(v)) for k, v in setup]))
     out += ["", "## Versions", ""]
@@ -501,15 +569,9 @@ def markdown(
             "holds each trial's own `versions`); below: this invocation's.",
             "",
         ]
-    out.append(
-        _md_table(
-            ("package", "version"), [(k, str(v)) for k, v in (meta.get("versions") or {}).items()]
-        )
-    )
+    out.append(_md_table(("package", "version"), [(k, str(v)) for k, v in m.versions.items()]))
     out += ["", "## Machine", ""]
-    out.append(
-        _md_table(("item", "value"), [(k, str(v)) for k, v in (meta.get("machine") or {}).items()])
-    )
+    out.append(_md_table(("item", "value"), [(k, str(v)) for k, v in m.machine.items()]))
     out.append("")
     return "\n".join(out)
 
@@ -621,41 +683,49 @@ def _one_line(s: str) -> str:
     return " ".join(str(s).split())
 
 
-def ompl_log(problem: str, records: Sequence[TrialRecord], meta: Mapping[str, Any]) -> str:
+#: the machine's line in an OMPL log, from :func:`machine_info`'s fields
+_MACHINE_LINE = "{cpu_model}, {cpu_count} CPUs, {memory_gb} GB, {platform}"
+_MACHINE_UNKNOWN = {"cpu_model": "unknown", "cpu_count": "?", "memory_gb": "?", "platform": ""}
+
+
+def ompl_log(
+    problem: str, records: Sequence[TrialRecord], meta: Mapping[str, Any] | ReportMeta
+) -> str:
     """One OMPL benchmark log (one experiment) for the records of ``problem``."""
+    m = ReportMeta.of(meta)
     recs = [r for r in records if r.problem == problem]
     planners = list(dict.fromkeys(r.planner for r in recs))
     by_planner = {p: [r for r in recs if r.planner == p] for p in planners}
-    versions = meta.get("versions") or {}
-    machine = meta.get("machine") or {}
-    budget = (meta.get("budgets_used") or {}).get(problem, {})
+    budget = m.budgets_used.get(problem, Budget())
     exp_props = [
-        ("max_iterations", "INTEGER", budget.get("max_iterations")),
-        ("max_collision_checks", "INTEGER", budget.get("max_collision_checks")),
-        ("time_limit_s", "REAL", budget.get("time_limit_s")),
-        ("executed", "BOOLEAN", bool(meta.get("execute"))),
+        ("max_iterations", "INTEGER", budget.max_iterations),
+        ("max_collision_checks", "INTEGER", budget.max_collision_checks),
+        ("time_limit_s", "REAL", budget.time_limit_s),
+        ("executed", "BOOLEAN", m.execute),
     ]
     exp_props = [(n, t, v) for n, t, v in exp_props if v is not None]
-    time_limit = budget.get("time_limit_s")
+    time_limit = budget.time_limit_s
     seeds = sorted({r.seed for r in recs})
+    machine = {**_MACHINE_UNKNOWN, "hostname": "unknown"} | dict(m.machine)
+    host = "{hostname}".format_map(machine)
+    version = "{plannerlab}".format_map({"plannerlab": "0", **m.versions})
     lines = [
-        f"plannerlab version {versions.get('plannerlab', '0')}",
+        f"plannerlab version {version}",
         f"Experiment {'_'.join(problem.split()) or 'problem'}",
         f"{len(exp_props)} experiment properties",
         *[f"{n} {t} = {_log_value(v)}" for n, t, v in exp_props],
-        f"Running on {'_'.join(str(machine.get('hostname', 'unknown')).split())}",
-        f"Starting at {str(meta.get('started_at', '')).replace('T', ' ')}",
+        f"Running on {'_'.join(host.split())}",
+        f"Starting at {m.started_at.replace('T', ' ')}",
         "<<<|",
-        f"command: {_one_line(meta.get('command', ''))}",
+        f"command: {_one_line(m.command)}",
         f"problem file: {recs[0].problem_file if recs else ''}",
-        f"seeds: {meta.get('seeds_spec', '')} (each run's seed is its 'seed' property)",
-        f"budget: {json.dumps(budget, sort_keys=True)}",
-        f"legs: {meta.get('legs') or 'all'}",
-        "versions: " + ", ".join(f"{k} {v}" for k, v in versions.items()),
+        f"seeds: {m.seeds_spec} (each run's seed is its 'seed' property)",
+        f"budget: {json.dumps(budget.to_dict(), sort_keys=True)}",
+        f"legs: {m.legs or 'all'}",
+        "versions: " + ", ".join(f"{k} {v}" for k, v in m.versions.items()),
         "|>>>",
         "<<<|",
-        f"{machine.get('cpu_model', 'unknown')}, {machine.get('cpu_count', '?')} CPUs, "
-        f"{machine.get('memory_gb', '?')} GB, {machine.get('platform', '')}",
+        _MACHINE_LINE.format_map(machine),
         "|>>>",
         f"{seeds[0] if seeds else 0} is the random seed",
         f"{float(time_limit) if time_limit is not None else math.inf!r} seconds per run",
@@ -730,6 +800,7 @@ def write_reports(
 
 __all__ = [
     "EXEC_HEADERS",
+    "ReportMeta",
     "LEG_COLUMNS",
     "STATUS_ENUM",
     "TABLE_HEADERS",

@@ -35,6 +35,7 @@ import math
 import threading
 import time
 from collections.abc import Callable, Sequence
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
@@ -186,7 +187,7 @@ class Viewer:
         sph = unit_sphere()
         q0 = self.legs[0].q_planned[0]
         b = capsule_batch(robot.link_segments(q0), radii)
-        self._robots: dict[str, dict[str, Any]] = {}
+        self._robots: dict[str, _RobotNodes] = {}
         executed = any(m.q_executed is not None for m in self.legs)
         # with an execution beside it, the planned robot is a translucent wireframe over
         # PyBullet's solid one, so both stay visible where they agree
@@ -201,8 +202,7 @@ class Viewer:
             # Panda's second finger): once per frame, so not at all while this view runs
             logging.getLogger("yourdfpy.urdf").addFilter(self._quiet)
         for kind, rgb, opacity in kinds:
-            nodes: dict[str, Any] = {}
-            nodes["links"] = self._add(
+            links = self._add(
                 f"/{kind}/links",
                 s.scene.add_batched_meshes_simple,
                 cyl[0],
@@ -215,7 +215,7 @@ class Viewer:
                 wireframe=kind == "planned" and executed,
                 lod="off",
             )
-            nodes["caps"] = self._add(
+            caps = self._add(
                 f"/{kind}/joints",
                 s.scene.add_batched_meshes_simple,
                 sph[0],
@@ -228,7 +228,8 @@ class Viewer:
                 wireframe=kind == "planned" and executed,
                 lod="off",
             )
-            nodes["tip"] = self._add(
+            nodes = _RobotNodes(links, caps, rgb=rgb)
+            nodes.tip = self._add(
                 f"/{kind}/tip",
                 s.scene.add_icosphere,
                 radius=MIN_MARK_M,
@@ -248,11 +249,10 @@ class Viewer:
                 )
                 alpha = 1.0 if opacity is None else opacity
                 color = (rgb[0] / 255, rgb[1] / 255, rgb[2] / 255, alpha)
-                nodes["urdf"] = ViserUrdf(
+                nodes.urdf = ViserUrdf(
                     s, model, root_node_name=f"/{kind}/meshes", mesh_color_override=color
                 )
-                nodes["model"] = model
-            nodes["rgb"] = rgb
+                nodes.model = model
             self._robots[kind] = nodes
         self._draw_gui(executed, model is not None)
         self._show_leg(0)
@@ -349,11 +349,11 @@ class Viewer:
         meshes = c.get("meshes", False)
         for kind, nodes in self._robots.items():
             on = c.get(kind, True)
-            nodes["links"].visible = on and not meshes
-            nodes["caps"].visible = on and not meshes
-            nodes["tip"].visible = on
-            if "urdf" in nodes:
-                nodes["urdf"].show_visual = on and meshes
+            nodes.links.visible = on and not meshes
+            nodes.caps.visible = on and not meshes
+            nodes.tip.visible = on
+            if nodes.urdf is not None:
+                nodes.urdf.show_visual = on and meshes
         for node in self._trace_nodes:
             node.visible = c["traces"]
         for node in self._goal_nodes():
@@ -454,7 +454,7 @@ class Viewer:
                     if q is None:  # this leg was not executed
                         q = m.q_planned[k]
                     b = capsule_batch(robot.link_segments(q), self._radii)
-                    colors = np.tile(np.array(nodes["rgb"], dtype=np.uint8), (len(self._radii), 1))
+                    colors = np.tile(np.array(nodes.rgb, dtype=np.uint8), (len(self._radii), 1))
                     cl = self._link_clearance(kind, k, q) if kind in states else None
                     if cl is not None:
                         d, other = cl
@@ -466,15 +466,15 @@ class Viewer:
                                 f"{kind}: nearest link {robot.link_names[j]} to "
                                 f"{other[j]}: {d[j] * 1000:.1f} mm"
                             )
-                    nodes["links"].batched_positions = b.cyl_positions
-                    nodes["links"].batched_wxyzs = b.cyl_wxyzs
-                    nodes["links"].batched_scales = b.cyl_scales
-                    nodes["links"].batched_colors = colors
-                    nodes["caps"].batched_positions = b.cap_positions
-                    nodes["caps"].batched_colors = np.concatenate([colors, colors])
-                    nodes["tip"].position = robot.tip(q)[0]
-                    if "urdf" in nodes:
-                        nodes["urdf"].update_cfg(urdf_cfg(robot, nodes["model"], q))
+                    nodes.links.batched_positions = b.cyl_positions
+                    nodes.links.batched_wxyzs = b.cyl_wxyzs
+                    nodes.links.batched_scales = b.cyl_scales
+                    nodes.links.batched_colors = colors
+                    nodes.caps.batched_positions = b.cap_positions
+                    nodes.caps.batched_colors = np.concatenate([colors, colors])
+                    nodes.tip.position = robot.tip(q)[0]
+                    if nodes.urdf is not None:
+                        nodes.urdf.update_cfg(urdf_cfg(robot, nodes.model, q))
             if m.q_executed is not None:
                 lines.append(f"leg {m.leg} '{m.goal}': {m.status}; {m.verdict}")
             else:
@@ -548,6 +548,19 @@ class Viewer:
 
     def __exit__(self, *exc: Any) -> None:
         self.close()
+
+
+@dataclass
+class _RobotNodes:
+    """The scene nodes of one drawn robot (planned or executed): its links' cylinders and
+    caps, its tip, its colour, and a URDF's visual meshes with their model (or None)."""
+
+    links: Any
+    caps: Any
+    tip: Any = None
+    rgb: tuple[int, int, int] = (0, 0, 0)
+    urdf: Any = None
+    model: Any = None
 
 
 class _QuietMimic(logging.Filter):

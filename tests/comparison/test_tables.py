@@ -30,14 +30,15 @@ from plannerlab.cli.tables import (
     print_summary_tables,
 )
 from plannerlab.comparison.statistics import SUMMARY_COLUMNS as ROW_KEYS
+from plannerlab.comparison.statistics import SummaryRow
 from plannerlab.errors import PlannerlabError
 from plannerlab.planners.base import PlanResult
 
 WIDTHS = (80, 120)
 
 
-def _row(planner: str, **changes: float) -> dict:
-    row = {k: math.nan for k in ROW_KEYS}
+def _row(planner: str, **changes: float) -> SummaryRow:
+    row: dict = {k: math.nan for k in ROW_KEYS}
     row.update(
         problem="armz_pocket",
         planner=planner,
@@ -62,9 +63,15 @@ def _row(planner: str, **changes: float) -> dict:
         exec_success_rate=80 / 97,
         exec_track_err_median_rad=0.00123,
         exec_contacts=17,
+        deterministic=False,
+        distinct_trials=100,
+        smoothness_median_rad2=0.987,
+        path_clearance_min_m=0.0126,
+        pos_tol_m=0.1,
+        angle_tol_deg=10.0,
     )
     row.update(changes)
-    return row
+    return SummaryRow(**row)
 
 
 ROWS = [
