@@ -63,6 +63,8 @@ class ComparisonSpec:
         trial_timeout_s: one wall-clock limit for every trial, or None to derive one from
             each trial's budget (:func:`default_trial_timeout_s`).
         retry_errors: rerun trials stored as ``error`` or ``timeout``.
+        built: each planner built with its settings (to check them), which every trial
+            of it takes (its process builds none).
     """
 
     problems: tuple[Problem, ...]
@@ -79,6 +81,7 @@ class ComparisonSpec:
     address: str | None = None
     trial_timeout_s: float | None = None
     retry_errors: bool = False
+    built: Mapping[str, Any] = field(default_factory=dict, repr=False)
 
     @classmethod
     def build(
@@ -150,8 +153,8 @@ class ComparisonSpec:
             raise PlannerlabError(
                 f"settings for {', '.join(stray)}, which is not among the planners compared"
             )
-        for name in planners:
-            make_planner(name, settings.get(name))  # unknown setting or bad value: raises now
+        # unknown setting or bad value: raises now; each trial takes its planner from here
+        built = {name: make_planner(name, settings.get(name)) for name in planners}
         loaded = [
             (load_problem(spec), resolve_problem_path(spec).resolve())
             for spec in dict.fromkeys(problems)
@@ -183,6 +186,7 @@ class ComparisonSpec:
             address=address,
             trial_timeout_s=trial_timeout_s,
             retry_errors=bool(retry_errors),
+            built=built,
         )
 
     @property
@@ -203,6 +207,8 @@ class ComparisonSpec:
                 settings=self.settings.get(planner),
                 legs=self.legs.get(problem.name),
                 execute=self.execute,
+                loaded=problem,  # parsed once, here: the trial's process does not parse it
+                planner_obj=self.built.get(planner),  # built once, here
             )
             for problem, path in zip(self.problems, self.problem_files, strict=True)
             for seed in self.seeds

@@ -11,7 +11,7 @@ import os
 import time
 import traceback
 from collections.abc import Iterable, Mapping, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from datetime import UTC, datetime
 from pathlib import Path
 from typing import Any
@@ -71,6 +71,12 @@ class Trial:
         settings: planner settings overrides, sorted ``(key, value)`` pairs.
         legs: leg indices to solve, in order (None: every leg).
         execute: also execute the planned legs in PyBullet.
+        loaded: the problem already parsed (the comparison's, checked before any trial
+            started): the trial's process takes it instead of parsing ``problem_file``
+            again (a mesh robot's problem takes seconds to parse). Not part of the key.
+        planner_obj: the planner already built with the settings (the comparison's, built
+            to check them): the trial's process takes it instead of building it again.
+            Not part of the key.
     """
 
     problem: str
@@ -81,6 +87,8 @@ class Trial:
     settings: tuple[tuple[str, Scalar], ...] = ()
     legs: tuple[int, ...] | None = None
     execute: bool = False
+    loaded: Any = field(default=None, compare=False, hash=False, repr=False)
+    planner_obj: Any = field(default=None, compare=False, hash=False, repr=False)
 
     @classmethod
     def make(
@@ -94,6 +102,8 @@ class Trial:
         settings: Mapping[str, Scalar] | None = None,
         legs: Sequence[int] | None = None,
         execute: bool = False,
+        loaded: Any = None,
+        planner_obj: Any = None,
     ) -> Trial:
         return cls(
             problem=str(problem),
@@ -104,6 +114,8 @@ class Trial:
             settings=_frozen_items(settings),
             legs=None if legs is None else tuple(int(i) for i in legs),
             execute=bool(execute),
+            loaded=loaded,
+            planner_obj=planner_obj,
         )
 
     @property
@@ -218,7 +230,8 @@ def run_trial(trial: Trial) -> TrialRecord:
         from plannerlab.problem.catalog import load_problem
         from plannerlab.run.pipeline import SharedChecker, solve_legs
 
-        problem = load_problem(trial.problem_file)
+        # parsed once: by the comparison that made the trial, or here
+        problem = trial.loaded if trial.loaded is not None else load_problem(trial.problem_file)
         budget = problem.budget.replace(**dict(trial.budget))
         # one checker (and compiled model) per trial: the solve and the execution's
         # re-check share it
@@ -232,6 +245,7 @@ def run_trial(trial: Trial) -> TrialRecord:
             overrides=dict(trial.settings),
             stop_on_failure=True,  # a task fails at its first failed leg
             shared=shared,
+            planner=trial.planner_obj,  # built once: by the comparison, or by solve_legs
         )
         legs = tuple(LegRecord.of(r, problem.robot.continuous) for r in plan.legs)
         fields.update(

@@ -178,6 +178,7 @@ def solve_legs(
     gui: bool = False,
     on_leg: Callable[[PlanResult], None] | None = None,
     shared: SharedChecker | None = None,
+    planner: Any = None,
 ) -> Plan:
     """Solve ``legs`` (default: all) in order; each starts where the previous one ended.
 
@@ -190,10 +191,12 @@ def solve_legs(
 
     ``shared``: the problem's checker built once and shared (with its compiled model) with
     the execution's re-check (:func:`execute_results`) of the same trial; None: built
-    here when a leg needs it.
+    here when a leg needs it. ``planner``: ``planner_name`` already built with
+    ``overrides`` (a comparison builds it once to check the settings); None: built here.
     """
     entry = get_entry(planner_name)
-    planner = make_planner(planner_name, overrides)
+    if planner is None:
+        planner = make_planner(planner_name, overrides)
     budget = budget or problem.budget
     legs = list(range(problem.legs)) if legs is None else list(legs)
     results: list[PlanResult] = []
