@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import argparse
-import math
 from pathlib import Path
 from typing import Any
 
@@ -19,7 +18,7 @@ from plannerlab.cli.common import (
     require_display,
     seed_int,
 )
-from plannerlab.cli.tables import table
+from plannerlab.cli.tables import path_note, table, tip_error_cells
 from plannerlab.record.cells import fmt
 from plannerlab.record.codec import dumps
 
@@ -34,8 +33,8 @@ def leg_table(plan: Any, title: str) -> Table:
             ("iters", "num"),
             ("time s", "num"),
             ("checks", "num"),
-            ("pos err m", "num"),
-            ("ang err °", "num"),
+            ("pos err\n/ tol m", "num"),
+            ("ang err\n/ tol °", "num"),
         ],
         compact=True,
     )
@@ -49,12 +48,9 @@ def leg_table(plan: Any, title: str) -> Table:
             str(r.iterations),
             fmt(r.time_s),
             str(r.collision_checks),
-            fmt(r.pos_err_m),
-            fmt(r.angle_err_deg),
+            *tip_error_cells(r),  # beside the tolerance; "—" for a leg with no result
         )
-        clearance = r.min_clearance_m
-        shown = f"; planned clearance {fmt(clearance)} m" if math.isfinite(clearance) else ""
-        reasons.append(f"{r.leg} {r.goal}: {r.reason}{shown}")
+        reasons.append(f"{r.leg} {r.goal}: {r.reason}{path_note(r)}")
     t.caption = "\n".join(reasons)
     return t
 

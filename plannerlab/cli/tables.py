@@ -28,6 +28,7 @@ from rich.table import Table
 
 from plannerlab.errors import UnknownNameError
 from plannerlab.record.cells import err_of_tol, fmt, mm
+from plannerlab.record.trial import reached_best
 
 #: width of piped output when neither COLUMNS nor a terminal says otherwise
 PIPE_WIDTH = 100
@@ -91,6 +92,31 @@ def table(
         else:
             t.add_column(header, overflow="fold")
     return t
+
+
+# ---------------------------------------------------------------------- legs
+#: what a leg's tip-error cells say when the leg has no best state (the reason says why)
+NO_RESULT = "—"
+
+
+def tip_error_cells(r: Any) -> tuple[str, str]:
+    """A planned leg's (:class:`~plannerlab.record.leg.PlanResult`) tip errors as cells:
+    each beside its goal tolerance (``0.0976 / 0.1``); :data:`NO_RESULT` for a leg that
+    has no best state (it planned nothing or gave up: its last state is no result)."""
+    if not reached_best(r.status, len(r.path)):
+        return NO_RESULT, NO_RESULT
+    return err_of_tol(r.pos_err_m, r.pos_tol_m), err_of_tol(r.angle_err_deg, r.angle_tol_deg)
+
+
+def path_note(r: Any) -> str:
+    """A solved leg's path quality for a table's caption: its smoothness and its smallest
+    clearance along the whole path ("" when not measured)."""
+    parts = []
+    if r.roughness_rad2 == r.roughness_rad2:
+        parts.append(f"smoothness {fmt(r.roughness_rad2)} rad²")
+    if r.path_clearance_m == r.path_clearance_m:
+        parts.append(f"clearance along the path {fmt(mm(r.path_clearance_m))} mm")
+    return "; " + ", ".join(parts) if parts else ""
 
 
 # ---------------------------------------------------------------------- compare

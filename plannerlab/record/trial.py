@@ -87,6 +87,17 @@ def nan(x: float | None) -> float:
     return math.nan if x is None else float(x)
 
 
+def reached_best(status: Status | str, path_points: int) -> bool:
+    """A leg's last state is the best it reached, so its tip errors describe a result: a
+    solved leg, or one that ended as close as it got (approximate) or stalled there (a
+    local minimum) after moving. A leg that planned nothing (its path is its start), gave
+    up or failed has no such state: its errors are those of wherever it stopped."""
+    status = Status(status)
+    return status is Status.SOLVED or (
+        status in (Status.APPROXIMATE, Status.LOCAL_MINIMUM) and path_points > 1
+    )
+
+
 class LegRecord(msgspec.Struct, frozen=True, kw_only=True):
     """One planned leg as a trial store keeps it: its
     :class:`~plannerlab.record.leg.PlanResult` without the path and trace (identified by
@@ -154,12 +165,9 @@ class LegRecord(msgspec.Struct, frozen=True, kw_only=True):
 
     @property
     def reached_best(self) -> bool:
-        """The leg's last state is the best it reached (a solved leg, or one that ended as
-        close as it got or stalled there after moving): its tip errors mean something.
-        A leg that planned nothing (its path is its start) or gave up has no such state."""
-        return self.solved or (
-            self.status in (Status.APPROXIMATE, Status.LOCAL_MINIMUM) and self.path_points > 1
-        )
+        """The leg's last state is the best it reached: its tip errors mean something
+        (:func:`reached_best`)."""
+        return reached_best(self.status, self.path_points)
 
 
 class ExecutionRecord(msgspec.Struct, frozen=True, kw_only=True):
@@ -534,5 +542,6 @@ __all__ = [
     "encode_trial",
     "nan",
     "num",
+    "reached_best",
     "trial_from_v1",
 ]

@@ -259,3 +259,30 @@ def test_execution_table_keeps_obstacle_names_whole(width: int) -> None:
     _whole(["11.8", "0.000173", "41.9", "0.000208"], lines)
     _whole(["217", "-3.1", "0.0012", "38.4"], lines)  # deviation and clearance [mm]
     _whole(["module_17 x boulder", "module_16 x boulder", "pocket", "collides"], lines)
+
+
+def test_leg_table_puts_tolerances_beside_errors_and_no_number_on_a_leg_without_result() -> None:
+    """A leg solved at 0.0976 m / 9.54° against 0.1 m / 10° says so; a leg that gave up at
+    its start prints "—" (its reason is in the caption), not 1.23 m / 180°."""
+
+    def leg(i: int, status: str, points: int, pos: float, ang: float, **kw) -> PlanResult:
+        return PlanResult(
+            "ompl.rrtconnect", "p", i, f"g{i}", status, f"reason {i}", np.zeros((points, 3)),
+            pos_err_m=pos, angle_err_deg=ang, pos_tol_m=0.1, angle_tol_deg=10.0, **kw,
+        )  # fmt: skip
+
+    class _Plan:
+        legs = [
+            leg(0, "solved", 5, 0.0976, 9.54, roughness_rad2=0.25, path_clearance_m=0.0126),
+            leg(1, "budget_exhausted", 1, 1.23, 180.0),
+            leg(2, "local_minimum", 7, 0.4, 30.0),
+        ]
+
+    lines = _render(120, lambda c: c.print(leg_table(_Plan(), "t")))
+    text = "\n".join(lines)
+    _whole(["0.0976 / 0.1", "9.54 / 10", "0.4 / 0.1", "30 / 10"], lines)
+    assert "1.23" not in text and "180" not in text
+    row = next(line for line in lines if "budget_exhausted" in line)
+    assert row.count("—") == 2
+    assert "reason 1" in text and "smoothness 0.25 rad²" in text
+    assert "clearance along the path 12.6 mm" in text
