@@ -44,9 +44,9 @@ def main(argv: list[str]) -> int:
                 run = run_comparison(trials, Path(tmp) / f"{method}.jsonl", backend=backend)
             finally:
                 backend.close()
-            ups = [r["startup_s"] for r in run.records]
+            ups = [r.startup_s or 0.0 for r in run.records]
             med[method] = statistics.median(ups)
-            paths[method] = [leg["path_sha256"] for r in run.records for leg in r["legs_run"]]
+            paths[method] = [leg.path_sha256 for r in run.records for leg in r.legs_run]
             print(
                 f"{method:>10}: start-up median {med[method]:.3f} s "
                 f"(min {min(ups):.3f}, max {max(ups):.3f})"
