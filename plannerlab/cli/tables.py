@@ -27,7 +27,7 @@ from rich.markup import escape
 from rich.table import Table
 
 from plannerlab.errors import UnknownNameError
-from plannerlab.record.cells import err_of_tol, fmt, mm
+from plannerlab.record.cells import err_of_tol, fmt, mm, rough
 from plannerlab.record.trial import reached_best
 
 #: width of piped output when neither COLUMNS nor a terminal says otherwise
@@ -113,7 +113,7 @@ def path_note(r: Any) -> str:
     clearance along the whole path ("" when not measured)."""
     parts = []
     if r.roughness_rad2 == r.roughness_rad2:
-        parts.append(f"smoothness {fmt(r.roughness_rad2)} rad²")
+        parts.append(f"smoothness {rough(r.roughness_rad2)} rad²")
     if r.path_clearance_m == r.path_clearance_m:
         parts.append(f"clearance along the path {fmt(mm(r.path_clearance_m))} mm")
     return "; " + ", ".join(parts) if parts else ""
@@ -201,7 +201,7 @@ SUMMARY_COLUMNS: dict[str, SummaryColumn] = {
     "smoothness": SummaryColumn(
         "smooth-\nness rad²",
         "num",
-        lambda r: fmt(r.smoothness_median_rad2),
+        lambda r: rough(r.smoothness_median_rad2),
         "the path's roughness: squared turning angles of each leg's path resampled at 200 "
         "states of equal joint-space arc length, summed over legs, median over solved "
         "trials [rad²]; lower is smoother",

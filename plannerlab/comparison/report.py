@@ -65,7 +65,7 @@ from typing import Any
 
 from plannerlab.comparison.statistics import SUMMARY_COLUMNS, SummaryRow
 from plannerlab.problem.load import Budget
-from plannerlab.record.cells import err_of_tol, fmt, mm
+from plannerlab.record.cells import err_of_tol, fmt, mm, rough
 from plannerlab.record.files import write_json_atomic, write_text_atomic
 from plannerlab.record.leg import Status
 from plannerlab.record.trial import (
@@ -429,7 +429,7 @@ def summary_cells(row: SummaryRow, executed: bool) -> list[str]:
         ),
         f"{fmt(row.time_median_s)} / {fmt(row.time_p75_s)} / {fmt(row.time_p95_s)}",
         fmt(row.path_length_median),
-        fmt(row.smoothness_median_rad2),
+        rough(row.smoothness_median_rad2),
         fmt(mm(row.path_clearance_min_m)),
         err_of_tol(row.pos_err_median_m, row.pos_tol_m),
         err_of_tol(row.angle_err_median_deg, row.angle_tol_deg),

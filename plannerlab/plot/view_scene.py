@@ -18,6 +18,7 @@ import numpy as np
 
 from plannerlab.problem.load import Problem
 from plannerlab.problem.scene import Box, Cylinder, Sphere
+from plannerlab.record.cells import rough as rough_cell
 from plannerlab.robots.base import Array
 from plannerlab.robots.paths import densify, path_length, roughness
 
@@ -108,7 +109,7 @@ def path_quality(problem: Problem, r: Any) -> str:
     clear = getattr(r, "path_clearance_m", math.nan)
     clear_text = f"{clear * 1000:.1f} mm" if math.isfinite(clear) else "not measured"
     return (
-        f"path: length {path_length(path, cont):.3g} rad, smoothness {rough:.3g} rad² "
+        f"path: length {path_length(path, cont):.3g} rad, smoothness {rough_cell(rough)} rad² "
         f"(roughness, lower is smoother), clearance along the whole path {clear_text}"
     )
 

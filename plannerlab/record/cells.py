@@ -33,3 +33,15 @@ def err_of_tol(err: Any, tol: Any, digits: int = 3) -> str:
     if tol is None or (isinstance(tol, float) and not math.isfinite(tol)):
         return fmt(float(err), digits)
     return f"{fmt(float(err), digits)} / {fmt(float(tol), digits)}"
+
+
+#: roughness below this is float noise of a straight path (a turn of 3e-5 rad) [rad²]
+ROUGHNESS_RESOLUTION_RAD2 = 1e-9
+
+
+def rough(x: Any) -> str:
+    """A roughness [rad²] for a table: 3 significant digits, 0 below
+    :data:`ROUGHNESS_RESOLUTION_RAD2` (a straight path's float noise), "-" when missing."""
+    if x is None or (isinstance(x, float) and not math.isfinite(x)):
+        return "-"
+    return fmt(0.0 if abs(float(x)) < ROUGHNESS_RESOLUTION_RAD2 else float(x))

@@ -286,3 +286,11 @@ def test_leg_table_puts_tolerances_beside_errors_and_no_number_on_a_leg_without_
     assert row.count("—") == 2
     assert "reason 1" in text and "smoothness 0.25 rad²" in text
     assert "clearance along the path 12.6 mm" in text
+
+
+def test_a_straight_paths_float_noise_is_no_roughness() -> None:
+    from plannerlab.record.cells import rough
+
+    assert rough(2.63e-14) == "0" and rough(0.25) == "0.25" and rough(None) == "-"
+    cell = SUMMARY_COLUMNS["smoothness"].cell(_row("x", smoothness_median_rad2=2.63e-14))
+    assert cell == "0"
