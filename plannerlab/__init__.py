@@ -36,7 +36,7 @@ from typing import TYPE_CHECKING, Any
 if TYPE_CHECKING:
     from plannerlab.comparison.report import markdown as markdown_report
     from plannerlab.comparison.runner import ComparisonRun, compare
-    from plannerlab.comparison.statistics import summarise
+    from plannerlab.comparison.statistics import SummaryRow, summarise
     from plannerlab.comparison.trial import Trial
     from plannerlab.errors import PlannerlabError
     from plannerlab.planners import make_planner, planner_names
@@ -48,6 +48,7 @@ if TYPE_CHECKING:
     from plannerlab.record.execution import Execution
     from plannerlab.record.leg import PlanResult, Status
     from plannerlab.record.plan import ExecutionFile, Plan
+    from plannerlab.record.trial import ExecutionRecord, LegRecord, TrialRecord
     from plannerlab.run.pipeline import execute_plan as execute
     from plannerlab.run.pipeline import solve_legs as solve
 
@@ -71,6 +72,10 @@ _EXPORTS: dict[str, str] = {
     "Plan": "plannerlab.record.plan:Plan",
     "Execution": "plannerlab.record.execution:Execution",
     "ExecutionFile": "plannerlab.record.plan:ExecutionFile",
+    "TrialRecord": "plannerlab.record.trial:TrialRecord",
+    "LegRecord": "plannerlab.record.trial:LegRecord",
+    "ExecutionRecord": "plannerlab.record.trial:ExecutionRecord",
+    "SummaryRow": "plannerlab.comparison.statistics:SummaryRow",
     "PlannerlabError": "plannerlab.errors:PlannerlabError",
     "markdown_report": "plannerlab.comparison.report:markdown",
     "snapshot_figure": "plannerlab.plot.plans:snapshot_figure",
@@ -84,12 +89,16 @@ __all__ = [
     "ComparisonRun",
     "Execution",
     "ExecutionFile",
+    "ExecutionRecord",
+    "LegRecord",
     "Plan",
     "PlanResult",
     "PlannerlabError",
     "Problem",
     "Status",
+    "SummaryRow",
     "Trial",
+    "TrialRecord",
     "Viewer",
     "animate_plan",
     "compare",
