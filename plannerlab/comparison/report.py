@@ -16,79 +16,26 @@ into the comparison's folder:
   OMPL planners, trials as runs. ``ompl_benchmark_statistics *.log -d results.db`` loads
   them into SQLite (and Planner Arena reads that database).
 
-The log follows "The benchmark logfile format" of OMPL's documentation
-(``doc/markdown/benchmark.md``) as parsed by ``readBenchmarkLog`` in the ``ompl`` wheel
-(``ompl/_benchmark_statistics.py``). What that parser requires, and this module keeps to:
-
-* the experiment name is the last whitespace-separated token of its line (problem names
-  have no spaces; spaces are replaced);
-* run properties are ``name TYPE`` lines (the name may hold spaces: they become ``_`` in
-  the SQL column, so ``collision checks INTEGER`` is column ``collision_checks``); types
-  are REAL, INTEGER, BOOLEAN (``0``/``1``) or ENUM (an index into the ``status`` enum,
-  declared in the preamble as ``status|solved|approximate|...``);
-* every run line is ``value; `` repeated, the last one included; an empty value, ``nan``
-  or ``inf`` becomes NULL;
-* ``runs per planner`` is written only when every planner has the same number of runs
-  (it is optional); the time limit is ``inf`` when there is none, the memory limit 0.
-
-Run properties: ``seed``, ``time`` (planning time summed over legs [s]), ``solved``
-(every leg SOLVED), ``status`` (the first unsolved leg's status, or ``error``),
-``approximate solution``, ``legs solved``, ``iterations``, ``collision checks``,
-``fk calls``, ``solution length`` (joint-space path length [rad], solved trials only),
-``path length`` (every trial), ``final position error`` [m], ``final angle error``
-[deg], ``local minima``, ``escapes``, ``wall time`` (the trial's process [s]) and, for
-executed comparisons, ``execution success``, ``execution max tracking error`` [rad] and
-``execution contacts`` (empty otherwise).
-
-Progress properties (OMPL's ``N progress properties`` block after the runs, one line of
-``v1,v2,…,;`` samples per run; Planner Arena's "Progress" tab plots them): ``time`` [s],
-``best goal distance`` (normalised, 0 inside the goal region), ``best cost`` (joint-space
-length of the best solution [rad], empty until one), ``collision checks`` and ``leg``,
-from each leg's :attr:`~plannerlab.planners.base.PlanResult.progress`; legs follow one
-another, times and checks counted from the trial's start. An escape from a local minimum
-shows as a drop of the best goal distance.
+The OMPL log is :mod:`plannerlab.comparison.ompl_log`; the metadata a report is given,
+:class:`~plannerlab.comparison.meta.ReportMeta`.
 """
 
 from __future__ import annotations
 
 import csv
-import dataclasses
 import io
 import json
 import math
-import os
-import platform
 from collections.abc import Iterable, Mapping, Sequence
-from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+from plannerlab.comparison.meta import ReportMeta, machine_info
+from plannerlab.comparison.ompl_log import STATUS_ENUM, log_paths, ompl_log
 from plannerlab.comparison.statistics import SUMMARY_COLUMNS, SummaryRow
-from plannerlab.problem.load import Budget
 from plannerlab.record.cells import err_of_tol, fmt, mm, rough
 from plannerlab.record.files import write_json_atomic, write_text_atomic
-from plannerlab.record.leg import Status
-from plannerlab.record.trial import (
-    DIED_STATUS,
-    ERROR_STATUS,
-    TIMEOUT_STATUS,
-    ExecutionRecord,
-    LegRecord,
-    TrialRecord,
-)
-
-#: values of the ``status ENUM`` run property (index = stored value): the planner statuses
-#: in :class:`Status` order, with ``error`` (the trial raised) at index 8, where it stood
-#: before statuses were added to :class:`Status`; those follow it, so that a stored index
-#: keeps its meaning
-_STATUSES = [s.value for s in Status]
-STATUS_ENUM: tuple[str, ...] = (
-    *_STATUSES[:8],
-    ERROR_STATUS,
-    *_STATUSES[8:],
-    TIMEOUT_STATUS,
-    DIED_STATUS,
-)
+from plannerlab.record.trial import ExecutionRecord, LegRecord, TrialRecord
 
 TRIAL_COLUMNS = (
     "key",
@@ -163,97 +110,6 @@ LEG_COLUMNS = (
     "reason",
     "exec_reason",
 )
-
-
-# ---------------------------------------------------------------------- metadata
-@dataclass(frozen=True)
-class ReportMeta:
-    """What a report says about its comparison besides the records (``meta.json``).
-
-    Build it with :meth:`of` from the mapping ``plannerlab compare`` writes (any subset of
-    these keys; others are kept in ``meta.json`` and not read here).
-
-    Attributes:
-        name, command: the comparison's name and the command that reproduces it.
-        problems, planners, seeds: what was compared; ``seeds_spec`` as given.
-        budget: the budget overrides; ``budgets_used``: per problem, the budget its
-            trials ran with (a :class:`~plannerlab.problem.load.Budget`).
-        settings: per planner, the settings overrides; ``legs``: the legs asked for.
-        execute, jobs: executed in PyBullet; trials run at once.
-        trials, ran, skipped, errors: trials asked for, run now, reused from the store,
-            and those that did not run to their end.
-        started_at, wall_s, store: this invocation's start, wall time [s] and the store.
-        versions, machine: package versions and the machine (:func:`machine_info`).
-    """
-
-    name: str = ""
-    command: str = ""
-    problems: tuple[str, ...] = ()
-    planners: tuple[str, ...] = ()
-    seeds: tuple[int, ...] = ()
-    seeds_spec: str = ""
-    budget: Mapping[str, Any] = field(default_factory=dict)
-    budgets_used: Mapping[str, Budget] = field(default_factory=dict)
-    settings: Mapping[str, Any] = field(default_factory=dict)
-    legs: str | None = None
-    execute: bool = False
-    jobs: int | str = ""
-    trials: int | None = None
-    ran: int | str = "?"
-    skipped: int | str = "?"
-    errors: int = 0
-    started_at: str = ""
-    wall_s: float | None = None
-    store: str = ""
-    versions: Mapping[str, str] = field(default_factory=dict)
-    machine: Mapping[str, Any] = field(default_factory=dict)
-
-    @classmethod
-    def of(cls, meta: Mapping[str, Any] | ReportMeta) -> ReportMeta:
-        """The metadata from a mapping (its keys among the fields)."""
-        if isinstance(meta, ReportMeta):
-            return meta
-        known = {f.name for f in dataclasses.fields(cls)}
-        values = {k: v for k, v in meta.items() if k in known and v is not None}
-        for k in ("problems", "planners", "seeds"):
-            if k in values:
-                values[k] = tuple(values[k])
-        budgets = values.pop("budgets_used", {})
-        values["budgets_used"] = {
-            p: b if isinstance(b, Budget) else Budget().replace(**b) for p, b in budgets.items()
-        }
-        return cls(**values)
-
-
-# ---------------------------------------------------------------------- machine
-def machine_info() -> dict[str, Any]:
-    """Where the numbers were measured: host, OS, CPU model and count, memory."""
-    info: dict[str, Any] = {
-        "hostname": platform.node() or "unknown",
-        "platform": platform.platform(),
-        "machine": platform.machine(),
-        "cpu_count": os.cpu_count(),
-        "cpu_model": platform.processor() or "unknown",
-    }
-    try:
-        info["cpu_affinity"] = len(os.sched_getaffinity(0))
-    except (AttributeError, OSError):
-        pass
-    try:
-        for line in Path("/proc/cpuinfo").read_text().splitlines():
-            if line.lower().startswith("model name"):
-                info["cpu_model"] = line.split(":", 1)[1].strip()
-                break
-    except OSError:
-        pass
-    try:
-        for line in Path("/proc/meminfo").read_text().splitlines():
-            if line.startswith("MemTotal:"):
-                info["memory_gb"] = round(int(line.split()[1]) / 1024**2, 1)
-                break
-    except (OSError, ValueError, IndexError):
-        pass
-    return info
 
 
 # ---------------------------------------------------------------------- CSV
@@ -574,200 +430,6 @@ def markdown(
     out.append(_md_table(("item", "value"), [(k, str(v)) for k, v in m.machine.items()]))
     out.append("")
     return "\n".join(out)
-
-
-# ---------------------------------------------------------------------- OMPL log
-_RUN_PROPERTIES: tuple[tuple[str, str], ...] = (
-    ("seed", "INTEGER"),
-    ("time", "REAL"),
-    ("solved", "BOOLEAN"),
-    ("status", "ENUM"),
-    ("approximate solution", "BOOLEAN"),
-    ("legs solved", "INTEGER"),
-    ("iterations", "INTEGER"),
-    ("collision checks", "INTEGER"),
-    ("fk calls", "INTEGER"),
-    ("solution length", "REAL"),
-    ("path length", "REAL"),
-    ("final position error", "REAL"),
-    ("final angle error", "REAL"),
-    ("local minima", "INTEGER"),
-    ("escapes", "INTEGER"),
-    ("wall time", "REAL"),
-    ("execution success", "BOOLEAN"),
-    ("execution max tracking error", "REAL"),
-    ("execution contacts", "INTEGER"),
-    ("execution max deviation", "REAL"),
-    ("execution min clearance", "REAL"),
-    ("smoothness", "REAL"),
-    ("path clearance", "REAL"),
-)
-
-
-#: progress properties of a run: its legs one after another, times and checks counted
-#: from the trial's start; the best goal distance is the current leg's
-_PROGRESS_PROPERTIES: tuple[tuple[str, str], ...] = (
-    ("time", "REAL"),
-    ("best goal distance", "REAL"),
-    ("best cost", "REAL"),
-    ("collision checks", "INTEGER"),
-    ("leg", "INTEGER"),
-)
-
-
-def _run_progress(r: TrialRecord) -> list[list[Any]]:
-    """A trial's progress rows (see :data:`_PROGRESS_PROPERTIES`), times strictly
-    increasing (OMPL's table keys progress on (run, time))."""
-    rows: list[list[Any]] = []
-    t_off = 0.0
-    c_off = 0
-    for leg in r.legs_run:
-        for t, checks, dist, cost in leg.progress:
-            if t is None:
-                continue
-            time_s = t_off + float(t)
-            c = None if checks is None else c_off + int(checks)
-            row = [time_s, dist, cost, c, leg.leg]
-            if rows and time_s <= rows[-1][0]:
-                rows[-1] = [rows[-1][0], *row[1:]]  # same instant: the later values
-            else:
-                rows.append(row)
-        t_off += leg.time_s
-        c_off += leg.collision_checks
-    return rows
-
-
-def _log_value(v: Any) -> str:
-    if v is None:
-        return ""
-    if isinstance(v, bool):
-        return "1" if v else "0"
-    if isinstance(v, float):
-        return repr(v) if math.isfinite(v) else ""
-    return str(v)
-
-
-def _run_values(r: TrialRecord) -> list[str]:
-    status = r.status
-    ok = r.success
-    last = r.last_leg if ok else None
-    values: list[Any] = [
-        r.seed,
-        r.time_s if r.ran else None,
-        ok,
-        STATUS_ENUM.index(status) if status in STATUS_ENUM else STATUS_ENUM.index("failed"),
-        status == "approximate",
-        r.legs_solved,
-        r.iterations,
-        r.collision_checks,
-        r.fk_calls,
-        r.path_length if ok else None,
-        r.path_length,
-        last.pos_err_m if last else None,
-        last.angle_err_deg if last else None,
-        r.local_minima,
-        r.escapes,
-        r.wall_s,
-        r.exec_success,
-        r.exec_max_track_err_rad,
-        r.exec_contacts,
-        r.exec_max_deviation_m,
-        r.exec_min_clearance_m,
-        r.roughness_rad2 if ok else None,
-        r.path_clearance_m if ok else None,
-    ]
-    return [_log_value(v) for v in values]
-
-
-def _one_line(s: str) -> str:
-    return " ".join(str(s).split())
-
-
-#: the machine's line in an OMPL log, from :func:`machine_info`'s fields
-_MACHINE_LINE = "{cpu_model}, {cpu_count} CPUs, {memory_gb} GB, {platform}"
-_MACHINE_UNKNOWN = {"cpu_model": "unknown", "cpu_count": "?", "memory_gb": "?", "platform": ""}
-
-
-def ompl_log(
-    problem: str, records: Sequence[TrialRecord], meta: Mapping[str, Any] | ReportMeta
-) -> str:
-    """One OMPL benchmark log (one experiment) for the records of ``problem``."""
-    m = ReportMeta.of(meta)
-    recs = [r for r in records if r.problem == problem]
-    planners = list(dict.fromkeys(r.planner for r in recs))
-    by_planner = {p: [r for r in recs if r.planner == p] for p in planners}
-    budget = m.budgets_used.get(problem, Budget())
-    exp_props = [
-        ("max_iterations", "INTEGER", budget.max_iterations),
-        ("max_collision_checks", "INTEGER", budget.max_collision_checks),
-        ("time_limit_s", "REAL", budget.time_limit_s),
-        ("executed", "BOOLEAN", m.execute),
-    ]
-    exp_props = [(n, t, v) for n, t, v in exp_props if v is not None]
-    time_limit = budget.time_limit_s
-    seeds = sorted({r.seed for r in recs})
-    machine = {**_MACHINE_UNKNOWN, "hostname": "unknown"} | dict(m.machine)
-    host = "{hostname}".format_map(machine)
-    version = "{plannerlab}".format_map({"plannerlab": "0", **m.versions})
-    lines = [
-        f"plannerlab version {version}",
-        f"Experiment {'_'.join(problem.split()) or 'problem'}",
-        f"{len(exp_props)} experiment properties",
-        *[f"{n} {t} = {_log_value(v)}" for n, t, v in exp_props],
-        f"Running on {'_'.join(host.split())}",
-        f"Starting at {m.started_at.replace('T', ' ')}",
-        "<<<|",
-        f"command: {_one_line(m.command)}",
-        f"problem file: {recs[0].problem_file if recs else ''}",
-        f"seeds: {m.seeds_spec} (each run's seed is its 'seed' property)",
-        f"budget: {json.dumps(budget.to_dict(), sort_keys=True)}",
-        f"legs: {m.legs or 'all'}",
-        "versions: " + ", ".join(f"{k} {v}" for k, v in m.versions.items()),
-        "|>>>",
-        "<<<|",
-        _MACHINE_LINE.format_map(machine),
-        "|>>>",
-        f"{seeds[0] if seeds else 0} is the random seed",
-        f"{float(time_limit) if time_limit is not None else math.inf!r} seconds per run",
-        "0 MB per run",
-    ]
-    counts = {len(v) for v in by_planner.values()}
-    if len(counts) == 1:
-        lines.append(f"{counts.pop()} runs per planner")
-    total = float(sum(r.wall_s or 0.0 for r in recs))
-    lines += [
-        f"{total!r} seconds spent to collect the data",
-        "1 enum type",
-        "status|" + "|".join(STATUS_ENUM),
-        f"{len(planners)} planners",
-    ]
-    for p in planners:
-        runs = by_planner[p]
-        settings: dict[str, Any] = next((r.settings_used for r in runs if r.settings_used), {})
-        common = [f"{k} = {_one_line(json.dumps(v))}" for k, v in sorted(settings.items())]
-        lines += [p, f"{len(common)} common properties", *common]
-        lines.append(f"{len(_RUN_PROPERTIES)} properties for each run")
-        lines += [f"{n} {t}" for n, t in _RUN_PROPERTIES]
-        lines.append(f"{len(runs)} runs")
-        lines += ["".join(f"{v}; " for v in _run_values(r)) for r in runs]
-        lines.append(f"{len(_PROGRESS_PROPERTIES)} progress properties")
-        lines += [f"{n} {t}" for n, t in _PROGRESS_PROPERTIES]
-        lines.append(f"{len(runs)} runs")
-        lines += [
-            "".join("".join(f"{_log_value(v)}," for v in row) + ";" for row in _run_progress(r))
-            for r in runs
-        ]
-        lines.append(".")
-    return "\n".join(lines) + "\n"
-
-
-def log_paths(folder: str | Path, name: str, problems: Sequence[str]) -> dict[str, Path]:
-    """Where each problem's OMPL log goes: ``<name>.log`` for one problem, else
-    ``<name>.<problem>.log``."""
-    folder = Path(folder)
-    if len(problems) == 1:
-        return {problems[0]: folder / f"{name}.log"}
-    return {p: folder / f"{name}.{p}.log" for p in problems}
 
 
 # ---------------------------------------------------------------------- writing
