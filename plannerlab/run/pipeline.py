@@ -197,13 +197,14 @@ def solve_legs(
     entry = get_entry(planner_name)
     if planner is None:
         planner = make_planner(planner_name, overrides)
+    shared = shared or SharedChecker(problem)  # built on first use, then the same
     budget = budget or problem.budget
     legs = list(range(problem.legs)) if legs is None else list(legs)
     results: list[PlanResult] = []
     checker = None
     if legs and hasattr(planner, "plan") and not getattr(planner, "allows_contact", False):
         # one per problem: every leg's context shares it
-        checker = (shared or SharedChecker(problem)).get()
+        checker = shared.get()
     with ExitStack() as stack:
         stepper = None
         if entry.needs_stepper:
@@ -241,9 +242,10 @@ def solve_legs(
                     problem, leg, budget, leg_rng(seed, leg), q_start=q, stepper=stepper
                 )
             r = canonical_result(r.replace(seed=seed))
-            if r.solved and checker is None and r.contact_plan is None:
-                checker = (shared or SharedChecker(problem)).get()  # to measure the path
-            r = measured(problem, r, checker)
+            meter = checker
+            if r.solved and meter is None and r.contact_plan is None:
+                meter = shared.get()  # the problem's one checker, to measure the path
+            r = measured(problem, r, meter)
             results.append(r)
             if on_leg is not None:
                 on_leg(r)
