@@ -8,7 +8,8 @@ from pathlib import Path
 from typing import Any
 
 from rich.console import Console
-from rich.markup import escape
+
+from plannerlab import extras as px
 
 
 def cmd_import_mbm(args: argparse.Namespace, console: Console) -> int:
@@ -22,9 +23,9 @@ def cmd_import_mbm(args: argparse.Namespace, console: Console) -> int:
     if args.fetch:
         got = mbm.fetch_vamp(robot.name, args.cache)
         console.print(
-            f"vamp-planner 0.6.4 (Apache-2.0, licence {escape(str(got.licence))}): "
-            f"{robot.name} URDF {escape(str(got.urdf))}, SRDF {escape(str(got.srdf))}, "
-            f"problems in {escape(str(got.problems))}",
+            f"vamp-planner 0.6.4 (Apache-2.0, licence {got.licence}): "
+            f"{robot.name} URDF {got.urdf}, SRDF {got.srdf}, "
+            f"problems in {got.problems}",
             highlight=False,
         )
         urdf = urdf or got.urdf
@@ -73,14 +74,13 @@ def cmd_import_mbm(args: argparse.Namespace, console: Console) -> int:
             joint_step_rad=args.joint_step,
         )
         target.write_text(text, encoding="utf-8")
-    console.print(f"{len(pairs)} problem files written to {escape(str(out))}", highlight=False)
+    console.print(f"{len(pairs)} problem files written to {out}", highlight=False)
     return 0
 
 
 def mbm_default_joint_step() -> float:
-    import plannerlab as pl
 
-    return pl.mbm.DEFAULT_JOINT_STEP_RAD
+    return px.mbm.DEFAULT_JOINT_STEP_RAD
 
 
 def add_parser(sub: Any) -> None:

@@ -12,7 +12,7 @@ import sys
 from collections.abc import Iterator, Sequence
 
 from rich.console import Console
-from rich.markup import escape
+from rich.text import Text
 
 from plannerlab.cli import animate, execute, planners, plot, problems, solve, variants, view
 from plannerlab.cli.tables import make_console
@@ -133,6 +133,11 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
+def _error_console() -> Console:
+    """stderr, printing messages as written (they name keys in brackets: "[goals[0].n]")."""
+    return Console(stderr=True, markup=False)
+
+
 def main(argv: Sequence[str] | None = None) -> int:
     args = build_parser().parse_args(argv)
     logging.basicConfig(
@@ -151,8 +156,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         with engine_output_kept_off_stdout(args.verbose):
             return int(args.func(args, console) or 0)
     except PlannerlabError as exc:
-        # escape: messages name keys in brackets ("[goals[0].n]"), which rich would eat
-        Console(stderr=True).print(f"[red]error:[/red] {escape(str(exc))}", highlight=False)
+        _error_console().print(Text.assemble(("error:", "red"), f" {exc}"), highlight=False)
         return 2
     except OSError as exc:
         if exc.filename is None:
@@ -160,10 +164,10 @@ def main(argv: Sequence[str] | None = None) -> int:
         # a path given on the command line (--out, a plan or problem file) that cannot be
         # read or written
         msg = f"{exc.filename}: {exc.strerror or exc}"
-        Console(stderr=True).print(f"[red]error:[/red] {escape(msg)}", highlight=False)
+        _error_console().print(Text.assemble(("error:", "red"), f" {msg}"), highlight=False)
         return 2
     except KeyboardInterrupt:
-        Console(stderr=True).print("interrupted")
+        _error_console().print("interrupted")
         return 130
     finally:
         ompl_logger.setLevel(ompl_level)

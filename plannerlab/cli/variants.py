@@ -10,9 +10,10 @@ state with ``--min-clearance`` of clearance for every goal (a clearance-aware IK
 planner) and writes the kept variants as problem files (``<out>/armz_inspection_vNN.toml``,
 each written atomically). A draw without a witness for some goal is dropped (reported on
 stderr) and the next draw is taken. The same seed gives the same files.
-
-Argument parsing and printing only; the generator is :mod:`plannerlab.problem.variants`.
 """
+
+# Argument parsing and printing only; the generator is plannerlab.extras.generate_variants
+# (plannerlab/problem/variants.py). The docstring above is the command's help.
 
 from __future__ import annotations
 
@@ -23,6 +24,7 @@ from typing import Any
 
 from rich.console import Console
 
+from plannerlab import extras as px
 from plannerlab.cli.common import positive_int, seed_int
 
 #: tasks the generator knows how to vary
@@ -84,13 +86,12 @@ def add_parser(subparsers: Any) -> argparse.ArgumentParser:
 
 
 def cmd_variants(args: argparse.Namespace, console: Console) -> int:
-    import plannerlab as pl
 
     out = args.out
     from pathlib import Path
 
     if Path(out).exists() and not Path(out).is_dir():
-        raise pl.VariantError(f"--out {out}: a folder, but a file is in the way")
+        raise px.VariantError(f"--out {out}: a folder, but a file is in the way")
     command = "plannerlab variants " + " ".join(
         shlex.quote(a)
         for a in [
@@ -109,7 +110,7 @@ def cmd_variants(args: argparse.Namespace, console: Console) -> int:
     def progress(line: str) -> None:
         print(line, file=sys.stderr, flush=True)
 
-    kept = pl.generate_variants(
+    kept = px.generate_variants(
         args.count,
         args.seed,
         min_clearance_m=args.min_clearance,
@@ -119,6 +120,6 @@ def cmd_variants(args: argparse.Namespace, console: Console) -> int:
         kinds=tuple(k.strip() for k in args.kind.split(",") if k.strip()),
         first_index=args.first_index,
     )
-    for path in pl.write_variants(kept, out):
+    for path in px.write_variants(kept, out):
         print(path)
     return 0
