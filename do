@@ -5,6 +5,7 @@
 #                minutes; results/runs/main/, a rerun resumes and only prints the table)
 #   ./do test    the test suite (what CI runs)
 #   ./do bench   the speed benchmarks (bench/)
+#   ./do jupyter Jupyter Lab on notebooks/compare.ipynb (installs jupyterlab into .venv once)
 set -euo pipefail
 cd "$(dirname "$0")"
 PY=${PYTHON:-python3}
@@ -33,6 +34,14 @@ case "$job" in
     exec "$VENV/bin/python" -m pytest -q "$@" ;;
   bench)
     for b in bench/*.py; do "$VENV/bin/python" "$b" "$@"; done ;;
+  jupyter)
+    # the [jupyter] extra of pyproject.toml (jupyterlab, nbconvert, ipykernel), once
+    if [ ! -x "$VENV/bin/jupyter-lab" ]; then
+      echo "installing Jupyter Lab into $VENV (once)" >&2
+      "$VENV/bin/python" -m pip install --quiet -c constraints.txt -e ".[test,jupyter]"
+    fi
+    if [ "$#" -eq 0 ]; then set -- notebooks/compare.ipynb; fi
+    exec "$VENV/bin/jupyter" lab "$@" ;;
   *)
-    echo "usage: ./do main|test|bench [args]" >&2; exit 2 ;;
+    echo "usage: ./do main|test|bench|jupyter [args]" >&2; exit 2 ;;
 esac

@@ -177,14 +177,13 @@ class ClearanceSettings:
             from the stall) when the descent near the stall finds no collision-free goal
             [1].
         hold_clearance: when a step would take a pair below ``min_clearance_m``, try
-            once the same step with the part that closes such pairs taken out
-            (:meth:`ClearanceDescent._hold_clearance`) before shrinking the step; without
+            once the same step with the part that closes such pairs taken out before
+            shrinking the step; without
             it the descent stalls against the clearance floor (measured on room
             variants: the leave leg stalled at iteration 7 and no retract got out).
-        backend: "compiled" (the field and the step in numba,
-            :mod:`plannerlab.planners.clearance.compiled`; Arm-Z only, other robots use numpy)
-            or "numpy" (the reference: the same iterates to rounding, 30-50 times slower;
-            `bench/descent_bench.py`).
+        backend: "compiled" (the field and the step compiled with numba; Arm-Z only,
+            other robots use numpy) or "numpy" (the reference: the same iterates to
+            rounding, 30-50 times slower; ``bench/descent_bench.py``).
     """
 
     r1: float = 1.0
