@@ -29,6 +29,7 @@ import importlib
 from typing import TYPE_CHECKING, Any
 
 if TYPE_CHECKING:
+    from plannerlab.comparison.minima import local_minima
     from plannerlab.comparison.report import markdown as markdown_report
     from plannerlab.comparison.report import write_reports
     from plannerlab.comparison.runner import ComparisonRun, compare
@@ -80,6 +81,7 @@ _EXPORTS: dict[str, str] = {
     "summarise": "plannerlab.comparison.statistics:summarise",
     "markdown_report": "plannerlab.comparison.report:markdown",
     "write_reports": "plannerlab.comparison.report:write_reports",
+    "local_minima": "plannerlab.comparison.minima:local_minima",
     # figures and the viewer
     "snapshot_figure": "plannerlab.plot.plans:snapshot_figure",
     "trace_figure": "plannerlab.plot.plans:trace_figure",
@@ -106,6 +108,7 @@ __all__ = [
     "compare",
     "execute",
     "load_problem",
+    "local_minima",
     "make_planner",
     "markdown_report",
     "parse_problem",

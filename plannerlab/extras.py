@@ -32,6 +32,7 @@ from typing import TYPE_CHECKING, Any
 if TYPE_CHECKING:
     from plannerlab.comparison.continuum import case_name as continuum_case_name
     from plannerlab.comparison.continuum import run_case as run_continuum_case
+    from plannerlab.comparison.minima import describe as describe_minima
     from plannerlab.comparison.report import BUDGET_NOTE, machine_info
     from plannerlab.comparison.runner import run_spec
     from plannerlab.comparison.spec import ComparisonSpec
@@ -62,6 +63,7 @@ _EXPORTS: dict[str, str] = {
     "TIMEOUT_STATUS": "plannerlab.comparison.trial:TIMEOUT_STATUS",
     "BUDGET_NOTE": "plannerlab.comparison.report:BUDGET_NOTE",
     "machine_info": "plannerlab.comparison.report:machine_info",
+    "describe_minima": "plannerlab.comparison.minima:describe",
     # plan files
     "read_checked_plan": "plannerlab.run.plan_check:read_checked_plan",
     "check_plan": "plannerlab.run.plan_check:check_plan",
@@ -97,6 +99,7 @@ __all__ = [
     "continuum_case_name",
     "continuum_thickness_figure",
     "default_store_name",
+    "describe_minima",
     "execute_results",
     "generate_variants",
     "irb6_ik",

@@ -144,6 +144,13 @@ def add_compare_parser(subparsers: Any) -> argparse.ArgumentParser:
         metavar="A,B,C",
         help="the table's columns, in order: " + ", ".join(SUMMARY_COLUMNS),
     )
+    p.add_argument(
+        "--minima",
+        action="store_true",
+        help="end with which planner escaped which local minimum: the legs the paper's "
+        "gradient (else the first planner) stalled on, who solved them, and the minima each "
+        "planner met and escaped itself (from the trial records)",
+    )
     p.set_defaults(func=cmd_compare)
     return p
 
@@ -325,6 +332,13 @@ def cmd_compare(args: argparse.Namespace, console: Console) -> int:
         )
         return 0
     _print_tables(console, rows, columns)
+    if args.minima:
+        planners = _split(args.planners)
+        baseline = "gradient" if "gradient" in planners else planners[0]
+        stalls, own = pl.local_minima(records, baseline)
+        console.print(Text("Local minima (from the trial records)", style="bold"))
+        for line in px.describe_minima(stalls, own, baseline):
+            console.print(line, highlight=False)
     errors = [r for r in records if r.get("status") == px.ERROR_STATUS]
     if errors:
         console.print(

@@ -10,6 +10,7 @@ from typing import Any
 from rich.console import Console
 
 from plannerlab import extras as px
+from plannerlab.cli.common import add_renamed_flag
 
 
 def cmd_import_mbm(args: argparse.Namespace, console: Console) -> int:
@@ -70,7 +71,7 @@ def cmd_import_mbm(args: argparse.Namespace, console: Console) -> int:
             srdf=Path(srdf) if srdf else None,
             tip_link=tip_link,
             name=name,
-            safety_margin_m=args.margin_m,
+            safety_margin_m=args.safety_margin_m,
             joint_step_rad=args.joint_step,
         )
         target.write_text(text, encoding="utf-8")
@@ -117,12 +118,13 @@ def add_parser(sub: Any) -> None:
     m.add_argument("--name", default=None, help="problem name (one scene + request)")
     m.add_argument("--limit", type=int, default=None, help="at most N problems per folder")
     m.add_argument(
-        "--margin-m",
+        "--safety-margin-m",
         type=float,
         default=0.0,
         help="[planning] safety_margin_m of the files (MotionBenchMaker's states are valid "
         "with no margin)",
     )
+    add_renamed_flag(m, "--margin-m", "--safety-margin-m", type=float)
     m.add_argument(
         "--joint-step",
         type=float,

@@ -9,6 +9,7 @@ import logging
 import os
 import re
 import sys
+import warnings
 from collections.abc import Iterator, Sequence
 
 from rich.console import Console
@@ -16,7 +17,7 @@ from rich.text import Text
 
 from plannerlab.cli import animate, execute, planners, plot, problems, solve, variants, view
 from plannerlab.cli.tables import make_console
-from plannerlab.errors import PlannerlabError
+from plannerlab.errors import PlannerlabError, RenamedWarning
 
 DESCRIPTION = """\
 Compare motion planners on hyper-redundant, industrial and continuum robots.
@@ -138,7 +139,32 @@ def _error_console() -> Console:
     return Console(stderr=True, markup=False)
 
 
+def _show_renamed(
+    message: Warning | str,
+    category: type[Warning],
+    filename: str,
+    lineno: int,
+    file: object = None,
+    line: str | None = None,
+) -> None:
+    """A renamed setting, key or flag as one line on stderr (``warning: ...``); any other
+    warning as Python shows it."""
+    if issubclass(category, RenamedWarning):
+        _error_console().print(Text.assemble(("warning:", "yellow"), f" {message}"))
+    else:
+        _PYTHON_SHOWWARNING(message, category, filename, lineno, file, line)  # type: ignore[arg-type]
+
+
+_PYTHON_SHOWWARNING = warnings.showwarning
+
+
 def main(argv: Sequence[str] | None = None) -> int:
+    with warnings.catch_warnings():
+        warnings.showwarning = _show_renamed
+        return _main(argv)
+
+
+def _main(argv: Sequence[str] | None) -> int:
     args = build_parser().parse_args(argv)
     logging.basicConfig(
         level=logging.INFO if args.verbose else logging.WARNING,

@@ -6,7 +6,7 @@
 
 Draws rooms (scaled, shifted, mirrored; the window moved and resized; 20-32 modules),
 places the goals relative to the walls as in the paper, finds a collision-free witness
-state with ``--min-clearance`` of clearance for every goal (a clearance-aware IK, no
+state with ``--clearance-floor`` of clearance for every goal (a clearance-aware IK, no
 planner) and writes the kept variants as problem files (``<out>/armz_inspection_vNN.toml``,
 each written atomically). A draw without a witness for some goal is dropped (reported on
 stderr) and the next draw is taken. The same seed gives the same files.
@@ -25,7 +25,7 @@ from typing import Any
 from rich.console import Console
 
 from plannerlab import extras as px
-from plannerlab.cli.common import positive_int, seed_int
+from plannerlab.cli.common import add_renamed_flag, positive_int, seed_int
 
 #: tasks the generator knows how to vary
 TEMPLATES = ("armz_inspection",)
@@ -54,12 +54,13 @@ def add_parser(subparsers: Any) -> argparse.ArgumentParser:
         "--out", default="problems/variants", metavar="DIR", help="folder for the problem files"
     )
     p.add_argument(
-        "--min-clearance",
+        "--clearance-floor",
         type=_clearance,
         default=0.04,
         metavar="M",
-        help="clearance every witness state keeps [m]",
+        help="clearance every witness state keeps at least [m] (its [witness] clearance_floor_m)",
     )
+    add_renamed_flag(p, "--min-clearance", "--clearance-floor", type=_clearance, metavar="M")
     p.add_argument(
         "--max-draws",
         type=positive_int,
@@ -100,8 +101,8 @@ def cmd_variants(args: argparse.Namespace, console: Console) -> int:
             str(args.count),
             "--seed",
             str(args.seed),
-            "--min-clearance",
-            f"{args.min_clearance:g}",
+            "--clearance-floor",
+            f"{args.clearance_floor:g}",
         ]
         + ([] if args.kind == "paper" else ["--kind", args.kind])
         + ([] if args.first_index == 0 else ["--first-index", str(args.first_index)])
@@ -113,7 +114,7 @@ def cmd_variants(args: argparse.Namespace, console: Console) -> int:
     kept = px.generate_variants(
         args.count,
         args.seed,
-        min_clearance_m=args.min_clearance,
+        min_clearance_m=args.clearance_floor,
         max_draws=args.max_draws,
         command=command,
         progress=progress,
