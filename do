@@ -12,19 +12,24 @@ set -euo pipefail
 cd "$(dirname "$0")"
 PY=${PYTHON:-python3}
 VENV=.venv
-stamp="$VENV/.installed-$(cat pyproject.toml constraints.txt | sha1sum | cut -c1-12)"
-if [ ! -x "$VENV/bin/python" ] || [ ! -f "$stamp" ]; then
+job=${1:-main}
+shift || true
+# the package and its engines; the test suite's tools ([test]: pytest, ray, selenium,
+# mypy, ...) only for ./do test, so that ./do main on a fresh clone installs half as much
+hash=$(cat pyproject.toml constraints.txt | sha1sum | cut -c1-12)
+extras=""
+if [ "$job" = test ]; then extras="[test]"; fi
+stamp="$VENV/.installed-$hash${extras:+-test}"
+if [ ! -x "$VENV/bin/python" ] || { [ ! -f "$stamp" ] && [ ! -f "$VENV/.installed-$hash-test" ]; }; then
   echo "setting up $VENV (once; a few minutes on a fresh machine)" >&2
   "$PY" -m venv "$VENV"
   "$VENV/bin/python" -m pip install --quiet --upgrade pip
   # pinned versions (constraints.txt): the goldens of tests/ depend on them
-  "$VENV/bin/python" -m pip install --quiet -c constraints.txt -e ".[test]"
+  "$VENV/bin/python" -m pip install --quiet -c constraints.txt -e ".$extras"
   rm -f "$VENV"/.installed-*
   touch "$stamp"
 fi
 export MPLBACKEND=Agg
-job=${1:-main}
-shift || true
 case "$job" in
   main)
     # the mission (issue 36, item 5): on the Arm-Z paper's task (enter, A-E, leave) the

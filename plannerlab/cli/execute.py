@@ -91,12 +91,13 @@ def execution_table(legs: Any, executions: Any, why: bool = True) -> Table:
                 f"leg {r.leg} {r.goal}: FCL re-check collides on edge "
                 f"{e.recheck_first_invalid_edge}: {pairs}"
             )
+        verdict: str | Text = {True: "valid", None: "contact plan"}.get(e.path_valid, "")
+        if e.path_valid is False:
+            verdict = Text("collides", style="red")
         t.add_row(
             str(r.leg),
             str(r.goal),
-            {True: "valid", False: Text("collides", style="red"), None: "contact plan"}[
-                e.path_valid
-            ],
+            verdict,
             fmt(e.final_pos_err_m),
             fmt(e.final_angle_err_deg),
             fmt(1e3 * e.max_deviation_m),

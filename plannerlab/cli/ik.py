@@ -136,7 +136,7 @@ def _print(console: Console, out: dict[str, Any]) -> None:
     t.add_column("", style="bold")
     t.add_column("")
 
-    def row(label: str, value: str) -> None:
+    def row(label: str, value: str | Text) -> None:
         t.add_row(label, value)
 
     source = f"problem {out['problem']}" if out["problem"] else "model defaults"

@@ -14,6 +14,8 @@ kernels twice at once)."""
 
 from __future__ import annotations
 
+from typing import Any
+
 import plannerlab.collision.fcl_checker
 import plannerlab.planners
 import plannerlab.planners.gradient
@@ -79,7 +81,11 @@ def _warm_core() -> None:
     scene = Scene((Sphere("far", trans(5.0, 0.0, 0.0), 0.1),))
     armz, chain = ArmZ(n_modules=4), ContinuumChain(n_links=3)
     # free states: Arm-Z's straight column, the chain pushed out straight
-    for robot, q in ((armz, np.full(armz.dof, np.pi)), (chain, np.r_[0.2, np.zeros(3)])):
+    robots: tuple[tuple[Any, np.ndarray], ...] = (
+        (armz, np.full(armz.dof, np.pi)),
+        (chain, np.r_[0.2, np.zeros(3)]),
+    )
+    for robot, q in robots:
         checker = CollisionChecker(robot, scene, margin_m=0.01)
         checker.is_valid(q)
         checker.check_path(np.array([q, q + 0.01]), 0.05)
