@@ -260,13 +260,13 @@ def summary_table(problem: str, rows: Sequence[Mapping[str, Any]], keys: Sequenc
     cols = [SUMMARY_COLUMNS[k] for k in keys]
     t = table(problem, [(c.header, c.kind) for c in cols], compact=True)
     for r in rows:
-        cells: list[str | Text] = [c.cell(r) for c in cols]
+        cells = [Text(c.cell(r)) for c in cols]  # Text: never read as markup, on any console
         if "solved" in keys or "solved_n" in keys:
             i = keys.index("solved") if "solved" in keys else keys.index("solved_n")
             style = (
                 "green" if r["success_rate"] >= 0.95 else "red" if r["successes"] == 0 else "yellow"
             )
-            cells[i] = Text(str(cells[i]), style=style)
+            cells[i].stylize(style)
         t.add_row(*cells)
     return t
 
