@@ -115,6 +115,7 @@ def _bench(name: str, problem: Any, n_states: int, repeats: int) -> None:
 
 
 def _bench_ik(repeats: int) -> None:
+    from plannerlab.collision.chain_ik import descent_for_robot
     from plannerlab.problem.goals import GoalRegion
     from plannerlab.problem.ik import sample_goal_state
 
@@ -125,7 +126,9 @@ def _bench_ik(repeats: int) -> None:
     p, n = robot.tip(problem.goal(0).q_rad)
     goal = GoalRegion("tip", p, n, 0.01, 10.0)
     print(f"\nPanda goal states for {goal.name} ({goal.pos_tol_m} m, {goal.angle_tol_deg} deg)")
-    sample_goal_state(robot, goal, checker, np.random.default_rng(0), attempts=1)  # compile
+    sample_goal_state(  # compile
+        robot, goal, checker, np.random.default_rng(0), attempts=1, descent=descent_for_robot(robot)
+    )
     for compiled in (True, False):
         times = []
         got = 0
@@ -133,7 +136,12 @@ def _bench_ik(repeats: int) -> None:
             rng = np.random.default_rng(seed)
             t = time.process_time()
             q = sample_goal_state(
-                robot, goal, checker, rng, seeds=[problem.q_start], compiled=compiled
+                robot,
+                goal,
+                checker,
+                rng,
+                seeds=[problem.q_start],
+                descent=descent_for_robot(robot) if compiled else None,
             )
             times.append((time.process_time() - t) * 1e3)
             got += q is not None

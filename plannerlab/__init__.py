@@ -11,21 +11,16 @@ none of the engines)::
     run = pl.compare(["armz_pocket"], ["gradient", "ompl.rrtconnect"], range(3), "t.jsonl")
     rows = pl.summarise(run.records)
 
-The data flow is one way: problem file → :func:`load_problem` → planner
-(:func:`make_planner`, :func:`solve`) → record (:class:`Plan`, :class:`PlanResult`) →
-:func:`execute` (:class:`Execution`) → table (:func:`compare`, :func:`summarise`,
-:func:`markdown_report`); figures with :func:`snapshot_figure` and :func:`trace_figure`,
-animations with :func:`animate_plan`; an interactive 3-D view in the browser (or inline in a
-notebook) with :func:`view`.
+The data flow is one way: problem file → ``load_problem`` → planner (``make_planner``,
+``solve``) → record (``Plan``, ``PlanResult``) → ``execute`` (``Execution``) → table
+(``compare``, ``summarise``, ``markdown_report``); figures with ``snapshot_figure``,
+``trace_figure`` and ``plot_plan``, animations with ``animate_plan``; an interactive 3-D
+view in the browser (or inline in a notebook) with ``view``. ``docs/api.md`` lists every
+name with what it does.
 
-The command line is this API's first client (``plannerlab/cli/`` imports nothing else of
-the package but its records), so whatever a command does is here too: plan files
-(:func:`read_checked_plan`, :func:`execute_results`, :func:`plot_plan`), the catalogues
-(:func:`problem_catalog`, :func:`planner_catalog`, :func:`planner_info`), comparisons
-(:class:`ComparisonSpec`, :func:`run_spec`, :class:`TrialStore`, :func:`write_reports`),
-the continuum paper's cases (:func:`run_continuum_case`), room variants
-(:func:`generate_variants`), the IRb-6's analytic IK (:func:`irb6_ik`) and
-MotionBenchMaker's importer (``pl.mbm``).
+What only the command line needs (store paths, report notes, the continuum paper's
+cases, room variants, the IRb-6's analytic IK, MotionBenchMaker's importer) is in
+:mod:`plannerlab.extras`, not here.
 """
 
 from __future__ import annotations
@@ -34,39 +29,47 @@ import importlib
 from typing import TYPE_CHECKING, Any
 
 if TYPE_CHECKING:
+    from plannerlab.comparison.minima import local_minima
     from plannerlab.comparison.report import markdown as markdown_report
+    from plannerlab.comparison.report import write_reports
     from plannerlab.comparison.runner import ComparisonRun, compare
     from plannerlab.comparison.statistics import SummaryRow, summarise
-    from plannerlab.comparison.trial import Trial
+    from plannerlab.comparison.store import TrialStore
     from plannerlab.errors import PlannerlabError
     from plannerlab.planners import make_planner, planner_names
     from plannerlab.plot.animate import animate_plan
-    from plannerlab.plot.plans import snapshot_figure, trace_figure
+    from plannerlab.plot.plans import plot_plan, snapshot_figure, trace_figure
     from plannerlab.plot.view import Viewer
-    from plannerlab.problem.catalog import list_problems, load_problem
-    from plannerlab.problem.load import Budget, Problem
+    from plannerlab.problem.catalog import load_problem, problem_catalog
+    from plannerlab.problem.load import Budget, Problem, parse_problem
     from plannerlab.record.execution import Execution
     from plannerlab.record.leg import PlanResult, Status
     from plannerlab.record.plan import ExecutionFile, Plan
     from plannerlab.record.trial import ExecutionRecord, LegRecord, TrialRecord
     from plannerlab.run.pipeline import execute_plan as execute
     from plannerlab.run.pipeline import solve_legs as solve
+    from plannerlab.run.plan_check import read_plan
+    from plannerlab.run.planner_info import planner_catalog, planner_info
 
-#: public name -> "module:attribute", imported on first access
+#: public name -> "module:attribute", imported on first access (the architecture test
+#: reads these strings as the imports they are)
 _EXPORTS: dict[str, str] = {
+    # problems
     "load_problem": "plannerlab.problem.catalog:load_problem",
-    "list_problems": "plannerlab.problem.catalog:list_problems",
-    "problems_dir": "plannerlab.problem.catalog:problems_dir",
+    "parse_problem": "plannerlab.problem.load:parse_problem",
+    "problem_catalog": "plannerlab.problem.catalog:problem_catalog",
     "Problem": "plannerlab.problem.load:Problem",
     "Budget": "plannerlab.problem.load:Budget",
+    # planners
     "planner_names": "plannerlab.planners:planner_names",
+    "planner_catalog": "plannerlab.run.planner_info:planner_catalog",
+    "planner_info": "plannerlab.run.planner_info:planner_info",
     "make_planner": "plannerlab.planners:make_planner",
+    # plans and their execution
     "solve": "plannerlab.run.pipeline:solve_legs",
     "execute": "plannerlab.run.pipeline:execute_plan",
-    "compare": "plannerlab.comparison.runner:compare",
-    "summarise": "plannerlab.comparison.statistics:summarise",
-    "Trial": "plannerlab.comparison.trial:Trial",
-    "ComparisonRun": "plannerlab.comparison.runner:ComparisonRun",
+    "read_plan": "plannerlab.run.plan_check:read_plan",
+    # records
     "Status": "plannerlab.record.leg:Status",
     "PlanResult": "plannerlab.record.leg:PlanResult",
     "Plan": "plannerlab.record.plan:Plan",
@@ -75,13 +78,23 @@ _EXPORTS: dict[str, str] = {
     "TrialRecord": "plannerlab.record.trial:TrialRecord",
     "LegRecord": "plannerlab.record.trial:LegRecord",
     "ExecutionRecord": "plannerlab.record.trial:ExecutionRecord",
+    # comparisons
+    "compare": "plannerlab.comparison.runner:compare",
+    "ComparisonRun": "plannerlab.comparison.runner:ComparisonRun",
+    "TrialStore": "plannerlab.comparison.store:TrialStore",
+    "summarise": "plannerlab.comparison.statistics:summarise",
     "SummaryRow": "plannerlab.comparison.statistics:SummaryRow",
-    "PlannerlabError": "plannerlab.errors:PlannerlabError",
     "markdown_report": "plannerlab.comparison.report:markdown",
+    "write_reports": "plannerlab.comparison.report:write_reports",
+    "local_minima": "plannerlab.comparison.minima:local_minima",
+    # figures and the viewer
     "snapshot_figure": "plannerlab.plot.plans:snapshot_figure",
     "trace_figure": "plannerlab.plot.plans:trace_figure",
+    "plot_plan": "plannerlab.plot.plans:plot_plan",
     "animate_plan": "plannerlab.plot.animate:animate_plan",
     "Viewer": "plannerlab.plot.view:Viewer",
+    # errors
+    "PlannerlabError": "plannerlab.errors:PlannerlabError",
 }
 
 __all__ = [
@@ -97,127 +110,29 @@ __all__ = [
     "Problem",
     "Status",
     "SummaryRow",
-    "Trial",
     "TrialRecord",
+    "TrialStore",
     "Viewer",
     "animate_plan",
     "compare",
     "execute",
-    "list_problems",
     "load_problem",
+    "local_minima",
     "make_planner",
     "markdown_report",
+    "parse_problem",
+    "planner_catalog",
+    "planner_info",
     "planner_names",
-    "problems_dir",
+    "plot_plan",
+    "problem_catalog",
+    "read_plan",
     "snapshot_figure",
     "solve",
     "summarise",
     "trace_figure",
     "view",
-]
-
-
-if TYPE_CHECKING:
-    from plannerlab.comparison.continuum import case_name as continuum_case_name
-    from plannerlab.comparison.continuum import run_case as run_continuum_case
-    from plannerlab.comparison.report import BUDGET_NOTE, machine_info, write_reports
-    from plannerlab.comparison.runner import run_spec
-    from plannerlab.comparison.spec import ComparisonSpec
-    from plannerlab.comparison.store import TrialStore, store_path
-    from plannerlab.comparison.store import default_name as default_store_name
-    from plannerlab.comparison.trial import ERROR_STATUS, TIMEOUT_STATUS, parse_seeds
-    from plannerlab.plot.continuum import draw_case as continuum_case_figure
-    from plannerlab.plot.continuum import save as save_figure
-    from plannerlab.plot.continuum import thickness_figure as continuum_thickness_figure
-    from plannerlab.plot.plans import plot_plan
-    from plannerlab.problem import mbm
-    from plannerlab.problem.catalog import problem_catalog, problem_origin, resolve_problem_path
-    from plannerlab.problem.load import parse_problem
-    from plannerlab.problem.variants import VariantError, write_variants
-    from plannerlab.problem.variants import generate as generate_variants
-    from plannerlab.robots.irb6.report import irb6_ik
-    from plannerlab.run.pipeline import execute_results, legs_from_spec
-    from plannerlab.run.plan_check import check_plan, read_checked_plan, read_plan
-    from plannerlab.run.planner_info import planner_catalog, planner_info
-
-#: what the command line needs beyond the road above (``cli/`` is this API's first
-#: client: it imports nothing else of plannerlab but ``record``); a name without an
-#: attribute is a module (``pl.mbm``)
-_EXPORTS |= {
-    # problems
-    "parse_problem": "plannerlab.problem.load:parse_problem",
-    "resolve_problem_path": "plannerlab.problem.catalog:resolve_problem_path",
-    "problem_origin": "plannerlab.problem.catalog:problem_origin",
-    "problem_catalog": "plannerlab.problem.catalog:problem_catalog",
-    "mbm": "plannerlab.problem.mbm",
-    # planners
-    "planner_catalog": "plannerlab.run.planner_info:planner_catalog",
-    "planner_info": "plannerlab.run.planner_info:planner_info",
-    # plan files and execution
-    "legs_from_spec": "plannerlab.run.pipeline:legs_from_spec",
-    "execute_results": "plannerlab.run.pipeline:execute_results",
-    "read_plan": "plannerlab.run.plan_check:read_plan",
-    "check_plan": "plannerlab.run.plan_check:check_plan",
-    "read_checked_plan": "plannerlab.run.plan_check:read_checked_plan",
-    # figures
-    "plot_plan": "plannerlab.plot.plans:plot_plan",
-    "continuum_case_figure": "plannerlab.plot.continuum:draw_case",
-    "continuum_thickness_figure": "plannerlab.plot.continuum:thickness_figure",
-    "save_figure": "plannerlab.plot.continuum:save",
-    # comparisons
-    "ComparisonSpec": "plannerlab.comparison.spec:ComparisonSpec",
-    "run_spec": "plannerlab.comparison.runner:run_spec",
-    "TrialStore": "plannerlab.comparison.store:TrialStore",
-    "store_path": "plannerlab.comparison.store:store_path",
-    "default_store_name": "plannerlab.comparison.store:default_name",
-    "parse_seeds": "plannerlab.comparison.trial:parse_seeds",
-    "ERROR_STATUS": "plannerlab.comparison.trial:ERROR_STATUS",
-    "TIMEOUT_STATUS": "plannerlab.comparison.trial:TIMEOUT_STATUS",
-    "machine_info": "plannerlab.comparison.report:machine_info",
-    "write_reports": "plannerlab.comparison.report:write_reports",
-    "BUDGET_NOTE": "plannerlab.comparison.report:BUDGET_NOTE",
-    "run_continuum_case": "plannerlab.comparison.continuum:run_case",
-    "continuum_case_name": "plannerlab.comparison.continuum:case_name",
-    # Arm-Z variants, the IRb-6's analytic IK
-    "generate_variants": "plannerlab.problem.variants:generate",
-    "write_variants": "plannerlab.problem.variants:write_variants",
-    "VariantError": "plannerlab.problem.variants:VariantError",
-    "irb6_ik": "plannerlab.robots.irb6.report:irb6_ik",
-}
-__all__ += [
-    "BUDGET_NOTE",
-    "ComparisonSpec",
-    "ERROR_STATUS",
-    "TIMEOUT_STATUS",
-    "TrialStore",
-    "VariantError",
-    "check_plan",
-    "continuum_case_figure",
-    "continuum_case_name",
-    "continuum_thickness_figure",
-    "default_store_name",
-    "execute_results",
-    "generate_variants",
-    "irb6_ik",
-    "legs_from_spec",
-    "machine_info",
-    "mbm",
-    "parse_problem",
-    "parse_seeds",
-    "planner_catalog",
-    "planner_info",
-    "plot_plan",
-    "problem_catalog",
-    "problem_origin",
-    "read_checked_plan",
-    "read_plan",
-    "resolve_problem_path",
-    "run_continuum_case",
-    "run_spec",
-    "save_figure",
-    "store_path",
     "write_reports",
-    "write_variants",
 ]
 
 
@@ -294,8 +209,7 @@ def __getattr__(name: str) -> Any:
     if target is None:
         raise AttributeError(f"module 'plannerlab' has no attribute {name!r}")
     module_name, _, attr = target.partition(":")
-    module = importlib.import_module(module_name)
-    value = getattr(module, attr) if attr else module
+    value = getattr(importlib.import_module(module_name), attr)
     globals()[name] = value  # later lookups skip this function
     return value
 

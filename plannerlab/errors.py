@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import difflib
+import warnings
 from collections.abc import Iterable
 
 
@@ -47,3 +48,20 @@ class UnknownNameError(PlannerlabError, KeyError):
 
 class PlanFileError(PlannerlabError):
     """A saved plan (JSON) cannot be read back."""
+
+
+class RenamedWarning(FutureWarning):
+    """A setting, problem-file key or flag was given by a name it no longer has: it still
+    works for one release, read as its new name, which the message names
+    (``docs/distances.md`` lists the renamed ones). A ``FutureWarning``: shown by default."""
+
+
+def warn_renamed(where: str, old: str, new: str) -> None:
+    """Warn that ``old`` (in ``where``: a file and table, a planner's settings, a command)
+    is read as ``new``, its name now."""
+    warnings.warn(
+        f"{where}: {old!r} is renamed {new!r}; the old name is read as {new!r} for one more "
+        f"release: write {new!r}",
+        RenamedWarning,
+        stacklevel=3,
+    )

@@ -9,6 +9,7 @@ from typing import Any
 
 from rich.console import Console
 
+from plannerlab import extras as px
 from plannerlab.cli.plot import plan_executions
 from plannerlab.errors import PlannerlabError
 
@@ -20,13 +21,13 @@ def cmd_animate(args: argparse.Namespace, console: Console) -> int:
         raise PlannerlabError(f"--frames: expected >= 2, got {args.frames}")
     if args.fps < 1:
         raise PlannerlabError(f"--fps: expected >= 1, got {args.fps}")
-    plan, problem = pl.read_checked_plan(args.plan)
+    plan, problem = px.read_checked_plan(args.plan)
     out = Path(args.out) if args.out else Path(args.plan).with_suffix(f".{args.format}")
     executions = plan_executions(args.plan)
     note = "with its execution record (PLAN.exec.json)"
     if not executions and not args.no_execute:
         with console.status(f"executing {len(plan.legs)} legs in PyBullet (none recorded)"):
-            executions = pl.execute_results(problem, plan.legs)
+            executions = px.execute_results(problem, plan.legs)
         note = "executed now (no PLAN.exec.json beside the plan; `plannerlab execute` writes one)"
     elif not executions:
         note = "planned motion only (--no-execute)"

@@ -11,9 +11,28 @@ from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
-from plannerlab.errors import PlannerlabError, UnknownNameError
+from plannerlab.errors import PlannerlabError, UnknownNameError, warn_renamed
 
 RESULTS_DIR = Path("results")
+
+
+def add_renamed_flag(p: argparse.ArgumentParser, old: str, new: str, **kwargs: Any) -> None:
+    """``old``, a flag renamed ``new`` (already added to ``p``): still read for one release,
+    into ``new``'s value, with a warning naming ``new``; not shown in the help."""
+
+    class _Renamed(argparse.Action):
+        def __call__(
+            self,
+            parser: argparse.ArgumentParser,
+            namespace: argparse.Namespace,
+            values: Any,
+            option_string: str | None = None,
+        ) -> None:
+            warn_renamed(parser.prog, old, new)
+            setattr(namespace, self.dest, values)
+
+    dest = new.lstrip("-").replace("-", "_")
+    p.add_argument(old, action=_Renamed, dest=dest, help=argparse.SUPPRESS, **kwargs)
 
 
 def parse_overrides(items: Sequence[str] | None) -> dict[str, str]:

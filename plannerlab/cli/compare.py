@@ -20,11 +20,12 @@ CSV, Markdown and OMPL benchmark logs in ``DIR/NAME/`` (load a log with
 ``ompl_benchmark_statistics LOG -d results.db``).
 
 Budgets are per leg; use ``--max-checks`` or ``--max-iterations`` for reproducible
-numbers, ``--time-limit`` for benchmarks. Argument parsing and printing only: the work
-is :class:`plannerlab.comparison.spec.ComparisonSpec` (the checks, shared with
-:func:`plannerlab.compare`), :func:`plannerlab.comparison.runner.run_spec` and
-:mod:`plannerlab.comparison.report`.
+numbers, ``--time-limit`` for benchmarks. The same from Python: ``plannerlab.compare``.
 """
+
+# Argument parsing and printing only: the work is plannerlab.extras.ComparisonSpec (the
+# checks, shared with plannerlab.compare), plannerlab.extras.run_spec and the reports of
+# plannerlab.write_reports. The docstring above is the command's help: no internal names.
 
 from __future__ import annotations
 
@@ -39,7 +40,6 @@ from pathlib import Path
 from typing import Any
 
 from rich.console import Console
-from rich.markup import escape
 from rich.progress import (
     BarColumn,
     MofNCompleteColumn,
@@ -49,7 +49,9 @@ from rich.progress import (
     TimeElapsedColumn,
     TimeRemainingColumn,
 )
+from rich.text import Text
 
+from plannerlab import extras as px
 from plannerlab.cli.common import (
     add_budget_args,
     leg_spec,
@@ -143,6 +145,13 @@ def add_compare_parser(subparsers: Any) -> argparse.ArgumentParser:
         metavar="A,B,C",
         help="the table's columns, in order: " + ", ".join(SUMMARY_COLUMNS),
     )
+    p.add_argument(
+        "--minima",
+        action="store_true",
+        help="end with which planner escaped which local minimum: the legs the paper's "
+        "gradient (else the first planner) stalled on, who solved them, and the minima each "
+        "planner met and escaped itself (from the trial records)",
+    )
     p.set_defaults(func=cmd_compare)
     return p
 
@@ -214,10 +223,10 @@ def cmd_compare(args: argparse.Namespace, console: Console) -> int:
         if v is not None and v <= 0:
             raise PlannerlabError(f"{flag}: expected > 0, got {v}")
     planners = list(dict.fromkeys(_split(args.planners)))
-    spec = pl.ComparisonSpec.build(
+    spec = px.ComparisonSpec.build(
         args.problems,
         planners,
-        pl.parse_seeds(args.seeds),
+        px.parse_seeds(args.seeds),
         budget={
             "max_iterations": args.max_iterations,
             "max_collision_checks": args.max_checks,
@@ -232,11 +241,11 @@ def cmd_compare(args: argparse.Namespace, console: Console) -> int:
         trial_timeout_s=args.trial_timeout,
         retry_errors=args.retry_errors,
     )
-    name = args.name or pl.default_store_name(spec.problem_names, list(spec.planners))
+    name = args.name or px.default_store_name(spec.problem_names, list(spec.planners))
     if not re.fullmatch(r"[A-Za-z0-9._+-]+", name) or name in (".", ".."):
         raise PlannerlabError(f"--name: letters, digits and . _ + - only, got {name!r}")
     folder = Path(args.out) / name
-    store = pl.TrialStore(pl.store_path(args.out, name))
+    store = pl.TrialStore(px.store_path(args.out, name))
     command = _command(args)
     trials = spec.trials
 
@@ -246,10 +255,10 @@ def cmd_compare(args: argparse.Namespace, console: Console) -> int:
     counts = {"ran": 0, "skipped": 0, "errors": 0}
     progress = Progress(
         SpinnerColumn(),
-        TextColumn("[bold]{task.description}"),
+        TextColumn("{task.description}", style="bold", markup=False),
         BarColumn(),
         MofNCompleteColumn(),
-        TextColumn("{task.fields[detail]}"),
+        TextColumn("{task.fields[detail]}", markup=False),
         TimeElapsedColumn(),
         TimeRemainingColumn(),
         console=console,
@@ -257,7 +266,7 @@ def cmd_compare(args: argparse.Namespace, console: Console) -> int:
 
     def detail() -> str:
         s = f"{counts['ran']} run, {counts['skipped']} skipped"
-        return s + (f", [red]{counts['errors']} errors[/red]" if counts["errors"] else "")
+        return s + (f", {counts['errors']} errors" if counts["errors"] else "")
 
     task = progress.add_task(f"compare {name}", total=len(trials), detail="")
 
@@ -265,18 +274,20 @@ def cmd_compare(args: argparse.Namespace, console: Console) -> int:
         counts["skipped" if skipped else "ran"] += 1
         if not rec.ran:
             counts["errors"] += 1
-        last = "" if skipped else f" · last: {escape(rec.planner)} s{rec.seed} {rec.status}"
+        last = "" if skipped else f" · last: {rec.planner} s{rec.seed} {rec.status}"
         progress.update(task, advance=1, detail=detail() + last)
 
     try:
         with progress:
-            run = pl.run_spec(spec, store, on_done)
+            run = px.run_spec(spec, store, on_done)
     except KeyboardInterrupt:
         done = counts["ran"] + counts["skipped"]
         console.print(
-            f"[yellow]interrupted[/yellow]: {done} of {len(trials)} trials are finished and "
-            f"safe in {store.path} (the running ones were stopped). Rerun the same command "
-            f"to resume:\n  {escape(command)}",
+            Text.assemble(
+                ("interrupted", "yellow"),
+                f": {done} of {len(trials)} trials are finished and safe in {store.path} (the "
+                f"running ones were stopped). Rerun the same command to resume:\n  {command}",
+            ),
             highlight=False,
         )
         return 130
@@ -296,7 +307,7 @@ def cmd_compare(args: argparse.Namespace, console: Console) -> int:
         "wall_s": wall_s,
         "store": str(store.path),
         "versions": versions(),
-        "machine": pl.machine_info(),
+        "machine": px.machine_info(),
     }
     files = pl.write_reports(folder, name, records, rows, meta)
 
@@ -320,18 +331,30 @@ def cmd_compare(args: argparse.Namespace, console: Console) -> int:
         )
         return 0
     _print_tables(console, rows, columns)
+    if args.minima:
+        planners = _split(args.planners)
+        baseline = "gradient" if "gradient" in planners else planners[0]
+        stalls, own = pl.local_minima(records, baseline)
+        console.print(Text("Local minima (from the trial records)", style="bold"))
+        for line in px.describe_minima(stalls, own, baseline):
+            console.print(line, highlight=False)
     errors = [r for r in records if r.status == ERROR_STATUS]
     if errors:
         console.print(
-            f"[red]{len(errors)} trial(s) raised[/red] (rerun them with "
-            f"--retry-errors), e.g. {escape(errors[0].key)}: {escape(str(errors[0].error))}",
+            Text.assemble(
+                (f"{len(errors)} trial(s) raised", "red"),
+                f" (rerun them with --retry-errors), e.g. {errors[0].key}: {errors[0].error}",
+            ),
             highlight=False,
         )
     died = [r for r in records if r.status == DIED_STATUS]
     if died:
         console.print(
-            f"[red]{len(died)} trial process(es) died[/red] (the next run of this command "
-            f"tries them again), e.g. {escape(died[0].key)}: {escape(str(died[0].error))}",
+            Text.assemble(
+                (f"{len(died)} trial process(es) died", "red"),
+                f" (the next run of this command tries them again), e.g. {died[0].key}: "
+                f"{died[0].error}",
+            ),
             highlight=False,
         )
     console.print(
@@ -349,10 +372,10 @@ def _print_tables(console: Console, rows: list[Any], columns: list[str]) -> None
     for problem in dict.fromkeys(r.problem for r in rows):
         print_summary_tables(console, problem, [r for r in rows if r.problem == problem], columns)
     console.print(
-        f"[dim]{escape(column_notes(columns))}. Medians over the trials that ran; times and "
-        "checks summed over legs. All columns: --wide, report.md, summary.csv.[/dim]",
+        f"{column_notes(columns)}. Medians over the trials that ran; times and "
+        "checks summed over legs. All columns: --wide, report.md, summary.csv.",
+        style="dim",
         highlight=False,
     )
-    import plannerlab as pl
 
-    console.print(f"[dim]{escape(pl.BUDGET_NOTE)}[/dim]", highlight=False)
+    console.print(px.BUDGET_NOTE, style="dim", highlight=False)

@@ -11,24 +11,23 @@ the median time of the whole ``solve`` (plus the joint paths and the FCL contact
 classification), collision points, solutions found, solutions dropped, and the chosen
 one. A figure like the paper's Fig. 4 (obstacles, collision points, every solution,
 target) is written per case to ``--figures`` (default ``results/``). ``--execute`` also
-runs the chosen solution in PyBullet (:func:`plannerlab.sim.continuum.execute_chord_arc`)
-and shows the tip error and the expected / unexpected contacts.
+runs the chosen solution in PyBullet (the continuum executor) and shows the tip error
+and the expected / unexpected contacts.
 
-The data behind each row are the house's records, made by
-:func:`plannerlab.comparison.continuum.run_case`: the first run is planned by
-:func:`plannerlab.run.pipeline.solve_legs` (seed 0) into a :class:`~plannerlab.record.plan.Plan`
-whose one :class:`~plannerlab.record.leg.PlanResult` gives the row, and the execution is
-an :class:`~plannerlab.record.execution.Execution`. ``--out DIR`` writes them as any
-``solve`` / ``execute`` would: ``DIR/<case>.plan.json`` and ``DIR/<case>.plan.exec.json``
-(so ``plannerlab plot`` and ``plannerlab execute`` read them). The figures are drawn from
-the legs' contact plans (:class:`~plannerlab.record.contact_plan.ContactPlan`): the first
-run's and the zero-thickness run's, so a case costs ``--runs`` + 2 searches. ``--json`` prints one
-document (``planner``, ``runs``, ``overrides``, ``cases``: per case the timing summary,
-the files written, and the ``plan`` and ``execution`` records through the one codec).
-
-Argument parsing, drawing and printing only: the runs are
-:func:`plannerlab.comparison.continuum.run_case`'s.
+The data behind each row are the usual records: the first run is planned as
+``plannerlab solve`` plans (seed 0), a plan whose one leg gives the row, and the
+execution is an execution record. ``--out DIR`` writes them as any ``solve`` /
+``execute`` would: ``DIR/<case>.plan.json`` and ``DIR/<case>.plan.exec.json`` (so
+``plannerlab plot`` and ``plannerlab execute`` read them). The figures are drawn from
+the legs' contact plans (the plane's obstacles, collision points, solutions): the first
+run's and the zero-thickness run's, so a case costs ``--runs`` + 2 searches. ``--json``
+prints one document (``planner``, ``runs``, ``overrides``, ``cases``: per case the timing
+summary, the files written, and the ``plan`` and ``execution`` records).
 """
+
+# Argument parsing, drawing and printing only: the runs are
+# plannerlab.extras.run_continuum_case's (plannerlab/comparison/continuum.py). The
+# docstring above is the command's help: no internal names.
 
 from __future__ import annotations
 
@@ -41,8 +40,10 @@ from pathlib import Path
 from typing import Any
 
 from rich.console import Console
-from rich.markup import escape
 from rich.table import Table
+from rich.text import Text
+
+from plannerlab import extras as px
 
 
 def add_continuum_parser(subparsers: Any) -> argparse.ArgumentParser:
@@ -106,7 +107,6 @@ def _stdout_to_stderr(active: bool) -> Iterator[None]:
 def _thickness_figure(thin: Any, thick: Any, problem: Any, out: Path) -> Path:
     """Where the paper's zero-thickness curves and the robot of the problem's radius part,
     from the two legs' contact plans."""
-    import plannerlab as pl
 
     thin_plan, thick_plan = thin.contact_plan, thick.contact_plan
     r = problem.robot.link_radius_m
@@ -117,20 +117,19 @@ def _thickness_figure(thin: Any, thick: Any, problem: Any, out: Path) -> Path:
         f"{len(thick_plan.searched)} for r = {r * 1e3:g} mm"
         + (f"; lost: {', '.join(str(list(c)) for c in lost)}" if lost else "")
     )
-    fig = pl.continuum_thickness_figure(thin_plan, thick_plan, title=title)
-    return pl.save_figure(fig, out / f"{problem.name}_thickness.png")
+    fig = px.continuum_thickness_figure(thin_plan, thick_plan, title=title)
+    return px.save_figure(fig, out / f"{problem.name}_thickness.png")
 
 
 def _figure(problem: Any, result: Any, out: Path) -> Path:
     """Fig. 4: the search's curves, the planner's kept and dropped ones."""
-    import plannerlab as pl
 
     plan = result.contact_plan
     title = (
         f"{problem.name}: {len(plan.solutions)} solution(s), "
         f"{len(plan.collision_points_m)} collision points"
     )
-    return pl.continuum_case_figure(plan, out / f"{problem.name}.png", title=title)
+    return px.continuum_case_figure(plan, out / f"{problem.name}.png", title=title)
 
 
 def _write(row: Any, figures: Path | None, out: Path | None) -> dict[str, str]:
@@ -158,7 +157,6 @@ def _write(row: Any, figures: Path | None, out: Path | None) -> dict[str, str]:
 
 def cmd_continuum(args: argparse.Namespace, console: Console) -> int:
     """``plannerlab continuum``: print the table (or JSON); write the figures and plans."""
-    import plannerlab as pl
     from plannerlab.cli.common import parse_overrides
     from plannerlab.errors import PlannerlabError
     from plannerlab.record.codec import dumps
@@ -176,10 +174,10 @@ def cmd_continuum(args: argparse.Namespace, console: Console) -> int:
     with console.status("chord_arc") as status, _stdout_to_stderr(args.json):
         for case in args.cases:
             status.update(
-                f"chord_arc on {pl.continuum_case_name(case)}: {args.runs} runs"
+                f"chord_arc on {px.continuum_case_name(case)}: {args.runs} runs"
                 + (" and PyBullet" if args.execute else "")
             )
-            rows.append(pl.run_continuum_case(case, args.runs, overrides, execute=args.execute))
+            rows.append(px.run_continuum_case(case, args.runs, overrides, execute=args.execute))
             written.append(_write(rows[-1], figures, out))
     if args.json:
         doc = {
@@ -211,7 +209,7 @@ def cmd_continuum(args: argparse.Namespace, console: Console) -> int:
     if args.execute:
         cols += ["tip err mm", "expected", "unexpected"]
     for col in cols:
-        t.add_column(escape(col), justify="right", no_wrap=(col == "case"))
+        t.add_column(col, justify="right", no_wrap=(col == "case"))
     notes = []
     for row, files in zip(rows, written, strict=True):
         r, timing = row.result, row.timing
@@ -225,7 +223,7 @@ def cmd_continuum(args: argparse.Namespace, console: Console) -> int:
         style = "green" if r.status == "solved" else "red"
         cells = [
             r.problem.removeprefix("continuum_"),
-            f"[{style}]{r.status.value}[/{style}]",
+            Text(r.status.value, style=style),
             f"{timing['search_median_s'] * 1e3:.2f}",
             f"{timing['solve_median_s'] * 1e3:.0f}",
             p_ms,
@@ -234,7 +232,7 @@ def cmd_continuum(args: argparse.Namespace, console: Console) -> int:
             str(timing["solutions_zero_thickness"]),
             str(len(cp.dropped) if cp else 0),
             "-" if chosen is None else f"#{chosen}: {list(sol[chosen].contact_indices)}",
-            "yes" if timing["same_every_run"] else "[red]no[/red]",
+            "yes" if timing["same_every_run"] else Text("no", style="red"),
         ]
         if args.execute:
             e = row.execution
@@ -245,7 +243,7 @@ def cmd_continuum(args: argparse.Namespace, console: Console) -> int:
                 cells += [
                     f"{e.final_pos_err_m * 1e3:.2f}",
                     str(len(e.expected_contacts)),
-                    f"[red]{u}[/red]" if u else "0",
+                    Text(str(u), style="red") if u else "0",
                 ]
                 notes.append(f"{r.problem} execution: {e.reason}")
         t.add_row(*cells)
@@ -261,17 +259,15 @@ def cmd_continuum(args: argparse.Namespace, console: Console) -> int:
                 f"{r.problem} written: "
                 + ", ".join(files[k] for k in ("plan_file", "execution_file") if k in files)
             )
-    t.caption = escape(
-        "\n".join(
-            [
-                "search ms: search + contact-type check (what the paper times); solve ms: the "
-                "planner's whole solve (joint paths, capsule contact classification); "
-                "solutions: for the robot's radius (inflate_by_radius) unless set false; "
-                "zero-thickness: the paper's model; same: every run gave the same status and "
-                "counts; expected / unexpected: contact pairs in PyBullet"
-            ]
-            + notes
-        )
+    t.caption = "\n".join(
+        [
+            "search ms: search + contact-type check (what the paper times); solve ms: the "
+            "planner's whole solve (joint paths, capsule contact classification); "
+            "solutions: for the robot's radius (inflate_by_radius) unless set false; "
+            "zero-thickness: the paper's model; same: every run gave the same status and "
+            "counts; expected / unexpected: contact pairs in PyBullet"
+        ]
+        + notes
     )
     console.print(t)
     return 0

@@ -8,9 +8,10 @@ from pathlib import Path
 from typing import Any
 
 from rich.console import Console
-from rich.markup import escape
 from rich.table import Table
+from rich.text import Text
 
+from plannerlab import extras as px
 from plannerlab.cli.common import require_display
 from plannerlab.cli.solve import add_plan_arguments, leg_table, solve_and_save
 from plannerlab.cli.tables import Kind, natural_width, table
@@ -31,8 +32,8 @@ def why_table(legs: Any, executions: Any) -> Table:
         compact=True,
     )
     for r, e in zip(legs, executions, strict=True):
-        ok = "[green]yes[/green]" if e.success else "[red]no[/red]"
-        t.add_row(str(r.leg), escape(str(r.goal)), ok, escape("; ".join(e.failures)))
+        ok = Text("yes", style="green") if e.success else Text("no", style="red")
+        t.add_row(str(r.leg), str(r.goal), ok, "; ".join(e.failures))
     return t
 
 
@@ -90,21 +91,24 @@ def execution_table(legs: Any, executions: Any, why: bool = True) -> Table:
                 f"leg {r.leg} {r.goal}: FCL re-check collides on edge "
                 f"{e.recheck_first_invalid_edge}: {pairs}"
             )
+        verdict: str | Text = {True: "valid", None: "contact plan"}.get(e.path_valid, "")
+        if e.path_valid is False:
+            verdict = Text("collides", style="red")
         t.add_row(
             str(r.leg),
-            escape(str(r.goal)),
-            {True: "valid", False: "[red]collides[/red]", None: "contact plan"}[e.path_valid],
+            str(r.goal),
+            verdict,
             fmt(e.final_pos_err_m),
             fmt(e.final_angle_err_deg),
             fmt(1e3 * e.max_deviation_m),
             fmt(1e3 * e.min_clearance_m),
             str(len(names)),
             fmt(e.wall_time_s),
-            "[green]yes[/green]" if e.success else "[red]no[/red]",
-            *([escape("; ".join(e.failures))] if why else []),
+            Text("yes", style="green") if e.success else Text("no", style="red"),
+            *(["; ".join(e.failures)] if why else []),
         )
     if notes:
-        t.caption = escape("\n".join(notes))
+        t.caption = "\n".join(notes)
     return t
 
 
@@ -128,7 +132,7 @@ def cmd_execute(args: argparse.Namespace, console: Console) -> int:
         if changed:
             logging.getLogger(__name__).warning("%s: %s", plan_file, changed)
             if not args.json:
-                console.print(f"[yellow]warning:[/yellow] {changed}")
+                console.print(Text.assemble(("warning:", "yellow"), f" {changed}"))
     else:
         if not args.planner:
             raise PlannerlabError("execute PROBLEM needs --planner NAME (or give a PLAN.json)")
@@ -136,7 +140,7 @@ def cmd_execute(args: argparse.Namespace, console: Console) -> int:
     out = Path(args.out) if args.out else execution_path(plan_file)
     problem = plan.load_problem()
     if args.problem.endswith(".json"):
-        pl.check_plan(plan, problem, args.problem)
+        px.check_plan(plan, problem, args.problem)
     if not args.json:
         console.print(f"simulation: {problem.simulation.origin}", highlight=False)
     with console.status(f"executing {len(plan.legs)} legs in PyBullet"):

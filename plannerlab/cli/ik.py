@@ -10,11 +10,11 @@ forward-kinematics check, or the reason the pose is unreachable. Units: the posi
 metres and the approach vector in the station frame (x_s horizontal, y_s up, z_s along
 the track; ``--frame world`` reads them in the world frame of ``--problem``'s robot),
 angles in degrees. Exit status: 0 when a solution exists, 1 when the pose is unreachable,
-2 on bad input (the CLI's main prints the :class:`PlannerlabError`).
-
-Argument parsing and printing only; the solver is :func:`plannerlab.irb6_ik`
-(:mod:`plannerlab.robots.irb6.ik`).
+2 on bad input (the message says which flag and what was expected).
 """
+
+# Argument parsing and printing only; the solver is plannerlab.extras.irb6_ik
+# (plannerlab/robots/irb6/ik.py). The docstring above is the command's help.
 
 from __future__ import annotations
 
@@ -23,9 +23,10 @@ import json
 from typing import Any
 
 from rich.console import Console
-from rich.markup import escape
 from rich.table import Table
+from rich.text import Text
 
+from plannerlab import extras as px
 from plannerlab.errors import PlannerlabError
 
 #: robots the ``ik`` command knows (those with an analytic IK)
@@ -109,10 +110,9 @@ def _robot(args: argparse.Namespace) -> tuple[Any, str | None]:
 
 def cmd_ik(args: argparse.Namespace, console: Console) -> int:
     """Run ``plannerlab ik``: 0 with solutions, 1 when unreachable (bad input raises)."""
-    import plannerlab as pl
 
     robot, problem_name = _robot(args)
-    report = pl.irb6_ik(
+    report = px.irb6_ik(
         args.position,
         args.approach,
         args.roll,
@@ -136,8 +136,8 @@ def _print(console: Console, out: dict[str, Any]) -> None:
     t.add_column("", style="bold")
     t.add_column("")
 
-    def row(label: str, value: str) -> None:
-        t.add_row(escape(label), value)
+    def row(label: str, value: str | Text) -> None:
+        t.add_row(label, value)
 
     source = f"problem {out['problem']}" if out["problem"] else "model defaults"
     row("robot", f"{out['robot']} ({source})")
@@ -150,9 +150,12 @@ def _print(console: Console, out: dict[str, Any]) -> None:
     spans = " ∪ ".join(f"[{lo:.4f}, {hi:.4f}]" for lo, hi in out["lambda0_intervals_m"])
     if out["case"] == "unambiguous" and out["lambda0_intervals_m"]:
         spans = f"{out['lambda0_intervals_m'][0][0]:.4f} (one value: d_z − d_x·c_z/c_x)"
-    row("λ0 intervals [m]", escape(spans or "none"))
+    row("λ0 intervals [m]", spans or "none")
     if not out["reachable"]:
-        row("unreachable", f"[red]{out['reason_code']}[/red]: {escape(out['reason'] or '')}")
+        row(
+            "unreachable",
+            Text.assemble((str(out["reason_code"]), "red"), f": {out['reason'] or ''}"),
+        )
     console.print(t)
     if not out["solutions"]:
         return

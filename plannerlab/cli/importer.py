@@ -8,7 +8,9 @@ from pathlib import Path
 from typing import Any
 
 from rich.console import Console
-from rich.markup import escape
+
+from plannerlab import extras as px
+from plannerlab.cli.common import add_renamed_flag
 
 
 def cmd_import_mbm(args: argparse.Namespace, console: Console) -> int:
@@ -22,9 +24,9 @@ def cmd_import_mbm(args: argparse.Namespace, console: Console) -> int:
     if args.fetch:
         got = mbm.fetch_vamp(robot.name, args.cache)
         console.print(
-            f"vamp-planner 0.6.4 (Apache-2.0, licence {escape(str(got.licence))}): "
-            f"{robot.name} URDF {escape(str(got.urdf))}, SRDF {escape(str(got.srdf))}, "
-            f"problems in {escape(str(got.problems))}",
+            f"vamp-planner 0.6.4 (Apache-2.0, licence {got.licence}): "
+            f"{robot.name} URDF {got.urdf}, SRDF {got.srdf}, "
+            f"problems in {got.problems}",
             highlight=False,
         )
         urdf = urdf or got.urdf
@@ -69,18 +71,17 @@ def cmd_import_mbm(args: argparse.Namespace, console: Console) -> int:
             srdf=Path(srdf) if srdf else None,
             tip_link=tip_link,
             name=name,
-            safety_margin_m=args.margin_m,
+            safety_margin_m=args.safety_margin_m,
             joint_step_rad=args.joint_step,
         )
         target.write_text(text, encoding="utf-8")
-    console.print(f"{len(pairs)} problem files written to {escape(str(out))}", highlight=False)
+    console.print(f"{len(pairs)} problem files written to {out}", highlight=False)
     return 0
 
 
 def mbm_default_joint_step() -> float:
-    import plannerlab as pl
 
-    return pl.mbm.DEFAULT_JOINT_STEP_RAD
+    return px.mbm.DEFAULT_JOINT_STEP_RAD
 
 
 def add_parser(sub: Any) -> None:
@@ -117,12 +118,13 @@ def add_parser(sub: Any) -> None:
     m.add_argument("--name", default=None, help="problem name (one scene + request)")
     m.add_argument("--limit", type=int, default=None, help="at most N problems per folder")
     m.add_argument(
-        "--margin-m",
+        "--safety-margin-m",
         type=float,
         default=0.0,
         help="[planning] safety_margin_m of the files (MotionBenchMaker's states are valid "
         "with no margin)",
     )
+    add_renamed_flag(m, "--margin-m", "--safety-margin-m", type=float)
     m.add_argument(
         "--joint-step",
         type=float,

@@ -9,14 +9,15 @@ import logging
 import os
 import re
 import sys
+import warnings
 from collections.abc import Iterator, Sequence
 
 from rich.console import Console
-from rich.markup import escape
+from rich.text import Text
 
 from plannerlab.cli import animate, execute, planners, plot, problems, solve, variants, view
 from plannerlab.cli.tables import make_console
-from plannerlab.errors import PlannerlabError
+from plannerlab.errors import PlannerlabError, RenamedWarning
 
 DESCRIPTION = """\
 Compare motion planners on hyper-redundant, industrial and continuum robots.
@@ -133,7 +134,37 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
+def _error_console() -> Console:
+    """stderr, printing messages as written (they name keys in brackets: "[goals[0].n]")."""
+    return Console(stderr=True, markup=False)
+
+
+def _show_renamed(
+    message: Warning | str,
+    category: type[Warning],
+    filename: str,
+    lineno: int,
+    file: object = None,
+    line: str | None = None,
+) -> None:
+    """A renamed setting, key or flag as one line on stderr (``warning: ...``); any other
+    warning as Python shows it."""
+    if issubclass(category, RenamedWarning):
+        _error_console().print(Text.assemble(("warning:", "yellow"), f" {message}"))
+    else:
+        _PYTHON_SHOWWARNING(message, category, filename, lineno, file, line)  # type: ignore[arg-type]
+
+
+_PYTHON_SHOWWARNING = warnings.showwarning
+
+
 def main(argv: Sequence[str] | None = None) -> int:
+    with warnings.catch_warnings():
+        warnings.showwarning = _show_renamed
+        return _main(argv)
+
+
+def _main(argv: Sequence[str] | None) -> int:
     args = build_parser().parse_args(argv)
     logging.basicConfig(
         level=logging.INFO if args.verbose else logging.WARNING,
@@ -151,8 +182,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         with engine_output_kept_off_stdout(args.verbose):
             return int(args.func(args, console) or 0)
     except PlannerlabError as exc:
-        # escape: messages name keys in brackets ("[goals[0].n]"), which rich would eat
-        Console(stderr=True).print(f"[red]error:[/red] {escape(str(exc))}", highlight=False)
+        _error_console().print(Text.assemble(("error:", "red"), f" {exc}"), highlight=False)
         return 2
     except OSError as exc:
         if exc.filename is None:
@@ -160,10 +190,10 @@ def main(argv: Sequence[str] | None = None) -> int:
         # a path given on the command line (--out, a plan or problem file) that cannot be
         # read or written
         msg = f"{exc.filename}: {exc.strerror or exc}"
-        Console(stderr=True).print(f"[red]error:[/red] {escape(msg)}", highlight=False)
+        _error_console().print(Text.assemble(("error:", "red"), f" {msg}"), highlight=False)
         return 2
     except KeyboardInterrupt:
-        Console(stderr=True).print("interrupted")
+        _error_console().print("interrupted")
         return 130
     finally:
         ompl_logger.setLevel(ompl_level)

@@ -8,7 +8,7 @@ import json
 from typing import Any
 
 from rich.console import Console
-from rich.markup import escape
+from rich.text import Text
 
 from plannerlab.cli.tables import table
 
@@ -24,21 +24,19 @@ def _default(value: Any) -> str:
 def _show_planner(console: Console, info: dict[str, Any]) -> None:
     robots = info["robots"] if isinstance(info["robots"], str) else ", ".join(info["robots"])
     seeds = "draws from its seed" if info["uses_rng"] else "deterministic: the seed changes nothing"
-    console.print(f"[bold]{escape(info['name'])}[/bold]: {escape(info['summary'])}")
-    console.print(f"suits: {escape(info['suits'] or '-')} (robot kinds: {escape(robots)})")
+    console.print(Text.assemble((info["name"], "bold"), f": {info['summary']}"))
+    console.print(f"suits: {info['suits'] or '-'} (robot kinds: {robots})")
     console.print(
         f"{seeds}" + ("; runs PyBullet in its loop" if info["needs_simulator"] else ""),
         highlight=False,
     )
     t = table(
-        f"settings ({info['settings_class']}); override with --set key=value",
+        "settings (override with --set key=value)",
         [("key", "name"), ("default", "num"), ("unit", "name"), ("what it does", "text")],
         compact=True,
     )
     for s in info["settings"]:
-        t.add_row(
-            escape(s["key"]), escape(_default(s["default"])), escape(s["unit"]), escape(s["doc"])
-        )
+        t.add_row(s["key"], _default(s["default"]), s["unit"], s["doc"])
     console.print(t)
 
 
@@ -60,7 +58,7 @@ def cmd_planners(args: argparse.Namespace, console: Console) -> int:
     for r in rows:
         only = "" if isinstance(r["robots"], str) else f" ({', '.join(r['robots'])} only)"
         seeds = "" if r["uses_rng"] else " (deterministic: the seed changes nothing)"
-        t.add_row(r["name"], escape(r["suits"] + only), escape(r["summary"] + seeds))
+        t.add_row(r["name"], r["suits"] + only, r["summary"] + seeds)
     console.print(t)
     console.print("a planner's settings: plannerlab planners NAME", highlight=False)
     return 0

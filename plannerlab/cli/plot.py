@@ -9,6 +9,8 @@ from typing import Any
 
 from rich.console import Console
 
+from plannerlab import extras as px
+
 
 def plan_executions(plan_file: str | Path) -> list[Any]:
     """The executions ``plannerlab execute PLAN.json`` wrote beside the plan
@@ -22,7 +24,7 @@ def plan_executions(plan_file: str | Path) -> list[Any]:
 def cmd_plot(args: argparse.Namespace, console: Console) -> int:
     import plannerlab as pl
 
-    plan, problem = pl.read_checked_plan(args.plan)
+    plan, problem = px.read_checked_plan(args.plan)
     out_dir = Path(args.out) if args.out else Path(args.plan).with_suffix("")
     files = pl.plot_plan(plan, problem, out_dir, plan_executions(args.plan))
     if args.json:

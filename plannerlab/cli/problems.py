@@ -8,7 +8,7 @@ import json
 from typing import Any
 
 from rich.console import Console
-from rich.markup import escape
+from rich.text import Text
 
 from plannerlab.cli.tables import Kind, table
 
@@ -21,8 +21,9 @@ def cmd_problems(args: argparse.Namespace, console: Console) -> int:
     from plannerlab.errors import PlannerlabError
 
     rows: list[dict[str, Any]] = []
-    for path, origin, group in pl.problem_catalog():
-        row: dict[str, Any] = {"name": path.stem, "file": str(path), "from": origin}
+    for name, path, origin, group in pl.problem_catalog():
+        # the name it loads by: its stem, or its sub-folder and stem when the stem is shared
+        row: dict[str, Any] = {"name": name, "file": str(path), "from": origin}
         row["group"] = group
         try:
             p = pl.parse_problem(path)
@@ -32,7 +33,7 @@ def cmd_problems(args: argparse.Namespace, console: Console) -> int:
             rows.append(row)
             continue
         row.update(
-            problem_name=p.name,  # its [problem] name; the command line uses the file's stem
+            problem_name=p.name,  # its [problem] name; the command line uses "name"
             robot=p.robot.kind,
             dof=p.robot.dof,
             legs=[g.name for g in p.goals],
@@ -69,11 +70,11 @@ def cmd_problems(args: argparse.Namespace, console: Console) -> int:
                 "-" if r["obstacles"] is None else str(r["obstacles"]),
                 ", ".join(r["legs"]),
             ]
-            t.add_row(*[escape(c) for c in cells], *([escape(r["description"])] if beside else []))
+            t.add_row(*cells, *([r["description"]] if beside else []))
         console.print(t)
         if not beside:
             for r in members:
-                console.print(f"[bold]{escape(r['name'])}[/bold]: {escape(r['description'])}")
+                console.print(Text.assemble((r["name"], "bold"), f": {r['description']}"))
     return 0
 
 

@@ -8,7 +8,9 @@ from typing import Any
 
 from rich.console import Console
 from rich.table import Table
+from rich.text import Text
 
+from plannerlab import extras as px
 from plannerlab.cli.common import (
     RESULTS_DIR,
     add_budget_args,
@@ -44,7 +46,7 @@ def leg_table(plan: Any, title: str) -> Table:
         t.add_row(
             str(r.leg),
             r.goal,
-            f"[{style}]{r.status.value}[/{style}]",
+            Text(r.status.value, style=style),
             str(r.iterations),
             fmt(r.time_s),
             str(r.collision_checks),
@@ -68,7 +70,7 @@ def solve_and_save(args: argparse.Namespace, console: Console, out: Path | None 
     if not getattr(args, "json", False):
         console.print(f"problem {problem.name} from {problem.source}", highlight=False)
     overrides = parse_overrides(args.set)
-    legs = pl.legs_from_spec(problem, args.legs)
+    legs = px.legs_from_spec(problem, args.legs)
     n_legs = len(legs) if legs is not None else problem.legs
     out = out or _default_plan_path(problem.name, args.planner, args.seed)
     out.parent.mkdir(parents=True, exist_ok=True)  # a path that cannot exist fails now

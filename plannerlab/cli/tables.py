@@ -23,8 +23,8 @@ from typing import Any, Literal, TextIO
 
 from rich import box
 from rich.console import Console
-from rich.markup import escape
 from rich.table import Table
+from rich.text import Text
 
 from plannerlab.errors import UnknownNameError
 from plannerlab.record.cells import err_of_tol, fmt, mm, rough
@@ -61,7 +61,9 @@ def make_console(stderr: bool = False, stream: TextIO | None = None) -> Console:
     import sys
 
     stream = stream or (sys.stderr if stderr else sys.stdout)
-    return Console(stderr=stderr, width=output_width(stream))
+    # markup off: user text (paths, names, messages with "[table]" keys) prints as written;
+    # styles are given as rich Text or style=, never as markup in a string
+    return Console(stderr=stderr, width=output_width(stream), markup=False)
 
 
 def table(
@@ -309,11 +311,11 @@ def summary_table(problem: str, rows: Sequence[Any], keys: Sequence[str]) -> Tab
     cols = [SUMMARY_COLUMNS[k] for k in keys]
     t = table(problem, [(c.header, c.kind) for c in cols], compact=True)
     for r in rows:
-        cells = [escape(c.cell(r)) for c in cols]
+        cells = [Text(c.cell(r)) for c in cols]  # Text: never read as markup, on any console
         if "solved" in keys or "solved_n" in keys:
             i = keys.index("solved") if "solved" in keys else keys.index("solved_n")
             style = "green" if r.success_rate >= 0.95 else "red" if r.successes == 0 else "yellow"
-            cells[i] = f"[{style}]{cells[i]}[/{style}]"
+            cells[i].stylize(style)
         t.add_row(*cells)
     return t
 

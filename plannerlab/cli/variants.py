@@ -6,13 +6,14 @@
 
 Draws rooms (scaled, shifted, mirrored; the window moved and resized; 20-32 modules),
 places the goals relative to the walls as in the paper, finds a collision-free witness
-state with ``--min-clearance`` of clearance for every goal (a clearance-aware IK, no
+state with ``--clearance-floor`` of clearance for every goal (a clearance-aware IK, no
 planner) and writes the kept variants as problem files (``<out>/armz_inspection_vNN.toml``,
 each written atomically). A draw without a witness for some goal is dropped (reported on
 stderr) and the next draw is taken. The same seed gives the same files.
-
-Argument parsing and printing only; the generator is :mod:`plannerlab.problem.variants`.
 """
+
+# Argument parsing and printing only; the generator is plannerlab.extras.generate_variants
+# (plannerlab/problem/variants.py). The docstring above is the command's help.
 
 from __future__ import annotations
 
@@ -23,7 +24,8 @@ from typing import Any
 
 from rich.console import Console
 
-from plannerlab.cli.common import positive_int, seed_int
+from plannerlab import extras as px
+from plannerlab.cli.common import add_renamed_flag, positive_int, seed_int
 
 #: tasks the generator knows how to vary
 TEMPLATES = ("armz_inspection",)
@@ -52,12 +54,13 @@ def add_parser(subparsers: Any) -> argparse.ArgumentParser:
         "--out", default="problems/variants", metavar="DIR", help="folder for the problem files"
     )
     p.add_argument(
-        "--min-clearance",
+        "--clearance-floor",
         type=_clearance,
         default=0.04,
         metavar="M",
-        help="clearance every witness state keeps [m]",
+        help="clearance every witness state keeps at least [m] (its [witness] clearance_floor_m)",
     )
+    add_renamed_flag(p, "--min-clearance", "--clearance-floor", type=_clearance, metavar="M")
     p.add_argument(
         "--max-draws",
         type=positive_int,
@@ -84,13 +87,12 @@ def add_parser(subparsers: Any) -> argparse.ArgumentParser:
 
 
 def cmd_variants(args: argparse.Namespace, console: Console) -> int:
-    import plannerlab as pl
 
     out = args.out
     from pathlib import Path
 
     if Path(out).exists() and not Path(out).is_dir():
-        raise pl.VariantError(f"--out {out}: a folder, but a file is in the way")
+        raise px.VariantError(f"--out {out}: a folder, but a file is in the way")
     command = "plannerlab variants " + " ".join(
         shlex.quote(a)
         for a in [
@@ -99,8 +101,8 @@ def cmd_variants(args: argparse.Namespace, console: Console) -> int:
             str(args.count),
             "--seed",
             str(args.seed),
-            "--min-clearance",
-            f"{args.min_clearance:g}",
+            "--clearance-floor",
+            f"{args.clearance_floor:g}",
         ]
         + ([] if args.kind == "paper" else ["--kind", args.kind])
         + ([] if args.first_index == 0 else ["--first-index", str(args.first_index)])
@@ -109,16 +111,16 @@ def cmd_variants(args: argparse.Namespace, console: Console) -> int:
     def progress(line: str) -> None:
         print(line, file=sys.stderr, flush=True)
 
-    kept = pl.generate_variants(
+    kept = px.generate_variants(
         args.count,
         args.seed,
-        min_clearance_m=args.min_clearance,
+        min_clearance_m=args.clearance_floor,
         max_draws=args.max_draws,
         command=command,
         progress=progress,
         kinds=tuple(k.strip() for k in args.kind.split(",") if k.strip()),
         first_index=args.first_index,
     )
-    for path in pl.write_variants(kept, out):
+    for path in px.write_variants(kept, out):
         print(path)
     return 0

@@ -12,10 +12,12 @@ the tip point and normal in its frame). The Jacobian is the chain's own: joint `
 ``dp/dv_i = w_i × (p − o_i)`` (``w_i``) and ``dn/dv_i = w_i × n`` (0), and through the
 coupling ``dv/dq``.
 
-A family opts in through its registry entry (:attr:`plannerlab.robots.registry.
-RobotFamily.ik_descent`, the URDF family's is :func:`descent_for`); :mod:`plannerlab.problem.ik`
-then runs its restarts on this descent instead of the numpy one. The goal states it
-returns are checked there as before (the region test in numpy, one collision check).
+A family opts in through the flag of its registry entry
+(:attr:`plannerlab.robots.registry.RobotFamily.compiled_ik`: the URDF family);
+:func:`descent_for_robot` gives its descent, which the planners' goal sampling hands to
+:func:`plannerlab.problem.ik.sample_goal_state` to restart instead of the numpy one. The
+goal states it returns are checked there as before (the region test in numpy, one
+collision check).
 """
 
 from __future__ import annotations
@@ -27,6 +29,7 @@ import numpy as np
 from numba import njit
 
 from plannerlab.collision.chain import chain_parts
+from plannerlab.robots.registry import compiled_ik
 
 
 @njit(cache=True, nogil=True)
@@ -338,9 +341,15 @@ class ChainDescent:
 
 
 def descent_for(robot: Any) -> ChainDescent:
-    """The registry's entry (:attr:`~plannerlab.robots.registry.RobotFamily.ik_descent`):
-    the compiled descent of a robot with a chain and a tip (``tip_data()``)."""
+    """The compiled descent of a robot with a chain and a tip (``tip_data()``)."""
     return ChainDescent(robot)
 
 
-__all__ = ["ChainDescent", "descend_kernel", "descent_for", "ik_arrays"]
+def descent_for_robot(robot: Any) -> ChainDescent | None:
+    """The compiled descent of ``robot`` when its family opts in
+    (:attr:`~plannerlab.robots.registry.RobotFamily.compiled_ik`: URDF chains), else None
+    (the numpy descent; also for a robot built in code whose kind is not registered)."""
+    return descent_for(robot) if compiled_ik(str(getattr(robot, "kind", ""))) else None
+
+
+__all__ = ["ChainDescent", "descend_kernel", "descent_for", "descent_for_robot", "ik_arrays"]

@@ -20,13 +20,12 @@ what a compiled planner needs without calling back into Python:
 * ``perm``: the capsules' packed order (capsule ``perm[k]`` of the robot is the ``k``-th
   packed one; :func:`segments` gives them back in the robot's order).
 
-Every robot family registers the builder of its model (:attr:`plannerlab.robots.registry.
-RobotFamily.model`, ``"module:function"`` called with the built core); the default is the
-generic serial-chain builder :func:`model_of_core`, which needs only the robot's
-``chain_data()`` (:mod:`plannerlab.collision.chain`: parents, fixed transforms, axes,
-sliding joints, capsules, and an optional linear coupling of the joints), so a new family
-takes the compiled road without a special case. :func:`build_model` looks the builder up;
-a robot without a chain gets a :class:`ModelError` naming its kind.
+Every robot's model is built by the generic serial-chain builder :func:`model_of_core`
+from the robot's own data, its ``chain_data()`` (:mod:`plannerlab.collision.chain`:
+parents, fixed transforms, axes, sliding joints, capsules, and an optional linear coupling
+of the joints), so a new family takes the compiled road without a special case and without
+naming this module in its registry entry; a robot without a chain gets a
+:class:`ModelError` naming its kind.
 
 The kernels below are the model's queries in compiled code: one state, a batch, and an
 edge checked on the checker's grid (the very states of ``densify``, bit for bit) in an
@@ -51,7 +50,6 @@ from plannerlab.collision.chain_valid import (
 )
 from plannerlab.collision.lanes import valid_states_lanes
 from plannerlab.errors import PlannerlabError
-from plannerlab.robots.registry import model_builder
 
 
 class ModelError(PlannerlabError):
@@ -152,15 +150,13 @@ def chain_model(robot: Any) -> CompiledModel:
 
 
 def build_model(core: Any) -> CompiledModel:
-    """The model of a built core by its robot family's registered builder (the generic
-    serial-chain :func:`model_of_core` unless the family names its own).
+    """The model of a built core: the generic serial-chain :func:`model_of_core`, from the
+    robot's ``chain_data()``.
 
     Raises:
-        ModelError: the robot gives no chain and its family no builder of its own.
+        ModelError: the robot gives no chain.
     """
-    builder = model_builder(str(getattr(core.robot, "kind", "")))
-    model: CompiledModel = builder(core)
-    return model
+    return model_of_core(core)
 
 
 # ---------------------------------------------------------------------- compiled queries

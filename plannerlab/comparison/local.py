@@ -7,13 +7,21 @@ Decisions:
 
 * **Fork server** (default, ``start_method="forkserver"``). Python's ``multiprocessing``
   fork server is a process started once per comparison that imports
-  :data:`PRELOAD_MODULES` (numpy, scipy, python-fcl, PyBullet, toppra, OMPL's Python
-  modules and plannerlab's planners, task runner and simulator) and then forks one child
+  :data:`PRELOAD_MODULES` (numpy, scipy, toppra, and :mod:`plannerlab.run.preload`:
+  python-fcl, PyBullet, OMPL's Python modules and plannerlab's planners, task runner and
+  simulator) and then forks one child
   per trial. Importing creates no OMPL object, so each child still seeds OMPL's
   process-global generator before any OMPL object exists
   (:func:`plannerlab.comparison.trial.run_trial` does so first), and a trial's result does
   not depend on which child ran it or on ``jobs``. The child skips the 0.6–0.7 s of
   imports a spawned interpreter pays. ``start_method="spawn"`` keeps the old behaviour.
+* **The caller's script is not run again.** multiprocessing starts a child by re-importing
+  the parent's ``__main__`` module (a user's script, as ``__mp_main__``), which re-runs a
+  script that is not guarded by ``if __name__ == "__main__":``: its own solves, and its
+  comparison, whose trials then die in their bootstrapping. A trial's process needs
+  nothing of ``__main__`` (its target, its trial and its runner are plannerlab's), so the
+  parent's ``__main__`` is left out of the launch (:func:`_main_module_left_out`): a script
+  that calls :func:`plannerlab.compare` at its top level works as written.
 * **A trial is a process**: a child that dies (a segfault in a native library) is an
   ``error`` for that trial only; a child that overruns its time limit is killed
   (SIGTERM, then SIGKILL) by :meth:`LocalBackend.kill`. Children ignore SIGINT: the
@@ -33,7 +41,9 @@ import hashlib
 import multiprocessing
 import os
 import signal
+import sys
 import time
+import types
 from collections.abc import Callable, Iterator
 from dataclasses import dataclass
 from multiprocessing.connection import Connection, wait
@@ -47,17 +57,8 @@ from plannerlab.record.trial import TrialRecord
 PRELOAD_MODULES: tuple[str, ...] = (
     "numpy",
     "scipy.spatial.transform",
-    "plannerlab.collision.fcl_checker",
-    "plannerlab.problem.catalog",
-    "plannerlab.planners",
-    "plannerlab.planners.ompl",
-    "plannerlab.planners.gradient",
-    "plannerlab.planners.hybrid",
-    "plannerlab.run.pipeline",
-    "plannerlab.comparison.trial",
-    "plannerlab.comparison.runner",
-    "plannerlab.sim.execute",
-    "plannerlab.record.files",
+    "plannerlab.run.preload",  # the rooms a trial walks through
+    "plannerlab.comparison.trial",  # run_trial, what a trial's process calls
     "toppra",  # imported by retiming on first use; itself imports scipy.interpolate
 )
 #: what a child imports before it is "started" (free when preloaded): plannerlab's
@@ -125,11 +126,25 @@ def _sigint_held() -> Iterator[None]:
         signal.pthread_sigmask(signal.SIG_SETMASK, previous)
 
 
+@contextlib.contextmanager
+def _main_module_left_out() -> Iterator[None]:
+    """While a trial's process is launched, ``sys.modules["__main__"]`` is a bare module
+    (no ``__file__``, no ``__spec__``): multiprocessing's preparation data then names no
+    main module, and the child does not run the caller's script again (see the module
+    docstring). Restored as soon as the launch returns (it is synchronous)."""
+    main = sys.modules.get("__main__")
+    sys.modules["__main__"] = types.ModuleType("__main__")
+    try:
+        yield
+    finally:
+        if main is not None:
+            sys.modules["__main__"] = main
+
+
 def _start_fork_server() -> None:
     """Start the fork server (once per process) with SIGINT ignored and its output sent
     to /dev/null: its imports print (PyBullet's banner goes to the C-level stdout), and
     it must not write into the parent's terminal or ``--json`` output."""
-    import sys
     from multiprocessing import forkserver
 
     sys.stdout.flush()
@@ -164,8 +179,6 @@ def _child_main(
     run: Callable[[Any], TrialRecord],
 ) -> None:
     """Entry point of a trial's process: ``run(trial)`` and send the record to the parent."""
-    import sys
-
     signal.signal(signal.SIGINT, signal.SIG_IGN)  # the parent handles Ctrl-C
     fd = os.open(out_path, os.O_WRONLY | os.O_CREAT | os.O_TRUNC, 0o644)
     os.dup2(fd, 1)
@@ -237,7 +250,7 @@ class LocalBackend:
             daemon=True,
         )
         self._running[recv] = _Running(trial, proc, recv, out)  # before start: cleanup
-        with _sigint_held():  # inherited: Ctrl-C is the parent's to handle
+        with _sigint_held(), _main_module_left_out():  # SIGINT: the parent's to handle
             proc.start()
         send.close()  # the child holds the only write end now
         return recv

@@ -1,16 +1,19 @@
 """The planner registry: planners are looked up by name and imported on first use.
 
-An entry maps a name to ``"module:factory"``; the factory is called as
-``factory(name, overrides, **entry.options)`` and returns a planner with frozen settings.
-OMPL planners are all served by :mod:`plannerlab.planners.ompl` (the only module importing
-``ompl``). Planners that run another planner (the hybrids' RRT-Connect escape) get its
-factory through their entry's options: no planner module looks anything up here.
+An entry maps a name to a *factory*, a function called as ``factory(name, overrides,
+**entry.options)`` that returns a planner with frozen settings. The factories below are
+entry points: each imports its planner's module inside its body (``from
+plannerlab.planners.gradient import make``), so that ``import plannerlab.planners`` loads no
+planner, and the architecture test (``tests/house/test_architecture.py``) sees every import
+a registry makes, as it sees any other (no ``"module:function"`` strings). OMPL planners
+are all served by :mod:`plannerlab.planners.ompl` (the only module importing ``ompl``).
+Planners that run another planner (the hybrids' RRT-Connect escape) get its factory
+through their entry's options: no planner module looks anything up here.
 """
 
 from __future__ import annotations
 
-import importlib
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from types import MappingProxyType
 from typing import Any
@@ -25,7 +28,9 @@ class PlannerEntry:
 
     Attributes:
         name: registry name (``gradient``, ``ompl.rrtconnect``, …).
-        target: ``"module:factory"``, imported lazily.
+        factory: the entry point, ``factory(name, overrides, **options) -> Planner``: a
+            function that imports its planner's module when called (see the module
+            docstring; a ``"module:function"`` string is refused).
         summary: one line for ``plannerlab planners``.
         needs_stepper: the planner runs a simulator in its loop (closed-loop modes).
         robots: robot kinds it applies to (None: every joint-vector robot).
@@ -37,12 +42,21 @@ class PlannerEntry:
     """
 
     name: str
-    target: str
+    factory: Callable[..., Planner]
     summary: str
     needs_stepper: bool = False
     robots: tuple[str, ...] | None = None
     uses_rng: bool = True
     options: Mapping[str, Any] = field(default_factory=dict)
+
+    def __post_init__(self) -> None:
+        if not callable(self.factory):
+            raise TypeError(
+                f"planner {self.name!r}: the factory must be a function that imports its "
+                f"module when called (an entry point), got {self.factory!r}; write "
+                "def _mine(name, overrides, **options): from plannerlab.planners.mine "
+                "import make; return make(name, overrides, **options)"
+            )
 
 
 #: OMPL geometric planners shipped in the ``ompl`` wheel: registry suffix -> OMPL class.
@@ -79,12 +93,59 @@ NATIVE_PLANNERS: Mapping[str, str] = MappingProxyType(
 )
 
 
+# ---------------------------------------------------------------- entry points
+def _gradient(name: str, overrides: Mapping[str, Any], **options: Any) -> Planner:
+    from plannerlab.planners.gradient import make
+
+    return make(name, dict(overrides), **options)
+
+
+def _hybrid(name: str, overrides: Mapping[str, Any], **options: Any) -> Planner:
+    from plannerlab.planners.hybrid import make
+
+    return make(name, dict(overrides), **options)
+
+
+def _clearance(name: str, overrides: Mapping[str, Any], **options: Any) -> Planner:
+    from plannerlab.planners.clearance.descent import make
+
+    return make(name, dict(overrides), **options)
+
+
+def _follow_leader(name: str, overrides: Mapping[str, Any], **options: Any) -> Planner:
+    from plannerlab.planners.follow_leader.planner import make
+
+    return make(name, dict(overrides), **options)
+
+
+def _chord_arc(name: str, overrides: Mapping[str, Any], **options: Any) -> Planner:
+    from plannerlab.planners.chord_arc.planner import make
+
+    return make(name, dict(overrides), **options)
+
+
+def _native(name: str, overrides: Mapping[str, Any], **options: Any) -> Planner:
+    from plannerlab.planners.native.planner import make
+
+    return make(name, dict(overrides), **options)
+
+
+def _native_leader(name: str, overrides: Mapping[str, Any], **options: Any) -> Planner:
+    from plannerlab.planners.native.leader import make
+
+    return make(name, dict(overrides), **options)
+
+
+def _ompl(name: str, overrides: Mapping[str, Any], **options: Any) -> Planner:
+    from plannerlab.planners.ompl.planner import make
+
+    return make(name, dict(overrides), **options)
+
+
 def _rrtconnect(overrides: Mapping[str, Any]) -> Planner:
     """OMPL's RRT-Connect (``ompl.rrtconnect``): the hybrids' escape planner, handed to
     their factories as ``escape_planner``; ``ompl`` is imported on first use."""
-    from plannerlab.planners.ompl import make
-
-    return make("ompl.rrtconnect", overrides, ompl_class=OMPL_PLANNERS["rrtconnect"])
+    return _ompl("ompl.rrtconnect", overrides, ompl_class=OMPL_PLANNERS["rrtconnect"])
 
 
 #: options of the planners that escape with RRT-Connect
@@ -95,13 +156,13 @@ def _entries() -> dict[str, PlannerEntry]:
     entries = [
         PlannerEntry(
             "gradient",
-            "plannerlab.planners.gradient:make",
+            _gradient,
             "the Arm-Z paper's gradient method, faithful (finite differences, kinematic steps)",
             uses_rng=False,
         ),
         PlannerEntry(
             "gradient.closed_loop",
-            "plannerlab.planners.gradient:make",
+            _gradient,
             "the paper's gradient method with PyBullet in the loop (100 steps of "
             "1/240 s per iteration)",
             needs_stepper=True,
@@ -109,7 +170,7 @@ def _entries() -> dict[str, PlannerEntry]:
         ),
         PlannerEntry(
             "gradient.analytic",
-            "plannerlab.planners.gradient:make",
+            _gradient,
             "faster variant: the same descent with the analytic Jacobian gradient "
             "instead of dof + 1 objective evaluations",
             uses_rng=False,
@@ -118,7 +179,7 @@ def _entries() -> dict[str, PlannerEntry]:
     entries.append(
         PlannerEntry(
             "gradient+rrtconnect",
-            "plannerlab.planners.hybrid:make",
+            _hybrid,
             "gradient descent; at a local minimum RRT-Connect plans from the stall to the goal",
             options=_ESCAPE_RRTCONNECT,
         )
@@ -126,7 +187,7 @@ def _entries() -> dict[str, PlannerEntry]:
     entries.append(
         PlannerEntry(
             "gradient.multistart",
-            "plannerlab.planners.hybrid:make",
+            _hybrid,
             "gradient descent restarted from random collision-free states near each stall",
             options=_ESCAPE_RRTCONNECT,
         )
@@ -161,7 +222,7 @@ def _entries() -> dict[str, PlannerEntry]:
         entries.append(
             PlannerEntry(
                 name,
-                "plannerlab.planners.clearance.descent:make",
+                _clearance,
                 summary,
                 uses_rng=uses_rng,
                 options=_ESCAPE_RRTCONNECT,
@@ -191,7 +252,7 @@ def _entries() -> dict[str, PlannerEntry]:
         entries.append(
             PlannerEntry(
                 name,
-                "plannerlab.planners.follow_leader.planner:make",
+                _follow_leader,
                 summary,
                 uses_rng=uses_rng,
                 options=_ESCAPE_RRTCONNECT,
@@ -200,7 +261,7 @@ def _entries() -> dict[str, PlannerEntry]:
     entries.append(
         PlannerEntry(
             "chord_arc",
-            "plannerlab.planners.chord_arc.planner:make",
+            _chord_arc,
             "continuum robot's chord-arc tree search with obstacle wrapping (contact at the "
             "problem's collision points)",
             robots=("continuum_chain",),
@@ -211,7 +272,7 @@ def _entries() -> dict[str, PlannerEntry]:
         entries.append(
             PlannerEntry(
                 f"native.{algorithm}",
-                "plannerlab.planners.native:make",
+                _native,
                 summary,
                 options=MappingProxyType({"algorithm": algorithm}),
             )
@@ -219,7 +280,7 @@ def _entries() -> dict[str, PlannerEntry]:
     entries.append(
         PlannerEntry(
             "native.rrtconnect+leader",
-            "plannerlab.planners.native.leader:make",
+            _native_leader,
             "native.rrtconnect helped by follow-the-leader: its body states from the start "
             "and from goal states into the start's tip seed both trees and bias the samples",
         )
@@ -228,7 +289,7 @@ def _entries() -> dict[str, PlannerEntry]:
         entries.append(
             PlannerEntry(
                 f"ompl.{suffix}",
-                "plannerlab.planners.ompl:make",
+                _ompl,
                 f"OMPL {cls} (geometric)",
                 options=MappingProxyType({"ompl_class": cls}),
             )
@@ -255,9 +316,7 @@ def get_entry(name: str) -> PlannerEntry:
 def make_planner(name: str, overrides: Mapping[str, Any] | None = None) -> Planner:
     """A planner by registry name, with some settings overridden."""
     entry = get_entry(name)
-    module_name, factory = entry.target.split(":")
-    factory_fn = getattr(importlib.import_module(module_name), factory)
-    return factory_fn(name, dict(overrides or {}), **entry.options)
+    return entry.factory(name, dict(overrides or {}), **entry.options)
 
 
 __all__ = [

@@ -22,7 +22,7 @@ from typing import Any, Protocol, runtime_checkable
 
 import numpy as np
 
-from plannerlab.errors import PlannerlabError
+from plannerlab.errors import PlannerlabError, warn_renamed
 from plannerlab.problem.load import Budget
 from plannerlab.record.leg import PROGRESS_COLUMNS, PlanResult, Status, settings_dict
 from plannerlab.robots.base import Array
@@ -485,12 +485,23 @@ class LegRun:
 def with_overrides(settings: Any, overrides: Mapping[str, Any], planner: str) -> Any:
     """A copy of frozen ``settings`` with some fields changed; strings are coerced to the
     field's type (so CLI ``--set key=value`` works). Unknown keys raise with the known ones.
+    A key the settings class renamed (its ``RENAMED_KEYS``: old -> new) is read as the new
+    one, with a :class:`~plannerlab.errors.RenamedWarning` naming it.
     """
     if not overrides:
         return settings
     fields = {f.name: f for f in dataclasses.fields(settings)}
+    renamed: Mapping[str, str] = getattr(type(settings), "RENAMED_KEYS", {})
     changes: dict[str, Any] = {}
     for key, value in overrides.items():
+        if key in renamed:  # an old name, read as the new one for one release
+            if renamed[key] in overrides:
+                raise PlannerlabError(
+                    f"settings of {planner}: {key!r} is the old name of {renamed[key]!r}; "
+                    f"give {renamed[key]!r} only"
+                )
+            warn_renamed(f"settings of {planner}", key, renamed[key])
+            key = renamed[key]
         if key not in fields:
             from plannerlab.errors import UnknownNameError
 

@@ -13,7 +13,7 @@ from plannerlab.planners.context import NearGoal, PlanningContext
 from plannerlab.problem.ik import sample_goal_state
 from plannerlab.robots.base import Array, wrap_to_pi
 
-__all__ = ["fill_goal_pool", "near_goal_finder"]
+__all__ = ["fill_goal_pool", "near_goal_finder", "selection_uses_ik"]
 
 
 def near_goal_finder(ctx: PlanningContext) -> NearGoal:
@@ -25,6 +25,11 @@ def near_goal_finder(ctx: PlanningContext) -> NearGoal:
     from plannerlab.planners.clearance.descent import make as make_clearance
 
     return make_clearance("gradient.clearance", {}).near_goal_state
+
+
+def selection_uses_ik(goal_selection: str) -> bool:
+    """Whether a ``goal_selection`` may draw goal states by IK (``"ik"``, ``"near_or_ik"``)."""
+    return goal_selection != "near"
 
 
 def fill_goal_pool(
@@ -45,8 +50,12 @@ def fill_goal_pool(
     ``settings`` gives ``goal_samples``, ``max_goal_attempts`` and ``goal_selection``;
     ``guard`` the checker (``checker``), ``exhausted()``, ``out_of_time()`` and
     ``is_valid(q)`` (refusing once the budget is spent); ``sampler`` the IK goal sampler
-    (:func:`~plannerlab.problem.ik.sample_goal_state`)."""
+    (:func:`~plannerlab.problem.ik.sample_goal_state`), given the robot's compiled IK
+    descent when its family has one (:func:`plannerlab.collision.chain_ik.descent_for_robot`)."""
+    from plannerlab.collision.chain_ik import descent_for_robot
+
     s, robot, checker = settings, ctx.robot, guard.checker
+    descent = descent_for_robot(robot) if selection_uses_ik(s.goal_selection) else None
     pool: list[Array] = []
     c_pool = checker.checks
     per_slot = max(1, s.max_goal_attempts // max(s.goal_samples, 1))
@@ -70,7 +79,14 @@ def fill_goal_pool(
             q_goal = near_goal(ctx, q0)
         else:
             q_goal = sampler(
-                robot, ctx.goal, guard, rng, seeds=[q0], attempts=per_slot, stop=guard.out_of_time
+                robot,
+                ctx.goal,
+                guard,
+                rng,
+                seeds=[q0],
+                attempts=per_slot,
+                stop=guard.out_of_time,
+                descent=descent,
             )
         if q_goal is not None:
             pool.append(wrap_to_pi(q_goal, robot.continuous))

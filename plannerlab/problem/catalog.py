@@ -9,8 +9,9 @@ from __future__ import annotations
 
 import os
 from pathlib import Path
+from typing import NamedTuple
 
-from plannerlab.errors import UnknownNameError
+from plannerlab.errors import PlannerlabError, UnknownNameError
 from plannerlab.problem.load import Problem, parse_problem
 
 
@@ -54,43 +55,88 @@ def _grouped(folder: Path) -> list[tuple[Path, str]]:
     return sorted(((p, "" if g == "." else g) for p, g in out), key=lambda x: (x[1], x[0].name))
 
 
-def problem_catalog(cwd: Path | None = None) -> list[tuple[Path, str, str]]:
-    """Every problem there is, for ``plannerlab problems``: (file, origin, group) with
-    origin ``"./problems"`` or ``"bundled"`` and group the sub-folder (``""``, or e.g.
-    ``urdf/panda``, ``variants``). The files of ``./problems`` (relative to ``cwd``) and
-    its sub-folders come first, then the bundled ones no local file of the same name
-    shadows. Each resolves by its name (:func:`resolve_problem_path`), a file of a
-    sub-folder when no other problem has its name."""
+class ProblemEntry(NamedTuple):
+    """One problem of :func:`problem_catalog`.
+
+    Attributes:
+        name: the name it loads by (``load_problem(name)`` reads ``path``): its file's stem
+            when no other listed problem has that stem, else its sub-folder and stem
+            (``urdf/panda_mesh/table``).
+        path: the problem file.
+        origin: ``"./problems"`` (the current directory's) or ``"bundled"``.
+        group: its sub-folder (``""`` at the top, ``urdf/panda``, ``variants``).
+    """
+
+    name: str
+    path: Path
+    origin: str
+    group: str
+
+
+def _files(cwd: Path | None) -> list[tuple[Path, str, str]]:
+    """(file, origin, group) of every problem, local ones first (see :func:`problem_catalog`)."""
     local_dir = (cwd or Path.cwd()) / "problems"
     bundled_dir = problems_dir()
     bundled = [(p, "bundled", g) for p, g in _grouped(bundled_dir)]
     if local_dir.is_dir() and bundled_dir.is_dir() and local_dir.samefile(bundled_dir):
         return bundled  # run from the repository: ./problems is the bundled folder
     local = [(p, "./problems", g) for p, g in _grouped(local_dir)]
-    names = {p.stem for p, _, _ in local}
-    return local + [row for row in bundled if row[0].stem not in names]
+    # a bundled file is shadowed by the local file at its place (the same folder and stem)
+    places = {(g, p.stem) for p, _, g in local}
+    return local + [row for row in bundled if (row[2], row[0].stem) not in places]
+
+
+def problem_catalog(cwd: Path | None = None) -> list[ProblemEntry]:
+    """Every problem there is, for ``plannerlab problems``, each with the name it loads by
+    (:class:`ProblemEntry`). The files of ``./problems`` (relative to ``cwd``) and its
+    sub-folders come first, then the bundled ones no local file shadows (a local file at
+    the same place: the same sub-folder and name);
+    the top folder first, then each sub-folder, each sorted by name. A file of a
+    sub-folder is named by its stem when no other problem has that stem, else by its
+    sub-folder and stem (``urdf/iiwa_mesh/table`` beside ``urdf/panda_mesh/table``)."""
+    files = _files(cwd)
+    top = {p.stem for p, _, g in files if not g}
+    stems: dict[str, int] = {}
+    for p, _, _ in files:
+        stems[p.stem] = stems.get(p.stem, 0) + 1
+    out = []
+    for p, origin, group in files:
+        unique = not group or (stems[p.stem] == 1 and p.stem not in top)
+        out.append(ProblemEntry(p.stem if unique else f"{group}/{p.stem}", p, origin, group))
+    return out
 
 
 def resolve_problem_path(name_or_path: str | Path, cwd: Path | None = None) -> Path:
-    """A problem file from a path or a problem's name (``armz_pocket``).
+    """A problem file from a path or a problem's name (``armz_pocket``,
+    ``urdf/panda_mesh/table``): the names :func:`problem_catalog` lists.
 
-    A name is looked up in ``./problems`` (relative to ``cwd``, default the current
-    directory) first, then in :func:`problems_dir` (the bundled problems), then in their
-    sub-folders (``variants/``, ``urdf/panda/``: a name found in exactly one of them).
+    A path (an existing file, or any name ending in ``.toml``) is itself. A name is looked
+    up as ``NAME.toml`` in ``./problems`` (relative to ``cwd``, default the current
+    directory) first, then in :func:`problems_dir` (the bundled problems); a name with a
+    sub-folder (``urdf/panda_mesh/table``) the same way; a bare stem found in exactly one
+    sub-folder is that file.
+
+    Raises:
+        PlannerlabError: a stem that several sub-folders hold (the error names them all).
+        UnknownNameError: a name no problem has (with "did you mean").
     """
     p = Path(name_or_path)
-    if p.suffix == ".toml" or p.exists() or len(p.parts) > 1:
+    if p.suffix == ".toml" or p.exists():
         return p
-    local = (cwd or Path.cwd()) / "problems" / f"{name_or_path}.toml"
-    if local.is_file():
-        return local
-    candidate = problems_dir() / f"{name_or_path}.toml"
-    if candidate.exists():
-        return candidate
-    nested = [p for p, _, _ in problem_catalog(cwd) if p.stem == str(name_or_path)]
+    for folder in ((cwd or Path.cwd()) / "problems", problems_dir()):
+        candidate = folder / f"{name_or_path}.toml"
+        if candidate.is_file():
+            return candidate
+    catalog = problem_catalog(cwd)
+    nested = [e for e in catalog if e.path.stem == str(name_or_path)]
     if len(nested) == 1:
-        return nested[0]
-    raise UnknownNameError("problem", str(name_or_path), [q.stem for q in list_problems(cwd)])
+        return nested[0].path
+    if len(nested) > 1:
+        raise PlannerlabError(
+            f"problem {str(name_or_path)!r} is ambiguous: "
+            f"{' and '.join(repr(e.name) for e in nested)} have that name; give one of these"
+        )
+    raise UnknownNameError("problem", str(name_or_path), [e.name for e in catalog])
 
 
 def load_problem(name_or_path: str | Path) -> Problem:

@@ -18,7 +18,7 @@ EXTRA_TABLES = ("witness", "continuum", "ik_expected")
 
 
 def _witness(reader: TableReader, robot: Robot, goals: tuple[GoalRegion, ...]) -> None:
-    reader.unknown_keys(("path_rad", "goal_states_rad", "min_clearance_m", "note"))
+    reader.unknown_keys(("path_rad", "goal_states_rad", "clearance_floor_m", "note"))
     if not (reader.has("path_rad") or reader.has("goal_states_rad")):
         raise reader.fail(
             "path_rad",
@@ -51,8 +51,8 @@ def _witness(reader: TableReader, robot: Robot, goals: tuple[GoalRegion, ...]) -
                     f"{goal.angle_tol_deg:g} deg); its tip is {pos_err:.3g} m and "
                     f"{ang_err:.3g} deg off",
                 )
-    if reader.has("min_clearance_m"):
-        reader.number("min_clearance_m", nonnegative=True)
+    if reader.has("clearance_floor_m"):
+        reader.number("clearance_floor_m", nonnegative=True)
 
 
 def _continuum(reader: TableReader, obstacle_names: list[str]) -> None:
@@ -93,10 +93,13 @@ def read_extras(
     goals: tuple[GoalRegion, ...],
     obstacle_names: list[str],
 ) -> dict[str, Any]:
-    """The extra tables of a parsed document, each validated, as they were written."""
+    """The extra tables of a parsed document, each validated, as they were written (a
+    renamed key under its new name)."""
     extras = {k: v for k, v in data.items() if k in EXTRA_TABLES}
     if "witness" in extras:
-        _witness(TableReader(source, "witness", extras["witness"]), robot, goals)
+        witness = TableReader(source, "witness", extras["witness"])
+        _witness(witness, robot, goals)
+        extras["witness"] = witness.table
     if "continuum" in extras:
         _continuum(TableReader(source, "continuum", extras["continuum"]), obstacle_names)
     if "ik_expected" in extras:

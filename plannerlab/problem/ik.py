@@ -25,7 +25,7 @@ import numpy as np
 
 from plannerlab.problem.goals import GoalRegion, JointGoal
 from plannerlab.robots.base import Array, Robot, wrap_to_pi
-from plannerlab.robots.registry import goal_sampler, ik_descent
+from plannerlab.robots.registry import goal_sampler
 
 
 class ValidityChecker(Protocol):
@@ -103,9 +103,10 @@ def solve_ik(
         max_step_rad: largest joint change per step [rad or m].
         target_fraction: stop once both scaled errors are below this fraction of the
             tolerances.
-        descent: the same descent compiled for this robot (its family's ``ik_descent``,
-            :func:`compiled_descent`), called as ``descent(goal, q_seed, max_iterations,
-            damping, max_step_rad, target_fraction) -> (q, steps)``; None: in numpy.
+        descent: the same descent compiled for this robot
+            (:func:`plannerlab.collision.chain_ik.descent_for_robot`), called as
+            ``descent(goal, q_seed, max_iterations, damping, max_step_rad,
+            target_fraction) -> (q, steps)``; None: in numpy.
 
     Returns:
         An :class:`IKResult`; ``success`` is False with a reason when the descent ends
@@ -175,13 +176,6 @@ def _verdict(
     return IKResult(q, True, iterations, "inside both tolerances", pos_err, ang_err)
 
 
-def compiled_descent(robot: Any) -> Any:
-    """The robot family's compiled IK descent for this robot (its registry entry's
-    ``ik_descent``: URDF chains), or None (the numpy descent)."""
-    factory = ik_descent(getattr(robot, "kind", ""))
-    return None if factory is None else factory(robot)
-
-
 def _analytic_goal_sampler(robot: Any) -> Any:
     """The robot family's analytic goal sampler (:mod:`plannerlab.robots.registry`)."""
     return goal_sampler(getattr(robot, "kind", ""))
@@ -199,7 +193,7 @@ def sample_goal_state(
     uniform_fraction: float = 0.5,
     max_iterations: int = 150,
     stop: Callable[[], bool] | None = None,
-    compiled: bool = True,
+    descent: Any = None,
 ) -> Array | None:
     """A collision-free state inside both tolerances of ``goal``, or None.
 
@@ -243,9 +237,11 @@ def sample_goal_state(
         uniform_fraction: share of restarts from uniformly random states.
         max_iterations: descent steps per attempt.
         stop: asked before each attempt (a time limit, say); True ends the search (None).
-        compiled: run the descent compiled when the robot's family has one
-            (:func:`compiled_descent`: URDF chains; ``bench/model_bench.py --ik``); the
-            restarts, the region test and the collision check are the same either way.
+        descent: the robot's IK descent compiled, restarted instead of the numpy one
+            (:func:`plannerlab.collision.chain_ik.descent_for_robot`: URDF chains, which
+            the planners' goal sampling passes; ``bench/model_bench.py --ik``); None: the
+            numpy descent. The restarts, the region test and the collision check are the
+            same either way.
 
     Returns:
         (dof,) state inside the region and collision-free, or None after ``attempts``
@@ -268,7 +264,6 @@ def sample_goal_state(
             if q is not None and checker.is_valid(q):
                 return np.asarray(q, dtype=float)
         return None
-    descent = compiled_descent(robot) if compiled else None
     for k in range(attempts):
         if stop is not None and stop():
             return None
@@ -286,4 +281,4 @@ def sample_goal_state(
     return None
 
 
-__all__ = ["IKResult", "ValidityChecker", "compiled_descent", "sample_goal_state", "solve_ik"]
+__all__ = ["IKResult", "ValidityChecker", "sample_goal_state", "solve_ik"]

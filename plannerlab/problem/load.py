@@ -22,7 +22,7 @@ File layout (every key is documented in ``docs/problem-format.md``)::
     [simulation] gravity_mps2 (default: Arm-Z off, others -9.81 along -z), max_deviation_m,
                 max_track_err_rad
     [witness]   path_rad        (a known collision-free path, for tests), goal_states_rad
-                (one collision-free state per goal, in leg order), min_clearance_m
+                (one collision-free state per goal, in leg order), clearance_floor_m
     [continuum] collision_points_m, guide_obstacles   (continuum planners)
     [ik_expected] free-form     (what tests expect of the IRb-6 analytic IK)
     Any other table or key is an error ("did you mean ...").

@@ -9,23 +9,51 @@ its limits or missing raises :class:`~plannerlab.errors.ProblemError` naming the
 from __future__ import annotations
 
 import math
+import re
+from collections.abc import Mapping
+from types import MappingProxyType
 from typing import Any
 
 import numpy as np
 
-from plannerlab.errors import ProblemError, did_you_mean
+from plannerlab.errors import ProblemError, did_you_mean, warn_renamed
 from plannerlab.robots.base import Array, pose_matrix
+
+#: problem-file keys renamed (table -> {old key: new key}): a file with the old key is
+#: read as if it had the new one for one release, with a warning naming the new key
+#: (``docs/distances.md``: each distance setting has one name and one meaning)
+RENAMED_KEYS: Mapping[str, Mapping[str, str]] = MappingProxyType(
+    {"witness": MappingProxyType({"min_clearance_m": "clearance_floor_m"})}
+)
+
+
+def _renamed(source: str, prefix: str, table: dict[str, Any]) -> dict[str, Any]:
+    """``table`` with its renamed keys (:data:`RENAMED_KEYS`) under their new names."""
+    renamed = RENAMED_KEYS.get(re.sub(r"\[\d+\]$", "", prefix), {})
+    if not any(old in table for old in renamed):
+        return table
+    out = dict(table)
+    for old, new in renamed.items():
+        if old in out:
+            if new in out:
+                raise ProblemError(
+                    source, f"{prefix}.{old}", f"{new!r} only ({old!r} is its old name)"
+                )
+            warn_renamed(f"{source}: [{prefix}]", old, new)
+            out[new] = out.pop(old)
+    return out
 
 
 class TableReader:
-    """Typed access to one TOML table with errors that name the file and the key."""
+    """Typed access to one TOML table with errors that name the file and the key. A key
+    the file format renamed (:data:`RENAMED_KEYS`) is read under its new name."""
 
     def __init__(self, source: str, prefix: str, table: Any) -> None:
         if not isinstance(table, dict):
             raise ProblemError(source, prefix, f"a table, got {type(table).__name__}")
         self.source = source
         self.prefix = prefix
-        self.table: dict[str, Any] = table
+        self.table: dict[str, Any] = _renamed(source, prefix, table)
 
     def key(self, name: str) -> str:
         return f"{self.prefix}.{name}" if self.prefix else name

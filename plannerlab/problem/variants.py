@@ -554,7 +554,7 @@ def make_variant(
     states, clear = found
     doc["witness"] = {
         "note": "one collision-free state per goal, in leg order (plannerlab.problem.variants)",
-        "min_clearance_m": min_clearance_m,
+        "clearance_floor_m": min_clearance_m,
         "goal_states_rad": [[round(float(v), 6) for v in q] for q in states],
     }
     text = to_toml(doc, _header(spec, name, command, min_clearance_m))

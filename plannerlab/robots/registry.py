@@ -5,22 +5,26 @@ A family is one package under ``plannerlab/robots/`` (kinematics, collision geom
 its :class:`RobotFamily` entry here, the way planners are reached through
 :mod:`plannerlab.planners`: the problem loader reads the entry's table, goal sampling its
 analytic IK (if it has one), the reachability pre-check its reach bound, and a new family
-plugs in with one entry, without touching ``problem/``, ``planners/`` or ``sim/``. Every
-target is a ``"module:attribute"`` string imported on first use, so loading a problem
-imports only its own family.
+plugs in with one entry, without touching ``problem/``, ``planners/`` or ``sim/``.
+
+Every target is an *entry point*: a function of this module that imports its family's
+module inside its body, so loading a problem imports only its own family, and the
+architecture test (``tests/house/test_architecture.py``) sees every import the registry
+makes (no ``"module:function"`` strings). The entries point only into ``robots/``: what
+another room builds from a robot (the compiled model and IK descent of ``collision/``)
+it builds from the robot's own data (``chain_data()``, ``tip_data()``), and a family
+opts in to a compiled IK descent with a flag (:attr:`RobotFamily.compiled_ik`), so no
+family entry names a module of another room.
 """
 
 from __future__ import annotations
 
-import importlib
+from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
 
 from plannerlab.errors import UnknownNameError
 from plannerlab.robots.schema import RobotTable
-
-#: the generic serial-chain builder of the compiled model (from ``robot.chain_data()``)
-DEFAULT_MODEL = "plannerlab.collision.model:model_of_core"
 
 
 @dataclass(frozen=True)
@@ -29,47 +33,85 @@ class RobotFamily:
 
     Attributes:
         kind: the ``[robot] type`` of a problem file (and ``Robot.kind``).
-        table: ``"module:attribute"`` of its ``[robot]`` table declaration
+        table: entry point returning its ``[robot]`` table declaration
             (:class:`~plannerlab.robots.schema.RobotTable`).
-        goal_sampler: ``"module:function"`` sampling a goal region through an analytic IK,
-            called as ``function(robot, goal, rng, seeds=...)`` and returning a state inside
-            the region (collision ignored) or None; None: the numeric IK of
+        goal_sampler: entry point sampling a goal region through an analytic IK, called as
+            ``function(robot, goal, rng, seeds=...)`` and returning a state inside the
+            region (collision ignored) or None; None: the numeric IK of
             :mod:`plannerlab.problem.ik` samples its goals.
-        reach: ``"module:function"`` bounding where the tip can be, called as
+        reach: entry point bounding where the tip can be, called as
             ``function(robot, p_world_m)`` and returning ``(distance_m, reach_m, where)``:
             the point's distance from the reference ``where`` names and the most the tip
             reaches from it; None: a fixed-base chain's bound (the base to the first link,
             every link's length, the last link to the tip).
         gravity_off: why the family's problems default to no gravity when their file has
             no ``[simulation]`` table, or None for the usual -9.81 m/s² along -z.
-        model: ``"module:function"`` building the family's compiled robot–scene model
-            (:class:`~plannerlab.collision.model.CompiledModel`) from a built collision core,
-            called as ``function(core)``; the default is the generic serial-chain builder,
-            which reads the robot's ``chain_data()`` (so a new family with a chain is on the
-            compiled road with no entry of its own).
-        ik_descent: ``"module:function"`` giving a robot's compiled IK descent
-            (``function(robot)`` -> ``descent(goal, q_seed, max_iterations, damping,
-            max_step_rad, target_fraction) -> (q, steps)``) that the numeric goal sampling
-            of :mod:`plannerlab.problem.ik` restarts instead of its numpy descent; None:
-            the numpy descent (on the robot's ``tip_jacobian``).
+        compiled_ik: the numeric goal sampling restarts the compiled IK descent of the
+            robot's chain (:func:`plannerlab.collision.chain_ik.descent_for_robot`, from its
+            ``tip_data()``) instead of the numpy descent on ``tip_jacobian``.
         summary: one line for the documentation.
     """
 
     kind: str
-    table: str
-    goal_sampler: str | None = None
-    reach: str | None = None
+    table: Callable[[], RobotTable]
+    goal_sampler: Callable[..., Any] | None = None
+    reach: Callable[..., tuple[float, float, str]] | None = None
     gravity_off: str | None = None
-    model: str = DEFAULT_MODEL
-    ik_descent: str | None = None
+    compiled_ik: bool = False
     summary: str = ""
+
+    def __post_init__(self) -> None:
+        for name in ("table", "goal_sampler", "reach"):
+            value = getattr(self, name)
+            if value is not None and not callable(value):
+                raise TypeError(
+                    f"robot family {self.kind!r}: {name} must be a function that imports its "
+                    f"module when called (an entry point), got {value!r}"
+                )
+
+
+# ---------------------------------------------------------------- entry points
+def _armz_table() -> RobotTable:
+    from plannerlab.robots.armz.schema import TABLE
+
+    return TABLE
+
+
+def _irb6_table() -> RobotTable:
+    from plannerlab.robots.irb6.schema import TABLE
+
+    return TABLE
+
+
+def _irb6_goal_state(robot: Any, goal: Any, rng: Any, seeds: Any = None) -> Any:
+    from plannerlab.robots.irb6.goals import sample_goal_state
+
+    return sample_goal_state(robot, goal, rng, seeds=seeds)
+
+
+def _irb6_reach(robot: Any, p_world_m: Any) -> tuple[float, float, str]:
+    from plannerlab.robots.irb6.goals import reach_from_track
+
+    return reach_from_track(robot, p_world_m)
+
+
+def _continuum_table() -> RobotTable:
+    from plannerlab.robots.continuum.schema import TABLE
+
+    return TABLE
+
+
+def _urdf_table() -> RobotTable:
+    from plannerlab.robots.urdf.schema import TABLE
+
+    return TABLE
 
 
 #: robot type in a problem file -> its family (one entry per package under robots/)
 FAMILIES: dict[str, RobotFamily] = {
     "armz": RobotFamily(
         "armz",
-        "plannerlab.robots.armz.schema:TABLE",
+        _armz_table,
         gravity_off=(
             "gravity off: the Arm-Z default when [simulation] is absent (as in every "
             "bundled Arm-Z problem); set gravity_mps2 to change it"
@@ -78,20 +120,20 @@ FAMILIES: dict[str, RobotFamily] = {
     ),
     "irb6": RobotFamily(
         "irb6",
-        "plannerlab.robots.irb6.schema:TABLE",
-        goal_sampler="plannerlab.robots.irb6.goals:sample_goal_state",
-        reach="plannerlab.robots.irb6.goals:reach_from_track",
+        _irb6_table,
+        goal_sampler=_irb6_goal_state,
+        reach=_irb6_reach,
         summary="the IRb-6 industrial arm on the LP-1 track (analytic IK)",
     ),
     "continuum_chain": RobotFamily(
         "continuum_chain",
-        "plannerlab.robots.continuum.schema:TABLE",
+        _continuum_table,
         summary="a planar continuum robot as a chain of rigid links behind a port",
     ),
     "urdf": RobotFamily(
         "urdf",
-        "plannerlab.robots.urdf.schema:TABLE",
-        ik_descent="plannerlab.collision.chain_ik:descent_for",
+        _urdf_table,
+        compiled_ik=True,
         summary="any serial chain read from a URDF (yourdfpy), with its collision spheres",
     ),
 }
@@ -108,46 +150,33 @@ def family(kind: str) -> RobotFamily:
     return FAMILIES[kind]
 
 
-def _target(spec: str) -> Any:
-    module_name, attribute = spec.split(":")
-    return getattr(importlib.import_module(module_name), attribute)
-
-
 def robot_table(kind: str) -> RobotTable:
     """The ``[robot]`` table declaration of robot type ``kind`` (imports its family).
 
     Raises:
         UnknownNameError: for a type that is not in :data:`FAMILIES`.
     """
-    table: RobotTable = _target(family(kind).table)
-    return table
+    return family(kind).table()
 
 
 def goal_sampler(kind: str) -> Any:
     """The family's analytic goal sampler (see :attr:`RobotFamily.goal_sampler`), or None
     (also for a kind that is not registered: a robot built in code)."""
     entry = FAMILIES.get(kind)
-    return None if entry is None or entry.goal_sampler is None else _target(entry.goal_sampler)
+    return None if entry is None else entry.goal_sampler
 
 
 def reach_function(kind: str) -> Any:
     """The family's reach bound (see :attr:`RobotFamily.reach`), or None for the chain's."""
     entry = FAMILIES.get(kind)
-    return None if entry is None or entry.reach is None else _target(entry.reach)
+    return None if entry is None else entry.reach
 
 
-def model_builder(kind: str) -> Any:
-    """The family's builder of its compiled model (see :attr:`RobotFamily.model`); the
-    generic serial-chain builder for a kind that is not registered (a robot built in code)."""
+def compiled_ik(kind: str) -> bool:
+    """Whether the family's goal sampling runs the compiled IK descent (see
+    :attr:`RobotFamily.compiled_ik`; False for a kind that is not registered)."""
     entry = FAMILIES.get(kind)
-    return _target(DEFAULT_MODEL if entry is None else entry.model)
-
-
-def ik_descent(kind: str) -> Any:
-    """The family's compiled IK descent factory (see :attr:`RobotFamily.ik_descent`), or
-    None (also for a kind that is not registered)."""
-    entry = FAMILIES.get(kind)
-    return None if entry is None or entry.ik_descent is None else _target(entry.ik_descent)
+    return entry is not None and entry.compiled_ik
 
 
 def gravity_off_reason(kind: str) -> str | None:
@@ -157,14 +186,12 @@ def gravity_off_reason(kind: str) -> str | None:
 
 
 __all__ = [
-    "DEFAULT_MODEL",
     "FAMILIES",
     "RobotFamily",
+    "compiled_ik",
     "family",
     "goal_sampler",
     "gravity_off_reason",
-    "ik_descent",
-    "model_builder",
     "reach_function",
     "robot_table",
 ]

@@ -166,12 +166,32 @@ def legs_from_spec(problem: Problem, spec: str | None) -> list[int] | None:
     return legs
 
 
+def resolve_legs(problem: Problem, legs: str | int | Sequence[int | str] | None) -> list[int]:
+    """The legs ``legs`` names, as the command line's ``--legs`` takes them: None or
+    ``"all"`` (every leg), a leg (its index or its goal's name: ``"home"``), a
+    comma-separated text (``"enter,A"``), or a sequence of indices and names.
+
+    Raises:
+        PlannerlabError: an unknown leg (the problem's legs listed) or one named twice.
+    """
+    if legs is None:
+        return list(range(problem.legs))
+    if isinstance(legs, str):
+        named = legs_from_spec(problem, legs)
+        return list(range(problem.legs)) if named is None else named
+    if isinstance(legs, int | np.integer):
+        legs = [int(legs)]
+    if not legs:
+        return []
+    return legs_from_spec(problem, ",".join(str(x) for x in legs)) or []
+
+
 def solve_legs(
     problem: Problem,
     planner_name: str,
     seed: int,
     *,
-    legs: Sequence[int] | None = None,
+    legs: str | int | Sequence[int | str] | None = None,
     budget: Budget | None = None,
     overrides: dict[str, Any] | None = None,
     stop_on_failure: bool = False,
@@ -181,6 +201,9 @@ def solve_legs(
     planner: Any = None,
 ) -> Plan:
     """Solve ``legs`` (default: all) in order; each starts where the previous one ended.
+
+    ``legs`` names legs by index or by goal name, as ``--legs`` does (:func:`resolve_legs`:
+    ``legs="home"``, ``legs=["enter", 2]``, ``legs="enter,A"``).
 
     One collision checker serves the problem (with its clearance margin); each leg gets
     one :class:`~plannerlab.planners.context.PlanningContext` (its start checked once, its
@@ -199,7 +222,7 @@ def solve_legs(
         planner = make_planner(planner_name, overrides)
     shared = shared or SharedChecker(problem)  # built on first use, then the same
     budget = budget or problem.budget
-    legs = list(range(problem.legs)) if legs is None else list(legs)
+    legs = resolve_legs(problem, legs)
     results: list[PlanResult] = []
     checker = None
     if legs and hasattr(planner, "plan") and not getattr(planner, "allows_contact", False):
@@ -325,14 +348,26 @@ def execute_plan(
         plan: what :func:`solve_legs` returned, or :meth:`Plan.load` read.
         problem: the problem it was planned on (default: load ``plan.problem_file``,
             refusing a file that changed since planning unless ``allow_changed_problem``).
+            A problem of another name, or whose robot or legs do not fit the plan's, is
+            refused.
         gui: a PyBullet window instead of DIRECT.
 
     Raises:
-        PlanFileError: the problem file changed since planning.
+        PlanFileError: the problem file changed since planning, or ``problem`` is not the
+            plan's.
     """
+    from plannerlab.run.plan_check import check_plan
+
     if problem is None:
         changed = plan.problem_changed()
         if changed and not allow_changed_problem:
             raise PlanFileError(f"{plan.problem}: {changed}")
         problem = plan.load_problem()
+    elif plan.problem != problem.name:
+        raise PlanFileError(
+            f"a plan of {plan.problem!r} ({plan.planner}, seed {plan.seed}) cannot be executed "
+            f"on {problem.name!r} ({problem.source}): give it its own problem, or none "
+            "(execute(plan) loads the problem the plan was made on)"
+        )
+    check_plan(plan, problem, f"the plan of {plan.problem} ({plan.planner}, seed {plan.seed})")
     return execute_results(problem, plan.legs, gui=gui)

@@ -115,6 +115,16 @@ def _unit(key: str, text: str) -> str:
     return ""
 
 
+#: a reStructuredText role (``:func:`~a.b.name```): its target's last part is kept
+_ROLE = re.compile(r":[a-z]+:`~?(?:[\w.]*\.)?([^`.]+)`")
+
+
+def plain_text(text: str) -> str:
+    """Documentation text as a terminal shows it: no reStructuredText markup (a role
+    keeps the last part of its target's name; ````x```` is ``x``)."""
+    return _ROLE.sub(r"\1", text).replace("``", "")
+
+
 def _docs_of(cls: type) -> dict[str, str]:
     out: dict[str, str] = {}
     for klass in cls.__mro__:
@@ -146,7 +156,7 @@ def _settings_rows(settings: Any, prefix: str = "") -> list[dict[str, Any]]:
                 else repr(value),
                 "type": "float" if derived else type(value).__name__,
                 "unit": _unit(f.name, doc),
-                "doc": doc,
+                "doc": plain_text(doc),
             }
         )
     return rows

@@ -10,7 +10,7 @@ point after every physics step and classifies it:
 * **expected**: a robot link touching the obstacle that owns one of the *chosen*
   solution's collision points, with the contact point within ``tolerance_m`` of that
   collision point (in the robot's plane). The default is the planner's
-  ``contact_plan.contact_tolerance_m`` = 2·link radius + ``contact_margin_m`` (10 mm): the
+  ``contact_plan.contact_tolerance_m`` = 2·link radius + ``contact_slack_m`` (10 mm): the
   capsule's axis passes through the corner, so the capsule overlaps the obstacle there by
   up to one radius, and when the robot meets the corner at a shallow angle ``α`` to one of
   its edges the overlap runs ``r / tan(α)`` along that edge (measured up to 7.6 mm for
@@ -100,7 +100,7 @@ SETTLE_STEPS: int = 240
 POSITION_GAIN: float | None = None
 VELOCITY_GAIN: float | None = None
 #: closest approaches to the obstacles are recorded up to this distance [m]
-APPROACH_M: float = 1e-3
+NEAR_M: float = 1e-3
 #: PyBullet constraint solver: "dantzig" (a direct MLCP solver) or "pgs" (PyBullet's
 #: default iterative projected Gauss-Seidel); see the module docstring
 SOLVER: str = "dantzig"
@@ -174,13 +174,13 @@ def _note_approaches(
     points: Mapping[int, tuple[float, float]],
     owners: Mapping[int, str],
     tol: float,
-    approach_m: float,
+    near_m: float,
     closest: dict[str, dict[str, Any]],
 ) -> None:
     """Update ``closest`` (per obstacle name) with the chain's closest points to each
-    watched obstacle within ``approach_m``, and the nearest chosen collision point."""
+    watched obstacle within ``near_m``, and the nearest chosen collision point."""
     for uid, name in watched.items():
-        for pt in world.client.getClosestPoints(world.body, uid, approach_m):
+        for pt in world.client.getClosestPoints(world.body, uid, near_m):
             d = float(pt[8])
             rec = closest.get(name)
             if rec is not None and d >= rec["distance_m"]:
@@ -308,7 +308,7 @@ def _simulate(
     solver: str,
     solver_iterations: int | None,
     min_depth_m: float,
-    approach_m: float,
+    near_m: float,
     gui: bool,
 ) -> _Run:
     """Run ``path`` in a fresh world: each waypoint for ``steps_per_waypoint`` steps, then
@@ -352,7 +352,7 @@ def _simulate(
         watched = {uid: n for uid, n in world.obstacle_names.items() if n not in guides}
 
         def approach() -> None:
-            _note_approaches(world, watched, points, owners, tol, approach_m, closest)
+            _note_approaches(world, watched, points, owners, tol, near_m, closest)
 
         world.reset(path[0])
         steps0 = world.steps_taken
@@ -384,7 +384,7 @@ def execute_chord_arc(
     solver: str = SOLVER,
     solver_iterations: int | None = SOLVER_ITERATIONS,
     min_depth_m: float = 0.0,
-    approach_m: float = APPROACH_M,
+    near_m: float = NEAR_M,
     gravity_mps2: tuple[float, float, float] | None = None,
     gui: bool = False,
 ) -> Execution:
@@ -406,7 +406,7 @@ def execute_chord_arc(
         ``executor`` ("chord_arc"), ``chosen``, ``collision_points_used``,
         ``contact_tolerance_m``, ``guide_obstacles``, ``solver``, ``solver_iterations``
         and ``approaches``: per obstacle (guides excepted) that the chain came within
-        ``approach_m`` of, the closest approach over the waypoints: ``obstacle``,
+        ``near_m`` of, the closest approach over the waypoints: ``obstacle``,
         ``distance_m`` (negative: penetration), ``link``, ``p_world_m`` (on the link),
         ``collision_point`` (nearest chosen one on that obstacle, or None),
         ``point_distance_m`` and ``at_collision_point`` (within the tolerance). With
@@ -429,7 +429,7 @@ def execute_chord_arc(
         solver_iterations: PyBullet's constraint-solver iterations per step (None: its
             default).
         min_depth_m: penetration depth above which a contact point counts [m].
-        approach_m: after every waypoint, the chain's closest points to every obstacle
+        near_m: after every waypoint, the chain's closest points to every obstacle
             but the guides are read up to this distance [m].
         gravity_mps2: default: the problem's ``[simulation] gravity_mps2``.
         gui: PyBullet's GUI instead of DIRECT.
@@ -485,7 +485,7 @@ def execute_chord_arc(
         solver=solver,
         solver_iterations=solver_iterations,
         min_depth_m=min_depth_m,
-        approach_m=approach_m,
+        near_m=near_m,
         gui=gui,
     )
     seen, closest = run.seen, run.closest

@@ -18,7 +18,7 @@ for i in np.argsort(pd.d_m)[:8]:
     o = f"module_{pd.other[i]}" if pd.other_is_link[i] else names[pd.other[i]]
     print(f"module_{pd.link[i]} - {o}: {pd.d_m[i]*100:.2f} cm t={pd.t_link[i]:.2f}")
 s = ClearanceSettings(escape="detour")
-field = ClearanceField(p.robot, p.scene, s.margin_m)
+field = ClearanceField(p.robot, p.scene, s.influence_m)
 c = field(q)
 print("field min dist", np.min(c.distances_m), "cost", c.cost)
 g = p.goal(len(p.goals)-1)
@@ -33,5 +33,5 @@ for r in [0.01, 0.001, 1e-4]:
     cn = field(qn)
     Fn = D._f(p.robot, sub, qn) + s.clearance_weight*cn.cost
     dn = cn.distances_m
-    bad = ~((dn >= s.min_clearance_m) | (dn >= d_now - 1e-9))
+    bad = ~((dn >= s.clearance_floor_m) | (dn >= d_now - 1e-9))
     print(r, "F", F, Fn, "spacious", not bad.any(), "n bad", bad.sum(), "min d_new", dn[bad].min() if bad.any() else None, "valid", ck.is_valid(qn))

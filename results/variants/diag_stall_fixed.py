@@ -19,7 +19,7 @@ for i in np.argsort(pd.d_m)[:6]:
     o = f"module_{pd.other[i]}" if pd.other_is_link[i] else names[pd.other[i]]
     print(f"module_{pd.link[i]} - {o}: {pd.d_m[i]*100:.2f} cm t={pd.t_link[i]:.2f}")
 s = ClearanceSettings(escape="detour")
-field = ClearanceField(p.robot, p.scene, s.margin_m)
+field = ClearanceField(p.robot, p.scene, s.influence_m)
 g = p.goal(leg)
 sub = GoalRegion("approach", g.p_world_m - 2.5*g.n_world, g.n_world, 0.5, 30)
 print("tip", p.robot.tip(q)[0], "goal", g.p_world_m, "approach", sub.p_world_m)
@@ -33,5 +33,5 @@ for label, dirn in (("plain", direction), ("held", D._hold_clearance(field, q, d
     cn = field(qn)
     Fn = D._f(p.robot, sub, qn) + s.clearance_weight*cn.cost
     dn = cn.distances_m
-    bad = ~((dn >= s.min_clearance_m) | (dn >= d_now - 1e-9))
+    bad = ~((dn >= s.clearance_floor_m) | (dn >= d_now - 1e-9))
     print(label, rr, "dF", Fn - F, "spacious", not bad.any(), "valid", ck.is_valid(qn))

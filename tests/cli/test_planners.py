@@ -41,9 +41,11 @@ def test_one_planner_shows_its_settings_as_one_json_document(capsys):
     # the defaults of this planner (its registry entry sets the escape)
     assert settings["escape"]["default"] == "detour"
     # derived from the robot's size when the leg is planned; the doc gives Arm-Z's value
-    assert settings["margin_m"]["default"] == "derived" and settings["margin_m"]["unit"] == "m"
-    assert "0.3 on Arm-Z" in settings["margin_m"]["doc"]
-    assert "the distance below which a pair of links" in settings["margin_m"]["doc"]
+    assert (
+        settings["influence_m"]["default"] == "derived" and settings["influence_m"]["unit"] == "m"
+    )
+    assert "0.3 on Arm-Z" in settings["influence_m"]["doc"]
+    assert "distance of influence" in settings["influence_m"]["doc"]
     assert settings["max_step_rad"]["unit"] == "rad"
     assert "tip position" in settings["r1"]["doc"] and "tip normal" in settings["r2"]["doc"]
 

@@ -8,9 +8,10 @@ import numpy as np
 import pytest
 from conftest import PROBLEMS
 
+from plannerlab.collision.chain_ik import descent_for_robot
 from plannerlab.collision.fcl_checker import problem_checker
 from plannerlab.problem.goals import GoalRegion
-from plannerlab.problem.ik import compiled_descent, sample_goal_state, solve_ik
+from plannerlab.problem.ik import sample_goal_state, solve_ik
 from plannerlab.problem.load import parse_problem
 from plannerlab.robots.armz.model import ArmZ
 
@@ -27,7 +28,7 @@ def panda():
 def test_the_compiled_descent_takes_the_numpy_descents_steps(panda):
     problem, goal = panda
     robot = problem.robot
-    descent = compiled_descent(robot)
+    descent = descent_for_robot(robot)
     assert descent is not None
     rng = np.random.default_rng(3)
     reached = 0
@@ -47,11 +48,22 @@ def test_compiled_goal_states_are_in_the_region_valid_and_seeded(panda):
     checker = problem_checker(problem)
     found = []
     for seed in range(6):
+        descent = descent_for_robot(robot)
         q = sample_goal_state(
-            robot, goal, checker, np.random.default_rng(seed), seeds=[problem.q_start]
+            robot,
+            goal,
+            checker,
+            np.random.default_rng(seed),
+            seeds=[problem.q_start],
+            descent=descent,
         )
         again = sample_goal_state(
-            robot, goal, checker, np.random.default_rng(seed), seeds=[problem.q_start]
+            robot,
+            goal,
+            checker,
+            np.random.default_rng(seed),
+            seeds=[problem.q_start],
+            descent=descent,
         )
         assert q is not None and np.array_equal(q, again)
         assert goal.contains(robot, q) and checker.is_valid(q)
@@ -61,4 +73,4 @@ def test_compiled_goal_states_are_in_the_region_valid_and_seeded(panda):
 
 
 def test_only_families_that_register_it_get_the_compiled_descent():
-    assert compiled_descent(ArmZ(n_modules=6)) is None
+    assert descent_for_robot(ArmZ(n_modules=6)) is None

@@ -40,13 +40,18 @@ def test_import_plannerlab_loads_no_engine_and_no_submodule():
     assert json.loads(out.stdout) == []
 
 
-def test_the_api_page_example_runs(tmp_path):
-    """docs/api.md's example (the README links it), as a user copies it."""
+def test_the_api_page_example_runs_as_a_script(tmp_path):
+    """docs/api.md's example (the README links it), pasted into a file and run as a script,
+    with no ``if __name__ == "__main__":``: the comparison's trial processes must not run
+    the script again (they did, and every trial died in its bootstrapping, issue 36)."""
     page = (ROOT / "docs" / "api.md").read_text(encoding="utf-8")
     (example,) = re.findall(r"```python\n(.*?)```", page, flags=re.S)
     assert len(example.strip().splitlines()) <= 14
+    assert "__main__" not in example
+    script = tmp_path / "example.py"
+    script.write_text(example, encoding="utf-8")
     out = subprocess.run(
-        [sys.executable, "-c", example],
+        [sys.executable, str(script)],
         capture_output=True,
         text=True,
         cwd=tmp_path,
@@ -62,6 +67,47 @@ def test_the_api_page_example_runs(tmp_path):
         ("ompl.rrtconnect", 0),
         ("ompl.rrtconnect", 1),
     ]
+    assert [r["error"] for r in records] == [None] * 4  # every trial ran, none died
+    assert all(r["legs_run"] for r in records)
+
+
+def _api_tables() -> tuple[list[str], list[str]]:
+    """The names docs/api.md lists: its table of ``plannerlab`` and its table of
+    ``plannerlab.extras`` (the first column's backticked name of each row)."""
+    page = (ROOT / "docs" / "api.md").read_text(encoding="utf-8")
+    top, extras = page.split("## What only the command line needs")
+    top = top.split("## Every name of `plannerlab`")[1]
+
+    def names(text: str) -> list[str]:
+        return re.findall(r"^\| `(\w+)` \|", text, flags=re.M)
+
+    return names(top), names(extras)
+
+
+def test_the_api_page_lists_every_public_name_and_no_other():
+    import plannerlab.extras
+
+    top, extras = _api_tables()
+    assert len(top) == len(set(top)) and len(extras) == len(set(extras))
+    assert sorted(top) == sorted(plannerlab.__all__)
+    assert sorted(extras) == sorted(plannerlab.extras.__all__)
+    assert set(top).isdisjoint(extras)
+
+
+def test_the_extras_resolve_and_import_nothing_until_used():
+    import plannerlab.extras
+
+    for name in plannerlab.extras.__all__:
+        assert getattr(plannerlab.extras, name) is not None
+    assert plannerlab.extras.__all__ == sorted(plannerlab.extras._EXPORTS)
+    code = (
+        "import json, sys\n"
+        "import plannerlab.extras\n"
+        "print(json.dumps(sorted(m for m in sys.modules if m.startswith('plannerlab.')\n"
+        "                        and m != 'plannerlab.extras')))\n"
+    )
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    assert json.loads(out.stdout) == []
 
 
 def test_the_notebook_uses_only_the_public_api():

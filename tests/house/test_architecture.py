@@ -38,8 +38,28 @@ def _modules() -> dict[str, Path]:
 MODULES = _modules()
 
 
+#: a string that names a plannerlab module, or an attribute of one (``"module:attribute"``):
+#: a lazy import (the public API's export table, a fork server's preload list), which
+#: counts as an import of that module
+MODULE_STRING = re.compile(r"^(plannerlab(?:\.\w+)+)(?::(\w+))?$")
+
+
+def _string_imports(tree: ast.AST) -> list[tuple[str, int, bool]]:
+    """(module, line, has an attribute) for every string constant naming a plannerlab module
+    (a bare dotted name counts only when it is a module of the package: a logger's name
+    such as ``"plannerlab.ompl"`` is not)."""
+    out = []
+    for node in ast.walk(tree):
+        if isinstance(node, ast.Constant) and isinstance(node.value, str):
+            m = MODULE_STRING.match(node.value)
+            if m and (m.group(2) or m.group(1) in MODULES):
+                out.append((m.group(1), node.lineno, m.group(2) is not None))
+    return out
+
+
 def _imports(module: str, path: Path) -> list[tuple[str, int]]:
-    """(imported module, line) for every import in ``path``, relative ones resolved."""
+    """(imported module, line) for every import in ``path``, relative ones resolved, and
+    every string naming a module (:data:`MODULE_STRING`): no import is hidden in a string."""
     tree = ast.parse(path.read_text(encoding="utf-8"), filename=str(path))
     package = module if path.name == "__init__.py" else module.rpartition(".")[0]
     out = []
@@ -57,6 +77,7 @@ def _imports(module: str, path: Path) -> list[tuple[str, int]]:
             for alias in node.names:
                 sub = f"{base}.{alias.name}"
                 out.append((sub if sub in MODULES else base, node.lineno))
+    out += [(name, line) for name, line, _ in _string_imports(tree)]
     return out
 
 
@@ -107,6 +128,43 @@ def _cycles(graph: dict[str, set[str]]) -> list[list[str]]:
 def test_no_import_cycles_between_plannerlab_modules():
     """Every import counts: at module level, inside functions and under TYPE_CHECKING."""
     assert _cycles(_internal_graph()) == []
+
+
+def test_every_string_naming_a_module_names_a_real_one():
+    """``"plannerlab.x.y:attribute"`` strings are imports (see :data:`MODULE_STRING`): each
+    names a module of the package that has the attribute, so a renamed module or function
+    fails here, not at run time."""
+    import importlib
+
+    broken = []
+    for path in MODULES.values():
+        tree = ast.parse(path.read_text(encoding="utf-8"))
+        for name, line, _ in _string_imports(tree):
+            text = next(
+                n.value
+                for n in ast.walk(tree)
+                if isinstance(n, ast.Constant)
+                and isinstance(n.value, str)
+                and n.lineno == line
+                and n.value.startswith(name)
+            )
+            attribute = text.partition(":")[2]
+            if name not in MODULES:
+                broken.append(f"{_module_rel(path)}:{line} {text!r}: no such module")
+            elif attribute and not hasattr(importlib.import_module(name), attribute):
+                broken.append(f"{_module_rel(path)}:{line} {text!r}: no such attribute")
+    assert broken == []
+
+
+def test_the_import_finder_sees_a_module_named_in_a_string():
+    tree = ast.parse(
+        'X = ("plannerlab.run.pipeline", "plannerlab.errors:PlannerlabError")\n'
+        'LOG = "plannerlab.ompl"\nDOC = "see plannerlab.run.pipeline here"\n'
+    )
+    assert [(n, attr) for n, _, attr in _string_imports(tree)] == [
+        ("plannerlab.run.pipeline", False),
+        ("plannerlab.errors", True),
+    ]
 
 
 def test_the_cycle_finder_finds_a_cycle():
@@ -272,10 +330,11 @@ def test_every_module_imports_only_what_its_room_may_import():
 
 
 def test_the_cli_is_a_client_of_the_public_api():
-    """A subcommand imports nothing of plannerlab but the public API (``plannerlab``),
-    ``record``, ``errors`` and ``cli/`` itself; of the third-party packages only rich:
-    what a command needs, a notebook finds in ``plannerlab`` too (issue 28, item 6)."""
-    allowed = ("plannerlab.cli", "plannerlab.record", "plannerlab.errors")
+    """A subcommand imports nothing of plannerlab but the public API (``plannerlab``), its
+    extras (``plannerlab.extras``), ``record``, ``errors`` and ``cli/`` itself; of the
+    third-party packages only rich: what a command needs, a notebook finds in ``plannerlab``
+    or ``plannerlab.extras`` too (issue 28, item 6; issue 36, item 4)."""
+    allowed = ("plannerlab.cli", "plannerlab.record", "plannerlab.errors", "plannerlab.extras")
     offenders = []
     for module, path in MODULES.items():
         if not (module.startswith("plannerlab.cli") or module == "plannerlab.__main__"):
@@ -294,7 +353,7 @@ def test_the_cli_row_of_the_room_table_names_only_the_api_and_record():
     rows = _room_table()
     cli_rows, packages = _allowed(_room_of("cli/main.py", rows), rows)
     named = {rows[i][0][0] for i in cli_rows}
-    assert named == {"cli/", "__init__.py", "record/"}
+    assert named == {"cli/", "__init__.py", "extras.py", "record/"}
     assert packages == {"rich"}
 
 

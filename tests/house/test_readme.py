@@ -31,7 +31,7 @@ def test_the_tour_has_the_five_steps():
         ["plannerlab", "execute"],
         ["plannerlab", "view"],
         ["plannerlab", "compare"],
-        ["jupyter", "lab"],
+        ["./do", "jupyter"],
     ]
 
 

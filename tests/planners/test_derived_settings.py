@@ -156,7 +156,7 @@ def test_every_arm_z_gets_exactly_todays_distances():
         for key, value in LEADER_DISTANCES.items():
             assert getattr(f, key) == value, (robot, key)
     # the values the clearance family was built with
-    assert (DERIVED_DISTANCES["margin_m"], DERIVED_DISTANCES["min_clearance_m"]) == (0.3, 0.03)
+    assert (DERIVED_DISTANCES["influence_m"], DERIVED_DISTANCES["clearance_floor_m"]) == (0.3, 0.03)
     assert DERIVED_DISTANCES["approach_m"] == 2.5 == LEADER_DISTANCES["approach_m"]
 
 
@@ -165,16 +165,16 @@ def test_a_small_arms_distances_are_scaled_and_a_users_value_wins(arm6):
     assert size.reach_m == pytest.approx(0.77)
     assert size.pitch_m == pytest.approx(0.06)  # its (upper) median link: the wrist's
     s = ClearanceSettings().for_robot(arm6.robot)
-    assert s.margin_m == pytest.approx(0.3 * 0.06 / 0.7160596, rel=1e-5)
-    assert s.min_clearance_m == pytest.approx(s.margin_m / 10)
+    assert s.influence_m == pytest.approx(0.3 * 0.06 / 0.7160596, rel=1e-5)
+    assert s.clearance_floor_m == pytest.approx(s.influence_m / 10)
     assert s.approach_m < 0.3 * size.reach_m
-    planner = make_planner("gradient.clearance", {"margin_m": "0.05"})
-    assert planner.settings.margin_m == 0.05 and planner.settings.min_clearance_m is None
+    planner = make_planner("gradient.clearance", {"influence_m": "0.05"})
+    assert planner.settings.influence_m == 0.05 and planner.settings.clearance_floor_m is None
     resolved = planner.for_robot(arm6.robot).settings
-    assert resolved.margin_m == 0.05  # set: kept
-    assert resolved.min_clearance_m == s.min_clearance_m  # left: derived
+    assert resolved.influence_m == 0.05  # set: kept
+    assert resolved.clearance_floor_m == s.clearance_floor_m  # left: derived
     # the planner's own settings are not changed by deriving them
-    assert planner.settings.min_clearance_m is None
+    assert planner.settings.clearance_floor_m is None
 
 
 def _legs(problem: Problem, name: str, overrides: dict) -> list:
@@ -198,7 +198,7 @@ def test_the_clearance_descent_solves_a_small_arm_with_its_defaults(arm6, name):
         check = checker.check_path(r.path, arm6.joint_step / 4)
         assert check.valid, (leg, check.first_invalid_edge, check.pairs)
         # the result records the distances it ran with, derived for this arm
-        assert r.settings["margin_m"] == pytest.approx(0.3 * robot_size(arm6.robot).ratio)
+        assert r.settings["influence_m"] == pytest.approx(0.3 * robot_size(arm6.robot).ratio)
 
 
 def test_with_arm_zs_distances_the_small_arm_stalls(arm6):

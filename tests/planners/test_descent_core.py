@@ -36,7 +36,7 @@ def test_compiled_field_step_and_hold_equal_numpy_at_states_near_walls(direction
     and the hold's projection agree to rounding. The clearance floor is raised to 0.1 m
     (the hold acts on pairs closer than 0.11 m) so that the hold has pairs to hold."""
     problem = load_problem("armz_pocket")
-    numpy_model, compiled = _models(problem, direction=direction, min_clearance_m=0.1)
+    numpy_model, compiled = _models(problem, direction=direction, clearance_floor_m=0.1)
     goal = problem.goal(0)
     rng = np.random.default_rng(7)
     margin = 0.3

@@ -17,7 +17,7 @@ from plannerlab.run.pipeline import leg_rng, solve_legs
 
 def test_clearance_gradient_is_the_derivative_of_the_cost():
     problem = load_problem("armz_inspection")
-    field = ClearanceField(problem.robot, problem.scene, margin_m=1.0)
+    field = ClearanceField(problem.robot, problem.scene, influence_m=1.0)
     rng = np.random.default_rng(3)
     q = problem.q_start + rng.normal(0.0, 0.4, problem.robot.dof)
     c = field(q)
@@ -34,7 +34,7 @@ def test_clearance_gradient_is_the_derivative_of_the_cost():
 
 def test_clearance_field_distance_matches_fcl_within_the_sphere_cover():
     problem = load_problem("armz_inspection")
-    field = ClearanceField(problem.robot, problem.scene, margin_m=1.0)
+    field = ClearanceField(problem.robot, problem.scene, influence_m=1.0)
     checker = CollisionChecker(problem.robot, problem.scene)
     rng = np.random.default_rng(4)
     for _ in range(5):

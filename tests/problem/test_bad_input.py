@@ -191,8 +191,8 @@ PROBLEM_CASES = {
     "witness_negative_clearance": (
         TINY_PROBLEM_TOML
         + "\n[witness]\npath_rad = [[3.14, 3.14, 3.14, 3.14, 3.14], [3.1, 3.1, 3.1, 3.1, 3.1]]\n"
-        + "min_clearance_m = -0.1\n",
-        "witness.min_clearance_m",
+        + "clearance_floor_m = -0.1\n",
+        "witness.clearance_floor_m",
     ),
     "continuum_nan_point": (
         TINY_PROBLEM_TOML + "\n[continuum]\ncollision_points_m = [[0.1, 0.2], [nan, 0.2]]\n",
@@ -324,8 +324,8 @@ def test_bad_compare_command_line(capsys, tmp_path, extra, name):
     [
         (["--count", "0"], "--count"),
         (["--seed", "-3"], "--seed"),
-        (["--min-clearance", "-0.01"], "--min-clearance"),
-        (["--min-clearance", "0.8"], "--min-clearance"),
+        (["--clearance-floor", "-0.01"], "--clearance-floor"),
+        (["--clearance-floor", "0.8"], "--clearance-floor"),
         (["--max-draws", "0"], "--max-draws"),
     ],
     ids=["count_zero", "seed_negative", "clearance_negative", "clearance_too_big", "draws_zero"],
@@ -355,7 +355,7 @@ def test_variants_that_cannot_all_be_kept_fail_with_the_count(capsys, tmp_path):
         "1",
         "--max-draws",
         "1",
-        "--min-clearance",
+        "--clearance-floor",
         "0.7",
         "--out",
         str(tmp_path / "v"),

@@ -70,7 +70,7 @@ def test_each_witness_is_free_with_its_clearance_and_inside_its_goal(path):
     problem = load_problem(path)
     witness = problem.extras["witness"]
     states = np.array(witness["goal_states_rad"], dtype=float)
-    clearance_m = float(witness["min_clearance_m"])
+    clearance_m = float(witness["clearance_floor_m"])
     assert clearance_m >= 0.04
     assert states.shape == (problem.legs, problem.robot.dof)
     assert MODULES_RANGE[0] <= problem.robot.n_modules <= MODULES_RANGE[1]

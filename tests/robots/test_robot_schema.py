@@ -166,7 +166,7 @@ def test_a_bad_value_names_the_file_the_key_and_the_expectation(case):
 def test_a_combination_the_constructor_refuses_names_its_key(monkeypatch):
     from plannerlab.robots import registry
 
-    monkeypatch.setitem(registry.FAMILIES, "toy", registry.RobotFamily("toy", f"{__name__}:TOY"))
+    monkeypatch.setitem(registry.FAMILIES, "toy", registry.RobotFamily("toy", lambda: TOY))
     reader = TableReader("toy.toml", "robot", {"type": "toy", "count": 7})
     with pytest.raises(ProblemError) as err:
         build_robot(reader)
@@ -220,9 +220,9 @@ def test_a_family_plugs_in_with_one_registry_entry(monkeypatch, tmp_path):
 
     entry = registry.RobotFamily(
         "armz_alias",
-        f"{__name__}:ALIAS_TABLE",
-        reach=f"{__name__}:_tiny_reach",
-        goal_sampler=f"{__name__}:_no_goal",
+        lambda: ALIAS_TABLE,
+        reach=_tiny_reach,
+        goal_sampler=_no_goal,
     )
     monkeypatch.setitem(registry.FAMILIES, "armz_alias", entry)
     path = tmp_path / "p.toml"

@@ -62,7 +62,7 @@ batched call (:func:`capsule_distances`: every state × link × obstacle; the ro
 the obstacles' cuts lie in one plane, so a capsule touches an obstacle exactly when its
 axis comes closer than r to the cut; it gives the same pairs as python-fcl state by
 state, 30-40 times faster); a touching (link, obstacle) pair is *expected* when the
-link's axis passes within ``contact_tolerance_m`` (= 2·r + ``contact_margin_m``) of one
+link's axis passes within ``contact_tolerance_m`` (= 2·r + ``contact_slack_m``) of one
 of the solution's collision points on that obstacle; ``contact_plan.expected_contacts``
 lists the chosen solution's expected pairs. Any other touching pair drops the solution
 (3. above). Every state checked counts as one of ``collision_checks``.
@@ -539,7 +539,7 @@ class ChordArcPlanner(LegPlanner):
         real = self.query(problem, leg)
         query = self.planning_query(problem, real)
         q0 = ctx.q_start.reshape(robot.dof)
-        tol = 2.0 * robot.link_radius_m + s.contact_margin_m
+        tol = 2.0 * robot.link_radius_m + s.contact_slack_m
         record = _empty_record(problem, real, query, tol, s.inflate_by_radius)
 
         # progress: the search starts at the straight robot, at time 0 with no checks

@@ -3,7 +3,10 @@
 from __future__ import annotations
 
 import math
+from collections.abc import Mapping
 from dataclasses import dataclass
+from types import MappingProxyType
+from typing import ClassVar
 
 from plannerlab.planners.chord_arc.geometry import ChordArcInputError
 
@@ -44,8 +47,9 @@ class ChordArcSettings:
         check_contacts: check every state of every surviving solution's path for the
             chain's capsules touching obstacles away from its collision points, and drop
             such solutions.
-        contact_margin_m: a contact is expected within 2·link radius + this of one of
-            the solution's collision points [m].
+        contact_slack_m: a contact is expected within 2·link radius + this of one of
+            the solution's collision points [m] (the contact tolerance's slack; named
+            ``contact_margin_m`` before issue 36: not the problem's safety margin).
     """
 
     max_depth: int = 0
@@ -64,7 +68,12 @@ class ChordArcSettings:
     path_step_m: float = 0.002
     path_joint_step_rad: float = 0.02
     check_contacts: bool = True
-    contact_margin_m: float = 0.01
+    contact_slack_m: float = 0.01
+
+    #: settings renamed (old key -> new): still read for one release, with a warning
+    RENAMED_KEYS: ClassVar[Mapping[str, str]] = MappingProxyType(
+        {"contact_margin_m": "contact_slack_m"}
+    )
 
     def __post_init__(self) -> None:
         if self.max_depth < 0:
@@ -81,7 +90,7 @@ class ChordArcSettings:
         ):
             if not getattr(self, name) > 0:
                 raise ChordArcInputError(f"{name} must be > 0, got {getattr(self, name)}")
-        for name in ("inside_tol_m", "boundary_tol_m", "contact_margin_m"):
+        for name in ("inside_tol_m", "boundary_tol_m", "contact_slack_m"):
             if not getattr(self, name) >= 0:
                 raise ChordArcInputError(f"{name} must be >= 0, got {getattr(self, name)}")
         if self.choose not in CHOICES:

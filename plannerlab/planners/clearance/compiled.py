@@ -546,7 +546,7 @@ class CompiledField:
             else:  # pragma: no cover - scene types are closed
                 raise TypeError(f"unknown obstacle {o!r}")
         A, B, lp_of_row, lp_links, ends = pair_spheres(scene_idx, k, self_a, self_b, link)
-        self.margin_m = float(field.margin_m)
+        self.influence_m = float(field.influence_m)
         # fresh (writeable, contiguous) arrays everywhere: numba compiles one version
         self._field = SphereField(
             ch=chain,
@@ -562,12 +562,12 @@ class CompiledField:
             lp_of_row=lp_of_row,
             lp_links=lp_links,
             ends=ends,
-            margin=self.margin_m,
+            margin=self.influence_m,
         )
         #: the field as plain tuples (see :func:`evaluate_at`)
         self._plain = (tuple(chain), *self._field[1:])
         #: pairs at least this far apart are reported at this distance (see pairs)
-        self.far_m = max(float(far_m), self.margin_m)
+        self.far_m = max(float(far_m), self.influence_m)
         self._no_ref = np.zeros(0)
         #: the last goal asked about and its arrays (fresh, writeable: one numba version;
         #: see :func:`_goal_arrays`)

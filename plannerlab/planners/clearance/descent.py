@@ -103,8 +103,8 @@ class ClearanceDescent(DescentStep, LegPlanner):
         self._resolved: tuple[Any, ClearanceDescent] | None = None
 
     def for_robot(self, robot: Any) -> ClearanceDescent:
-        """This descent with its derived distance settings (None: ``margin_m``,
-        ``min_clearance_m``, ``approach_m``, …) set for ``robot``
+        """This descent with its derived distance settings (None: ``influence_m``,
+        ``clearance_floor_m``, ``approach_m``, …) set for ``robot``
         (:meth:`ClearanceSettings.for_robot`); itself when none is left to derive. Every
         entry point plans with it, so a solve's result records the values used."""
         if self.settings.resolved:
@@ -176,7 +176,7 @@ class ClearanceDescent(DescentStep, LegPlanner):
         cached = self._model_cache
         if cached is not None and cached[0] is problem:
             return cached[1]
-        field = ClearanceField(problem.robot, problem.scene, self.settings.margin_m, stop=stop)
+        field = ClearanceField(problem.robot, problem.scene, self.settings.influence_m, stop=stop)
         model: Model
         if self.backend_for(problem.robot) == "compiled":
             model = CompiledModel(self, field, _compiled_model(checker))
@@ -272,7 +272,7 @@ class ClearanceDescent(DescentStep, LegPlanner):
             q_new = wrap_to_pi(q + step, robot.continuous)
             there = model.point(goal, q_new, d_now)
             F_new = there.F
-            # keep min_clearance_m (a tracking arm overshoots a little), unless already closer
+            # keep clearance_floor_m (a tracking arm overshoots a little), unless already closer
             d_new = there.distances_m
             spacious = there.spacious
             if F_new < F_now and spacious and (checker is None or checker.is_valid(q_new)):
@@ -285,7 +285,7 @@ class ClearanceDescent(DescentStep, LegPlanner):
                 f_now = here.f
                 held = False
             elif not spacious and not held and s.hold_clearance:
-                # the step takes a pair below min_clearance_m: slide along it instead
+                # the step takes a pair below clearance_floor_m: slide along it instead
                 direction = model.hold(goal, q, direction)
                 held = True
             else:

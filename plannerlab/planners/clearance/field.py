@@ -145,7 +145,7 @@ class ClearanceField:
         robot: the robot (``link_segments``, ``link_radii_m``, ``fixed_links``,
             ``excluded_pairs``; Arm-Z frames for analytic Jacobians).
         scene: the obstacles.
-        margin_m: pairs farther apart than this cost nothing.
+        influence_m: pairs farther apart than this cost nothing.
         include_self: also link against link.
         max_spheres: the most spheres in all (see the module docstring).
         stop: asked between the links while the pairs are built; True raises
@@ -156,17 +156,17 @@ class ClearanceField:
         self,
         robot: Robot,
         scene: Scene,
-        margin_m: float,
+        influence_m: float,
         include_self: bool = True,
         *,
         max_spheres: int = MAX_SPHERES,
         stop: Callable[[], bool] | None = None,
     ):
-        if not margin_m > 0:
-            raise ValueError(f"margin_m must be > 0, got {margin_m}")
+        if not influence_m > 0:
+            raise ValueError(f"influence_m must be > 0, got {influence_m}")
         self.robot = robot
         self.scene = scene
-        self.margin_m = float(margin_m)
+        self.influence_m = float(influence_m)
         radii = np.asarray(robot.link_radii_m, dtype=float)
         L = len(radii)
         q_ref = np.clip(np.zeros(robot.dof), robot.lower, robot.upper)
@@ -276,7 +276,7 @@ class ClearanceField:
         q = np.asarray(q, dtype=float)
         p, J = self._centres_and_jacobians(q)
         d, n, a, b = self._pairs(p)
-        m = self.margin_m
+        m = self.influence_m
         close = d < m
         min_d = float(d.min()) if len(d) else np.inf
         if not close.any():

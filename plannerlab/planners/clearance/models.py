@@ -34,10 +34,10 @@ class NumpyPoint:
 
     @cached_property
     def spacious(self) -> bool:
-        """No pair below ``min_clearance_m`` that came closer than in ``d_ref``."""
+        """No pair below ``clearance_floor_m`` that came closer than in ``d_ref``."""
         if self._d_ref is None:
             return True
-        d_new, floor = self.distances_m, self._descent.settings.min_clearance_m
+        d_new, floor = self.distances_m, self._descent.settings.clearance_floor_m
         return bool(np.all((d_new >= floor) | (d_new >= self._d_ref - 1e-9)))
 
     @cached_property
@@ -125,21 +125,23 @@ class CompiledModel:
         s = descent.settings
         self._settings = s
         # distances beyond both the margin and the hold's floor matter to no test of the
-        # descent (the spacious test looks only below min_clearance_m)
-        far_m = max(s.margin_m, s.min_clearance_m + s.hold_band_m)
+        # descent (the spacious test looks only below clearance_floor_m)
+        far_m = max(s.influence_m, s.clearance_floor_m + s.hold_band_m)
         self._core = CompiledField(field, far_m=far_m, model=compiled_model)
         self._rule = step_rule(
             s.r1, s.r2, s.clearance_weight, s.direction == "gauss_newton", s.damping, s.goal_depth
         )
 
     def point(self, goal, q: Array, d_ref: Array | None = None):
-        return self._core.evaluate(q, goal, self._rule, True, d_ref, self._settings.min_clearance_m)
+        return self._core.evaluate(
+            q, goal, self._rule, True, d_ref, self._settings.clearance_floor_m
+        )
 
     def hold(self, goal, q: Array, direction: Array) -> Array:
         """The held step, projected in the metric of the step's quadratic model at q
         (:meth:`ClearanceDescent._metric`, which the compiled evaluation returns)."""
         metric = self.point(goal, q).metric
-        floor = self._settings.min_clearance_m + self._settings.hold_band_m
+        floor = self._settings.clearance_floor_m + self._settings.hold_band_m
         return self._core.hold_clearance(q, direction, floor, metric)
 
     def warm_up(self, goal, q: Array) -> None:

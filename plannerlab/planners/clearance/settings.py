@@ -9,15 +9,17 @@ Arm-Z's 0.716-m modules), scaled by the robot's typical link length over Arm-Z's
 (:class:`RobotSize`: the median distance between successive frames of its chain). On
 every Arm-Z (any radius, any number of modules) the ratio is exactly 1.0, so every
 derived value is today's and the paths are bit-identical; a 0.7-m six-joint arm with
-links of about 12 cm gets about a sixth of them (``margin_m`` about 5 cm). A value the
-user sets (``--set margin_m=0.05``) wins.
+links of about 12 cm gets about a sixth of them (``influence_m`` about 5 cm). A value the
+user sets (``--set influence_m=0.05``) wins.
 """
 
 from __future__ import annotations
 
 import dataclasses
+from collections.abc import Mapping
 from dataclasses import dataclass
-from typing import Any, cast
+from types import MappingProxyType
+from typing import Any, ClassVar, cast
 
 import numpy as np
 
@@ -84,7 +86,7 @@ def robot_size(robot: Any) -> RobotSize:
         raise PlannerlabError(
             f"robot {getattr(robot, 'kind', '?')}: no size to derive the clearance "
             "settings from (its chain has no length at the reference state); set "
-            "margin_m, min_clearance_m, approach_m, subgoal_pos_tol_m, retract_jitter_m "
+            "influence_m, clearance_floor_m, approach_m, subgoal_pos_tol_m, retract_jitter_m "
             "and hold_band_m explicitly"
         )
     radii = np.asarray(robot.link_radii_m, dtype=float)
@@ -113,8 +115,8 @@ def resolve_distances(settings: Any, defaults: dict[str, float], robot: Any) -> 
 #: the distance settings of :class:`ClearanceSettings` derived from the robot: their
 #: values on Arm-Z [m]
 DERIVED_DISTANCES: dict[str, float] = {
-    "margin_m": 0.3,
-    "min_clearance_m": 0.03,
+    "influence_m": 0.3,
+    "clearance_floor_m": 0.03,
     "hold_band_m": 0.01,
     "approach_m": 2.5,
     "subgoal_pos_tol_m": 0.5,
@@ -133,8 +135,9 @@ class ClearanceSettings:
         r1: weight of the tip position term (paper: 1) [1/m].
         r2: weight of the tip normal term (paper: 1) [1].
         clearance_weight: w, weight of the clearance term [1].
-        margin_m: m, the distance below which a pair of links (or a link and an obstacle)
-            costs, ``(m − d)² / m`` [m]; derived, 0.3 on Arm-Z.
+        influence_m: m, the clearance term's distance of influence: a pair of links (or a
+            link and an obstacle) closer than m costs ``(m − d)² / m`` [m]; derived, 0.3 on
+            Arm-Z. (Named ``margin_m`` before issue 36: not the problem's safety margin.)
         direction: the step rule: "gradient" (steepest descent) or "gauss_newton" (damped
             Gauss-Newton on the residuals; see the module docstring).
         damping: Gauss-Newton damping λ [tolerance units].
@@ -150,9 +153,11 @@ class ClearanceSettings:
             ``tol_rad`` for a goal state) [1].
         deepen_iterations: iterations the descent goes on inside the goal region towards
             ``goal_depth`` while it makes progress [1].
-        min_clearance_m: the clearance floor: a step that takes a pair below it (and
-            closer than it was) is refused [m]; derived, 0.03 on Arm-Z.
-        hold_band_m: pairs within this of ``min_clearance_m`` are held by
+        clearance_floor_m: the clearance the descent keeps: a step that takes a pair below
+            it (and closer than it was) is refused [m]; derived, 0.03 on Arm-Z. (Named
+            ``min_clearance_m`` before issue 36: a record's ``min_clearance_m`` is the
+            smallest clearance measured along a path.)
+        hold_band_m: pairs within this of ``clearance_floor_m`` are held by
             ``hold_clearance`` (they may not come closer) [m]; derived, 0.01 on Arm-Z.
         settle_iterations: in the goal region, iterations of the clearance term alone,
             so the arm does not end close to a wall when the region leaves room [1].
@@ -176,21 +181,20 @@ class ClearanceSettings:
         escape_goal_samples: goal states the ``rrtconnect`` escape draws by IK (seeded
             from the stall) when the descent near the stall finds no collision-free goal
             [1].
-        hold_clearance: when a step would take a pair below ``min_clearance_m``, try
-            once the same step with the part that closes such pairs taken out
-            (:meth:`ClearanceDescent._hold_clearance`) before shrinking the step; without
+        hold_clearance: when a step would take a pair below ``clearance_floor_m``, try
+            once the same step with the part that closes such pairs taken out before
+            shrinking the step; without
             it the descent stalls against the clearance floor (measured on room
             variants: the leave leg stalled at iteration 7 and no retract got out).
-        backend: "compiled" (the field and the step in numba,
-            :mod:`plannerlab.planners.clearance.compiled`; Arm-Z only, other robots use numpy)
-            or "numpy" (the reference: the same iterates to rounding, 30-50 times slower;
-            `bench/descent_bench.py`).
+        backend: "compiled" (the field and the step compiled with numba; Arm-Z only,
+            other robots use numpy) or "numpy" (the reference: the same iterates to
+            rounding, 30-50 times slower; ``bench/descent_bench.py``).
     """
 
     r1: float = 1.0
     r2: float = 1.0
     clearance_weight: float = 0.2
-    margin_m: float = DERIVED
+    influence_m: float = DERIVED
     direction: str = "gauss_newton"
     damping: float = 0.1
     max_step_rad: float = 0.0
@@ -199,7 +203,7 @@ class ClearanceSettings:
     stall_min_decrease: float = 1e-3
     goal_depth: float = 0.3
     deepen_iterations: int = 100
-    min_clearance_m: float = DERIVED
+    clearance_floor_m: float = DERIVED
     hold_band_m: float = DERIVED
     settle_iterations: int = 100
     settle_fraction: float = 0.7
@@ -215,16 +219,22 @@ class ClearanceSettings:
     hold_clearance: bool = True
     backend: str = "compiled"
 
+    #: settings renamed (old key -> new): ``--set`` and overrides still take the old key
+    #: for one release, with a warning naming the new one (``with_overrides``)
+    RENAMED_KEYS: ClassVar[Mapping[str, str]] = MappingProxyType(
+        {"margin_m": "influence_m", "min_clearance_m": "clearance_floor_m"}
+    )
+
     def __post_init__(self) -> None:
         if self.direction not in ("gradient", "gauss_newton"):
             raise PlannerlabError(
                 f"direction setting: 'gradient' or 'gauss_newton', got {self.direction!r}"
             )
-        for key in ("margin_m", "subgoal_pos_tol_m"):
+        for key in ("influence_m", "subgoal_pos_tol_m"):
             value = getattr(self, key)
             if value is not None and not value > 0:
                 raise PlannerlabError(f"{key} must be > 0, got {value}")
-        for key in ("min_clearance_m", "hold_band_m", "approach_m", "retract_jitter_m"):
+        for key in ("clearance_floor_m", "hold_band_m", "approach_m", "retract_jitter_m"):
             value = getattr(self, key)
             if value is not None and not value >= 0:
                 raise PlannerlabError(f"{key} must be >= 0, got {value}")

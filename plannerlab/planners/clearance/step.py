@@ -64,7 +64,7 @@ class DescentStep:
             # residual r = k (m − d), k = √(w/m); J_r = −k ∇d; Gauss-Newton uses −J_r^T r
             # = k² (m − d) ∇d = −(w/2) ∇cost, and J_r^T J_r = k² ∇d ∇d^T
             dd = self._distance_gradients(field, q)
-            k2 = s.clearance_weight / s.margin_m
+            k2 = s.clearance_weight / s.influence_m
             A = A + k2 * dd.T @ dd
             b = b - 0.5 * s.clearance_weight * c.gradient
         A = A + s.damping**2 * np.eye(robot.dof)
@@ -86,7 +86,7 @@ class DescentStep:
             A = J.T @ J
         if field(q).close_pairs:
             dd = self._distance_gradients(field, q)
-            A = A + (s.clearance_weight / s.margin_m) * dd.T @ dd
+            A = A + (s.clearance_weight / s.influence_m) * dd.T @ dd
         return A + s.damping**2 * np.eye(robot.dof)
 
     def _joint_direction(
@@ -111,7 +111,7 @@ class DescentStep:
         b = scale * e
         if c.close_pairs:
             dd = self._distance_gradients(field, q)
-            k2 = s.clearance_weight / s.margin_m
+            k2 = s.clearance_weight / s.influence_m
             A = A + k2 * dd.T @ dd
             b = b - 0.5 * s.clearance_weight * c.gradient
         A = A + s.damping**2 * np.eye(len(q))
@@ -123,7 +123,7 @@ class DescentStep:
         """∇d (c, dof) of the pairs inside the margin."""
         p, J = field._centres_and_jacobians(q)
         d, n, a, b = field._pairs(p)
-        close = d < field.margin_m
+        close = d < field.influence_m
         n, a, b = n[close], a[close], b[close]
         g = np.einsum("ck,ckj->cj", n, J[a])
         is_self = b >= 0
@@ -135,7 +135,7 @@ class DescentStep:
         self, field: ClearanceField, q: Array, direction: Array, metric: Array | None = None
     ) -> Array:
         """The step ``direction`` (dof,) changed as little as possible so that no sphere
-        pair within ``hold_band_m`` (1 cm on Arm-Z) of ``min_clearance_m`` comes closer
+        pair within ``hold_band_m`` (1 cm on Arm-Z) of ``clearance_floor_m`` comes closer
         (to first order: it moves away at a small angle, 0.1 of its gradient's full
         rate), so the descent slides along the clearance floor instead of stalling
         against it (a step that would take such a pair closer is refused, and the
@@ -151,7 +151,7 @@ class DescentStep:
         s = self.settings
         p, J = field._centres_and_jacobians(q)
         d, n, a, b = field._pairs(p)
-        active = np.flatnonzero(d < s.min_clearance_m + s.hold_band_m)
+        active = np.flatnonzero(d < s.clearance_floor_m + s.hold_band_m)
         if active.size == 0:
             return direction
         G = np.einsum("ck,ckj->cj", n[active], J[a[active]])

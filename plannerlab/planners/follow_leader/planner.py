@@ -108,7 +108,7 @@ class FollowLeaderSettings:
         voxel_m: edge of the search grid's voxels [m]; 0: half the tip module's radius
             or a fiftieth of the arm's reach, the larger (0.375 on Arm-Z), but never so
             fine that the search box holds more than ``max_voxels`` voxels
-            (then the edge that fits, :func:`grid_voxel_m`).
+            (then the finest edge that fits).
         max_voxels: the most voxels the search grid may hold [1]: the grid's memory and
             time cap (measured: about 400 bytes and 3 µs a voxel while it is built and
             searched, so 1e6 voxels take about 400 MB and 3 s; an Arm-Z's grid holds at
@@ -138,8 +138,9 @@ class FollowLeaderSettings:
             ``centre_weight`` by a random factor in [0.5, 1.5] (the seed's draw).
         max_replans: (``random_grid``) new leader paths drawn from where a try ended [1].
         retract: when the tries from the start end in a stall, one more try from the
-            start: the tip drawn back along the start's own body first
-            (:meth:`FollowLeader.retract`), then the leader's path from there.
+            start: the tip drawn back along the start's own body first (sub-goals at
+            its modules' faces, from the tip's towards the base), then the leader's path
+            from there.
 
     The clearance descent's settings are its own (:class:`ClearanceSettings`), overridden
     as ``descent.<key>``.

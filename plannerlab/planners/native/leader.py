@@ -77,9 +77,8 @@ class LeaderSettings(RRTConnectSettings):
         guide_sigma_rad: (here 0.05) their Gaussian noise per joint [rad].
         forward: follow the leader from the start (a branch of the start tree).
         retract: a second branch from the start: the tip drawn back along the start's
-            own body (:meth:`~plannerlab.planners.follow_leader.FollowLeader.retract`),
-            then the leader from there; first when the leader's path runs back through
-            the body (:func:`~plannerlab.planners.follow_leader.crosses_body`), else
+            own body (as ``gradient.follow_leader``'s ``retract``), then the leader from
+            there; first when the leader's path runs back through the body, else
             when the forward branch does not reach the goal.
         backward: follow the leader from goal states into the start's tip (branches of
             the goal tree), when the forward branch did not reach the goal.

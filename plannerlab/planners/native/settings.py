@@ -20,8 +20,8 @@ class NativeSettings:
         goal_samples: goal states drawn by IK for a position + normal goal (a joint goal
             is its one state), as the OMPL planners' pool.
         max_goal_attempts: IK descents at most to fill the pool.
-        goal_selection: ``"ik"``, ``"near"`` or ``"near_or_ik"`` (see
-            :class:`~plannerlab.planners.ompl.settings.OMPLSettings`).
+        goal_selection: ``"ik"``, ``"near"`` or ``"near_or_ik"``, as for the OMPL
+            planners (``plannerlab planners ompl.rrtconnect`` says what each does).
         simplify: shorten the found path in compiled code (random shortcuts, then
             dropping the waypoints whose neighbours see each other), within the budget.
         shortcut_tries: random shortcuts tried (0: four per waypoint of the found path,

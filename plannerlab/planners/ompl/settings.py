@@ -24,8 +24,8 @@ class OMPLSettings:
         max_goal_attempts: IK descents at most to fill the pool.
         motion_check: ``"batched"`` (plannerlab edge check, Linf steps of joint_step) or
             ``"ompl"`` (OMPL's discrete motion validator).
-        goal_selection: ``"ik"`` (numeric IK restarts seeded from the leg start, see
-            :func:`~plannerlab.problem.ik.sample_goal_state`) or ``"near"`` (the goal state
+        goal_selection: ``"ik"`` (numeric IK restarts seeded from the leg start,
+            the same sampling every planner's goal pool uses) or ``"near"`` (the goal state
             ``gradient.clearance`` selects, with the caller's settings when OMPL is its
             escape: its descent from the leg start with the path unchecked, so the goal
             stays near the start; one state, one check) or
