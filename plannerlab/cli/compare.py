@@ -338,6 +338,20 @@ def cmd_compare(args: argparse.Namespace, console: Console) -> int:
         console.print(Text("Local minima (from the trial records)", style="bold"))
         for line in px.describe_minima(stalls, own, baseline):
             console.print(line, highlight=False)
+    _print_failed_trials(console, records)
+    console.print(
+        f"{len(trials)} trials: {run.ran} run now, {run.skipped} already in the "
+        f"store; {wall_s:.1f} s",
+        highlight=False,
+    )
+    console.print(f"trial store: {store.path}", highlight=False, soft_wrap=True)
+    for f in files:
+        console.print(f"wrote {f}", highlight=False, soft_wrap=True)
+    return 0
+
+
+def _print_failed_trials(console: Console, records: list[Any]) -> None:
+    """One line each for the trials that raised and the trials whose process died."""
     errors = [r for r in records if r.status == ERROR_STATUS]
     if errors:
         console.print(
@@ -357,15 +371,6 @@ def cmd_compare(args: argparse.Namespace, console: Console) -> int:
             ),
             highlight=False,
         )
-    console.print(
-        f"{len(trials)} trials: {run.ran} run now, {run.skipped} already in the "
-        f"store; {wall_s:.1f} s",
-        highlight=False,
-    )
-    console.print(f"trial store: {store.path}", highlight=False, soft_wrap=True)
-    for f in files:
-        console.print(f"wrote {f}", highlight=False, soft_wrap=True)
-    return 0
 
 
 def _print_tables(console: Console, rows: list[Any], columns: list[str]) -> None:
