@@ -79,6 +79,21 @@ NATIVE_PLANNERS: Mapping[str, str] = MappingProxyType(
 )
 
 
+#: trajectory optimisers over whole paths (``plannerlab.planners.trajopt``): name -> summary
+TRAJOPT_PLANNERS: Mapping[str, str] = MappingProxyType(
+    {
+        "trajopt.line": "trajectory optimisation of the whole path (squared accelerations "
+        "under a collision hinge, Gauss-Newton on the banded structure) from the straight "
+        "line to each goal state, random restarts",
+        "trajopt.gradient": "trajectory optimisation seeded by the paper's gradient descent",
+        "trajopt.rrtconnect": "trajectory optimisation seeded by native.rrtconnect's path",
+        "trajopt.leader": "trajectory optimisation seeded by native.rrtconnect+leader's path",
+        "trajopt.line+rrtconnect": "trajopt.line, then native.rrtconnect's path as the "
+        "seed when no line seed gives a path",
+    }
+)
+
+
 def _rrtconnect(overrides: Mapping[str, Any]) -> Planner:
     """OMPL's RRT-Connect (``ompl.rrtconnect``): the hybrids' escape planner, handed to
     their factories as ``escape_planner``; ``ompl`` is imported on first use."""
@@ -224,6 +239,8 @@ def _entries() -> dict[str, PlannerEntry]:
             "and from goal states into the start's tip seed both trees and bias the samples",
         )
     )
+    for name, summary in TRAJOPT_PLANNERS.items():
+        entries.append(PlannerEntry(name, "plannerlab.planners.trajopt:make", summary))
     for suffix, cls in OMPL_PLANNERS.items():
         entries.append(
             PlannerEntry(
@@ -264,6 +281,7 @@ __all__ = [
     "NATIVE_PLANNERS",
     "OMPL_PLANNERS",
     "REGISTRY",
+    "TRAJOPT_PLANNERS",
     "PlanResult",
     "Planner",
     "PlannerEntry",
