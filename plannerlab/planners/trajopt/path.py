@@ -6,7 +6,7 @@ state (fixed) or free in a tip goal region. Continuous joints are kept unwrapped
 path is a curve in the joint space's cover; it is wrapped once it is returned). The
 merit of a path, for a penalty weight μ::
 
-    M(X) = S(X) + μ C(X) + w_g G(X)
+    M(X) = S(X) + μ (C(X) + w_g G(X))
 
 * **Smoothness** ``S = w_s (K−1)³ Σ_k |X[k+1] − 2 X[k] + X[k−1]|²``: the squared joint
   accelerations of the path parameterised on [0, 1] (``∫ |q''(s)|² ds`` to second order,
@@ -16,7 +16,8 @@ merit of a path, for a penalty weight μ::
   ``d_safe = margin + δ`` (the checker's margin and the optimiser's buffer δ),
   evaluated at every waypoint and at ``substeps`` states on every edge
   (``(1 − t) X[k] + t X[k+1]``), whose gradients go to both ends.
-* **Goal** (a tip region only; a goal state is the fixed last waypoint)
+* **Goal** (a tip region only; a goal state is the fixed last waypoint), a constraint
+  held by the same penalty weight as the collision hinge
   ``G = max(0, |p − p_g| / tol_p − ρ)² + max(0, θ / tol_θ − ρ)²``: the last waypoint's
   tip within ρ (``goal_depth``) of both tolerances.
 
@@ -57,8 +58,8 @@ class Evaluation:
     """The merit and its parts at one path, with what the solvers need.
 
     Attributes:
-        merit: ``S + μ C + w_g G``; ``smooth``, ``collision``, ``goal`` its parts
-            (``collision`` before μ).
+        merit: ``S + μ (C + w_g G)``; ``smooth``, ``collision``, ``goal`` its parts
+            (``collision`` and ``goal`` before their weights).
         gradient: (n,) ∇M over the free variables (waypoint-major).
         band: (2 dof + 1, n) the Gauss-Newton matrix of M in LAPACK's lower banded form
             (empty unless asked for).
@@ -221,11 +222,12 @@ class PathProblem:
         goal_val, goal_ok = 0.0, True
         if not self.joint_goal:
             goal_val, g_goal, B_goal, goal_ok = self._goal_terms(X[K - 1])
-            G_full[K - 1] += self.goal_weight * g_goal
+            wg = mu * self.goal_weight
+            G_full[K - 1] += wg * g_goal
             if want_matrix:
-                _add_block(band, self.goal_weight * B_goal, self.n_free - 1)
+                _add_block(band, wg * B_goal, self.n_free - 1)
         grad = G_full[1 : self.last_free + 1].reshape(-1)
-        merit = smooth + collision_merit + self.goal_weight * goal_val
+        merit = smooth + collision_merit + mu * self.goal_weight * goal_val
         return Evaluation(merit, smooth, collision, goal_val, grad, band, dmin, goal_ok, c_n)
 
     def _goal_terms(self, q: Array) -> tuple[float, Array, Array, bool]:

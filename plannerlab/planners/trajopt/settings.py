@@ -44,7 +44,8 @@ class TrajOptSettings:
         buffer_m: δ, how far beyond the checker's margin the hinge starts [m]; None:
             derived from the robot (Arm-Z: 4 cm, the Panda 1.8 cm).
         smooth_weight: w_s, the weight of the squared accelerations.
-        goal_weight: w_g, the weight of a tip goal region's residuals.
+        goal_weight: w_g, the weight of a tip goal region's residuals beside the
+            collision hinge's (both grow with the penalty weight).
         goal_depth: ρ, how deep in the region (fraction of each tolerance) the last
             waypoint's tip is drawn.
         penalty_start, penalty_growth, max_penalty, feasible_fraction, rel_tol,
@@ -67,7 +68,7 @@ class TrajOptSettings:
     substeps: int = 1
     buffer_m: float = DERIVED
     smooth_weight: float = 1.0
-    goal_weight: float = 100.0
+    goal_weight: float = 10.0
     goal_depth: float = 0.5
     penalty_start: float = 10.0
     penalty_growth: float = 10.0

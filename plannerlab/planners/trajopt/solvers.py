@@ -2,7 +2,7 @@
 PathProblem`), each inside the same penalty loop.
 
 **The penalty loop** (TrajOpt's, Schulman et al. 2014, with squared hinges): the merit
-``S + μ C + w_g G`` is lowered at a penalty weight μ until the solver converges; if the
+``S + μ (C + w_g G)`` is lowered at a penalty weight μ until the solver converges; if the
 path is then not feasible (a state closer than ``margin + feasible_fraction · δ``, or the
 goal not reached) μ grows by ``penalty_growth`` and the solver goes on from there, up to
 ``max_penalty``.
