@@ -35,6 +35,7 @@ Run::
     PYTHONPATH=. .venv/bin/python bench/trajopt_bench.py /tmp/mbm [--execute] [--solvers]
         [--planners trajopt.line+rrtconnect,trajopt.rrtconnect] [--per-scenario 20]
         [--time-limit 10] [--vamp-python ~/.cache/vamp-peer/venv/bin/python]
+        [--rows rows.jsonl]   # each solve as it ends; a rerun resumes from them
 """
 
 from __future__ import annotations
@@ -147,14 +148,19 @@ def mbm(args: argparse.Namespace) -> list[str]:
     problems = load_problems(args, args.per_scenario)
     budget = Budget(time_limit_s=args.time_limit)
     names = [BASELINE, *[n for n in args.planners.split(",") if n and n != BASELINE]]
+    runs: dict[str, list[dict[str, Any]]] = {n: [] for n in names}
+    done = _rows_done(args.rows)
     planners = {n: make_planner(n) for n in names}
     for n in names:  # warm-up, untimed (compiled kernels)
         planners[n].solve(problems[0], 0, budget, np.random.default_rng(10**6))
     load0 = os.getloadavg()
-    runs: dict[str, list[dict[str, Any]]] = {n: [] for n in names}
     for i, p in enumerate(problems):
         for n in names:
-            runs[n].append(solve_once(planners[n], p, budget, i, args.execute))
+            row = done.get((p.name, n))
+            if row is None:
+                row = solve_once(planners[n], p, budget, i, args.execute)
+                _append_row(args.rows, {"problem": p.name, "planner": n, **row})
+            runs[n].append(row)
         if (i + 1) % 10 == 0:
             print(f"  {i + 1}/{len(problems)} problems (load {os.getloadavg()[0]:.1f})", flush=True)
     load1 = os.getloadavg()
@@ -217,6 +223,21 @@ def mbm(args: argparse.Namespace) -> list[str]:
             out += ["", f"`{n}` not executed cleanly: " + "; ".join(unclean)]
     out += vamp_rows(args, problems, invalid)
     return out
+
+
+def _rows_done(path: Path | None) -> dict[tuple[str, str], dict[str, Any]]:
+    """The rows of an earlier, interrupted run (``--rows``), by (problem, planner)."""
+    if path is None or not path.exists():
+        return {}
+    rows = [json.loads(line) for line in path.read_text().splitlines() if line.strip()]
+    return {(r["problem"], r["planner"]): r for r in rows}
+
+
+def _append_row(path: Path | None, row: dict[str, Any]) -> None:
+    """One problem's row, appended (a run that is stopped resumes from its rows)."""
+    if path is not None:
+        with path.open("a") as f:
+            f.write(json.dumps(row) + "\n")
 
 
 def vamp_rows(args: argparse.Namespace, problems: list[Any], invalid: set[str]) -> list[str]:
@@ -324,6 +345,9 @@ def main() -> None:
     ap.add_argument("--solvers", action="store_true", help="(c): the solvers side by side")
     ap.add_argument("--solver-problems", type=int, default=5)
     ap.add_argument("--skip-mbm", action="store_true")
+    ap.add_argument(
+        "--rows", type=Path, help="JSON lines of each solve: written as it goes, read on a rerun"
+    )
     ap.add_argument("--vamp-python", default="~/.cache/vamp-peer/venv/bin/python")
     ap.add_argument("--vamp-sdist", type=Path, default=VAMP_SDIST)
     args = ap.parse_args()
