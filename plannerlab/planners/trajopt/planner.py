@@ -36,6 +36,7 @@ import numpy as np
 
 from plannerlab.errors import PlannerlabError
 from plannerlab.planners.base import PlanResult, Status, with_overrides
+from plannerlab.planners.clearance.field import SetupStopped
 from plannerlab.planners.context import LegPlanner, PlanningContext
 from plannerlab.planners.trajopt.path import PathProblem
 from plannerlab.planners.trajopt.seeds import (
@@ -147,10 +148,14 @@ class _Solve:
             raise PlannerlabError(
                 f"{self.planner.name}: no compiled model of this problem: {e}"
             ) from e
-        except PlannerlabError as e:
-            if "time is up" in str(e):
-                return self.result(Status.BUDGET_EXHAUSTED, str(e), start)
-            raise
+        except SetupStopped as e:
+            limit = self.tracker.budget.time_limit_s
+            return self.result(
+                Status.BUDGET_EXHAUSTED,
+                f"{self.planner.name}: time limit of {limit:g} s reached while building the "
+                f"sphere field ({e})",
+                start,
+            )
         reach = self.checker.reach_m
         self.reach = None if reach is None else np.asarray(reach, dtype=float)
         self.extra.update(seeds=[], attempts=0)
@@ -198,6 +203,14 @@ class _Solve:
                 {"seed": name, "status": None if r is None else r.status.value}
             )
             if seed is None:
+                if r is None or r.status is Status.BUDGET_EXHAUSTED:
+                    # the leg's budget (or the seed's share of it) ran out in the seed
+                    why = "the budget was used up" if r is None else r.reason
+                    yield self.result(
+                        Status.BUDGET_EXHAUSTED,
+                        f"{self.planner.name}: the {name} seed found no path ({why})",
+                        self.q0[None],
+                    )
                 return
             if name == "gradient" and not bool(self.goal.contains(self.robot, seed.path[-1])):
                 goals = self.goal_states(seed.path[-1])

@@ -12,9 +12,9 @@ the short way round), resampled to K waypoints at equal motion (:func:`resample`
   ``native.rrtconnect+leader``, re-checked by them.
 
 The seed planners run as sub-solves in the leg's context (``ctx.sub``: the same checker,
-a child tracker with ``seed_share`` of what the leg has left; their iterations are the
-leg's). A restart bends a seed by a smooth random bump drawn from the trial's generator
-(:func:`bumped`).
+a child tracker with ``seed_share`` of what the leg has left, all of it by default; their
+iterations are the leg's). A restart bends a seed by a smooth random bump drawn from the
+trial's generator (:func:`bumped`).
 """
 
 from __future__ import annotations
