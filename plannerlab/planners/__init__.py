@@ -93,6 +93,21 @@ NATIVE_PLANNERS: Mapping[str, str] = MappingProxyType(
 )
 
 
+#: trajectory optimisers over whole paths (``plannerlab.planners.trajopt``): name -> summary
+TRAJOPT_PLANNERS: Mapping[str, str] = MappingProxyType(
+    {
+        "trajopt.line": "trajectory optimisation of the whole path (squared accelerations "
+        "under a collision hinge, Gauss-Newton on the banded structure) from the straight "
+        "line to each goal state, random restarts",
+        "trajopt.gradient": "trajectory optimisation seeded by the paper's gradient descent",
+        "trajopt.rrtconnect": "trajectory optimisation seeded by native.rrtconnect's path",
+        "trajopt.leader": "trajectory optimisation seeded by native.rrtconnect+leader's path",
+        "trajopt.line+rrtconnect": "trajopt.line, then native.rrtconnect's path as the "
+        "seed when no line seed gives a path",
+    }
+)
+
+
 # ---------------------------------------------------------------- entry points
 def _gradient(name: str, overrides: Mapping[str, Any], **options: Any) -> Planner:
     from plannerlab.planners.gradient import make
@@ -138,6 +153,12 @@ def _native_leader(name: str, overrides: Mapping[str, Any], **options: Any) -> P
 
 def _ompl(name: str, overrides: Mapping[str, Any], **options: Any) -> Planner:
     from plannerlab.planners.ompl.planner import make
+
+    return make(name, dict(overrides), **options)
+
+
+def _trajopt(name: str, overrides: Mapping[str, Any], **options: Any) -> Planner:
+    from plannerlab.planners.trajopt.planner import make
 
     return make(name, dict(overrides), **options)
 
@@ -285,6 +306,8 @@ def _entries() -> dict[str, PlannerEntry]:
             "and from goal states into the start's tip seed both trees and bias the samples",
         )
     )
+    for name, summary in TRAJOPT_PLANNERS.items():
+        entries.append(PlannerEntry(name, _trajopt, summary))
     for suffix, cls in OMPL_PLANNERS.items():
         entries.append(
             PlannerEntry(
@@ -323,6 +346,7 @@ __all__ = [
     "NATIVE_PLANNERS",
     "OMPL_PLANNERS",
     "REGISTRY",
+    "TRAJOPT_PLANNERS",
     "PlanResult",
     "Planner",
     "PlannerEntry",

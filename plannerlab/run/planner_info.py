@@ -38,6 +38,11 @@ SUITS: tuple[tuple[str, str], ...] = (
         "chains): sampling compiled end to end; tip or joint goals",
     ),
     (
+        "trajopt.",
+        "any chain with a compiled model and a tip (6-7-joint arms, hyper-redundant "
+        "chains): smooth whole paths, optimised from seeds; tip or joint goals",
+    ),
+    (
         "ompl.",
         "any joint-space robot: 6-7-joint arms (Panda, IRb-6 on its track), "
         "hyper-redundant chains; tip or joint goals",
