@@ -74,9 +74,10 @@ from plannerlab.planners.base import (
 from plannerlab.planners.clearance import SetupStopped
 from plannerlab.planners.clearance.descent import ClearanceDescent, ClearanceSettings, LegPath
 from plannerlab.planners.clearance.settings import DERIVED, resolve_distances
+from plannerlab.planners.clearance.slide import sees
 from plannerlab.planners.context import LegPlanner, PlanningContext
 from plannerlab.planners.follow_leader import moves as leader_moves
-from plannerlab.planners.follow_leader.grid import TipPath, scene_distance_m, tip_path
+from plannerlab.planners.follow_leader.grid import TipPath, tip_path
 from plannerlab.planners.follow_leader.moves import Track, crosses_body
 from plannerlab.problem.goals import GoalRegion
 from plannerlab.robots.base import Array, joint_difference
@@ -382,14 +383,17 @@ class FollowLeader(LegPlanner):
         goal, robot = ctx.goal, ctx.robot
         p_tip, _ = robot.tip(q)
         approach = goal.p_world_m - s.approach_m * goal.n_world
-        clearance = (
-            float(np.asarray(robot.link_radii_m)[-1])
+        return sees(ctx.scene, p_tip, approach, self.leader_clearance_m(ctx))
+
+    def leader_clearance_m(self, ctx: PlanningContext) -> float:
+        """The clearance the leader's path keeps from the scene [m]: the tip module's
+        radius, the problem's safety margin and ``extra_clearance_m``."""
+        s = self.for_robot(ctx.robot).settings
+        return (
+            float(np.asarray(ctx.robot.link_radii_m)[-1])
             + ctx.problem.safety_margin_m
             + s.extra_clearance_m
         )
-        n = max(2, int(np.ceil(np.linalg.norm(approach - p_tip) / 0.1)) + 1)
-        line = p_tip + np.linspace(0.0, 1.0, n)[:, None] * (approach - p_tip)
-        return bool(scene_distance_m(ctx.scene, line).min() >= clearance)
 
     def retract(self, ctx: PlanningContext, q0: Array, used: int = 0) -> Track:
         """:func:`plannerlab.planners.follow_leader.moves.retract` with this planner (its derived
