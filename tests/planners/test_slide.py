@@ -14,6 +14,7 @@ from plannerlab.planners import make_planner
 from plannerlab.planners.clearance.settings import robot_size
 from plannerlab.planners.clearance.slide import (
     deep_inside,
+    openness,
     pivot_face,
     sees,
     sight_clearance_m,
@@ -108,16 +109,31 @@ def test_the_tip_alone_coils_the_body_inside(v29):
     assert not sees(problem.scene, problem.robot.fk(end)[-1, :3, 3], target, clearance)
 
 
-def test_deep_inside_is_a_third_of_the_body_beyond_the_pivot(v29):
+def test_deep_inside_is_a_third_of_the_body_beyond_the_pivot_and_the_tip_enclosed(v29):
+    """From B: 15 of 30 faces beyond the pivot, the tip's rays (a third of the body long)
+    open in 1 of 26 directions, the approach point's in all. The traps' straight column
+    is not deep inside: on armz_thin_wall a quarter of it lies beyond the pivot; on
+    armz_deep_e more than half does, but its tip is in the open and the approach point
+    inside the room."""
     problem, q_b = v29
     target, clearance, _ = _target(problem)
-    assert deep_inside(problem.scene, problem.robot.fk(q_b)[:, :3, 3], target, clearance)
-    trap = load_problem("armz_thin_wall")  # the straight column: 6 of 24 beyond the pivot
-    goal = trap.goal(0)
-    faces = trap.robot.fk(trap.q_start)[:, :3, 3]
-    tgt = goal.p_world_m - 2.5 * goal.n_world
-    assert pivot_face(trap.scene, faces, tgt, clearance) == 18
-    assert not deep_inside(trap.scene, faces, tgt, clearance)
+
+    def deep(problem, q, target):
+        faces = problem.robot.fk(q)[:, :3, 3]
+        reach = float(np.sum(np.linalg.norm(np.diff(faces, axis=0), axis=1)))
+        return deep_inside(problem.scene, faces, target, clearance, reach / 3)
+
+    faces = problem.robot.fk(q_b)[:, :3, 3]
+    assert openness(problem.scene, faces[-1], clearance / 2, 7.0) < 0.1
+    assert openness(problem.scene, target, clearance / 2, 7.0) == 1.0
+    assert deep(problem, q_b, target)
+    for name, pivot in (("armz_thin_wall", 18), ("armz_deep_e", 11)):
+        trap = load_problem(name)
+        goal = trap.goal(0)
+        tgt = goal.p_world_m - 2.5 * goal.n_world
+        column = trap.robot.fk(trap.q_start)[:, :3, 3]
+        assert pivot_face(trap.scene, column, tgt, clearance) == pivot, name
+        assert not deep(trap, trap.q_start, tgt), name
 
 
 def test_no_slide_where_the_tip_sees_the_target(v29):

@@ -426,7 +426,9 @@ class ClearanceDescent(DescentStep, LegPlanner):
         stalls within 0.5 m on two of three variants, from the start it gets out;
         ``results/leave.md``)."""
         target, clearance, _ = self._slide_target(ctx)
-        if not deep_inside(ctx.scene, np.asarray(ctx.robot.fk(q0))[:, :3, 3], target, clearance):
+        faces = np.asarray(ctx.robot.fk(q0))[:, :3, 3]
+        reach = float(np.sum(np.linalg.norm(np.diff(faces, axis=0), axis=1)))
+        if not deep_inside(ctx.scene, faces, target, clearance, reach / 3.0):
             return None, 0, "not deep inside"
         sl = self._slide(ctx, q0, used)
         iterations = sl.iterations

@@ -150,15 +150,37 @@ def pivot_face(scene: Scene, faces_m: Array, target_m: Array, clearance_m: float
     return k
 
 
-def deep_inside(scene: Scene, faces_m: Array, target_m: Array, clearance_m: float) -> bool:
-    """Whether more than a third of the body lies beyond its pivot (:func:`pivot_face`):
-    the body is deep inside something and its tip's way out runs back along it (the rule
-    of follow-the-leader's ``crosses_body``: a third of the body). Measured: the
-    clearance descent's tip retract leaves every far-wall variant with up to 0.46 of the
-    body beyond the pivot and fails all six above it (0.50-0.56); ``results/leave.md``."""
+def openness(scene: Scene, p_m: Array, clearance_m: float, length_m: float) -> float:
+    """The share of 26 directions (the grid's neighbours) in which a ray from ``p_m``
+    keeps ``clearance_m`` from the scene for ``length_m`` [m]: near 1 in the open, small
+    inside a room (its rays end on the walls, but for those through the window)."""
+    d = np.array([(i, j, k) for i in (-1, 0, 1) for j in (-1, 0, 1) for k in (-1, 0, 1)])
+    d = d[np.any(d != 0, axis=1)] / np.linalg.norm(d[np.any(d != 0, axis=1)], axis=1)[:, None]
+    steps = np.linspace(0.0, length_m, max(2, int(np.ceil(length_m / 0.1)) + 1))
+    pts = np.asarray(p_m, dtype=float) + steps[None, :, None] * d[:, None, :]
+    dist = scene_distance_m(scene, pts.reshape(-1, 3)).reshape(len(d), len(steps))
+    return float(np.mean(dist.min(axis=1) >= clearance_m))
+
+
+def deep_inside(
+    scene: Scene, faces_m: Array, target_m: Array, clearance_m: float, length_m: float
+) -> bool:
+    """Whether the body is deep inside something the target is outside of: its tip is
+    more enclosed than the target (:func:`openness`, rays of ``length_m``: a third of the
+    body), and more than a third of the body lies beyond its pivot
+    (:func:`pivot_face`; the rule of follow-the-leader's ``crosses_body``: a third of the
+    body). A column standing before a room whose goal is inside is not: its tip is in the
+    open. Measured: the clearance descent's tip retract leaves every far-wall variant with
+    up to 0.46 of the body beyond the pivot and fails all six above it (0.50-0.56);
+    ``results/leave.md``."""
     pivot = pivot_face(scene, faces_m, target_m, clearance_m)
     n = len(faces_m) - 1
-    return pivot >= 0 and (n - pivot) * 3 > n
+    if pivot < 0 or (n - pivot) * 3 <= n:
+        return False
+    radius = clearance_m / 2.0
+    return openness(scene, faces_m[-1], radius, length_m) < openness(
+        scene, target_m, radius, length_m
+    )
 
 
 def _faces(robot, Q: Array) -> Array:

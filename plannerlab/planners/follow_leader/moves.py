@@ -46,10 +46,13 @@ class Track:
 
 def crosses_body(robot: Any, q: Array, leader: TipPath, step_m: float = 0.1) -> bool:
     """Whether the leader's path from the tip of ``q`` runs back through the body of
-    ``q``: a point of the path inside the capsule of a module more than a third of the
-    body behind the tip. (Near the tip every path touches the body: the tip turns.)
+    ``q``: a point of the path where the tip module, whose axis follows the path, would
+    touch a module more than a third of the body behind the tip (closer to that module's
+    axis than the two radii). (Near the tip every path touches the body: the tip turns.)
     The voxel grid knows the scene, not the body: deep in a room, the way out for the
-    tip leads back through the window its own body fills."""
+    tip leads back through the window its own body fills. (Until issue 33 a path point
+    had to lie inside the module's capsule, which a path running beside the body through
+    the window never does: ``armz_inspection_v29``, ``results/leave.md``.)"""
     F = robot.fk(q)
     faces = F[:, :3, 3]
     radii = np.asarray(robot.link_radii_m, dtype=float)
@@ -67,7 +70,27 @@ def crosses_body(robot: Any, q: Array, leader: TipPath, step_m: float = 0.1) -> 
     closest = a[None] + np.clip(t, 0.0, 1.0)[..., None] * ab[None]
     d = np.linalg.norm(p[:, None, :] - closest, axis=2)  # (m, behind)
     r = np.resize(radii, behind) if len(radii) < behind else radii[:behind]
-    return bool(np.any(d < r[None, :]))
+    return bool(np.any(d < r[None, :] + radii[-1]))
+
+
+def leaves_from_inside(fl: FollowLeader, ctx: PlanningContext, q: Array, leader: Any) -> bool:
+    """Whether leaving from ``q`` starts with the retract: the tip does not see the leg
+    goal's approach point, and the leader's path runs back through the body
+    (:func:`crosses_body`) or the body is deep inside something the approach point is
+    outside of (:func:`~plannerlab.planners.clearance.slide.deep_inside`). Otherwise the
+    forward tries come first (measured: on ``armz_inspection_v25``, ``v29`` and ``v44``
+    the forward tracking spent 3-6 s before the retract got out)."""
+    from plannerlab.planners.clearance.slide import deep_inside
+
+    if fl.sees_approach(ctx, q):
+        return False
+    if leader is not None and crosses_body(ctx.robot, q, leader):
+        return True
+    s, goal = fl.settings, ctx.goal
+    faces = np.asarray(ctx.robot.fk(q))[:, :3, 3]
+    reach = float(np.sum(np.linalg.norm(np.diff(faces, axis=0), axis=1)))
+    target = goal.p_world_m - s.approach_m * goal.n_world
+    return deep_inside(ctx.scene, faces, target, fl.leader_clearance_m(ctx), reach / 3.0)
 
 
 def track(

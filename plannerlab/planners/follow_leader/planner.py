@@ -40,13 +40,16 @@ follow-the-leader:
    across the room and out through the window that its own body fills, and the tracking
    stalls at the second sub-goal (measured on the far-ended variants
    ``problems/variants/armz_inspection_v21`` … ``v39``, leaving from B: 5 of 10 stall
-   so; ``gradient.clearance+detour`` stalls at its eighth iteration and no retract of its
-   detour works on 6 of 10). What got the body in gets it out: the body lies on the curve
-   its tip came in by, so the tip is drawn back along the start's own body
-   (:meth:`FollowLeader.retract`: sub-goals at its faces from the tip's towards the
-   base's, each looking along the body) until it sees the goal's approach point, then
-   the leader's path from there. It comes first when the leader's path runs back
-   through the body (:func:`crosses_body`), else after the forward tries.
+   so). What got the body in gets it out: the body lies on the curve its tip came in by,
+   so it slides back out along that curve, every face inside at once, while the faces
+   outside take up the length (:meth:`FollowLeader.retract`, the slide of
+   :mod:`plannerlab.planners.clearance.slide`; the tip alone drawn back face by face, the
+   retract before issue 33, is its fallback: it coils the body inside the room), until
+   the tip sees the goal's approach point, then the leader's path from there. It comes
+   first when the leader's path runs back through the body (:func:`crosses_body`) or the
+   body is deep inside something the approach point is outside of
+   (:func:`~plannerlab.planners.follow_leader.moves.leaves_from_inside`), else after the
+   forward tries.
 
 The search and the tracking are deterministic (``gradient.follow_leader``: its seeds are
 one run). The randomised variant (``+random``, ``random_grid``) shifts the voxel grid by
@@ -78,7 +81,7 @@ from plannerlab.planners.clearance.slide import sees
 from plannerlab.planners.context import LegPlanner, PlanningContext
 from plannerlab.planners.follow_leader import moves as leader_moves
 from plannerlab.planners.follow_leader.grid import TipPath, tip_path
-from plannerlab.planners.follow_leader.moves import Track, crosses_body
+from plannerlab.planners.follow_leader.moves import Track
 from plannerlab.problem.goals import GoalRegion
 from plannerlab.robots.base import Array, joint_difference
 
@@ -466,9 +469,7 @@ class FollowLeader(LegPlanner):
                 s.retract
                 and not retracted
                 and attempt == 0
-                and leader is not None
-                and crosses_body(robot, q0, leader)
-                and not self.sees_approach(ctx, q0)
+                and leader_moves.leaves_from_inside(self, ctx, q0, leader)
             ):
                 # the leader leads the tip back through its own body: retract first
                 out = retract_from_start()

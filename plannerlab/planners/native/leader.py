@@ -50,7 +50,7 @@ from plannerlab.errors import PlannerlabError
 from plannerlab.planners.base import PlanResult, Status, with_overrides
 from plannerlab.planners.clearance.descent import ClearanceSettings
 from plannerlab.planners.context import PlanningContext
-from plannerlab.planners.follow_leader.moves import Track, crosses_body
+from plannerlab.planners.follow_leader.moves import Track, leaves_from_inside
 from plannerlab.planners.follow_leader.planner import FollowLeader, FollowLeaderSettings
 from plannerlab.planners.native import kernels as K
 from plannerlab.planners.native.planner import NativePlanner, _check_settings
@@ -233,12 +233,7 @@ def build_guidance(
         lead = leader.leader_path(
             ctx.problem, ctx.leg, q0, rng, lambda: tracker.exhausted(used) is not None
         )
-        if (
-            s.retract
-            and lead is not None
-            and crosses_body(robot, q0, lead)
-            and not leader.sees_approach(ctx, q0)
-        ):
+        if s.retract and leaves_from_inside(leader, ctx, q0, lead):
             # the leader's path runs back through the body: the retract branch first
             log["retract_first"] = True
             retract_branch()
