@@ -252,6 +252,7 @@ def run_trial(trial: Trial) -> dict[str, Any]:
     (the task has failed there; ``legs_run`` shows how far it got).
     """
     t0 = time.perf_counter()
+    cpu0 = time.process_time()
     ompl_seeded = _seed_ompl(trial.seed)  # first: before any OMPL object exists
     from plannerlab.record.files import versions
 
@@ -319,6 +320,8 @@ def run_trial(trial: Trial) -> dict[str, Any]:
     rec["versions"] = versions()
     rec["pid"] = os.getpid()
     rec["wall_s"] = time.perf_counter() - t0
+    # the trial's own CPU time: its wall time on a machine with a core to spare for it
+    rec["cpu_s"] = time.process_time() - cpu0
     rec["finished_at"] = datetime.now(UTC).isoformat(timespec="seconds")
     return rec
 
