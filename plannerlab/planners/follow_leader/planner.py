@@ -378,6 +378,31 @@ class FollowLeader(LegPlanner):
         fl = self.for_robot(ctx.robot)
         return leader_moves.track(fl, ctx, q0, goal, rng, used, leader)
 
+    def detour_from(
+        self, ctx: PlanningContext, q: Array, rng: np.random.Generator, used: int = 0
+    ) -> Track:
+        """The clearance descent's plan from ``q`` with its detour escape (the ``+detour``
+        variant's escape from a stalled finish), a sub-solve in the leg's context with
+        what the leg has left (``used``: its iterations so far)."""
+        fl = self.for_robot(ctx.robot)
+        tracker = ctx.tracker
+        sub = tracker.remaining(limit_iterations=False)
+        if sub is None:
+            why = str(tracker.exhausted(used) or "no budget left")
+            return Track(None, Status.BUDGET_EXHAUSTED, why, [np.array(q)], 0)
+        b = tracker.budget
+        if b.max_iterations is not None:
+            sub = sub.replace(max_iterations=max(b.max_iterations - used, 1))
+        r = fl._detour.plan(ctx.sub(sub, np.array(q)), rng)
+        return Track(None, r.status, r.reason, list(r.path), r.iterations)
+
+    def near_goal_state(self, ctx: PlanningContext, q: Array) -> Array | None:
+        """A collision-free state in the leg's goal region near ``q``: the finish
+        descent's :meth:`~plannerlab.planners.clearance.descent.ClearanceDescent.
+        near_goal_state` (the leg's descent from ``q`` with its path unchecked)."""
+        out: Array | None = self.for_robot(ctx.robot)._finish.near_goal_state(ctx, q)
+        return out
+
     def sees_approach(self, ctx: PlanningContext, q: Array) -> bool:
         """Whether the straight line from the tip of ``q`` to the leg goal's approach
         point keeps the leader's clearance from the scene (the retract has got the tip

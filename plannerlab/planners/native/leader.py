@@ -17,10 +17,13 @@ stops when they are spent):
    follow_leader.FollowLeader.track`: the leader's tip path on a voxel grid shifted by a
    random fraction of a voxel, its centring weight scaled at random, tracked by the
    clearance descent, then the descent into the goal). The body states it passes through
-   are a branch of the start tree (their edges re-checked on the search's grid first).
-2. **Goal states**: the forward branch's end when it reached the goal, the problem's
-   start state when it lies in the goal region (a task that ends at rest), and the goal
-   pool's IK states (``goal_samples``) when those give none.
+   are a branch of the start tree (their edges re-checked on the search's grid first);
+   where a branch stalls, the clearance descent's detour from there is one more
+   (``detour``).
+2. **Goal states**: the forward branch's end when it reached the goal; else goal states
+   near where the branches ended (``near_goals``: the leg's descent from there, its path
+   unchecked); the problem's start state when it lies in the goal region (a task that
+   ends at rest); and the goal pool's IK states (``goal_samples``) when those give none.
 3. **Backwards** ("what gets a body in gets it out"): from each of ``backward_goals`` goal
    states, follow-the-leader into the start's tip pose (its tip, looking along the start
    tip's normal), unless the forward branch already reached the goal. Its states are a
@@ -86,6 +89,20 @@ class LeaderSettings(RRTConnectSettings):
         backward_goals: goal states to go backwards from, at most.
         guide_stride: every this many states of a branch (thinned to every 8th state of
             the descent) is a guide state.
+        detour: when no branch reached the goal, from where each ended the clearance
+            descent's detour (``gradient.follow_leader+detour``'s escape: the tip drawn
+            back 2, 4, ... modules along the body, each followed by the leg's descent), a
+            branch of the start tree (measured: ``armz_inspection_v28`` and ``v34``, leg E
+            from C's witness: the forward branch's finish stalls by E, the detour gets in
+            from there, RRT-Connect did not in 30 s).
+        near_goals: when no branch reached the goal, goal states near where each branch
+            ended (the leg's descent from there with its path unchecked,
+            :meth:`~plannerlab.planners.clearance.descent.ClearanceDescent.near_goal_state`)
+            root the goal tree, before the goal pool's IK states (used only when there
+            is none): the IK's goal states lie far from the branches in joint space
+            (measured: ``armz_inspection_v28`` and ``v34``, leg E from C's witness, the
+            forward branch stalls 0.1 m from E and the trees do not join in 30 s from four
+            IK goal states).
         leader_max_replans: new leader paths the forward tracking draws from a stall.
     """
 
@@ -97,6 +114,8 @@ class LeaderSettings(RRTConnectSettings):
     backward_goals: int = 2
     guide_stride: int = 1
     leader_max_replans: int = 0
+    detour: bool = True
+    near_goals: bool = True
 
 
 @dataclass(frozen=True)
@@ -206,6 +225,7 @@ def build_guidance(
     chains: list[Array] = [q0[None]]
     reached: list[Array] = []
     reached_nodes: list[int] = []
+    ends: list[tuple[int, Array]] = []  # where the branches that missed the goal ended
 
     def out_of_budget() -> PlanResult | None:
         why = tracker.exhausted(used)
@@ -222,12 +242,21 @@ def build_guidance(
         if tr.status is Status.SOLVED and whole and bool(goal.contains(robot, chain[-1])):
             reached.append(chain[-1])
             reached_nodes.append(end)
+        else:
+            ends.append((end, chain[-1]))
         return end
+
+    def detour(node: int, key: str) -> None:
+        """The clearance descent's detour from where a branch stalled (its tip drawn back
+        along its body, then the leg's descent): a branch of the start tree."""
+        if s.detour and not reached and tracker.exhausted(used) is None:
+            grow_start(node, leader.detour_from(ctx, A.Q[node], rng, used), key)
 
     def retract_branch() -> None:
         end = grow_start(0, leader.retract(ctx, q0, used), "retract")
         if tracker.exhausted(used) is None:
-            grow_start(end, leader.track(ctx, A.Q[end], goal, rng, used), "after_retract")
+            end = grow_start(end, leader.track(ctx, A.Q[end], goal, rng, used), "after_retract")
+            detour(end, "detour_after_retract")
 
     if s.forward:
         lead = leader.leader_path(
@@ -238,7 +267,8 @@ def build_guidance(
             log["retract_first"] = True
             retract_branch()
         if not reached and tracker.exhausted(used) is None:
-            grow_start(0, leader.track(ctx, q0, goal, rng, used, leader=lead), "forward")
+            end = grow_start(0, leader.track(ctx, q0, goal, rng, used, leader=lead), "forward")
+            detour(end, "detour_after_forward")
         if not reached and s.retract and "retract" not in log and tracker.exhausted(used) is None:
             # leaving from deep inside: the tip drawn back along its own body, then the
             # leader from there (a second branch of the start tree)
@@ -247,6 +277,18 @@ def build_guidance(
     if failed is not None:
         return failed
     goal_states = list(reached)
+    if not reached and s.near_goals:
+        # goal states near where the branches stalled: the leg's descent from there with
+        # its path unchecked (the clearance still steers), checked at its end
+        near = []
+        for _, q_end in ends:
+            if tracker.exhausted(used) is not None:
+                break
+            g = leader.near_goal_state(ctx, q_end)
+            if g is not None:
+                near.append(wrap_to_pi(np.asarray(g, dtype=float), robot.continuous))
+        log["near_goals"] = len(near)
+        goal_states.extend(near)
     q_rest = wrap_to_pi(np.asarray(ctx.problem.q_start, dtype=float), robot.continuous)
     if bool(goal.contains(robot, q_rest)) and ctx.checker.is_valid(q_rest):
         goal_states.append(q_rest)
