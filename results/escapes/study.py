@@ -42,6 +42,7 @@ from __future__ import annotations
 import argparse
 import json
 import os
+import signal
 import subprocess
 import sys
 import time
@@ -205,6 +206,10 @@ def cmd_run(args: argparse.Namespace) -> int:
                 flush=True,
             )
 
+    def stop(signum: int, frame: Any) -> None:
+        raise KeyboardInterrupt  # the runner stops its trials; the store keeps the rest
+
+    signal.signal(signal.SIGTERM, stop)
     run = run_comparison(
         [t for t, _ in grid],
         TrialStore(out / "trials.jsonl"),

@@ -396,13 +396,6 @@ class FollowLeader(LegPlanner):
         r = fl._detour.plan(ctx.sub(sub, np.array(q)), rng)
         return Track(None, r.status, r.reason, list(r.path), r.iterations)
 
-    def near_goal_state(self, ctx: PlanningContext, q: Array) -> Array | None:
-        """A collision-free state in the leg's goal region near ``q``: the finish
-        descent's :meth:`~plannerlab.planners.clearance.descent.ClearanceDescent.
-        near_goal_state` (the leg's descent from ``q`` with its path unchecked)."""
-        out: Array | None = self.for_robot(ctx.robot)._finish.near_goal_state(ctx, q)
-        return out
-
     def sees_approach(self, ctx: PlanningContext, q: Array) -> bool:
         """Whether the straight line from the tip of ``q`` to the leg goal's approach
         point keeps the leader's clearance from the scene (the retract has got the tip

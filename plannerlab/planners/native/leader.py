@@ -20,10 +20,9 @@ stops when they are spent):
    are a branch of the start tree (their edges re-checked on the search's grid first);
    where a branch stalls, the clearance descent's detour from there is one more
    (``detour``).
-2. **Goal states**: the forward branch's end when it reached the goal; else goal states
-   near where the branches ended (``near_goals``: the leg's descent from there, its path
-   unchecked); the problem's start state when it lies in the goal region (a task that
-   ends at rest); and the goal pool's IK states (``goal_samples``) when those give none.
+2. **Goal states**: the forward branch's end when it reached the goal, the problem's
+   start state when it lies in the goal region (a task that ends at rest), and the goal
+   pool's IK states (``goal_samples``) when those give none.
 3. **Backwards** ("what gets a body in gets it out"): from each of ``backward_goals`` goal
    states, follow-the-leader into the start's tip pose (its tip, looking along the start
    tip's normal), unless the forward branch already reached the goal. Its states are a
@@ -95,14 +94,6 @@ class LeaderSettings(RRTConnectSettings):
             branch of the start tree (measured: ``armz_inspection_v28`` and ``v34``, leg E
             from C's witness: the forward branch's finish stalls by E, the detour gets in
             from there, RRT-Connect did not in 30 s).
-        near_goals: when no branch reached the goal, goal states near where each branch
-            ended (the leg's descent from there with its path unchecked,
-            :meth:`~plannerlab.planners.clearance.descent.ClearanceDescent.near_goal_state`)
-            root the goal tree, before the goal pool's IK states (used only when there
-            is none): the IK's goal states lie far from the branches in joint space
-            (measured: ``armz_inspection_v28`` and ``v34``, leg E from C's witness, the
-            forward branch stalls 0.1 m from E and the trees do not join in 30 s from four
-            IK goal states).
         leader_max_replans: new leader paths the forward tracking draws from a stall.
     """
 
@@ -115,7 +106,6 @@ class LeaderSettings(RRTConnectSettings):
     guide_stride: int = 1
     leader_max_replans: int = 0
     detour: bool = True
-    near_goals: bool = True
 
 
 @dataclass(frozen=True)
@@ -225,7 +215,6 @@ def build_guidance(
     chains: list[Array] = [q0[None]]
     reached: list[Array] = []
     reached_nodes: list[int] = []
-    ends: list[tuple[int, Array]] = []  # where the branches that missed the goal ended
 
     def out_of_budget() -> PlanResult | None:
         why = tracker.exhausted(used)
@@ -242,8 +231,6 @@ def build_guidance(
         if tr.status is Status.SOLVED and whole and bool(goal.contains(robot, chain[-1])):
             reached.append(chain[-1])
             reached_nodes.append(end)
-        else:
-            ends.append((end, chain[-1]))
         return end
 
     def detour(node: int, key: str) -> None:
@@ -277,18 +264,6 @@ def build_guidance(
     if failed is not None:
         return failed
     goal_states = list(reached)
-    if not reached and s.near_goals:
-        # goal states near where the branches stalled: the leg's descent from there with
-        # its path unchecked (the clearance still steers), checked at its end
-        near = []
-        for _, q_end in ends:
-            if tracker.exhausted(used) is not None:
-                break
-            g = leader.near_goal_state(ctx, q_end)
-            if g is not None:
-                near.append(wrap_to_pi(np.asarray(g, dtype=float), robot.continuous))
-        log["near_goals"] = len(near)
-        goal_states.extend(near)
     q_rest = wrap_to_pi(np.asarray(ctx.problem.q_start, dtype=float), robot.continuous)
     if bool(goal.contains(robot, q_rest)) and ctx.checker.is_valid(q_rest):
         goal_states.append(q_rest)
