@@ -222,6 +222,7 @@ def run_trial(trial: Trial) -> TrialRecord:
     failed there; ``legs_run`` shows how far it got).
     """
     t0 = time.perf_counter()
+    cpu0 = time.process_time()
     ompl_seeded = _seed_ompl(trial.seed)  # first: before any OMPL object exists
     from plannerlab.record.files import versions
 
@@ -274,6 +275,8 @@ def run_trial(trial: Trial) -> TrialRecord:
     fields["versions"] = versions()
     fields["pid"] = os.getpid()
     fields["wall_s"] = time.perf_counter() - t0
+    # the trial's own CPU time: its wall time on a machine with a core to spare for it
+    fields["cpu_s"] = time.process_time() - cpu0
     fields["finished_at"] = datetime.now(UTC).isoformat(timespec="seconds")
     return TrialRecord(**fields)
 

@@ -268,7 +268,8 @@ class TrialRecord(msgspec.Struct, frozen=True, kw_only=True):
         executions: the executed legs (the solved ones up to the first that is not), or
             None when nothing was executed; ``executed_legs`` their number.
         budget_used, settings_used: the budget and the planner's settings in effect.
-        ompl_seeded, versions, pid, wall_s, startup_s, finished_at: where and how it ran.
+        ompl_seeded, versions, pid, wall_s, cpu_s (the trial process's CPU time), startup_s,
+            finished_at: where and how it ran.
     """
 
     key: str
@@ -296,6 +297,7 @@ class TrialRecord(msgspec.Struct, frozen=True, kw_only=True):
     versions: dict[str, str] = {}
     pid: int | None = None
     wall_s: Num = None
+    cpu_s: Num = None
     startup_s: Num = None
     finished_at: str = ""
 

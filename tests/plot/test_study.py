@@ -35,3 +35,22 @@ def test_progress_panels_draws_one_panel_per_problem_and_a_line_per_planner():
     assert [len(ax.get_lines()) for ax in axes] == [2, 1]
     solved = axes[0].get_lines()[0].get_ydata()
     assert solved[-1] == 0.0 and solved[0] == 3.0
+
+
+def test_escape_matrix_colours_each_cell_by_its_share_and_greys_what_did_not_run():
+    """plot/escapes.py: rows × columns of cells; the colour is the share executed cleanly
+    (green at 1, red at 0, grey for a cell not run), the text the count and its note."""
+    from plannerlab.plot.escapes import Cell, escape_matrix
+
+    cells = [[Cell(20, 20, "leader"), Cell(0, 20)], [Cell(1, 1, "1 run"), Cell(0, 0)]]
+    fig = escape_matrix(["native", "clearance"], ["armz_deep_a", "armz_pocket"], cells, "t", [0])
+    ax = fig.axes[0]
+    texts = sorted(t.get_text() for t in ax.texts)
+    assert texts == sorted(["20/20\nleader", "0/20", "1/1\n1 run", "–"])
+    assert [t.get_text() for t in ax.get_xticklabels()] == ["deep_a", "pocket"]
+    image = ax.get_images()[0]
+    rgba = image.to_rgba(image.get_array())
+    assert rgba[0, 0, 1] > rgba[0, 0, 0]  # all clean: green over red
+    assert rgba[0, 1, 0] > rgba[0, 1, 1]  # none clean: red over green
+    assert np.ma.is_masked(image.get_array()[1, 1])  # not run: masked, drawn grey
+    assert len(ax.get_lines()) == 1  # the line between the two families

@@ -69,15 +69,16 @@ import numpy as np
 from plannerlab.collision.fcl_checker import CollisionChecker
 from plannerlab.errors import PlannerlabError
 from plannerlab.planners.base import (
-    LegRun,
     Planner,
     PlanResult,
     Status,
     with_overrides,
 )
 from plannerlab.planners.clearance.field import ClearanceField, SetupStopped
+from plannerlab.planners.clearance.legpath import LegPath
 from plannerlab.planners.clearance.models import CompiledModel, Model, NumpyModel
-from plannerlab.planners.clearance.settings import ClearanceSettings
+from plannerlab.planners.clearance.settings import ClearanceSettings, robot_size
+from plannerlab.planners.clearance.slide import Slide, deep_inside, sight_clearance_m, slide_out
 from plannerlab.planners.clearance.step import DescentStep
 from plannerlab.planners.context import LegPlanner, PlanningContext, plan_in
 from plannerlab.problem.goals import GoalRegion, JointGoal
@@ -411,6 +412,61 @@ class ClearanceDescent(DescentStep, LegPlanner):
                 return kept + seg2[1:], iterations, f"retract {back} modules"
         return [np.array(q_stall)], iterations, "none"
 
+    def _slide_escape(
+        self, ctx: PlanningContext, q0: Array, used: int
+    ) -> tuple[list[Array] | None, int, str]:
+        """The detours' first escape, from the leg's first stall: the body of the leg's
+        start slid back along its own curve until the tip sees the goal's approach point
+        (:meth:`_slide`), then the leg's descent. Returns the path from ``q0`` into the
+        goal region (None when there is no slide or the descent after it stalls), the
+        iterations and how. Only when the start is deep inside
+        (:func:`~plannerlab.planners.clearance.slide.deep_inside`). From the start, not
+        the stall: the slide's premise is the body as it came in, and the descent that
+        stalled has pressed it against a wall (measured: from such stalls the slide
+        stalls within 0.5 m on two of three variants, from the start it gets out;
+        ``results/leave.md``)."""
+        target, clearance, _ = self._slide_target(ctx)
+        faces = np.asarray(ctx.robot.fk(q0))[:, :3, 3]
+        reach = float(np.sum(np.linalg.norm(np.diff(faces, axis=0), axis=1)))
+        if not deep_inside(ctx.scene, faces, target, clearance, reach / 3.0):
+            return None, 0, "not deep inside"
+        sl = self._slide(ctx, q0, used)
+        iterations = sl.iterations
+        if sl.status is not Status.SOLVED:
+            return None, iterations, sl.reason
+        st, _, seg, _, it = self.leg_descent(ctx, sl.states[-1], used + iterations)
+        if st is not Status.SOLVED:
+            return None, iterations + it, f"{sl.reason}; the descent after it: {st.value}"
+        return sl.states + seg[1:], iterations + it, f"slide {sl.slid_m:.2f} m"
+
+    def _slide_target(self, ctx: PlanningContext) -> tuple[Array, float, float]:
+        """The slide's target (the goal's approach point; a goal state's tip), the
+        clearance its line of sight keeps and the robot's link length [m]."""
+        s, robot, goal = self.settings, ctx.robot, ctx.goal
+        back = 0.0 if isinstance(goal, JointGoal) else s.approach_m
+        link = robot_size(robot).pitch_m
+        clearance = sight_clearance_m(robot, ctx.problem.safety_margin_m, link)
+        return goal.p_world_m - back * goal.n_world, clearance, link
+
+    def _slide(self, ctx: PlanningContext, q_stall: Array, used: int) -> Slide:
+        """The body of ``q_stall`` slid back along its own curve until the tip sees the
+        goal's approach point (:func:`~plannerlab.planners.clearance.slide.slide_out`; a
+        goal state's: its tip), at the descent's step and clearance floor. Leaving a
+        room from its far wall the descent stalls at once, pressing the body against the
+        near wall; the tip alone drawn back coils the body inside (``results/leave.md``)."""
+        s = self.settings
+        target, clearance, link = self._slide_target(ctx)
+        return slide_out(
+            ctx,
+            q_stall,
+            target,
+            clearance,
+            used,
+            min_clearance_m=s.min_clearance_m,
+            max_step_rad=s.max_step_rad if s.max_step_rad > 0 else ctx.problem.joint_step / 2,
+            link_m=link,
+        )
+
     def _retract_depths(self, dof: int, rng: np.random.Generator | None) -> list[int]:
         """Modules the detour's sub-goals go back, in order: every ``retract_step`` below
         ``dof``, or (with ``rng``) random steps of 1 … ``2 retract_step``."""
@@ -538,13 +594,23 @@ class ClearanceDescent(DescentStep, LegPlanner):
                 return done(st, f"{reason}; {minima} local minima met, {escapes} escaped; gave up")
             c0 = tracker.checks_used
             used = leg_path.iterations
-            if s.escape == "detour":
+            slid = None
+            if minima == 1 and s.escape in ("detour", "random_detour"):
+                # leaving from deep inside: the body as it came in, slid back out
+                slid, it, how = self._slide_escape(ctx, q0, used)
+                leg_path.iterations += it
+                used = leg_path.iterations
+            if slid is not None:
+                esc = slid
+                del path[1:]  # the leg starts again: the slide starts at its start
+            elif s.escape == "detour":
                 esc, it, how = self._detour(ctx, q_stall, used)
             elif s.escape == "random_detour":
                 esc, it, how = self._random_detours(ctx, q_stall, used, rng)
             else:
                 esc, it, how = self._rrtconnect(ctx, q_stall, rng)
-            leg_path.iterations += it
+            if slid is None:
+                leg_path.iterations += it
             left_stall = len(esc) > 1
             leg_path.escapes += int(left_stall)
             escapes_log.append(
@@ -571,69 +637,6 @@ class ClearanceDescent(DescentStep, LegPlanner):
                     Status.SOLVED,
                     f"descent stalled {minima} times; escaped from the stall by {how}",
                 )
-
-
-class LegPath:
-    """A leg's path built from segments (descents, escapes, a leader's tracking), the
-    counts the planner keeps on it, and its result: the one home of the result of the
-    clearance family (``gradient.clearance*``, ``gradient.follow_leader*``).
-
-    Progress is noted after each segment (the best goal distance it reached); the result
-    adds ``extra["path_rad"]`` (the path's joint-space length) and, at a local minimum,
-    ``extra["q_stall"]`` (the state it stalled at) to the planner's own ``extra``.
-
-    Args:
-        run: the leg's :class:`~plannerlab.planners.base.LegRun`.
-        q0: (dof,) the leg's start, the path's first state.
-    """
-
-    def __init__(self, run: LegRun, q0: Array) -> None:
-        self.run = run
-        self.path: list[Array] = [q0]
-        #: the planner's counts, reported in the result
-        self.iterations = 0
-        self.minima = 0
-        self.escapes = 0
-
-    def note(self, states: Any) -> None:
-        """Progress after a segment: the best goal distance its states reach."""
-        if len(states):
-            run = self.run
-            run.progress.note(float(np.min(run.goal.distance(run.robot, np.asarray(states)))))
-
-    def add(self, segment: Any) -> None:
-        """Append a segment that starts at the path's last state (its first state is
-        dropped) and note its progress."""
-        self.note(list(segment))
-        self.path.extend(list(segment[1:]))
-
-    def result(
-        self,
-        status: Status,
-        reason: str,
-        *,
-        trace: Any = None,
-        extra: Mapping[str, Any] | None = None,
-    ) -> PlanResult:
-        """The leg's result: the path, the counts, the planner's ``extra`` with the
-        path's length and, at a local minimum, the stall state."""
-        robot = self.run.robot
-        out: dict[str, Any] = {
-            **(extra or {}),
-            "path_rad": path_length(np.array(self.path), robot.continuous),
-        }
-        if status is Status.LOCAL_MINIMUM:
-            out["q_stall"] = np.asarray(self.path[-1], dtype=float).tolist()
-        return self.run.result(
-            status,
-            reason,
-            self.path,
-            iterations=self.iterations,
-            trace=trace,
-            local_minima=self.minima,
-            escapes=self.escapes,
-            extra=out,
-        )
 
 
 def _compiled_model(checker: Any) -> Any:

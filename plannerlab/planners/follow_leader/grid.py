@@ -14,35 +14,9 @@ from scipy.sparse import coo_matrix
 from scipy.sparse.csgraph import dijkstra
 
 from plannerlab.errors import PlannerlabError
-from plannerlab.problem.scene import Box, Cylinder, Scene, Sphere
+from plannerlab.planners.clearance.slide import scene_distance_m
+from plannerlab.problem.scene import Box, Scene
 from plannerlab.robots.base import Array
-
-
-def scene_distance_m(scene: Scene, points_m: Array) -> Array:
-    """Signed distance [m] of points (k, 3) to the nearest obstacle (inf without any)."""
-    p = np.asarray(points_m, dtype=float).reshape(-1, 3)
-    d = np.full(len(p), np.inf)
-    for o in scene.obstacles:
-        T = o.T_world_obstacle
-        local = (p - T[:3, 3]) @ T[:3, :3]
-        if isinstance(o, Box):
-            q = np.abs(local) - o.size_m / 2.0
-            di = np.linalg.norm(np.maximum(q, 0.0), axis=1) + np.minimum(q.max(axis=1), 0.0)
-        elif isinstance(o, Cylinder):
-            q = np.stack(
-                [
-                    np.hypot(local[:, 0], local[:, 1]) - o.radius_m,
-                    np.abs(local[:, 2]) - o.length_m / 2,
-                ],
-                axis=1,
-            )
-            di = np.linalg.norm(np.maximum(q, 0.0), axis=1) + np.minimum(q.max(axis=1), 0.0)
-        elif isinstance(o, Sphere):
-            di = np.linalg.norm(local, axis=1) - o.radius_m
-        else:  # pragma: no cover - the scene's types are closed
-            raise PlannerlabError(f"obstacle {o.name}: unknown kind {o.kind!r}")
-        d = np.minimum(d, di)
-    return d
 
 
 def grid_distance_m(scene: Scene, axes: list[Array], cap_m: float) -> Array:

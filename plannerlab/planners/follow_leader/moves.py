@@ -46,10 +46,13 @@ class Track:
 
 def crosses_body(robot: Any, q: Array, leader: TipPath, step_m: float = 0.1) -> bool:
     """Whether the leader's path from the tip of ``q`` runs back through the body of
-    ``q``: a point of the path inside the capsule of a module more than a third of the
-    body behind the tip. (Near the tip every path touches the body: the tip turns.)
+    ``q``: a point of the path where the tip module, whose axis follows the path, would
+    touch a module more than a third of the body behind the tip (closer to that module's
+    axis than the two radii). (Near the tip every path touches the body: the tip turns.)
     The voxel grid knows the scene, not the body: deep in a room, the way out for the
-    tip leads back through the window its own body fills."""
+    tip leads back through the window its own body fills. (Until issue 33 a path point
+    had to lie inside the module's capsule, which a path running beside the body through
+    the window never does: ``armz_inspection_v29``, ``results/leave.md``.)"""
     F = robot.fk(q)
     faces = F[:, :3, 3]
     radii = np.asarray(robot.link_radii_m, dtype=float)
@@ -67,7 +70,27 @@ def crosses_body(robot: Any, q: Array, leader: TipPath, step_m: float = 0.1) -> 
     closest = a[None] + np.clip(t, 0.0, 1.0)[..., None] * ab[None]
     d = np.linalg.norm(p[:, None, :] - closest, axis=2)  # (m, behind)
     r = np.resize(radii, behind) if len(radii) < behind else radii[:behind]
-    return bool(np.any(d < r[None, :]))
+    return bool(np.any(d < r[None, :] + radii[-1]))
+
+
+def leaves_from_inside(fl: FollowLeader, ctx: PlanningContext, q: Array, leader: Any) -> bool:
+    """Whether leaving from ``q`` starts with the retract: the tip does not see the leg
+    goal's approach point, and the leader's path runs back through the body
+    (:func:`crosses_body`) or the body is deep inside something the approach point is
+    outside of (:func:`~plannerlab.planners.clearance.slide.deep_inside`). Otherwise the
+    forward tries come first (measured: on ``armz_inspection_v25``, ``v29`` and ``v44``
+    the forward tracking spent 3-6 s before the retract got out)."""
+    from plannerlab.planners.clearance.slide import deep_inside
+
+    if fl.sees_approach(ctx, q):
+        return False
+    if leader is not None and crosses_body(ctx.robot, q, leader):
+        return True
+    s, goal = fl.settings, ctx.goal
+    faces = np.asarray(ctx.robot.fk(q))[:, :3, 3]
+    reach = float(np.sum(np.linalg.norm(np.diff(faces, axis=0), axis=1)))
+    target = goal.p_world_m - s.approach_m * goal.n_world
+    return deep_inside(ctx.scene, faces, target, fl.leader_clearance_m(ctx), reach / 3.0)
 
 
 def track(
@@ -108,15 +131,53 @@ def track(
 
 
 def retract(fl: FollowLeader, ctx: PlanningContext, q0: Array, used: int = 0) -> Track:
-    """The tip drawn back along the start's own body: sub-goals at the body's faces
-    from the tip's towards the base's (each looking along the body, within the
-    sub-goal tolerances), tracked by the descent, until the tip sees the leg goal's
-    approach point (``fl.sees_approach``); a sub-goal the descent stalls before is
-    passed over, two in a row end it. What got the body in gets it out: the
-    body lies on the curve its tip came in by, so the tip backs out along it while the
-    modules outside take up the length; the leader's path forwards would lead the tip
-    back through the window its own body fills (measured on the far-ended variants:
-    the tracking stalls at sub-goal 2)."""
+    """Leaving from deep inside: the body drawn back along its own curve until the tip
+    sees the leg goal's approach point. What got the body in gets it out: the body lies
+    on the curve its tip came in by; the leader's path forwards would lead the tip back
+    through the window its own body fills (measured on the far-ended variants: the
+    tracking stalls at sub-goal 2).
+
+    First the slide (:func:`~plannerlab.planners.clearance.slide.slide_out`): every face
+    of the part inside slides back along the curve at once while the faces outside take
+    up the length. When there is nothing to slide back to (no face sees the approach
+    point) or the slide stalls, the tip alone is drawn back, from the start: sub-goals at
+    the body's faces from the tip's towards the base's (each looking along the body,
+    within the sub-goal tolerances), tracked by the descent, until the tip sees the
+    approach point (``fl.sees_approach``); a sub-goal the descent stalls before is passed
+    over, two in a row end it. (The tip alone leaves the body to the descent, which
+    coils it inside the room: the window must then take two passes of the body,
+    ``results/leave.md``.)"""
+    sl = _slide(fl, ctx, q0, used)
+    if sl.status in (Status.SOLVED, Status.BUDGET_EXHAUSTED):
+        return Track(None, sl.status, sl.reason, sl.states, sl.iterations)
+    tr = _retract_tip(fl, ctx, q0, used + sl.iterations)
+    reason = f"{tr.reason} ({sl.reason})" if sl.iterations else tr.reason
+    return Track(None, tr.status, reason, tr.states, tr.iterations + sl.iterations)
+
+
+def _slide(fl: FollowLeader, ctx: PlanningContext, q0: Array, used: int):
+    """The slide of :func:`retract`, towards the leg goal's approach point with the
+    leader's clearance, at the tracking descent's step and clearance floor."""
+    from plannerlab.planners.clearance.settings import robot_size
+    from plannerlab.planners.clearance.slide import slide_out
+
+    s = fl.settings
+    robot, goal = ctx.robot, ctx.goal
+    d = fl._track.for_robot(robot).settings
+    return slide_out(
+        ctx,
+        q0,
+        goal.p_world_m - s.approach_m * goal.n_world,
+        fl.leader_clearance_m(ctx),
+        used,
+        min_clearance_m=d.min_clearance_m,
+        max_step_rad=d.max_step_rad if d.max_step_rad > 0 else ctx.problem.joint_step / 2,
+        link_m=robot_size(robot).pitch_m,
+    )
+
+
+def _retract_tip(fl: FollowLeader, ctx: PlanningContext, q0: Array, used: int = 0) -> Track:
+    """The tip alone drawn back along the start's body, face by face (see :func:`retract`)."""
     s = fl.settings
     F = ctx.robot.fk(q0)
     faces, normals = F[:, :3, 3], F[:, :3, 2]

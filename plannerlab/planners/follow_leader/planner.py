@@ -40,13 +40,16 @@ follow-the-leader:
    across the room and out through the window that its own body fills, and the tracking
    stalls at the second sub-goal (measured on the far-ended variants
    ``problems/variants/armz_inspection_v21`` … ``v39``, leaving from B: 5 of 10 stall
-   so; ``gradient.clearance+detour`` stalls at its eighth iteration and no retract of its
-   detour works on 6 of 10). What got the body in gets it out: the body lies on the curve
-   its tip came in by, so the tip is drawn back along the start's own body
-   (:meth:`FollowLeader.retract`: sub-goals at its faces from the tip's towards the
-   base's, each looking along the body) until it sees the goal's approach point, then
-   the leader's path from there. It comes first when the leader's path runs back
-   through the body (:func:`crosses_body`), else after the forward tries.
+   so). What got the body in gets it out: the body lies on the curve its tip came in by,
+   so it slides back out along that curve, every face inside at once, while the faces
+   outside take up the length (:meth:`FollowLeader.retract`, the slide of
+   :mod:`plannerlab.planners.clearance.slide`; the tip alone drawn back face by face, the
+   retract before issue 33, is its fallback: it coils the body inside the room), until
+   the tip sees the goal's approach point, then the leader's path from there. It comes
+   first when the leader's path runs back through the body (:func:`crosses_body`) or the
+   body is deep inside something the approach point is outside of
+   (:func:`~plannerlab.planners.follow_leader.moves.leaves_from_inside`), else after the
+   forward tries.
 
 The search and the tracking are deterministic (``gradient.follow_leader``: its seeds are
 one run). The randomised variant (``+random``, ``random_grid``) shifts the voxel grid by
@@ -74,10 +77,11 @@ from plannerlab.planners.base import (
 from plannerlab.planners.clearance import SetupStopped
 from plannerlab.planners.clearance.descent import ClearanceDescent, ClearanceSettings, LegPath
 from plannerlab.planners.clearance.settings import DERIVED, resolve_distances
+from plannerlab.planners.clearance.slide import sees
 from plannerlab.planners.context import LegPlanner, PlanningContext
 from plannerlab.planners.follow_leader import moves as leader_moves
-from plannerlab.planners.follow_leader.grid import TipPath, scene_distance_m, tip_path
-from plannerlab.planners.follow_leader.moves import Track, crosses_body
+from plannerlab.planners.follow_leader.grid import TipPath, tip_path
+from plannerlab.planners.follow_leader.moves import Track
 from plannerlab.problem.goals import GoalRegion
 from plannerlab.robots.base import Array, joint_difference
 
@@ -375,6 +379,24 @@ class FollowLeader(LegPlanner):
         fl = self.for_robot(ctx.robot)
         return leader_moves.track(fl, ctx, q0, goal, rng, used, leader)
 
+    def detour_from(
+        self, ctx: PlanningContext, q: Array, rng: np.random.Generator, used: int = 0
+    ) -> Track:
+        """The clearance descent's plan from ``q`` with its detour escape (the ``+detour``
+        variant's escape from a stalled finish), a sub-solve in the leg's context with
+        what the leg has left (``used``: its iterations so far)."""
+        fl = self.for_robot(ctx.robot)
+        tracker = ctx.tracker
+        sub = tracker.remaining(limit_iterations=False)
+        if sub is None:
+            why = str(tracker.exhausted(used) or "no budget left")
+            return Track(None, Status.BUDGET_EXHAUSTED, why, [np.array(q)], 0)
+        b = tracker.budget
+        if b.max_iterations is not None:
+            sub = sub.replace(max_iterations=max(b.max_iterations - used, 1))
+        r = fl._detour.plan(ctx.sub(sub, np.array(q)), rng)
+        return Track(None, r.status, r.reason, list(r.path), r.iterations)
+
     def sees_approach(self, ctx: PlanningContext, q: Array) -> bool:
         """Whether the straight line from the tip of ``q`` to the leg goal's approach
         point keeps the leader's clearance from the scene (the retract has got the tip
@@ -383,14 +405,17 @@ class FollowLeader(LegPlanner):
         goal, robot = ctx.goal, ctx.robot
         p_tip, _ = robot.tip(q)
         approach = goal.p_world_m - s.approach_m * goal.n_world
-        clearance = (
-            float(np.asarray(robot.link_radii_m)[-1])
+        return sees(ctx.scene, p_tip, approach, self.leader_clearance_m(ctx))
+
+    def leader_clearance_m(self, ctx: PlanningContext) -> float:
+        """The clearance the leader's path keeps from the scene [m]: the tip module's
+        radius, the problem's safety margin and ``extra_clearance_m``."""
+        s = self.for_robot(ctx.robot).settings
+        return (
+            float(np.asarray(ctx.robot.link_radii_m)[-1])
             + ctx.problem.safety_margin_m
             + s.extra_clearance_m
         )
-        n = max(2, int(np.ceil(np.linalg.norm(approach - p_tip) / 0.1)) + 1)
-        line = p_tip + np.linspace(0.0, 1.0, n)[:, None] * (approach - p_tip)
-        return bool(scene_distance_m(ctx.scene, line).min() >= clearance)
 
     def retract(self, ctx: PlanningContext, q0: Array, used: int = 0) -> Track:
         """:func:`plannerlab.planners.follow_leader.moves.retract` with this planner (its derived
@@ -463,9 +488,7 @@ class FollowLeader(LegPlanner):
                 s.retract
                 and not retracted
                 and attempt == 0
-                and leader is not None
-                and crosses_body(robot, q0, leader)
-                and not self.sees_approach(ctx, q0)
+                and leader_moves.leaves_from_inside(self, ctx, q0, leader)
             ):
                 # the leader leads the tip back through its own body: retract first
                 out = retract_from_start()

@@ -17,7 +17,9 @@ stops when they are spent):
    follow_leader.FollowLeader.track`: the leader's tip path on a voxel grid shifted by a
    random fraction of a voxel, its centring weight scaled at random, tracked by the
    clearance descent, then the descent into the goal). The body states it passes through
-   are a branch of the start tree (their edges re-checked on the search's grid first).
+   are a branch of the start tree (their edges re-checked on the search's grid first);
+   where a branch stalls, the clearance descent's detour from there is one more
+   (``detour``).
 2. **Goal states**: the forward branch's end when it reached the goal, the problem's
    start state when it lies in the goal region (a task that ends at rest), and the goal
    pool's IK states (``goal_samples``) when those give none.
@@ -50,7 +52,7 @@ from plannerlab.errors import PlannerlabError
 from plannerlab.planners.base import PlanResult, Status, with_overrides
 from plannerlab.planners.clearance.descent import ClearanceSettings
 from plannerlab.planners.context import PlanningContext
-from plannerlab.planners.follow_leader.moves import Track, crosses_body
+from plannerlab.planners.follow_leader.moves import Track, leaves_from_inside
 from plannerlab.planners.follow_leader.planner import FollowLeader, FollowLeaderSettings
 from plannerlab.planners.native import kernels as K
 from plannerlab.planners.native.planner import NativePlanner, _check_settings
@@ -85,6 +87,12 @@ class LeaderSettings(RRTConnectSettings):
         backward_goals: goal states to go backwards from, at most.
         guide_stride: every this many states of a branch (thinned to every 8th state of
             the descent) is a guide state.
+        detour: when no branch reached the goal, from where each ended the clearance
+            descent's detour (``gradient.follow_leader+detour``'s escape: the tip drawn
+            back 2, 4, ... modules along the body, each followed by the leg's descent), a
+            branch of the start tree (measured: ``armz_inspection_v28`` and ``v34``, leg E
+            from C's witness: the forward branch's finish stalls by E, the detour gets in
+            from there, RRT-Connect did not in 30 s).
         leader_max_replans: new leader paths the forward tracking draws from a stall.
     """
 
@@ -96,6 +104,7 @@ class LeaderSettings(RRTConnectSettings):
     backward_goals: int = 2
     guide_stride: int = 1
     leader_max_replans: int = 0
+    detour: bool = True
 
 
 @dataclass(frozen=True)
@@ -223,26 +232,29 @@ def build_guidance(
             reached_nodes.append(end)
         return end
 
+    def detour(node: int, key: str) -> None:
+        """The clearance descent's detour from where a branch stalled (its tip drawn back
+        along its body, then the leg's descent): a branch of the start tree."""
+        if s.detour and not reached and tracker.exhausted(used) is None:
+            grow_start(node, leader.detour_from(ctx, A.Q[node], rng, used), key)
+
     def retract_branch() -> None:
         end = grow_start(0, leader.retract(ctx, q0, used), "retract")
         if tracker.exhausted(used) is None:
-            grow_start(end, leader.track(ctx, A.Q[end], goal, rng, used), "after_retract")
+            end = grow_start(end, leader.track(ctx, A.Q[end], goal, rng, used), "after_retract")
+            detour(end, "detour_after_retract")
 
     if s.forward:
         lead = leader.leader_path(
             ctx.problem, ctx.leg, q0, rng, lambda: tracker.exhausted(used) is not None
         )
-        if (
-            s.retract
-            and lead is not None
-            and crosses_body(robot, q0, lead)
-            and not leader.sees_approach(ctx, q0)
-        ):
+        if s.retract and leaves_from_inside(leader, ctx, q0, lead):
             # the leader's path runs back through the body: the retract branch first
             log["retract_first"] = True
             retract_branch()
         if not reached and tracker.exhausted(used) is None:
-            grow_start(0, leader.track(ctx, q0, goal, rng, used, leader=lead), "forward")
+            end = grow_start(0, leader.track(ctx, q0, goal, rng, used, leader=lead), "forward")
+            detour(end, "detour_after_forward")
         if not reached and s.retract and "retract" not in log and tracker.exhausted(used) is None:
             # leaving from deep inside: the tip drawn back along its own body, then the
             # leader from there (a second branch of the start tree)
