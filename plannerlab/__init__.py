@@ -121,6 +121,7 @@ if TYPE_CHECKING:
     from plannerlab.plot.continuum import save as save_figure
     from plannerlab.plot.continuum import thickness_figure as continuum_thickness_figure
     from plannerlab.plot.plans import plot_plan
+    from plannerlab.plot.view import serve_robot
     from plannerlab.problem import mbm
     from plannerlab.problem.catalog import problem_catalog, problem_origin, resolve_problem_path
     from plannerlab.problem.load import parse_problem
@@ -130,6 +131,7 @@ if TYPE_CHECKING:
     from plannerlab.run.pipeline import execute_results, legs_from_spec
     from plannerlab.run.plan_check import check_plan, read_checked_plan, read_plan
     from plannerlab.run.planner_info import planner_catalog, planner_info
+    from plannerlab.run.robot_info import robot_report
 
 #: what the command line needs beyond the road above (``cli/`` is this API's first
 #: client: it imports nothing else of plannerlab but ``record``); a name without an
@@ -141,6 +143,9 @@ _EXPORTS |= {
     "problem_origin": "plannerlab.problem.catalog:problem_origin",
     "problem_catalog": "plannerlab.problem.catalog:problem_catalog",
     "mbm": "plannerlab.problem.mbm",
+    # robots
+    "robot_report": "plannerlab.run.robot_info:robot_report",
+    "serve_robot": "plannerlab.plot.view:serve_robot",
     # planners
     "planner_catalog": "plannerlab.run.planner_info:planner_catalog",
     "planner_info": "plannerlab.run.planner_info:planner_info",
@@ -203,9 +208,11 @@ __all__ += [
     "read_checked_plan",
     "read_plan",
     "resolve_problem_path",
+    "robot_report",
     "run_continuum_case",
     "run_spec",
     "save_figure",
+    "serve_robot",
     "store_path",
     "write_reports",
     "write_variants",
