@@ -9,7 +9,8 @@ and neighbouring bodies. Collision meshes become capsule covers
 (:mod:`plannerlab.robots.urdf.meshes`): ``mesh_paths`` are more folders searched for
 ``package://`` paths, ``cover_excess_m`` is the excess aimed at, ``cover_max_primitives``
 the budget of capsules per mesh (the excess grows when the budget needs it). The root
-link's pose in the world is ``base_xyz_m`` [m] and ``base_rpy_deg`` [deg]. The table in ``docs/problem-format.md`` lists the same keys.
+link's pose in the world is ``base_xyz_m`` [m] and ``base_rpy_deg`` [deg]. The table in
+``docs/problem-format.md`` lists the same keys.
 """
 
 from __future__ import annotations
