@@ -3,8 +3,8 @@ cover of each collision mesh (primitives, worst excess), the self-collision pair
 computes (:func:`plannerlab.run.srdf.disabled_pairs`) and the SRDF it writes, and how
 long loading took.
 
-The tip link, when not given, is the end of the longest chain of movable joints from the
-root (the first such link in the file when several tie).
+The tip link, when not given, is the end of the arm (:func:`default_tip_link`): where the
+chain of movable joints from the root ends or branches (a gripper's fingers).
 """
 
 from __future__ import annotations
@@ -53,32 +53,44 @@ class RobotReport:
 
 
 def default_tip_link(urdf: Path) -> str:
-    """The end of the longest chain of movable joints from the URDF's root."""
+    """The end of the arm: from the URDF's root, down the one child whose subtree holds
+    the most movable joints, stopping where two children each hold movable joints (a
+    gripper's fingers) or none does."""
     try:
         root = ET.parse(urdf).getroot()
     except (OSError, ET.ParseError) as exc:
         raise PlannerlabError(f"{urdf}: expected a readable URDF (XML): {exc}") from None
-    parent: dict[str, tuple[str, bool]] = {}
     links = [e.get("name", "") for e in root.findall("link")]
-    for j in root.findall("joint"):
-        p, c = j.find("parent"), j.find("child")
-        if p is not None and c is not None:
-            parent[c.get("link", "")] = (p.get("link", ""), j.get("type") in MOVABLE)
-
-    def depth(link: str) -> int:
-        n, seen = 0, set()
-        while link in parent and link not in seen:
-            seen.add(link)
-            link, moves = parent[link]
-            n += moves
-        return n
-
     if not links:
         raise PlannerlabError(f"{urdf}: expected a URDF with links; it has none")
-    best = max(links, key=lambda n: (depth(n), -links.index(n)))
-    if depth(best) == 0:
+    children: dict[str, list[tuple[str, bool]]] = {n: [] for n in links}
+    has_parent = set()
+    for j in root.findall("joint"):
+        p, c = j.find("parent"), j.find("child")
+        if p is not None and c is not None and p.get("link") in children:
+            children[p.get("link", "")].append((c.get("link", ""), j.get("type") in MOVABLE))
+            has_parent.add(c.get("link", ""))
+    memo: dict[str, int] = {}
+
+    def movable_below(link: str, seen: frozenset[str] = frozenset()) -> int:
+        if link not in memo:
+            memo[link] = sum(
+                int(m) + movable_below(c, seen | {link})
+                for c, m in children.get(link, [])
+                if c not in seen
+            )
+        return memo[link]
+
+    tops = [n for n in links if n not in has_parent]
+    link = max(tops, key=movable_below)
+    if movable_below(link) == 0:
         raise PlannerlabError(f"{urdf}: expected movable joints; it has none")
-    return best
+    while True:
+        held = [(c, int(m) + movable_below(c)) for c, m in children.get(link, [])]
+        moving = [h for h in held if h[1] > 0]
+        if len(moving) != 1:
+            return link
+        link = moving[0][0]
 
 
 def robot_report(

@@ -331,3 +331,23 @@ def test_the_bundled_mesh_robots_ship_every_cover(
     robot = load_problem(root / "problems" / "urdf" / f"{problem}.toml").robot
     assert robot.mesh_covers and all(c.cached for c in robot.mesh_covers)
     assert not (tmp_path / "plannerlab" / "covers").exists()
+
+
+def test_a_start_in_collision_is_refused_naming_the_urdf_links(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """docs/problem-format.md: the start must be collision-free, the error names the
+    colliding pairs: by the URDF's links, not the capsules of their covers."""
+    import plannerlab as pl
+
+    monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path / "cache"))
+    free = problem_from_dict(_problem(URDF, mesh_paths="pkgroot"), str(tmp_path / "p.toml"))
+    p_tip, _ = free.robot.tip(np.zeros(3))
+    doc = _problem(URDF, mesh_paths="pkgroot")
+    doc["obstacles"] = [
+        {"name": "block", "type": "box", "center_m": p_tip.tolist(), "size_m": [0.1] * 3}
+    ]
+    problem = problem_from_dict(doc, str(tmp_path / "p.toml"))
+    with pytest.raises(ProblemError) as e:
+        pl.solve(problem, "ompl.rrtconnect", 0)
+    assert "tool x block" in str(e.value) and "#" not in str(e.value)
