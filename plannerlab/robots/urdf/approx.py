@@ -54,6 +54,8 @@ GRID_CELLS: int = 40
 MAX_CANDIDATES: int = 2_500
 #: surface points checked against every cover (besides every vertex)
 VERIFY_SAMPLES: int = 20_000
+#: inner and surface candidates of the greedy sphere cover (each)
+SPHERE_CANDIDATES: int = 700
 #: inner points along the solid's longest side (the pieces are clusters of them)
 INNER_CELLS: int = 32
 #: the nearest inner points a surface point's owner is chosen from
@@ -319,18 +321,19 @@ def _fit(
         _, vecs = np.linalg.eigh(np.cov((Y - c).T) + 1e-18 * np.eye(3))
     else:
         vecs = np.eye(3)
-    sub = X if len(X) <= 1500 else X[np.linspace(0, len(X) - 1, 1500).astype(int)]
     best: tuple[float, Array, Array, Array] | None = None
     for u in vecs.T[::-1]:
         t = (X - c) @ u
+        rho2 = np.maximum(np.sum((X - c) ** 2, axis=1) - t * t, 0.0)  # to the axis line
         lo, hi = float(t.min()), float(t.max())
         half = (hi - lo) / 2
         s0, s1 = np.meshgrid(_SHRINK * half, _SHRINK * half, indexing="ij")
         ok = (lo + s0) <= (hi - s1) + 1e-15
         ta, tb = (lo + s0)[ok], np.maximum(hi - s1, lo + s0)[ok]
+        out = np.maximum(np.maximum(t[None, :] - tb[:, None], ta[:, None] - t[None, :]), 0.0)
+        rad = np.sqrt(np.max(rho2[None, :] + out * out, axis=1)) + delta
         A = c + ta[:, None] * u
         B = c + tb[:, None] * u
-        rad = np.max(_seg_dist(sub[None, :, :], A[:, None, :], B[:, None, :]), axis=1) + delta
         exc = rad - _axis_depth(solid, A, B)
         k = int(np.argmin(exc))
         if best is None or exc[k] < best[0]:
@@ -436,6 +439,76 @@ def _pieces(solid: _Solid, P: Array, delta: float, eps: float, budget: int) -> l
     return best[1]
 
 
+# ---------------------------------------------------------------------- spheres
+def _greedy_spheres(
+    P: Array, G: Array, D: Array, delta: float, eps: float, budget: int
+) -> tuple[Array, Array] | None:
+    """A greedy sphere cover of the surface points: candidates the inner points (depth
+    ``D``) and surface points (depth 0), each reaching ``D + eps − delta``; the one
+    holding most uncovered points taken, its radius shrunk to its farthest point plus
+    ``delta``; uncovered points become candidates themselves, so it always completes.
+    Centres and radii, or None past ``budget`` spheres."""
+    from scipy.sparse import csr_matrix
+    from scipy.spatial import cKDTree
+
+    rng = np.random.default_rng(0)
+    tree = cKDTree(P)
+    n_surf = min(len(P), SPHERE_CANDIDATES)
+    pick = rng.choice(len(P), size=n_surf, replace=False)
+    inner = np.linspace(0, len(G) - 1, min(len(G), SPHERE_CANDIDATES)).astype(int)
+    cand = np.concatenate([G[inner], P[pick]])
+    depth = np.concatenate([D[inner], np.zeros(n_surf)])
+    uncovered = np.ones(len(P), dtype=bool)
+    centres: list[Array] = []
+    radii: list[float] = []
+    while uncovered.any():
+        lists = tree.query_ball_point(cand, np.maximum(depth + eps - delta, 1e-12))
+        rows = np.repeat(np.arange(len(cand)), [len(x) for x in lists])
+        cols = np.fromiter((i for x in lists for i in x), dtype=np.int64, count=len(rows))
+        keep = uncovered[cols]
+        cov = csr_matrix(
+            (np.ones(int(keep.sum()), dtype=np.int32), (rows[keep], cols[keep])),
+            shape=(len(cand), len(P)),
+        )
+        covT = cov.T.tocsr()
+        counts = np.asarray(cov.sum(axis=1)).ravel().astype(np.int64)
+        while counts.max(initial=0) > 0:
+            if len(centres) >= budget:
+                return None
+            best = int(np.argmax(counts))
+            row = cov.indices[cov.indptr[best] : cov.indptr[best + 1]]
+            new = row[uncovered[row]]
+            centres.append(cand[best])
+            radii.append(float(np.max(np.linalg.norm(P[new] - cand[best], axis=1))) + delta)
+            uncovered[new] = False
+            np.subtract.at(counts, covT[new].indices, 1)
+        left = np.flatnonzero(uncovered)
+        take = left if len(left) <= 500 else rng.choice(left, size=500, replace=False)
+        cand, depth = P[take], np.zeros(len(take))
+    return np.array(centres), np.array(radii)
+
+
+def _spheres_within(
+    P: Array, G: Array, D: Array, delta: float, eps: float, budget: int
+) -> tuple[Array, Array, float]:
+    """The greedy sphere cover with the smallest allowance (``eps`` grown geometrically,
+    then bisected) that needs at most ``budget`` spheres; with that allowance."""
+    lo, hi = None, eps
+    found = _greedy_spheres(P, G, D, delta, hi, budget)
+    while found is None:
+        lo, hi = hi, hi * 2.0
+        found = _greedy_spheres(P, G, D, delta, hi, budget)
+    if lo is not None:
+        for _ in range(5):
+            mid = float(np.sqrt(lo * hi))
+            trial = _greedy_spheres(P, G, D, delta, mid, budget)
+            if trial is None:
+                lo = mid
+            else:
+                hi, found = mid, trial
+    return found[0], found[1], hi
+
+
 # ---------------------------------------------------------------------- steps 5, 6
 def _measured_excess(solid: _Solid, a: Array, b: Array, r: Array, h: float) -> Array:
     """Per capsule an upper bound of how far it reaches outside the solid (step 5)."""
@@ -485,11 +558,20 @@ def capsule_cover(V: Array, F: np.ndarray, target_m: float, budget: int) -> Caps
     solid = _solid(V, F)
     P, delta = _surface_points(solid, target_m)
     eps = max(target_m, 2.0 * delta)
-    pieces = _pieces(solid, P, delta, eps, max(1, int(budget)))
+    budget = max(1, int(budget))
+    pieces = _pieces(solid, P, delta, eps, budget)
     a = np.array([p.a for p in pieces])
     b = np.array([p.b for p in pieces])
     r = np.array([p.r for p in pieces])
-    excess = _measured_excess(solid, a, b, r, max(eps / 2.0, 1e-4))
+    h = max(eps / 2.0, 1e-4)
+    excess = _measured_excess(solid, a, b, r, h)
+    # spheres (zero-length capsules) by greedy set cover, where they do better: thin
+    # plates and compact parts
+    G, D = _inner_points(solid, P)
+    c, rs, _ = _spheres_within(P, G, D, delta, eps, budget)
+    sphere_excess = _measured_excess(solid, c, c, rs, h)
+    if sphere_excess.max() < excess.max():
+        a, b, r, excess = c, c.copy(), rs, sphere_excess
     verified = _verify(V, solid, a, b, r)
     return CapsuleCover(
         a,
