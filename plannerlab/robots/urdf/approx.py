@@ -49,7 +49,7 @@ from plannerlab.robots.base import Array
 #: the most surface points a cover is computed on (the cells grow to keep within it)
 MAX_POINTS: int = 60_000
 #: inner grid cells along the solid's longest side (depth estimate and candidates)
-GRID_CELLS: int = 40
+GRID_CELLS: int = 64
 #: the most candidate centres of the first greedy round
 MAX_CANDIDATES: int = 2_500
 #: surface points checked against every cover (besides every vertex)
@@ -386,8 +386,28 @@ def _inner_points(solid: _Solid, P: Array) -> tuple[Array, Array]:
     ]
     grid = np.stack(np.meshgrid(*axes, indexing="ij"), axis=-1).reshape(-1, 3)
     d = solid.depth_estimate(grid)
-    G = grid[d > 0]
-    return (G, d[d > 0]) if len(G) >= 8 else (P, np.zeros(len(P)))
+    G, D = grid[d > 0], d[d > 0]
+    if len(G) < 8:
+        return P, np.zeros(len(P))
+    if solid.kind == "mesh":  # the voxel estimate is a cell off: exact depths
+        D = solid.depth_exact(G)
+        G, D = G[D > 0], D[D > 0]
+    return (G, D) if len(G) >= 8 else (P, np.zeros(len(P)))
+
+
+def _offset_points(solid: _Solid, eps: float) -> tuple[Array, Array]:
+    """Sphere candidates under the surface: seeded surface samples moved inward along
+    their face's normal by 1, 2 and 4 ``eps``, kept where inside, with exact depths (the
+    centres that cover rims and flat faces within the allowance)."""
+    import trimesh
+
+    if solid.kind == "surface":
+        return np.zeros((0, 3)), np.zeros(0)
+    pts, face = trimesh.sample.sample_surface(solid.mesh, SPHERE_CANDIDATES, seed=0)
+    n = np.asarray(solid.mesh.face_normals)[face]
+    X = np.concatenate([pts - k * eps * n for k in (1.0, 2.0, 4.0)])
+    D = solid.depth_exact(X)
+    return X[D > 0], D[D > 0]
 
 
 def _owners(P: Array, G: Array, D: Array) -> np.ndarray:
@@ -455,7 +475,7 @@ def _greedy_spheres(
     tree = cKDTree(P)
     n_surf = min(len(P), SPHERE_CANDIDATES)
     pick = rng.choice(len(P), size=n_surf, replace=False)
-    inner = np.linspace(0, len(G) - 1, min(len(G), SPHERE_CANDIDATES)).astype(int)
+    inner = np.linspace(0, len(G) - 1, min(len(G), 4 * SPHERE_CANDIDATES)).astype(int)
     cand = np.concatenate([G[inner], P[pick]])
     depth = np.concatenate([D[inner], np.zeros(n_surf)])
     uncovered = np.ones(len(P), dtype=bool)
@@ -568,7 +588,10 @@ def capsule_cover(V: Array, F: np.ndarray, target_m: float, budget: int) -> Caps
     # spheres (zero-length capsules) by greedy set cover, where they do better: thin
     # plates and compact parts
     G, D = _inner_points(solid, P)
-    c, rs, _ = _spheres_within(P, G, D, delta, eps, budget)
+    X, DX = _offset_points(solid, eps)
+    c, rs, _ = _spheres_within(
+        P, np.concatenate([G, X]), np.concatenate([D, DX]), delta, eps, budget
+    )
     sphere_excess = _measured_excess(solid, c, c, rs, h)
     if sphere_excess.max() < excess.max():
         a, b, r, excess = c, c.copy(), rs, sphere_excess
