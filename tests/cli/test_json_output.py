@@ -107,6 +107,8 @@ def test_robot_command_reports_covers_pairs_and_writes_the_srdf(tmp_path):
         str(data / "pkgroot"),
         "--max-primitives",
         "4",
+        "--excess-mm",
+        "20",
         "--states",
         "100",
         "--srdf",

@@ -54,6 +54,8 @@ GRID_CELLS: int = 64
 MAX_CANDIDATES: int = 2_500
 #: surface points checked against every cover (besides every vertex)
 VERIFY_SAMPLES: int = 20_000
+#: the most (candidate, point) pairs a greedy sphere round lists
+MAX_COVER_ENTRIES: int = 4_000_000
 #: inner and surface candidates of the greedy sphere cover (each)
 SPHERE_CANDIDATES: int = 700
 #: inner points along the solid's longest side (the pieces are clusters of them)
@@ -482,7 +484,16 @@ def _greedy_spheres(
     centres: list[Array] = []
     radii: list[float] = []
     while uncovered.any():
-        lists = tree.query_ball_point(cand, np.maximum(depth + eps - delta, 1e-12))
+        reach = np.maximum(depth + eps - delta, 1e-12)
+        # a large allowance makes every ball hold most points: fewer candidates then, so
+        # that the coverage lists stay within MAX_COVER_ENTRIES
+        probe = rng.choice(len(cand), size=min(len(cand), 32), replace=False)
+        held = tree.query_ball_point(cand[probe], reach[probe], return_length=True)
+        keep_n = int(MAX_COVER_ENTRIES / max(float(np.mean(held)), 1.0))
+        if keep_n < len(cand):
+            pick = rng.choice(len(cand), size=max(keep_n, 16), replace=False)
+            cand, depth, reach = cand[pick], depth[pick], reach[pick]
+        lists = tree.query_ball_point(cand, reach)
         rows = np.repeat(np.arange(len(cand)), [len(x) for x in lists])
         cols = np.fromiter((i for x in lists for i in x), dtype=np.int64, count=len(rows))
         keep = uncovered[cols]
