@@ -49,7 +49,7 @@ MAX_MESH_FACES: int = 5_000_000
 #: the most small triangles a box cover cuts a surface into (a quarter of its limit)
 MAX_COVER_TRIANGLES: int = 60_000
 #: bump when the cover algorithm changes (part of the cache key)
-COVER_VERSION: int = 4
+COVER_VERSION: int = 5
 
 
 class MeshError(PlannerlabError):
