@@ -53,7 +53,12 @@ def _shipped_urdf(path: Path, tmp: Path) -> Path:
             fn = m.get("filename", "")
             if fn.startswith("package://"):
                 rest = fn[len("package://") :]
-                cands = [folder / rest, folder / rest.partition("/")[2]]
+                # the URDF's folder and its parents, as a ROS package path would hold it
+                cands = [
+                    b / r
+                    for b in [folder, *list(folder.parents)[:4]]
+                    for r in (rest, rest.partition("/")[2])
+                ]
             else:
                 cands = [folder / fn]
             m.set("filename", str(next((p for p in cands if p.is_file()), cands[0])))

@@ -19,7 +19,9 @@ These are the names a user rarely needs, kept out of the top-level ``plannerlab`
   their figures :func:`continuum_case_figure`, :func:`continuum_thickness_figure`,
   :func:`save_figure`); room variants of the paper's task (:func:`generate_variants`,
   :func:`write_variants`, :class:`VariantError`); the IRb-6's analytic IK
-  (:func:`irb6_ik`); MotionBenchMaker's importer (``mbm``, a module).
+  (:func:`irb6_ik`); MotionBenchMaker's importer (``mbm``, a module);
+* what plannerlab makes of a URDF (:func:`robot_report`, ``plannerlab robot``) and its
+  view in the browser (:func:`serve_robot`).
 
 Each name is imported on first use, as in ``plannerlab``.
 """
@@ -42,6 +44,7 @@ if TYPE_CHECKING:
     from plannerlab.plot.continuum import draw_case as continuum_case_figure
     from plannerlab.plot.continuum import save as save_figure
     from plannerlab.plot.continuum import thickness_figure as continuum_thickness_figure
+    from plannerlab.plot.view import serve_robot
     from plannerlab.problem import mbm
     from plannerlab.problem.catalog import problem_origin, problems_dir, resolve_problem_path
     from plannerlab.problem.variants import VariantError, write_variants
@@ -49,6 +52,7 @@ if TYPE_CHECKING:
     from plannerlab.robots.irb6.report import irb6_ik
     from plannerlab.run.pipeline import execute_results, legs_from_spec
     from plannerlab.run.plan_check import check_plan, read_checked_plan
+    from plannerlab.run.robot_info import robot_report
 
 #: name -> "module:attribute" ("module" alone: the module itself), imported on first access
 _EXPORTS: dict[str, str] = {
@@ -84,6 +88,8 @@ _EXPORTS: dict[str, str] = {
     "write_variants": "plannerlab.problem.variants:write_variants",
     "VariantError": "plannerlab.problem.variants:VariantError",
     "irb6_ik": "plannerlab.robots.irb6.report:irb6_ik",
+    "robot_report": "plannerlab.run.robot_info:robot_report",
+    "serve_robot": "plannerlab.plot.view:serve_robot",
     "mbm": "plannerlab.problem.mbm",
 }
 
@@ -111,9 +117,11 @@ __all__ = [
     "problems_dir",
     "read_checked_plan",
     "resolve_problem_path",
+    "robot_report",
     "run_continuum_case",
     "run_spec",
     "save_figure",
+    "serve_robot",
     "store_path",
     "write_variants",
 ]

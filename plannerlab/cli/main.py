@@ -15,7 +15,17 @@ from collections.abc import Iterator, Sequence
 from rich.console import Console
 from rich.text import Text
 
-from plannerlab.cli import animate, execute, planners, plot, problems, solve, variants, view
+from plannerlab.cli import (
+    animate,
+    execute,
+    planners,
+    plot,
+    problems,
+    robot,
+    solve,
+    variants,
+    view,
+)
 from plannerlab.cli.tables import make_console
 from plannerlab.errors import PlannerlabError, RenamedWarning
 
@@ -32,6 +42,7 @@ typical use:
   plannerlab execute results/plans/armz_pocket__ompl.rrtconnect__seed3.json
   plannerlab plot results/plans/armz_pocket__ompl.rrtconnect__seed3.json
   plannerlab compare armz_pocket --planners gradient,ompl.rrtconnect --seeds 0-4
+  plannerlab robot path/to/arm.urdf                     what plannerlab makes of a URDF
 
 Every subcommand has its own help: plannerlab SUBCOMMAND --help.
 Exit codes: 0 done, 1 --strict and a leg failed, 2 bad input (the message names the
@@ -112,7 +123,7 @@ def build_parser() -> argparse.ArgumentParser:
     )
     sub = parser.add_subparsers(dest="command", required=True, metavar="SUBCOMMAND")
 
-    for module in (problems, planners, solve, execute, plot, animate, view, variants):
+    for module in (problems, planners, solve, execute, plot, animate, view, variants, robot):
         module.add_parser(sub)
     from plannerlab.cli.ik import add_ik_parser
 

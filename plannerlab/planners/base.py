@@ -168,10 +168,23 @@ class Progress:
 
 def start_collision(checker: Any, q_start: Array) -> str | None:
     """Why a leg cannot start at ``q_start``: its colliding pairs in words, or None when it
-    is collision-free. The one start-state check (one collision check when valid)."""
+    is collision-free. The one start-state check (one collision check when valid).
+
+    Pairs are named by the robot's links as its file names them: the capsules of a
+    mesh's cover (``panda_link1#40``) by their URDF link (``panda_link1``), each pair once.
+    """
     if checker.is_valid(q_start):
         return None
-    pairs = ", ".join(f"{a} x {b}" for a, b in checker.colliding_pairs(q_start))
+    robot = getattr(checker, "robot", None)
+    urdf_of = dict(
+        zip(
+            getattr(robot, "link_names", ()),
+            getattr(robot, "link_urdf_names", getattr(robot, "link_names", ())),
+            strict=True,
+        )
+    )
+    named = ((urdf_of.get(a, a), urdf_of.get(b, b)) for a, b in checker.colliding_pairs(q_start))
+    pairs = ", ".join(f"{a} x {b}" for a, b in dict.fromkeys(named))
     return f"the start state collides: {pairs}"
 
 

@@ -594,4 +594,65 @@ def serve(
     return viewer
 
 
-__all__ = ["Viewer", "serve"]
+def serve_robot(robot: Any, *, host: str = "127.0.0.1", port: int = 8080) -> Any:
+    """Serve a 3-D view of a robot's collision model at its zero state (every joint at 0,
+    clipped into its limits): each link's capsules, spheres and capsules of the mesh
+    covers coloured per URDF link; returns the :class:`viser.ViserServer` (stop it with
+    ``.stop()``). A port in use raises :class:`~plannerlab.errors.PlannerlabError`."""
+    if port and not port_free(host, int(port)):
+        raise PlannerlabError(f"--port {port}: {host}:{port} is in use; give another --port")
+    import viser
+
+    with contextlib.redirect_stdout(io.StringIO()):  # viser's banner
+        server = viser.ViserServer(host=host, port=int(port), verbose=False)
+    server.scene.set_up_direction("+z")
+    q0 = np.clip(np.zeros(robot.dof), robot.lower, robot.upper)
+    seg = np.asarray(robot.link_segments(q0), dtype=float)
+    radii = np.asarray(robot.link_radii_m, dtype=float)
+    names = list(getattr(robot, "link_urdf_names", robot.link_names))
+    palette = np.array(
+        [
+            [31, 119, 180],
+            [255, 127, 14],
+            [44, 160, 44],
+            [214, 39, 40],
+            [148, 103, 189],
+            [140, 86, 75],
+            [227, 119, 194],
+            [127, 127, 127],
+            [188, 189, 34],
+            [23, 190, 207],
+        ],
+        dtype=np.uint8,
+    )
+    order = {n: i for i, n in enumerate(dict.fromkeys(names))}
+    colours = palette[[order[n] % len(palette) for n in names]]
+    b = capsule_batch(seg, radii)
+    cyl, sph = unit_cylinder(), unit_sphere()
+    server.scene.add_batched_meshes_simple(
+        "/robot/links",
+        cyl[0],
+        cyl[1],
+        batched_wxyzs=b.cyl_wxyzs,
+        batched_positions=b.cyl_positions,
+        batched_scales=b.cyl_scales,
+        batched_colors=colours,
+        lod="off",
+    )
+    server.scene.add_batched_meshes_simple(
+        "/robot/ends",
+        sph[0],
+        sph[1],
+        batched_wxyzs=np.tile([1.0, 0.0, 0.0, 0.0], (2 * len(radii), 1)),
+        batched_positions=b.cap_positions,
+        batched_scales=b.cap_scales,
+        batched_colors=np.concatenate([colours, colours]),
+        lod="off",
+    )
+    span = float(np.ptp(seg.reshape(-1, 3), axis=0).max()) + 2 * float(radii.max())
+    server.initial_camera.position = tuple(seg.reshape(-1, 3).mean(axis=0) + [span, span, span])
+    server.initial_camera.look_at = tuple(seg.reshape(-1, 3).mean(axis=0))
+    return server
+
+
+__all__ = ["Viewer", "serve", "serve_robot"]

@@ -90,3 +90,51 @@ def test_pybullet_banner_stays_off_a_normal_terminal_unless_verbose(plans):
     loud = plannerlab("-v", "execute", str(plans["gradient"]))
     assert loud.returncode == 0, loud.stderr
     assert "argv[0]" not in loud.stdout and "argv[0]" in loud.stderr
+
+
+def test_robot_command_reports_covers_pairs_and_writes_the_srdf(tmp_path):
+    """``plannerlab robot URDF --json``: one document with the joints, every mesh's cover
+    (primitives within the budget, its worst excess), the pairs never checked with their
+    reasons, the load time; the SRDF it wrote reads back as the same pairs."""
+    from plannerlab.robots.urdf.model import read_srdf_disabled
+
+    data = Path(__file__).resolve().parents[1] / "data" / "mesh_arm"
+    srdf = tmp_path / "arm.srdf"
+    proc = plannerlab(
+        "robot",
+        str(data / "mesh_arm.urdf"),
+        "--mesh-path",
+        str(data / "pkgroot"),
+        "--max-primitives",
+        "4",
+        "--excess-mm",
+        "20",
+        "--states",
+        "100",
+        "--srdf",
+        str(srdf),
+        "--no-cache",
+        "--json",
+    )
+    assert proc.returncode == 0, proc.stderr
+    doc = one_json_document(proc.stdout)
+    assert doc["tip_link"] == "tool" and doc["dof"] == 3
+    assert [c["link"] for c in doc["covers"]] == ["base", "upper", "fore", "tool"]
+    assert all(1 <= c["primitives"] <= 4 and c["max_excess_mm"] > 0 for c in doc["covers"])
+    reasons = {p["reason"] for p in doc["pairs"]}
+    assert "Adjacent" in reasons and doc["load_s"] > 0
+    pairs = {(p["link1"], p["link2"]) for p in doc["pairs"]}
+    assert set(read_srdf_disabled(srdf)) == pairs
+
+
+def test_robot_command_names_a_broken_mesh_and_exits_2(tmp_path):
+    import shutil
+
+    data = Path(__file__).resolve().parents[1] / "data" / "mesh_arm"
+    d = tmp_path / "arm"
+    shutil.copytree(data, d)
+    (d / "meshes" / "upper.obj").write_text("not a mesh")
+    proc = plannerlab("robot", str(d / "mesh_arm.urdf"), "--mesh-path", str(d / "pkgroot"))
+    assert proc.returncode == 2
+    err = proc.stderr.replace("\n", "")  # the terminal's lines wrap the message
+    assert "upper.obj" in err and "link upper" in err

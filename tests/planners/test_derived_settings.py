@@ -226,3 +226,47 @@ def test_every_setting_is_documented_in_one_attributes_form(cls):
             assert "[m]" in entries[name], name
         if name in derived:
             assert "derived" in entries[name] and f"{derived[name]:g} on Arm-Z" in entries[name]
+
+
+def _scaled_arm6(folder: Path, s: float) -> Problem:
+    """The arm and its shelf problem scaled by s: every length of the URDF, the scene, the
+    goal's point and tolerance, the margin (joint values and angles unchanged)."""
+    urdf = arm6_urdf()
+    urdf = re.sub(r'(radius|length)="([0-9.]+)"', lambda m: f'{m[1]}="{float(m[2]) * s}"', urdf)
+    urdf = re.sub(r'xyz="0 0 ([0-9.]+)"', lambda m: f'xyz="0 0 {float(m[1]) * s}"', urdf)
+    toml = ARM6_SHELF_TOML
+
+    def vec(m: re.Match[str]) -> str:
+        return f"{m[1]} = [{', '.join(str(float(v) * s) for v in m[2].split(','))}]"
+
+    toml = re.sub(r"(center_m|size_m|p_m) = \[([^\]]+)\]", vec, toml)
+    toml = re.sub(
+        r"(pos_tol_m|safety_margin_m) = ([0-9.]+)", lambda m: f"{m[1]} = {float(m[2]) * s}", toml
+    )
+    (folder / "arm6.urdf").write_text(urdf, "utf-8")
+    (folder / "arm6_shelf.toml").write_text(toml, "utf-8")
+    return load_problem(folder / "arm6_shelf.toml")
+
+
+@pytest.mark.parametrize("name", ["ompl.rrtconnect", "native.rrtconnect"])
+def test_sampling_planners_defaults_fit_every_robot_size(tmp_path, name):
+    """The same arm and shelf at 0.4x (a 30-cm hobby arm), 1x and 20x (Arm-Z's 16 m): the
+    sampling planners' defaults (steps, ranges, tolerances, edge cuts: joint-space or
+    derived from the robot's reach and the problem's margin) solve every size with the
+    same budget of checks, and the paths, in joint space, keep the same shape."""
+    lengths, checks = [], []
+    for s in (0.4, 1.0, 20.0):
+        folder = tmp_path / f"x{s}"
+        folder.mkdir()
+        problem = _scaled_arm6(folder, s)
+        assert robot_size(problem.robot).reach_m == pytest.approx(0.77 * s)
+        checker = problem_checker(problem)
+        for leg, r in enumerate(_legs(problem, name, {})):
+            assert r.status is Status.SOLVED, (s, leg, r.reason)
+            assert checker.check_path(r.path, problem.joint_step / 4).valid
+            if leg == 0:
+                lengths.append(float(np.sum(np.linalg.norm(np.diff(r.path, axis=0), axis=1))))
+                checks.append(r.collision_checks)
+    # scale-free: within a factor of two of each other in joint length and checks
+    assert max(lengths) < 2 * min(lengths), lengths
+    assert max(checks) < 4 * min(checks), checks

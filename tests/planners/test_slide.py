@@ -76,7 +76,7 @@ def test_the_body_slides_out_along_its_own_curve(v29):
         q_b,
         target,
         clearance,
-        min_clearance_m=0.03,
+        clearance_floor_m=0.03,
         max_step_rad=problem.joint_step / 2,
         link_m=link,
     )
@@ -145,7 +145,7 @@ def test_no_slide_where_the_tip_sees_the_target(v29):
         q,
         target,
         clearance,
-        min_clearance_m=0.03,
+        clearance_floor_m=0.03,
         max_step_rad=0.01,
         link_m=link,
     )

@@ -17,7 +17,8 @@ import trimesh
 
 from plannerlab.errors import ProblemError
 from plannerlab.problem.load import problem_from_dict
-from plannerlab.robots.urdf.meshes import MeshError, sphere_cover
+from plannerlab.robots.urdf.approx import capsule_cover
+from plannerlab.robots.urdf.meshes import load_mesh, mesh_cover
 from plannerlab.robots.urdf.model import UrdfChain, UrdfError, read_srdf_disabled
 from plannerlab.run.srdf import disabled_pairs, write_srdf
 
@@ -46,40 +47,79 @@ def _mesh(file: Path) -> trimesh.Trimesh:
     return trimesh.load(str(file), force="mesh", process=True)
 
 
+def _capsule_surface(a: np.ndarray, b: np.ndarray, r: np.ndarray, n: int) -> np.ndarray:
+    """Points on every capsule's boundary (n per capsule, seeded) not inside another."""
+    rng = np.random.default_rng(3)
+    u = rng.normal(size=(len(r), n, 3))
+    u /= np.linalg.norm(u, axis=2, keepdims=True)
+    t = rng.random((len(r), n, 1))
+    p = a[:, None] + t * (b - a)[:, None] + r[:, None, None] * u
+    ab = b - a
+    ll = np.maximum(np.sum(ab * ab, axis=1), 1e-300)
+    # pushed out to the own capsule's boundary along the direction from its axis
+    s = np.clip(np.einsum("kpj,kj->kp", p - a[:, None], ab) / ll[:, None], 0, 1)
+    foot = a[:, None] + s[..., None] * ab[:, None]
+    away = p - foot
+    away /= np.maximum(np.linalg.norm(away, axis=2, keepdims=True), 1e-300)
+    surf = (foot + r[:, None, None] * away).reshape(-1, 3)
+    tt = np.clip(np.einsum("pkj,kj->pk", surf[:, None] - a[None], ab) / ll, 0, 1)
+    d = np.linalg.norm(surf[:, None] - (a[None] + tt[..., None] * ab[None]), axis=-1) - r[None]
+    return surf[~(d < -1e-9).any(axis=1)]
+
+
 @pytest.mark.parametrize("name", ["base.stl", "upper.obj", "fore.dae"])
-def test_sphere_cover_holds_the_mesh_and_its_excess_is_bounded(name: str) -> None:
+@pytest.mark.parametrize("budget", [1, 4, 32])
+def test_capsule_cover_holds_the_mesh_and_its_excess_is_bounded(name: str, budget: int) -> None:
+    """Any budget gives a cover (one capsule at worst); it holds every vertex and an
+    independent surface sample, and no point of its boundary lies further outside the
+    solid than the reported excess (trimesh's signed distance, another measure)."""
     file = DATA / "meshes" / name
-    cover = sphere_cover(file, np.ones(3), EXCESS_M, 256, "test", None)
-    C, R = cover.centres_m, cover.radii_m
-    assert len(R) <= 256 and cover.max_excess_m <= EXCESS_M + 1e-12
+    cover = mesh_cover(file, np.ones(3), EXCESS_M, budget, "test", None)
+    a, b, r = cover.a_m, cover.b_m, cover.radii_m
+    assert 1 <= cover.count <= budget
     mesh = _mesh(file)
-    # every vertex and an independent surface sample (another seed) lie inside the cover
     pts, _ = trimesh.sample.sample_surface(mesh, 5000, seed=7)
     pts = np.concatenate([mesh.vertices, pts])
-    d = np.linalg.norm(pts[:, None] - C[None], axis=-1) - R[None]
+    ab = b - a
+    ll = np.maximum(np.sum(ab * ab, axis=1), 1e-300)
+    t = np.clip(np.einsum("pkj,kj->pk", pts[:, None] - a[None], ab) / ll, 0, 1)
+    d = np.linalg.norm(pts[:, None] - (a[None] + t[..., None] * ab[None]), axis=-1) - r[None]
     assert np.all(d.min(axis=1) <= 1e-9)
-    # the cover's boundary (points on each sphere not inside another) lies within the
-    # reported excess of the solid: measured here with trimesh's signed distance
-    rng = np.random.default_rng(3)
-    u = rng.normal(size=(200, 3))
-    u /= np.linalg.norm(u, axis=1, keepdims=True)
-    surf = (C[:, None, :] + R[:, None, None] * u[None]).reshape(-1, 3)
-    inner = (np.linalg.norm(surf[:, None] - C[None], axis=-1) < R[None] - 1e-9).any(axis=1)
-    outside = -trimesh.proximity.signed_distance(mesh, surf[~inner])
+    solid = mesh if cover.solid == "mesh" else mesh.convex_hull
+    outside = -trimesh.proximity.signed_distance(solid, _capsule_surface(a, b, r, 300))
     assert outside.max() <= cover.max_excess_m + 1e-6
-    assert outside.max() > 0.5 * EXCESS_M  # the bound is not slack by orders
+    assert outside.max() > 0.3 * cover.max_excess_m  # the bound is not slack by orders
+
+
+def test_a_larger_budget_never_gives_a_coarser_cover() -> None:
+    file = DATA / "meshes" / "base.stl"
+    excess = [mesh_cover(file, np.ones(3), 0.005, k, "test", None).max_excess_m for k in (1, 8, 64)]
+    assert excess[0] > excess[1] > excess[2]
+
+
+def test_a_detailed_mesh_is_covered_within_the_budget_not_refused() -> None:
+    """A sphere of 80 000 triangles (what a CAD export gives) and a plate with no inside:
+    both covered within the budget, the excess measured."""
+    ball = trimesh.creation.icosphere(subdivisions=7, radius=0.1)
+    assert len(ball.faces) > 80_000
+    cover = capsule_cover(np.asarray(ball.vertices), np.asarray(ball.faces), 0.002, 8)
+    assert cover.count <= 8 and cover.solid == "mesh"
+    assert cover.max_excess_m < 0.02
+    plate = trimesh.Trimesh([[0, 0, 0], [0.2, 0, 0], [0, 0.1, 0]], [[0, 1, 2]])
+    flat = capsule_cover(np.asarray(plate.vertices), np.asarray(plate.faces), 0.005, 4)
+    assert flat.solid == "surface" and 1 <= flat.count <= 4
 
 
 def test_mesh_arm_loads_with_every_format_and_the_root_mesh(covers: Path) -> None:
     r = arm(covers)
     assert [c.link for c in r.mesh_covers] == ["base", "upper", "fore", "tool"]
     assert r.mesh_covers[3].file.endswith("pkgroot/mesh_arm_tools/meshes/tool.stl")
-    assert all(c.max_excess_m <= EXCESS_M for c in r.mesh_covers)
-    n_base = r.mesh_covers[0].spheres
-    # the root link's spheres are the fixed links, one zero-length capsule per sphere
+    assert all(c.primitives <= 32 and c.max_excess_m > 0 for c in r.mesh_covers)
+    n_base = r.mesh_covers[0].primitives
+    # the root link's capsules are the fixed links
     assert r.fixed_links == frozenset(range(n_base))
-    assert np.allclose(r._cap_a, r._cap_b)
-    assert len(r.link_names) == sum(c.spheres for c in r.mesh_covers)
+    assert sum(c.capsules for c in r.mesh_covers) > 0
+    assert len(r.link_names) == sum(c.primitives for c in r.mesh_covers)
     assert r.link_names[0] == "base#0" and set(r.link_urdf_names) == {
         "base",
         "upper",
@@ -91,12 +131,16 @@ def test_mesh_arm_loads_with_every_format_and_the_root_mesh(covers: Path) -> Non
 def test_covers_move_with_their_link(covers: Path) -> None:
     r = arm(covers)
     q = np.array([0.4, 0.9, -0.7])
-    segs = r.link_segments(q)[:, 0]
     tool = [i for i, n in enumerate(r.link_urdf_names) if n == "tool"]
+    segs = r.link_segments(q)[tool]
     T_tool = r.fk(q)[3]  # frames: base, upper, fore, tool, tip
     verts = _mesh(PKG / "mesh_arm_tools" / "meshes" / "tool.stl").vertices + [0, 0, 0.075]
     p = verts @ T_tool[:3, :3].T + T_tool[:3, 3]
-    d = np.linalg.norm(p[:, None] - segs[tool][None], axis=-1) - r.link_radii_m[tool][None]
+    a, ab = segs[:, 0], segs[:, 1] - segs[:, 0]
+    ll = np.maximum(np.sum(ab * ab, axis=1), 1e-300)
+    t = np.clip(np.einsum("pkj,kj->pk", p[:, None] - a[None], ab) / ll, 0, 1)
+    foot = a[None] + t[..., None] * ab[None]
+    d = np.linalg.norm(p[:, None] - foot, axis=-1) - r.link_radii_m[tool][None]
     assert np.all(d.min(axis=1) <= 1e-9)
 
 
@@ -230,14 +274,26 @@ def test_an_unreadable_or_empty_mesh_is_refused(
     assert f"link {name.split('.')[0]}" in str(e.value)
 
 
-def test_a_mesh_too_large_to_cover_within_the_limits_is_refused(tmp_path: Path) -> None:
-    with pytest.raises(UrdfError, match="too large to cover.*cover_max_spheres"):
-        arm(tmp_path, cover_max_spheres=3, cover_cache=False)
-    # a surface needing more small triangles than the limit is refused before covering
-    big = trimesh.creation.box((20.0, 20.0, 20.0))
+def test_the_excess_grows_as_the_budget_shrinks_and_is_reported(tmp_path: Path) -> None:
+    one = arm(tmp_path, cover_max_primitives=1, cover_cache=False)
+    many = arm(tmp_path, cover_max_primitives=32, cover_cache=False)
+    assert [c.primitives for c in one.mesh_covers] == [1] * 4
+    assert all(
+        a.max_excess_m > b.max_excess_m
+        for a, b in zip(one.mesh_covers, many.mesh_covers, strict=True)
+    )
+
+
+def test_a_mesh_larger_than_plannerlab_reads_is_refused_naming_it(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    import plannerlab.robots.urdf.meshes as meshes
+
+    monkeypatch.setattr(meshes, "MAX_MESH_BYTES", 100)
+    big = trimesh.creation.box((0.2, 0.2, 0.2))
     big.export(tmp_path / "big.stl")
-    with pytest.raises(MeshError, match="too large to cover within the limits"):
-        sphere_cover(tmp_path / "big.stl", np.ones(3), 0.01, 256, "link x", None)
+    with pytest.raises(meshes.MeshError, match=r"big.stl \(link x\).*simplify"):
+        load_mesh(tmp_path / "big.stl", np.ones(3), "link x")
 
 
 # ---------------------------------------------------------------------- SRDF
@@ -275,3 +331,23 @@ def test_the_bundled_mesh_robots_ship_every_cover(
     robot = load_problem(root / "problems" / "urdf" / f"{problem}.toml").robot
     assert robot.mesh_covers and all(c.cached for c in robot.mesh_covers)
     assert not (tmp_path / "plannerlab" / "covers").exists()
+
+
+def test_a_start_in_collision_is_refused_naming_the_urdf_links(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """docs/problem-format.md: the start must be collision-free, the error names the
+    colliding pairs: by the URDF's links, not the capsules of their covers."""
+    import plannerlab as pl
+
+    monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path / "cache"))
+    free = problem_from_dict(_problem(URDF, mesh_paths="pkgroot"), str(tmp_path / "p.toml"))
+    p_tip, _ = free.robot.tip(np.zeros(3))
+    doc = _problem(URDF, mesh_paths="pkgroot")
+    doc["obstacles"] = [
+        {"name": "block", "type": "box", "center_m": p_tip.tolist(), "size_m": [0.1] * 3}
+    ]
+    problem = problem_from_dict(doc, str(tmp_path / "p.toml"))
+    with pytest.raises(ProblemError) as e:
+        pl.solve(problem, "ompl.rrtconnect", 0)
+    assert "tool x block" in str(e.value) and "#" not in str(e.value)

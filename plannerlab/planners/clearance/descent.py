@@ -462,7 +462,7 @@ class ClearanceDescent(DescentStep, LegPlanner):
             target,
             clearance,
             used,
-            min_clearance_m=s.min_clearance_m,
+            clearance_floor_m=s.clearance_floor_m,
             max_step_rad=s.max_step_rad if s.max_step_rad > 0 else ctx.problem.joint_step / 2,
             link_m=link,
         )

@@ -25,7 +25,7 @@ cut the corner and the clearance push holds them off it), and the slide ends onc
 tip sees the target.
 
 Each step is a damped least-squares step on the pulled faces' errors, with every pair of
-the checker closer than ``min_clearance_m`` plus two thirds of it pushed apart through
+the checker closer than ``clearance_floor_m`` plus two thirds of it pushed apart through
 its points' Jacobians (as the room variants' witness IK,
 :mod:`plannerlab.problem.variant_witness`), at most ``max_step_rad`` per joint; a step
 is kept when the checker finds the state valid, as the clearance descent keeps its
@@ -252,7 +252,7 @@ def slide_out(
     clearance_m: float,
     used: int = 0,
     *,
-    min_clearance_m: float,
+    clearance_floor_m: float,
     max_step_rad: float,
     link_m: float,
     stop: Callable[[int], str | None] | None = None,
@@ -279,9 +279,9 @@ def slide_out(
     arc_u, curve_u = arc[keep], curve[keep]
     total = float(arc[-1] - arc[pivot])
     tol, advance = TRACK_TOL_LINKS * link_m, ADVANCE_LINKS * link_m
-    band = 2.0 * min_clearance_m / 3.0
+    band = 2.0 * clearance_floor_m / 3.0
     spread = SPREAD_LINKS * link_m
-    want = min_clearance_m + band
+    want = clearance_floor_m + band
     dof = robot.dof
 
     def point_at(s: Array) -> Array:

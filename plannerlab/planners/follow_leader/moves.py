@@ -170,7 +170,7 @@ def _slide(fl: FollowLeader, ctx: PlanningContext, q0: Array, used: int):
         goal.p_world_m - s.approach_m * goal.n_world,
         fl.leader_clearance_m(ctx),
         used,
-        min_clearance_m=d.min_clearance_m,
+        clearance_floor_m=d.clearance_floor_m,
         max_step_rad=d.max_step_rad if d.max_step_rad > 0 else ctx.problem.joint_step / 2,
         link_m=robot_size(robot).pitch_m,
     )

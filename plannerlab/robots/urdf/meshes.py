@@ -1,4 +1,4 @@
-"""Mesh files: found, read, and covered by spheres (robot links) or boxes (obstacles).
+"""Mesh files: found, read, and covered by capsules (robot links) or boxes (obstacles).
 
 Reading is ``trimesh``'s (STL, OBJ, PLY, DAE through ``pycollada``); this module turns
 what can go wrong into a :class:`MeshError` that names the file, the place it was named
@@ -9,27 +9,11 @@ and ``base/rest`` under each search folder given (the ``[robot] mesh_paths``), t
 URDF's folder and its three parents (PyBullet's data and most description packages keep
 their meshes there); ``file://`` and plain paths are absolute or relative to the URDF.
 
-Sphere covers (:func:`sphere_cover`), for the capsule model of a robot link:
-
-1. the surface is cut into triangles whose edges are at most ``excess_m``;
-2. candidate centres: the points of a grid inside the mesh, each with its depth ``D``
-   (exact distance to the surface, ``trimesh.proximity``), and every small triangle's
-   centroid (depth 0); a candidate may grow to radius ``D + excess_m``;
-3. greedy set cover of the *triangles* (a ball holding a triangle's three corners holds
-   the whole triangle, balls being convex): the candidate covering most uncovered
-   triangles is taken, its radius then shrunk to the farthest corner it must hold;
-4. a sphere of radius ``r`` centred at depth ``D`` lies within ``r - D`` of the solid
-   (the ball of radius ``D`` about its centre is inside), so the cover's outward excess
-   is at most ``max(r - D)`` (reported, ``<= excess_m`` by construction);
-5. verified: every vertex and a dense surface sample (seeded) inside the union.
-
-The surface is covered exactly; the solid's inside is covered where the interior
-spheres reach (an obstacle wholly inside a link without touching its surface is not
-seen). A mesh that is not watertight has no inside: its convex hull is covered instead
-(depths measured to it; PyBullet, too, checks a moving link's mesh as its convex hull),
-and the report says so. More than ``max_spheres`` spheres, or a surface
-needing more than :data:`MAX_COVER_TRIANGLES` small triangles, is refused
-(:class:`MeshError`: raise ``cover_excess_m`` or ``cover_max_spheres``, or simplify).
+Link covers (:func:`mesh_cover`): capsules (:mod:`plannerlab.robots.urdf.approx`), at
+most ``max_primitives`` per mesh, aiming at an excess of :func:`cover_target_m` and
+coarser when the budget needs it; the cover always succeeds (a detailed mesh is never
+refused: only a file that cannot be read, or holds no triangle, or is larger than
+:data:`MAX_MESH_BYTES`, the memory guard) and reports its measured excess.
 
 Covers are cached on disk (``~/.cache/plannerlab/covers``, or ``$XDG_CACHE_HOME``) by a
 hash of the file's bytes, the scale, the parameters and :data:`COVER_VERSION`, written
@@ -56,17 +40,16 @@ import numpy as np
 
 from plannerlab.errors import PlannerlabError
 from plannerlab.robots.base import Array
+from plannerlab.robots.urdf.approx import CapsuleCover, capsule_cover
 
 #: files larger than this are refused before reading [bytes]
 MAX_MESH_BYTES: int = 200_000_000
 #: meshes with more faces than this are refused
-MAX_MESH_FACES: int = 2_000_000
-#: the most small triangles a sphere cover may cut a surface into
+MAX_MESH_FACES: int = 5_000_000
+#: the most small triangles a box cover cuts a surface into (a quarter of its limit)
 MAX_COVER_TRIANGLES: int = 60_000
 #: bump when the cover algorithm changes (part of the cache key)
-COVER_VERSION: int = 2
-#: surface points checked against every cover (besides every vertex)
-VERIFY_SAMPLES: int = 20_000
+COVER_VERSION: int = 5
 
 
 class MeshError(PlannerlabError):
@@ -187,179 +170,27 @@ def default_cache_dir() -> Path:
     return Path(base) / "plannerlab" / "covers"
 
 
-# ---------------------------------------------------------------------- sphere covers
-@dataclass(frozen=True)
-class SphereCover:
-    """Spheres covering a mesh, in the mesh's frame.
-
-    Attributes:
-        centres_m: (s, 3) [m].
-        radii_m: (s,) [m].
-        max_excess_m: the largest distance a point of the cover can lie outside the
-            mesh's solid [m] (an upper bound, see the module docstring).
-        points_verified: vertices + surface samples checked inside the cover.
-        watertight: the depths were measured to the mesh (else to its convex hull).
-        cached: read from the disk cache.
-    """
-
-    centres_m: Array
-    radii_m: Array
-    max_excess_m: float
-    points_verified: int
-    watertight: bool
-    cached: bool = False
+# ---------------------------------------------------------------------- link covers
+def cover_target_m(V: Array, excess_m: float) -> float:
+    """The excess aimed at for a mesh: ``excess_m``, but at most 3 % of the mesh's
+    bounding-box diagonal (a hobby arm's 3 cm link is not covered to 1 cm), and at
+    least 1 mm."""
+    diag = float(np.linalg.norm(V.max(axis=0) - V.min(axis=0)))
+    return float(min(excess_m, max(0.03 * diag, 1e-3)))
 
 
-def _small_triangles(V: Array, F: np.ndarray, edge_m: float, where: str, file: str) -> Array:
-    """The surface as triangles (t, 3, 3) with edges <= edge_m."""
-    import trimesh
-
-    tri = V[F]
-    area = float(
-        np.sum(np.linalg.norm(np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0]), axis=1)) / 2
-    )
-    # a triangle of edges <= e has area <= e^2 sqrt(3)/4; subdivision reaches about a third
-    estimate = len(F) + area / (0.1 * edge_m**2)
-    if estimate > MAX_COVER_TRIANGLES:
-        raise MeshError(
-            file,
-            where,
-            f"too large to cover within the limits: about {estimate:.0f} triangles of "
-            f"{edge_m * 1e3:.3g} mm (at most {MAX_COVER_TRIANGLES})",
-            "raise cover_excess_m in [robot], or scale/simplify the mesh",
-        )
-    Vs, Fs = trimesh.remesh.subdivide_to_size(V, F, max_edge=edge_m, max_iter=30)
-    if len(Fs) > 2 * MAX_COVER_TRIANGLES:
-        raise MeshError(
-            file,
-            where,
-            f"too large to cover within the limits: {len(Fs)} triangles of {edge_m * 1e3:.3g} mm",
-            "raise cover_excess_m in [robot], or scale/simplify the mesh",
-        )
-    return np.asarray(Vs, dtype=float)[np.asarray(Fs)]
-
-
-def _depths(V: Array, F: np.ndarray, pts: Array) -> tuple[Array, bool]:
-    """Signed depth (positive inside) of points against the mesh when it is watertight,
-    else against its convex hull; and whether it was the mesh."""
-    import trimesh
-
-    mesh = trimesh.Trimesh(V, F, process=True)
-    watertight = bool(mesh.is_watertight and mesh.is_volume)
-    if not watertight:
-        mesh = mesh.convex_hull
-    if len(pts) == 0:
-        return np.zeros(0), watertight
-    d = np.asarray(trimesh.proximity.signed_distance(mesh, pts), dtype=float)
-    return d, watertight
-
-
-def _compute_sphere_cover(
-    V: Array, F: np.ndarray, excess_m: float, max_spheres: int, where: str, file: str
-) -> SphereCover:
-    import trimesh
-
-    mesh = trimesh.Trimesh(V, F, process=True)
-    V_in = V
-    if not (mesh.is_watertight and mesh.is_volume):
-        # no inside: the convex hull is the solid (as PyBullet sees a moving mesh)
-        hull = mesh.convex_hull
-        V, F = np.asarray(hull.vertices, dtype=float), np.asarray(hull.faces, dtype=np.int64)
-    tris = _small_triangles(V, F, excess_m, where, file)
-    corners = tris.reshape(-1, 3)
-    lo, hi = V.min(axis=0), V.max(axis=0)
-    ext = hi - lo
-    step = max(float(ext.max()) / 16.0, excess_m / 2.0)
-    axes = [
-        np.arange(lo[k] + step / 2, hi[k], step)
-        if ext[k] > step
-        else np.array([(lo[k] + hi[k]) / 2])
-        for k in range(3)
-    ]
-    grid = np.stack(np.meshgrid(*axes, indexing="ij"), axis=-1).reshape(-1, 3)
-    depth, watertight = _depths(V, F, grid)
-    inner = depth > 1e-6
-    centroids = tris.mean(axis=1)
-    nT = len(tris)
-    rng = np.random.default_rng(0)
-    uncovered = np.ones(nT, dtype=bool)
-    centres: list[Array] = []
-    radii: list[float] = []
-    excess: list[float] = []
-    # round 0: the inner grid and a sample of centroids; later rounds: the centroids of
-    # what is left (each covers at least its own triangle: the cover always completes)
-    sample = rng.choice(nT, size=min(nT, 1500), replace=False)
-    cand: Array | None = np.concatenate([grid[inner], centroids[sample]])
-    D = np.concatenate([depth[inner], np.zeros(len(sample))])
-    while uncovered.any():
-        left = np.flatnonzero(uncovered)
-        if cand is None:
-            pick = left if len(left) <= 1500 else rng.choice(left, size=1500, replace=False)
-            cand, D = centroids[pick], np.zeros(len(pick))
-        sub = tris[left]
-        R = D + excess_m
-        cov = np.zeros((len(cand), len(left)), dtype=bool)
-        chunk = max(1, 4_000_000 // max(len(left), 1))
-        for s in range(0, len(cand), chunk):
-            c = cand[s : s + chunk]
-            far = np.zeros((len(c), len(left)))
-            for k in range(3):
-                far = np.maximum(far, np.linalg.norm(sub[None, :, k, :] - c[:, None, :], axis=-1))
-            cov[s : s + chunk] = far <= R[s : s + chunk, None]
-        open_ = np.ones(len(left), dtype=bool)
-        counts = cov.sum(axis=1).astype(np.int64)
-        while open_.any() and counts.max(initial=0) > 0:
-            if len(centres) >= max_spheres:
-                raise MeshError(
-                    file,
-                    where,
-                    f"too large to cover within the limits: {max_spheres} spheres leave "
-                    f"{int(uncovered.sum())} of {nT} surface pieces uncovered at "
-                    f"{excess_m * 1e3:.3g} mm excess",
-                    "raise cover_max_spheres or cover_excess_m in [robot]",
-                )
-            best = int(np.argmax(counts))
-            new = cov[best] & open_
-            held = sub[new].reshape(-1, 3)
-            r = float(np.max(np.linalg.norm(held - cand[best], axis=1)))
-            centres.append(cand[best])
-            radii.append(r)
-            excess.append(max(0.0, r - float(D[best])))
-            open_ &= ~new
-            uncovered[left[new]] = False
-            counts -= cov[:, new].sum(axis=1)
-        cand = None
-    C, Rr = np.array(centres), np.array(radii)
-    # verification: every vertex and a dense seeded surface sample inside the union
-    rng = np.random.default_rng(0)
-    tri = V[F]
-    area = np.linalg.norm(np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0]), axis=1)
-    pick = rng.choice(len(F), size=VERIFY_SAMPLES, p=area / area.sum() if area.sum() > 0 else None)
-    u, v = rng.random(VERIFY_SAMPLES), rng.random(VERIFY_SAMPLES)
-    flip = u + v > 1
-    u[flip], v[flip] = 1 - u[flip], 1 - v[flip]
-    t = tri[pick]
-    samples = t[:, 0] + u[:, None] * (t[:, 1] - t[:, 0]) + v[:, None] * (t[:, 2] - t[:, 0])
-    pts = np.concatenate([V_in, V, corners, samples])
-    inside = np.zeros(len(pts), dtype=bool)
-    for s in range(0, len(pts), 20_000):
-        d = np.linalg.norm(pts[s : s + 20_000, None, :] - C[None], axis=-1) - Rr[None]
-        inside[s : s + 20_000] = (d <= 1e-9).any(axis=1)
-    if not inside.all():  # pragma: no cover - the construction covers every corner
-        raise MeshError(file, where, "its sphere cover failed verification", "report this")
-    return SphereCover(C, Rr, float(max(excess)), len(V_in) + VERIFY_SAMPLES, watertight)
-
-
-def sphere_cover(
+def mesh_cover(
     path: Path,
     scale: Array,
     excess_m: float,
-    max_spheres: int,
+    max_primitives: int,
     where: str,
     cache_dir: Path | None,
     shipped_dirs: tuple[Path, ...] = (),
-) -> SphereCover:
-    """The sphere cover of a mesh file (scaled), from the disk cache when there.
+) -> CapsuleCover:
+    """The capsule cover of a mesh file (scaled), at most ``max_primitives`` capsules,
+    aiming at :func:`cover_target_m` (coarser when the budget asks for it; see
+    :mod:`plannerlab.robots.urdf.approx`), from the disk cache when there.
 
     Args:
         cache_dir: the cache folder (:func:`default_cache_dir`), or None: no cache.
@@ -369,44 +200,52 @@ def sphere_cover(
             cache only.
 
     Raises:
-        MeshError: the file cannot be read, or cannot be covered within the limits.
+        MeshError: the file cannot be read (a detailed mesh is never refused).
     """
     if not (excess_m > 0 and np.isfinite(excess_m)):
         raise MeshError(str(path), where, f"cover_excess_m {excess_m}", "give a positive length")
-    if max_spheres < 1:
-        raise MeshError(str(path), where, f"cover_max_spheres {max_spheres}", "give at least 1")
+    if max_primitives < 1:
+        raise MeshError(
+            str(path), where, f"cover_max_primitives {max_primitives}", "give at least 1"
+        )
     s = np.broadcast_to(np.asarray(scale, dtype=float), (3,))
     key = None
     if cache_dir is not None and Path(path).is_file():
         h = hashlib.sha256()
         h.update(file_digest(Path(path)).encode())
-        h.update(np.asarray([*s, excess_m, max_spheres, COVER_VERSION], dtype=float).tobytes())
+        h.update(np.asarray([*s, excess_m, max_primitives, COVER_VERSION], dtype=float).tobytes())
         key = Path(cache_dir) / f"{h.hexdigest()[:32]}.npz"
         for found in (key, *(Path(d) / key.name for d in shipped_dirs)):
             if not found.is_file():
                 continue
             try:
                 with np.load(found) as z:
-                    return SphereCover(
-                        np.array(z["centres"]),
+                    return CapsuleCover(
+                        np.array(z["a"]),
+                        np.array(z["b"]),
                         np.array(z["radii"]),
                         float(z["excess"]),
+                        float(z["target"]),
                         int(z["verified"]),
                         bool(z["watertight"]),
+                        str(z["solid"]),
                         cached=True,
                     )
             except Exception:  # a damaged cache entry: compute again
                 pass
     V, F = load_mesh(Path(path), s, where)
-    cover = _compute_sphere_cover(V, F, float(excess_m), int(max_spheres), where, str(path))
+    cover = capsule_cover(V, F, cover_target_m(V, float(excess_m)), int(max_primitives))
     if key is not None:
         _atomic_savez(
             key,
-            centres=cover.centres_m,
+            a=cover.a_m,
+            b=cover.b_m,
             radii=cover.radii_m,
             excess=np.float64(cover.max_excess_m),
+            target=np.float64(cover.target_excess_m),
             verified=np.int64(cover.points_verified),
             watertight=np.bool_(cover.watertight),
+            solid=np.str_(cover.solid),
         )
     return cover
 
@@ -430,29 +269,33 @@ def _atomic_savez(path: Path, **arrays: Any) -> None:
 
 @dataclass(frozen=True)
 class MeshCover:
-    """How one ``<collision>`` mesh of a URDF link became spheres: the link, the file,
-    the number of spheres, the largest outward excess of the cover [m] (an upper bound),
-    the points verified inside it, whether depths were measured to the mesh (watertight)
-    or its convex hull, and whether it came from the disk cache."""
+    """How one ``<collision>`` mesh of a URDF link became capsules: the link, the file,
+    the number of primitives and how many of them are capsules of non-zero length (the
+    rest spheres), the largest outward excess of the cover [m] (an upper bound) and the
+    excess aimed at, the points verified inside it, what the excess is measured from
+    (``solid``: the mesh, its convex hull when it is not watertight, or its surface when
+    flat), and whether it came from the disk cache."""
 
     link: str
     file: str
-    spheres: int
+    primitives: int
+    capsules: int
     max_excess_m: float
+    target_excess_m: float
     points_verified: int
-    watertight: bool
+    solid: str
     cached: bool
 
 
 @dataclass(frozen=True)
 class CoverSettings:
-    """Mesh handling of a URDF: folders searched for ``package://`` paths, the largest
-    outward excess of a link's sphere cover [m], the most spheres per mesh, and the
-    cover cache folder (None: no cache)."""
+    """Mesh handling of a URDF: folders searched for ``package://`` paths, the excess
+    aimed at for a link's cover [m], the most primitives per mesh, and the cover cache
+    folder (None: no cache)."""
 
     mesh_paths: tuple[Path, ...] = ()
     excess_m: float = 0.01
-    max_spheres: int = 256
+    max_primitives: int = 32
     cache_dir: Path | None = None
     #: read-only folders of shipped covers (``covers/`` beside the URDF), after the cache
     shipped_dirs: tuple[Path, ...] = ()
@@ -542,10 +385,11 @@ __all__ = [
     "CoverSettings",
     "MeshCover",
     "MeshError",
-    "SphereCover",
+    "CapsuleCover",
     "box_cover",
+    "cover_target_m",
     "default_cache_dir",
     "load_mesh",
+    "mesh_cover",
     "resolve_mesh",
-    "sphere_cover",
 ]

@@ -28,9 +28,10 @@ Every ``<collision>`` element becomes one capsule (a plannerlab "link", named
   (covers the box, conservative);
 * a mesh (STL, OBJ, DAE; ``package://``, ``file://`` or a path relative to the URDF,
   searched as :func:`~plannerlab.robots.urdf.meshes.resolve_mesh` says): a conservative
-  cover of zero-length capsules (spheres), one capsule per sphere
-  (:func:`~plannerlab.robots.urdf.meshes.sphere_cover`: every vertex and a dense surface
-  sample inside, outward excess at most ``cover_excess_m``, cached on disk; a
+  cover of at most ``cover_max_primitives`` capsules
+  (:func:`~plannerlab.robots.urdf.meshes.mesh_cover`: every vertex and a dense surface
+  sample inside, outward excess aimed at ``cover_excess_m`` (at most 3 % of the mesh's
+  size) and coarser when the budget needs it, measured and reported, cached on disk; a
   ``covers/`` folder beside the URDF may ship them, read-only: ``SHIPPED_COVERS``);
   :attr:`UrdfChain.mesh_covers` reports each. The simulator is given the meshes
   themselves (:meth:`UrdfChain.urdf`): verdicts are measured on the real geometry.
@@ -238,7 +239,7 @@ def _capsules(
 ) -> tuple[_Capsules, list[MeshCover], dict[str, Path]]:
     """One capsule per primitive ``<collision>`` element and a sphere cover per mesh (see
     the module docstring); the covers' reports and every collision mesh's file."""
-    from plannerlab.robots.urdf.meshes import MeshError, resolve_mesh, sphere_cover
+    from plannerlab.robots.urdf.meshes import MeshError, mesh_cover, resolve_mesh
 
     caps = _Capsules([], [], [], [], [], [])
     reports: list[MeshCover] = []
@@ -255,11 +256,11 @@ def _capsules(
                 try:
                     file = resolve_mesh(str(g.mesh.filename), path, cover.mesh_paths, where)
                     scale = np.ones(3) if g.mesh.scale is None else np.asarray(g.mesh.scale, float)
-                    sc = sphere_cover(
+                    sc = mesh_cover(
                         file,
                         scale,
                         cover.excess_m,
-                        cover.max_spheres,
+                        cover.max_primitives,
                         where,
                         cover.cache_dir,
                         cover.shipped_dirs,
@@ -271,16 +272,19 @@ def _capsules(
                     MeshCover(
                         lname,
                         str(file),
-                        len(sc.radii_m),
+                        sc.count,
+                        sc.capsules,
                         sc.max_excess_m,
+                        sc.target_excess_m,
                         sc.points_verified,
-                        sc.watertight,
+                        sc.solid,
                         sc.cached,
                     )
                 )
-                centres = sc.centres_m @ T[:3, :3].T + T[:3, 3]
-                for c, r in zip(centres, sc.radii_m, strict=True):
-                    pieces.append((c, c, float(r)))
+                A = sc.a_m @ T[:3, :3].T + T[:3, 3]
+                B = sc.b_m @ T[:3, :3].T + T[:3, 3]
+                for ea, eb, r in zip(A, B, sc.radii_m, strict=True):
+                    pieces.append((ea, eb, float(r)))
                 continue
             if g.sphere is not None:
                 r, half = float(g.sphere.radius), np.zeros(3)
@@ -335,8 +339,9 @@ class UrdfChain:
         T_world_base: (4, 4) pose of the root link in the world.
         mesh_paths: folders searched for ``package://`` mesh paths (see
             :mod:`plannerlab.robots.urdf.meshes`).
-        cover_excess_m: the largest outward excess of a mesh's sphere cover [m].
-        cover_max_spheres: the most spheres a mesh's cover may have.
+        cover_excess_m: the outward excess aimed at for a mesh's cover [m] (at most 3 %
+            of the mesh's size; coarser when ``cover_max_primitives`` needs it).
+        cover_max_primitives: the most capsules covering one mesh.
         cover_cache: keep covers on disk; ``cover_cache_dir`` (None:
             ``~/.cache/plannerlab/covers``).
         sim_urdf_path: the robot's real geometry for the simulator: a URDF with the same
@@ -354,7 +359,7 @@ class UrdfChain:
     T_world_base: Array = field(default_factory=lambda: np.eye(4))
     mesh_paths: tuple[Path, ...] = ()
     cover_excess_m: float = 0.01
-    cover_max_spheres: int = 256
+    cover_max_primitives: int = 32
     cover_cache: bool = True
     cover_cache_dir: Path | None = None
     sim_urdf_path: Path | None = None
@@ -375,7 +380,7 @@ class UrdfChain:
     link_urdf_names: tuple[str, ...] = field(init=False, repr=False)
     #: an upper bound of the tip's distance from the root link's origin [m]
     max_reach_m: float = field(init=False, repr=False)
-    #: how each collision mesh became spheres (empty for a URDF of primitives)
+    #: how each collision mesh became capsules (empty for a URDF of primitives)
     mesh_covers: tuple[MeshCover, ...] = field(init=False, repr=False)
     #: links that move (not on the root body) and have no collision geometry
     links_without_geometry: tuple[str, ...] = field(init=False, repr=False)
@@ -436,7 +441,7 @@ class UrdfChain:
         settings = CoverSettings(
             tuple(Path(p) for p in self.mesh_paths),
             float(self.cover_excess_m),
-            int(self.cover_max_spheres),
+            int(self.cover_max_primitives),
             (
                 None
                 if not self.cover_cache

@@ -5,11 +5,12 @@ its constructor.
 the point ``tip_offset_m`` of the tip link's frame, its normal ``tip_axis`` in that frame.
 ``srdf`` (optional, a path relative to the problem file) and ``allowed_collisions`` (URDF
 link pairs) name link pairs whose self-collision is not checked, besides links on one body
-and neighbouring bodies. Collision meshes become sphere covers
+and neighbouring bodies. Collision meshes become capsule covers
 (:mod:`plannerlab.robots.urdf.meshes`): ``mesh_paths`` are more folders searched for
-``package://`` paths, ``cover_excess_m`` bounds how far a cover reaches outside its mesh,
-``cover_max_spheres`` caps its spheres. The root link's pose in the world is ``base_xyz_m`` [m] and
-``base_rpy_deg`` [deg]. The table in ``docs/problem-format.md`` lists the same keys.
+``package://`` paths, ``cover_excess_m`` is the excess aimed at, ``cover_max_primitives``
+the budget of capsules per mesh (the excess grows when the budget needs it). The root
+link's pose in the world is ``base_xyz_m`` [m] and ``base_rpy_deg`` [deg]. The table in
+``docs/problem-format.md`` lists the same keys.
 """
 
 from __future__ import annotations
@@ -53,7 +54,7 @@ def build(values: Mapping[str, Any]) -> UrdfChain:
             T_world_base=base_pose(values),
             mesh_paths=mesh_paths,
             cover_excess_m=float(values["cover_excess_m"]),
-            cover_max_spheres=int(values["cover_max_spheres"]),
+            cover_max_primitives=int(values["cover_max_primitives"]),
             sim_urdf_path=Path(values["sim_urdf"]) if values["sim_urdf"] else None,
         )
     except UrdfError as exc:
@@ -108,20 +109,21 @@ TABLE = RobotTable(
             "number",
             0.01,
             "m",
-            "the largest distance a mesh link's sphere cover may reach outside the mesh",
+            "the distance a mesh link's cover aims to reach outside the mesh at most (at most "
+            "3 % of the mesh's size; more when cover_max_primitives needs it)",
             positive=True,
             maximum=0.5,
             why_maximum="a cover is an approximation of the link, not a blob around it",
         ),
         Key(
-            "cover_max_spheres",
+            "cover_max_primitives",
             "integer",
-            256,
+            32,
             "",
-            "the most spheres covering one collision mesh",
+            "the most capsules covering one collision mesh",
             minimum=1,
-            maximum=4096,
-            why_maximum="every sphere is one more capsule to check",
+            maximum=1024,
+            why_maximum="every capsule is one more to check",
         ),
         Key(
             "sim_urdf",
