@@ -380,7 +380,7 @@ class Core:
                 its family registers no builder of its own.
         """
         if self._model is None:
-            from plannerlab.collision.model import build_model
+            from plannerlab.collision.model_old import build_model
 
             self._model = build_model(self)
         return self._model

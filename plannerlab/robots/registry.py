@@ -20,7 +20,7 @@ from plannerlab.errors import UnknownNameError
 from plannerlab.robots.schema import RobotTable
 
 #: the generic serial-chain builder of the compiled model (from ``robot.chain_data()``)
-DEFAULT_MODEL = "plannerlab.collision.model:model_of_core"
+DEFAULT_MODEL = "plannerlab.collision.model_old:model_of_core"
 
 
 @dataclass(frozen=True)

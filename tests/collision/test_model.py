@@ -15,7 +15,7 @@ from conftest import PROBLEMS
 from plannerlab.collision.core import Core
 from plannerlab.collision.fcl_checker import CollisionChecker, problem_checker
 from plannerlab.collision.kernels import valid_batch
-from plannerlab.collision.model import (
+from plannerlab.collision.model_old import (
     CompiledModel,
     ModelError,
     edge_ok,

@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 from plannerlab.collision.fcl_checker import CollisionChecker
-from plannerlab.collision.model import chain_model
+from plannerlab.collision.model_old import chain_model
 from plannerlab.collision.spheres import (
     frames,
     kin,

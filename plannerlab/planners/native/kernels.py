@@ -31,7 +31,7 @@ import math
 import numpy as np
 from numba import njit
 
-from plannerlab.collision.model import edge_count, edge_delta, edge_state, state_ok
+from plannerlab.collision.model_old import edge_count, edge_delta, edge_state, state_ok
 from plannerlab.planners.native.kdtree import kd_catch_up, kd_insert, kd_nearest, split_dims
 
 # ---------------------------------------------------------------------- return codes

@@ -429,6 +429,6 @@ class NativeSolve:
 
 def K_views(model: Any) -> tuple[Any, Any]:  # noqa: N802
     """The model's views for the kernels (:func:`plannerlab.collision.model.views`)."""
-    from plannerlab.collision.model import views
+    from plannerlab.collision.model_old import views
 
     return views(model)

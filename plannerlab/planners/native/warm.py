@@ -11,7 +11,7 @@ import numpy as np
 def warm_up(model: Any | None = None) -> None:
     """Run every kernel entry point once, doing no work of note (``model``: a compiled
     model to run them on; default: a two-joint chain in an empty room)."""
-    from plannerlab.collision.model import views
+    from plannerlab.collision.model_old import views
     from plannerlab.planners.native import kernels as K
     from plannerlab.planners.native import rrtstar as R
 
