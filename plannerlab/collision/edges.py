@@ -99,27 +99,11 @@ def step_rates(m, d, n, out):
 
 
 @njit(cache=True, nogil=True)
-def edge_scratch(m):
-    """The scratch of :func:`edge_check` (made once per search): the edge's direction
-    (dof,), a state (dof,), the capsules' step rates (L,), the stack of stretches (S, 2),
-    and the stretches of one call (3, W)."""
-    dof = m.lower.shape[0]
-    L = max(m.cap_body.shape[0], 1)
-    return (
-        np.zeros(dof),
-        np.zeros(dof),
-        np.zeros(L),
-        np.zeros((4096, 2), dtype=np.int64),
-        np.zeros((3, W), dtype=np.int64),
-    )
-
-
-@njit(cache=True, nogil=True)
-def edge_check(m, Z, E, qa, qb, joint_step, limit):
-    """Check edge qa -> qb on the grid (see the module). Z: the state test's lanes; E:
-    :func:`edge_scratch`. Returns ``(status, checks, n)``: FREE, INVALID or LIMIT, the
+def edge_check(m, Z, qa, qb, joint_step, limit):
+    """Check edge qa -> qb on the grid (see the module). Z: the state test's scratch
+    (:func:`~plannerlab.collision.state_test.lanes`). Returns ``(status, checks, n)``: FREE, INVALID or LIMIT, the
     lanes tested, the grid's number of states."""
-    d, q, rate, stack, marks = E
+    d, q, rate, stack, marks = Z.edge_d, Z.edge_q, Z.edge_rate, Z.edge_stack, Z.edge_marks
     los, mids, his = marks[0], marks[1], marks[2]
     edge_delta(qa, qb, m.continuous, d)
     n = edge_count(d, joint_step, m.edge_weights)
@@ -179,7 +163,6 @@ __all__ = [
     "edge_check",
     "edge_count",
     "edge_delta",
-    "edge_scratch",
     "edge_state",
     "step_rates",
 ]

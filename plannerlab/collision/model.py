@@ -6,7 +6,8 @@ loads the kernels that take it from its cache), built once per (robot, scene, ma
 :mod:`plannerlab.collision.chain`: every robot family gives it) and the scene's
 obstacles. Its fields are named; no consumer indexes packed arrays by position.
 
-* **Kinematics** (``parent``, ``slide``, ``T0``, ``pre``, the coupling ``cpl_*``): each
+* **Kinematics** (``parent``, ``slide``, ``T0``, ``pre``, the coupling ``cpl_*``, and
+  ``fold``: a point ``p`` of body ``b``'s own frame is ``fold[b]ᵀ p`` here): each
   joint's axis is turned onto its frame's z axis once (with ``A e_z = u``, a turn about
   ``u`` is ``A Rz(q) Aᵀ``: body frames are kept as ``B · A`` and ``A`` is folded into the
   fixed transforms and the capsules' points), so the one kinematics of
@@ -62,6 +63,7 @@ class CompiledModel(NamedTuple):
     slide: np.ndarray  # (m,) bool
     T0: np.ndarray  # (12,) float64
     pre: np.ndarray  # (m, 12) float64
+    fold: np.ndarray  # (m + 1, 3, 3): a point p of body b's own frame is fold[b]ᵀ p here
     T0_32: np.ndarray  # (12,) float32
     pre_32: np.ndarray  # (m, 12) float32
     cpl_start: np.ndarray  # (m + 1,) int64, or (0,): no coupling
@@ -306,6 +308,7 @@ def build_model(
         slide=_f(prismatic, np.bool_),
         T0=_f(T0),
         pre=_f(pre_f.reshape(m, 12)),
+        fold=_f(np.array(A).reshape(nb, 3, 3)),
         T0_32=_f(T0, np.float32),
         pre_32=_f(pre_f.reshape(m, 12), np.float32),
         cpl_start=_f(cpl_start, np.int64),

@@ -74,22 +74,10 @@ _ALL = (1 << LANES) - 1
 _F4 = np.float32
 
 
-class Exact(NamedTuple):
-    """The float64 confirmation's scratch: one state of the same kinematics."""
-
-    Q: np.ndarray  # (dof,)
-    V: np.ndarray  # (m,)
-    F: np.ndarray  # (nb * 12,)
-    XA: np.ndarray  # (L, 3)
-    XB: np.ndarray  # (L, 3)
-    placed: np.ndarray  # (nb,) int64
-    w: np.ndarray  # (64,) the exact tests' scratch
-    R: np.ndarray  # (n, 3, 3): the obstacles' rotations as matrices
-
-
 class Lanes(NamedTuple):
-    """The scratch of :func:`test_lanes` (made once per search by :func:`lanes`); flat
-    float32 arrays of 8-lane slots."""
+    """The scratch of the state test and the edge check (made once per search by
+    :func:`lanes`); flat float32 arrays of 8-lane slots, then the float64 confirmation's
+    one state (``e_*``), then the edge check's (``edge_*``)."""
 
     Q: np.ndarray  # (dof * W,) the states, continuous joints wrapped
     V: np.ndarray  # (m * W,) the chain's joint values (a coupled chain)
@@ -106,12 +94,24 @@ class Lanes(NamedTuple):
     grow64: np.ndarray  # (W,) float64
     rate64: np.ndarray  # (L,) float64
     brate64: np.ndarray  # (nb,) float64
-    one: Exact
+    e_Q: np.ndarray  # (dof,) the confirmation's state
+    e_V: np.ndarray  # (m,)
+    e_F: np.ndarray  # (nb * 12,) its frames
+    e_XA: np.ndarray  # (L, 3) its capsule ends
+    e_XB: np.ndarray  # (L, 3)
+    e_placed: np.ndarray  # (nb,) int64
+    e_w: np.ndarray  # (64,) the exact tests' scratch
+    e_R: np.ndarray  # (n, 3, 3) the obstacles' rotations as matrices
+    edge_d: np.ndarray  # (dof,) an edge's direction
+    edge_q: np.ndarray  # (dof,) a grid state
+    edge_rate: np.ndarray  # (L,) the capsules' motion per grid step [m]
+    edge_stack: np.ndarray  # (S, 2) int64 stretches still to prove
+    edge_marks: np.ndarray  # (3, W) int64 the stretches of one call
 
 
 @njit(cache=True, nogil=True)
 def lanes(m):
-    """The scratch of :func:`test_lanes` for the model m."""
+    """The scratch of the state test and the edge check for the model m."""
     dof = m.lower.shape[0]
     nj = m.parent.shape[0]
     nb = nj + 1
@@ -123,16 +123,6 @@ def lanes(m):
         for a in range(3):
             for b in range(3):
                 R[o, a, b] = m.obs_R[o, 3 * a + b]
-    one = Exact(
-        np.zeros(dof),
-        np.zeros(max(nj, 1)),
-        np.zeros(nb * 12),
-        np.zeros((L, 3)),
-        np.zeros((L, 3)),
-        np.zeros(nb, dtype=np.int64),
-        np.zeros(64),
-        R,
-    )
     f4 = np.float32
     return Lanes(
         np.zeros(dof * W, dtype=f4),
@@ -150,7 +140,19 @@ def lanes(m):
         np.zeros(W),
         np.zeros(L),
         np.zeros(nb),
-        one,
+        np.zeros(dof),
+        np.zeros(max(nj, 1)),
+        np.zeros(nb * 12),
+        np.zeros((L, 3)),
+        np.zeros((L, 3)),
+        np.zeros(nb, dtype=np.int64),
+        np.zeros(64),
+        R,
+        np.zeros(dof),
+        np.zeros(dof),
+        np.zeros(L),
+        np.zeros((4096, 2), dtype=np.int64),
+        np.zeros((3, W), dtype=np.int64),
     )
 
 
@@ -580,7 +582,7 @@ def test_lanes(m, Z, mode):
     for k in range(W):
         if (todo >> k) & 1:
             confirmed += 1
-            if exact_state(m, Z.one, Z.Q64[k], 0.0, Z.rate64, Z.brate64):
+            if exact_state(m, Z, Z.Q64[k], 0.0):
                 unsure &= ~(1 << k)
             else:
                 hit |= 1 << k
@@ -591,13 +593,13 @@ def test_lanes(m, Z, mode):
 
 # ------------------------------------------------------------------ float64, exact
 @njit(cache=True, nogil=True, _nrt=False)
-def _place64(m, E, b):
+def _place64(m, Z, b):
     for l in range(m.body_caps[b], m.body_caps[b + 1]):
-        x, y, z = place(E.F, b, m.cap_a, l, 0)
-        E.XA[l, 0], E.XA[l, 1], E.XA[l, 2] = x, y, z
-        x, y, z = place(E.F, b, m.cap_b, l, 0)
-        E.XB[l, 0], E.XB[l, 1], E.XB[l, 2] = x, y, z
-    E.placed[b] = 1
+        x, y, z = place(Z.e_F, b, m.cap_a, l, 0)
+        Z.e_XA[l, 0], Z.e_XA[l, 1], Z.e_XA[l, 2] = x, y, z
+        x, y, z = place(Z.e_F, b, m.cap_b, l, 0)
+        Z.e_XB[l, 0], Z.e_XB[l, 1], Z.e_XB[l, 2] = x, y, z
+    Z.e_placed[b] = 1
 
 
 @njit(cache=True, nogil=True, _nrt=False)
@@ -625,59 +627,61 @@ def _clear64(m, o, x, y, z, r):
 
 
 @njit(cache=True, nogil=True, _nrt=False)
-def frames64(m, E, q):
-    """Every body's frame of one state q (dof,) in float64 into E.F (the one kinematics)."""
+def frames64(m, Z, q):
+    """Every body's frame of one state q (dof,) in float64 into Z.e_F (the one kinematics)."""
     for i in range(q.shape[0]):
-        E.Q[i] = q[i]
+        Z.e_Q[i] = q[i]
     if m.cpl_start.shape[0] > 0:
-        chain_values(E.Q, (m.cpl_start, m.cpl_idx, m.cpl_val), E.V)
-        chain_frames(E.F, E.V, m.T0, m.pre, m.parent, m.slide)
+        chain_values(Z.e_Q, (m.cpl_start, m.cpl_idx, m.cpl_val), Z.e_V)
+        chain_frames(Z.e_F, Z.e_V, m.T0, m.pre, m.parent, m.slide)
     else:
-        chain_frames(E.F, E.Q, m.T0, m.pre, m.parent, m.slide)
+        chain_frames(Z.e_F, Z.e_Q, m.T0, m.pre, m.parent, m.slide)
 
 
 @njit(cache=True, nogil=True, _nrt=False)
-def exact_state(m, E, q, grow, rate, brate):
+def exact_state(m, Z, q, grow):
     """One state q (dof,) is free with every capsule grown by ``grow · rate`` (float64,
-    the exact tests of ``geometry``: FCL's verdicts)."""
-    frames64(m, E, q)
-    for b in range(E.placed.shape[0]):
-        E.placed[b] = 0
+    the exact tests of ``geometry``: FCL's verdicts); ``Z.rate64``, ``Z.brate64``: the
+    capsules' and bodies' rates."""
+    rate, brate = Z.rate64, Z.brate64
+    frames64(m, Z, q)
+    for b in range(Z.e_placed.shape[0]):
+        Z.e_placed[b] = 0
     for kb in range(m.body_order.shape[0]):
         b = m.body_order[kb]
         gr = m.gate_r_scene[b]
         if gr < 0.0:
             continue
-        x, y, z = place(E.F, b, m.gate_c, b, 0)
+        x, y, z = place(Z.e_F, b, m.gate_c, b, 0)
         gb = gr + grow * brate[b]
         for o in range(m.obs_kind.shape[0]):
             if _clear64(m, o, x, y, z, gb):
                 continue
-            if E.placed[b] == 0:
-                _place64(m, E, b)
+            if Z.e_placed[b] == 0:
+                _place64(m, Z, b)
             for l in range(m.body_caps[b], m.body_caps[b + 1]):
                 if m.cap_moving[l] and capsule_obstacle_hit(
-                    m.obs_kind[o], E.R[o], m.obs_c[o], m.obs_h[o], E.XA[l], E.XB[l],
-                    m.r_scene[l] + grow * rate[l], E.w,
+                    m.obs_kind[o], Z.e_R[o], m.obs_c[o], m.obs_h[o], Z.e_XA[l], Z.e_XB[l],
+                    m.r_scene[l] + grow * rate[l], Z.e_w,
                 ):  # fmt: skip
                     return False
     for p in range(m.bpairs.shape[0]):
         u, v = m.bpairs[p, 0], m.bpairs[p, 1]
         if u != v:
-            xu, yu, zu = place(E.F, u, m.gate_c, u, 0)
-            xv, yv, zv = place(E.F, v, m.gate_c, v, 0)
+            xu, yu, zu = place(Z.e_F, u, m.gate_c, u, 0)
+            xv, yv, zv = place(Z.e_F, v, m.gate_c, v, 0)
             rr = m.gate_r_self[u] + m.gate_r_self[v] + grow * (brate[u] + brate[v]) + 1e-9
             dx, dy, dz = xu - xv, yu - yv, zu - zv
             if dx * dx + dy * dy + dz * dz > rr * rr:
                 continue
-        if E.placed[u] == 0:
-            _place64(m, E, u)
-        if E.placed[v] == 0:
-            _place64(m, E, v)
+        if Z.e_placed[u] == 0:
+            _place64(m, Z, u)
+        if Z.e_placed[v] == 0:
+            _place64(m, Z, v)
         for q2 in range(m.clpair_start[m.bpair_start[p]], m.clpair_start[m.bpair_start[p + 1]]):
             i, j = m.cpairs[q2, 0], m.cpairs[q2, 1]
             rr = m.r_self[i] + m.r_self[j] + grow * (rate[i] + rate[j])
-            d2, _, _ = seg_seg(E.XA[i], E.XB[i], E.XA[j], E.XB[j])
+            d2, _, _ = seg_seg(Z.e_XA[i], Z.e_XB[i], Z.e_XA[j], Z.e_XB[j])
             if d2 <= rr * rr:
                 return False
     return True
@@ -718,5 +722,5 @@ def exact_batch(m, Q, out):
     filter's verdicts equal."""
     Z = lanes(m)
     for s in range(Q.shape[0]):
-        out[s] = exact_state(m, Z.one, Q[s], 0.0, Z.rate64, Z.brate64)
+        out[s] = exact_state(m, Z, Q[s], 0.0)
     return out

@@ -1,0 +1,162 @@
+"""The checker's compiled queries, called from Python on the packed model.
+
+Each takes ``P``: :func:`~plannerlab.collision.packing.pack` ``(model, lanes)`` as a tuple
+of its five arrays, rebuilt into the named model and the state test's scratch inside
+(views: ~1 µs), so a call from Python unboxes five arrays, not seventy. Compiled
+consumers call :mod:`plannerlab.collision.state_test` and :mod:`plannerlab.collision.edges`
+with the named tuples directly.
+
+* :func:`valid_one`: one state; :func:`valid_many`: a batch, eight states a call;
+  :func:`first_invalid`: the first invalid state of a sequence, in order;
+* :func:`edge_certified`: an edge on the grid, certified in rakes (the verdict of the
+  grid, few tests); :func:`edge_first_invalid`: the grid's first invalid state, in order;
+* :func:`segments`: capsule axes of a batch in float64 (the one kinematics);
+  :func:`tip`: the robot's tip (position, normal) from the same frames.
+"""
+
+from __future__ import annotations
+
+from numba import njit
+
+from plannerlab.collision._unpacked import unpack_lanes, unpack_model
+from plannerlab.collision.edges import edge_check, edge_count, edge_delta, edge_state
+from plannerlab.collision.kinematics import place
+from plannerlab.collision.state_test import (
+    ANY_HIT,
+    EVERY_LANE,
+    W,
+    fill_lanes,
+    frames64,
+    load_state,
+    set_plain,
+    test_lanes,
+)
+
+
+@njit(cache=True, nogil=True, inline="always")
+def _open(P):
+    f64, f32, i64, b1, head = P
+    return unpack_model(f64, f32, i64, b1, head), unpack_lanes(f64, f32, i64, b1, head)
+
+
+@njit(cache=True, nogil=True, _nrt=False)
+def valid_one(P, q):
+    """One state q (dof,) is valid."""
+    m, Z = _open(P)
+    set_plain(Z)
+    load_state(Z, 0, q, m.continuous)
+    fill_lanes(Z, 1)
+    free, _, _ = test_lanes(m, Z, ANY_HIT)
+    return (free & 1) != 0
+
+
+@njit(cache=True, nogil=True, _nrt=False)
+def valid_many(P, Q, out):
+    """Validity of Q (k, dof) -> out (k,) bool. Returns how many states the float64
+    confirmation decided."""
+    m, Z = _open(P)
+    set_plain(Z)
+    confirmed = 0
+    for s0 in range(0, Q.shape[0], W):
+        nn = min(W, Q.shape[0] - s0)
+        for j in range(nn):
+            load_state(Z, j, Q[s0 + j], m.continuous)
+        fill_lanes(Z, nn)
+        free, _, c = test_lanes(m, Z, EVERY_LANE)
+        confirmed += c
+        for j in range(nn):
+            out[s0 + j] = (free >> j) & 1
+    return confirmed
+
+
+@njit(cache=True, nogil=True, _nrt=False)
+def first_invalid(P, Q):
+    """Index of the first invalid state of Q (k, dof) in order, -1 if all are valid."""
+    m, Z = _open(P)
+    set_plain(Z)
+    for s0 in range(0, Q.shape[0], W):
+        nn = min(W, Q.shape[0] - s0)
+        for j in range(nn):
+            load_state(Z, j, Q[s0 + j], m.continuous)
+        fill_lanes(Z, nn)
+        free, _, _ = test_lanes(m, Z, EVERY_LANE)
+        for j in range(nn):
+            if not (free >> j) & 1:
+                return s0 + j
+    return -1
+
+
+@njit(cache=True, nogil=True, _nrt=False)
+def edge_certified(P, qa, qb, joint_step, limit):
+    """Edge qa -> qb on the grid, certified in rakes
+    (:func:`~plannerlab.collision.edges.edge_check`): (status, checks, grid states)."""
+    m, Z = _open(P)
+    return edge_check(m, Z, qa, qb, joint_step, limit)
+
+
+@njit(cache=True, nogil=True, _nrt=False)
+def edge_first_invalid(P, qa, qb, joint_step, limit):
+    """The grid states of edge qa -> qb (1..n) in order, at most ``limit`` of them: (n,
+    the index of the first invalid one among those, -1 if none)."""
+    m, Z = _open(P)
+    set_plain(Z)
+    d, q = Z.edge_d, Z.edge_q
+    edge_delta(qa, qb, m.continuous, d)
+    n = edge_count(d, joint_step, m.edge_weights)
+    k = min(n, limit)
+    for s0 in range(0, k, W):
+        nn = min(W, k - s0)
+        for j in range(nn):
+            edge_state(qa, d, s0 + j + 1, n, q)
+            load_state(Z, j, q, m.continuous)
+        fill_lanes(Z, nn)
+        free, _, _ = test_lanes(m, Z, EVERY_LANE)
+        for j in range(nn):
+            if not (free >> j) & 1:
+                return n, s0 + j
+    return n, -1
+
+
+@njit(cache=True, nogil=True, _nrt=False)
+def segments(P, Q, out):
+    """Capsule axes of a batch in the robot's capsule order, float64 (the one kinematics):
+    Q (k, dof) -> out (k, L, 2, 3)."""
+    m, Z = _open(P)
+    for s in range(Q.shape[0]):
+        frames64(m, Z, Q[s])
+        for k in range(m.cap_body.shape[0]):
+            b = m.cap_body[k]
+            l = m.perm[k]
+            x, y, z = place(Z.e_F, b, m.cap_a, k, 0)
+            out[s, l, 0, 0], out[s, l, 0, 1], out[s, l, 0, 2] = x, y, z
+            x, y, z = place(Z.e_F, b, m.cap_b, k, 0)
+            out[s, l, 1, 0], out[s, l, 1, 1], out[s, l, 1, 2] = x, y, z
+    return out
+
+
+@njit(cache=True, nogil=True, _nrt=False)
+def tip(P, q, body, tip_p, out):
+    """The tip of one state q (dof,): ``tip_p`` (2, 3) the tip point and its normal in
+    body ``body``'s frame (axes folded: see the model) -> out (2, 3): position [m], unit
+    normal, in the world."""
+    m, Z = _open(P)
+    frames64(m, Z, q)
+    x, y, z = place(Z.e_F, body, tip_p, 0, 0)
+    out[0, 0], out[0, 1], out[0, 2] = x, y, z
+    F = Z.e_F
+    o = 12 * body
+    for a in range(3):
+        out[1, a] = (F[o + 4 * a] * tip_p[1, 0] + F[o + 4 * a + 1] * tip_p[1, 1]
+                     + F[o + 4 * a + 2] * tip_p[1, 2])  # fmt: skip
+    return out
+
+
+__all__ = [
+    "edge_certified",
+    "edge_first_invalid",
+    "first_invalid",
+    "segments",
+    "tip",
+    "valid_many",
+    "valid_one",
+]
