@@ -185,7 +185,11 @@ class Core:
             robot, geo, self.margin_m, self.edge_weights, link_rates
         )
         self._P = tuple(pack(self.model, lanes(self.model)))
+        #: the model and the state test's scratch packed (:mod:`plannerlab.collision.
+        #: packing`): what compiled kernels called from Python take (five arrays)
+        self.packed = self._P
         self._one = (robot.dof,)
+        self._one_out = np.empty(1, dtype=np.bool_)
         self._tip: tuple[int, np.ndarray] | None = None
         tip_data = getattr(robot, "tip_data", None)
         if callable(tip_data):
@@ -247,16 +251,20 @@ class Core:
         """(k,) bool validity of Q (k, dof)."""
         Qc = self._Q(Q)
         out = np.empty(len(Qc), dtype=np.bool_)
-        queries.valid_many(self._P, Qc, out)
+        queries.states(self._P, Qc, out, queries.EACH)
         return out
 
     def is_valid(self, q: Array) -> bool:
         """Validity of one state q (dof,)."""
-        return bool(queries.valid_one(self._P, self._q(q)))
+        q1 = self._q(q).reshape(1, -1)
+        out = self._one_out
+        queries.states(self._P, q1, out, queries.EACH)
+        return bool(out[0])
 
     def first_invalid(self, Q: Array) -> int:
         """Index of the first invalid state of Q (k, dof) in order, -1 if all are valid."""
-        return int(queries.first_invalid(self._P, self._Q(Q)))
+        Qc = self._Q(Q)
+        return int(queries.states(self._P, Qc, np.empty(len(Qc), np.bool_), queries.FIRST))
 
     # ------------------------------------------------------------------ edges
     def _edge_args(
@@ -299,7 +307,7 @@ class Core:
         qa, qb, step = self._edge_args(q_a, q_b, joint_step)
         self._grid_n(qa, qb, step)
         lim = _NO_LIMIT if limit is None else max(int(limit), 0)
-        n, bad = queries.edge_first_invalid(self._P, qa, qb, step, lim)
+        n, bad, _ = queries.edge(self._P, qa, qb, step, (lim, queries.IN_ORDER))
         return int(n), int(bad)
 
     def edge_certified(
@@ -316,7 +324,7 @@ class Core:
         qa, qb, step = self._edge_args(q_a, q_b, joint_step)
         self._grid_n(qa, qb, step)
         lim = _NO_LIMIT if limit is None else max(int(limit), 0)
-        status, tests, n = queries.edge_certified(self._P, qa, qb, step, lim)
+        status, tests, n = queries.edge(self._P, qa, qb, step, (lim, queries.CERTIFIED))
         return int(status), int(tests), int(n)
 
     # ------------------------------------------------------------------ distances

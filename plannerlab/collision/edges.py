@@ -51,7 +51,7 @@ INVALID = 1
 LIMIT = 2
 
 
-@njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True, _nrt=False)
 def edge_delta(q_a, q_b, continuous, d):
     """d = q_b - q_a, continuous joints the short way round (``joint_difference``)."""
     for i in range(q_a.shape[0]):
@@ -61,7 +61,7 @@ def edge_delta(q_a, q_b, continuous, d):
         d[i] = x
 
 
-@njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True, _nrt=False)
 def edge_count(d, joint_step, edge_weights):
     """The grid's number of steps of an edge ``d``: at most ``joint_step`` per joint and
     ``ceil(Σ |d_i| · w_i)`` (``robots.paths.edge_counts``)."""
@@ -74,7 +74,7 @@ def edge_count(d, joint_step, edge_weights):
     return int(max(1.0, math.ceil(span / joint_step - 1e-12), math.ceil(metric - 1e-12)))
 
 
-@njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True, _nrt=False)
 def edge_state(q_a, d, j, n, out):
     """Grid state ``j`` (0..n) of the edge: ``q_a + t d``, ``t = j · (1 / n)`` (exactly 1
     at ``j = n``), the floats of ``densify``."""
@@ -83,7 +83,7 @@ def edge_state(q_a, d, j, n, out):
         out[i] = q_a[i] + t * d[i]
 
 
-@njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True, _nrt=False)
 def step_rates(m, d, n, out):
     """Per capsule (packed order), how far [m] it can move in one grid step of edge d
     with n steps: ``Σ_i |d_i| / n · link_rates[i, l]``."""
@@ -98,11 +98,48 @@ def step_rates(m, d, n, out):
             out[l] += a * R[i, l]
 
 
-@njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True, _nrt=False)
+def _push_pieces(stack, top, lo, hi, pieces):
+    """Push [lo, hi] cut into at most ``pieces`` stretches (nothing when empty)."""
+    s = hi - lo + 1
+    if s <= 0:
+        return top
+    k = min(pieces, s)
+    for p in range(k):
+        stack[top, 0] = lo + (p * s) // k
+        stack[top, 1] = lo + ((p + 1) * s) // k - 1
+        top += 1
+    return top
+
+
+@njit(cache=True, nogil=True, _nrt=False)
+def _load_stretches(m, Z, E, q_ad, stack, top):
+    """Pop up to W stretches into the lanes (each its middle grid state, grown by its
+    half-length): returns (lanes filled, top). ``E`` = (los, mids, his) the lanes'
+    stretches; ``q_ad`` = (qa, d, n)."""
+    los, mids, his = E
+    qa, d, n = q_ad
+    q = Z.edge_q
+    k = 0
+    while k < W and top > 0:
+        top -= 1
+        lo, hi = stack[top, 0], stack[top, 1]
+        mid = (lo + hi) // 2
+        reach = max(mid - lo, hi - mid)
+        edge_state(qa, d, mid, n, q)
+        load_state(Z, k, q, m.continuous)
+        Z.grow[k] = np.float32(reach)
+        Z.grow64[k] = float(reach)
+        los[k], mids[k], his[k] = lo, mid, hi
+        k += 1
+    return k, top
+
+
+@njit(cache=True, nogil=True, _nrt=False)
 def edge_check(m, Z, qa, qb, joint_step, limit):
     """Check edge qa -> qb on the grid (see the module). Z: the state test's scratch
-    (:func:`~plannerlab.collision.state_test.lanes`). Returns ``(status, checks, n)``: FREE, INVALID or LIMIT, the
-    lanes tested, the grid's number of states."""
+    (:func:`~plannerlab.collision.state_test.lanes`). Returns ``(status, checks, n)``:
+    FREE, INVALID or LIMIT, the lanes tested, the grid's number of states."""
     d, q, rate, stack, marks = Z.edge_d, Z.edge_q, Z.edge_rate, Z.edge_stack, Z.edge_marks
     los, mids, his = marks[0], marks[1], marks[2]
     edge_delta(qa, qb, m.continuous, d)
@@ -110,28 +147,10 @@ def edge_check(m, Z, qa, qb, joint_step, limit):
     step_rates(m, d, n, rate)
     set_rates(m, Z, rate)
     # the first stretches: [1, n] cut into at most W pieces
-    top = 0
-    pieces = min(W, n)
-    for p in range(pieces):
-        lo = 1 + (p * n) // pieces
-        hi = ((p + 1) * n) // pieces
-        stack[top, 0] = lo
-        stack[top, 1] = hi
-        top += 1
+    top = _push_pieces(stack, 0, 1, n, W)
     checks = 0
     while top > 0:
-        k = 0
-        while k < W and top > 0:
-            top -= 1
-            lo, hi = stack[top, 0], stack[top, 1]
-            mid = (lo + hi) // 2
-            reach = max(mid - lo, hi - mid)
-            edge_state(qa, d, mid, n, q)
-            load_state(Z, k, q, m.continuous)
-            Z.grow[k] = np.float32(reach)
-            Z.grow64[k] = float(reach)
-            los[k], mids[k], his[k] = lo, mid, hi
-            k += 1
+        k, top = _load_stretches(m, Z, (los, mids, his), (qa, d, n), stack, top)
         if checks + k > limit:
             return LIMIT, checks, n
         fill_lanes(Z, k)
@@ -142,18 +161,57 @@ def edge_check(m, Z, qa, qb, joint_step, limit):
         for j in range(k):
             if (free >> j) & 1:
                 continue
-            # not proved at its growth: its stretch in at most W pieces (a stretch of one
-            # state was tested plain: it is free or hit, never here)
-            lo, hi = los[j], his[j]
-            s = hi - lo + 1
-            pieces = min(W, s)
-            if top + pieces > stack.shape[0]:
+            # not proved at its growth (its own state is free: not hit): the stretch's
+            # two sides of it, in at most W pieces
+            lo, mid, hi = los[j], mids[j], his[j]
+            if top + W > stack.shape[0]:
                 return LIMIT, checks, n
-            for p in range(pieces):
-                stack[top, 0] = lo + (p * s) // pieces
-                stack[top, 1] = lo + ((p + 1) * s) // pieces - 1
-                top += 1
+            top = _push_pieces(stack, top, lo, mid - 1, W // 2)
+            top = _push_pieces(stack, top, mid + 1, hi, W // 2)
     return FREE, checks, n
+
+
+@njit(cache=True, nogil=True, _nrt=False)
+def edge_rake(m, Z, qa, qb, joint_step, stride, limit):
+    """The edge's coarse check: its grid cut into stretches of ``stride`` states, each
+    stretch's middle state tested (eight a call) grown by the stretch's half-length.
+    Returns ``(status, checks, n, proved)``: INVALID when a tested state collides, LIMIT
+    when ``limit`` came first, else FREE, and then ``proved`` when every stretch was
+    proved free (the whole grid: :func:`edge_check` would say FREE), else only the tested
+    states are known free (the rest is the lazy planners' to check later)."""
+    d = Z.edge_d
+    los, mids, his = Z.edge_marks[0], Z.edge_marks[1], Z.edge_marks[2]
+    stack = Z.edge_stack
+    edge_delta(qa, qb, m.continuous, d)
+    n = edge_count(d, joint_step, m.edge_weights)
+    step_rates(m, d, n, Z.edge_rate)
+    set_rates(m, Z, Z.edge_rate)
+    pieces = (n + stride - 1) // stride
+    checks = 0
+    proved = True
+    done = 0
+    while done < pieces:
+        # up to W stretches, the far end's first (an extension's new node): pushed
+        # nearest first, popped from the top
+        b = min(W, pieces - done)
+        top = 0
+        for r in range(b):
+            p = pieces - done - b + r
+            stack[top, 0] = 1 + (p * n) // pieces
+            stack[top, 1] = ((p + 1) * n) // pieces
+            top += 1
+        done += b
+        k, _ = _load_stretches(m, Z, (los, mids, his), (qa, d, n), stack, top)
+        if checks + k > limit:
+            return LIMIT, checks, n, False
+        fill_lanes(Z, k)
+        free, hit, _ = test_lanes(m, Z, ANY_HIT)
+        checks += k
+        if hit & ((1 << k) - 1):
+            return INVALID, checks, n, False
+        if (free & ((1 << k) - 1)) != (1 << k) - 1:
+            proved = False
+    return FREE, checks, n, proved
 
 
 __all__ = [
@@ -163,6 +221,7 @@ __all__ = [
     "edge_check",
     "edge_count",
     "edge_delta",
+    "edge_rake",
     "edge_state",
     "step_rates",
 ]

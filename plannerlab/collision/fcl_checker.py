@@ -479,6 +479,21 @@ class CollisionChecker:
             )
         return self._core.model
 
+    @property
+    def packed_model(self) -> tuple[np.ndarray, ...]:
+        """The compiled model and the state test's scratch, packed (five arrays:
+        :mod:`plannerlab.collision.packing`), what compiled kernels called from Python
+        take.
+
+        Raises:
+            ValueError: the checker has no compiled core.
+        """
+        if self._core is None:
+            raise ValueError(
+                "the compiled model needs the core backend (boxes, cylinders, spheres)"
+            )
+        return self._core.packed
+
     def check_path(
         self,
         path: Array,

@@ -1,15 +1,15 @@
 """The checker's compiled queries, called from Python on the packed model.
 
 Each takes ``P``: :func:`~plannerlab.collision.packing.pack` ``(model, lanes)`` as a tuple
-of its five arrays, rebuilt into the named model and the state test's scratch inside
+of its five arrays, and they are few (every compiled entry compiles the state test again
+into itself, numba linking and optimizing its callees with it), rebuilt into the named model and the state test's scratch inside
 (views: ~1 µs), so a call from Python unboxes five arrays, not seventy. Compiled
 consumers call :mod:`plannerlab.collision.state_test` and :mod:`plannerlab.collision.edges`
 with the named tuples directly.
 
-* :func:`valid_one`: one state; :func:`valid_many`: a batch, eight states a call;
-  :func:`first_invalid`: the first invalid state of a sequence, in order;
-* :func:`edge_certified`: an edge on the grid, certified in rakes (the verdict of the
-  grid, few tests); :func:`edge_first_invalid`: the grid's first invalid state, in order;
+* :func:`states`: a batch's verdicts, eight states a call, or its first invalid state;
+* :func:`edge`: an edge on the grid, certified in rakes (the verdict of the grid, few
+  tests), or the grid's first invalid state, in order;
 * :func:`segments`: capsule axes of a batch in float64 (the one kinematics);
   :func:`tip`: the robot's tip (position, normal) from the same frames.
 """
@@ -39,21 +39,19 @@ def _open(P):
     return unpack_model(f64, f32, i64, b1, head), unpack_lanes(f64, f32, i64, b1, head)
 
 
-@njit(cache=True, nogil=True, _nrt=False)
-def valid_one(P, q):
-    """One state q (dof,) is valid."""
-    m, Z = _open(P)
-    set_plain(Z)
-    load_state(Z, 0, q, m.continuous)
-    fill_lanes(Z, 1)
-    free, _, _ = test_lanes(m, Z, ANY_HIT)
-    return (free & 1) != 0
+#: :func:`states`' modes: every state's verdict; the first invalid state's index
+EACH, FIRST = 0, 1
+#: :func:`edge`'s modes: certified stretches; the grid's first invalid state in order
+CERTIFIED, IN_ORDER = 0, 1
 
 
 @njit(cache=True, nogil=True, _nrt=False)
-def valid_many(P, Q, out):
-    """Validity of Q (k, dof) -> out (k,) bool. Returns how many states the float64
-    confirmation decided."""
+def states(P, Q, out, mode):
+    """Validity of Q (k, dof), eight states a call (one compiled entry for every state
+    query: each entry compiles the state test again into itself). ``EACH``: every verdict
+    into out (k,) bool, returns how many the float64 confirmation decided; ``FIRST``:
+    returns the index of the first invalid state in order, -1 if none (out not written
+    past it)."""
     m, Z = _open(P)
     set_plain(Z)
     confirmed = 0
@@ -62,43 +60,26 @@ def valid_many(P, Q, out):
         for j in range(nn):
             load_state(Z, j, Q[s0 + j], m.continuous)
         fill_lanes(Z, nn)
-        free, _, c = test_lanes(m, Z, EVERY_LANE)
+        free, _, c = test_lanes(m, Z, ANY_HIT if nn == 1 else EVERY_LANE)
         confirmed += c
         for j in range(nn):
-            out[s0 + j] = (free >> j) & 1
-    return confirmed
-
-
-@njit(cache=True, nogil=True, _nrt=False)
-def first_invalid(P, Q):
-    """Index of the first invalid state of Q (k, dof) in order, -1 if all are valid."""
-    m, Z = _open(P)
-    set_plain(Z)
-    for s0 in range(0, Q.shape[0], W):
-        nn = min(W, Q.shape[0] - s0)
-        for j in range(nn):
-            load_state(Z, j, Q[s0 + j], m.continuous)
-        fill_lanes(Z, nn)
-        free, _, _ = test_lanes(m, Z, EVERY_LANE)
-        for j in range(nn):
-            if not (free >> j) & 1:
+            ok = (free >> j) & 1
+            out[s0 + j] = ok
+            if mode == FIRST and not ok:
                 return s0 + j
-    return -1
+    return -1 if mode == FIRST else confirmed
 
 
 @njit(cache=True, nogil=True, _nrt=False)
-def edge_certified(P, qa, qb, joint_step, limit):
-    """Edge qa -> qb on the grid, certified in rakes
-    (:func:`~plannerlab.collision.edges.edge_check`): (status, checks, grid states)."""
+def edge(P, qa, qb, joint_step, limits):
+    """Edge qa -> qb on the grid, ``limits`` = (limit, mode). ``CERTIFIED``: (status,
+    tests, n) of :func:`~plannerlab.collision.edges.edge_check` (the grid's verdict from
+    certified stretches); ``IN_ORDER``: (n, the index of the first invalid grid state among
+    the first ``limit`` in order, -1 if none, 0)."""
+    limit, mode = limits
     m, Z = _open(P)
-    return edge_check(m, Z, qa, qb, joint_step, limit)
-
-
-@njit(cache=True, nogil=True, _nrt=False)
-def edge_first_invalid(P, qa, qb, joint_step, limit):
-    """The grid states of edge qa -> qb (1..n) in order, at most ``limit`` of them: (n,
-    the index of the first invalid one among those, -1 if none)."""
-    m, Z = _open(P)
+    if mode == CERTIFIED:
+        return edge_check(m, Z, qa, qb, joint_step, limit)
     set_plain(Z)
     d, q = Z.edge_d, Z.edge_q
     edge_delta(qa, qb, m.continuous, d)
@@ -113,8 +94,8 @@ def edge_first_invalid(P, qa, qb, joint_step, limit):
         free, _, _ = test_lanes(m, Z, EVERY_LANE)
         for j in range(nn):
             if not (free >> j) & 1:
-                return n, s0 + j
-    return n, -1
+                return n, s0 + j, 0
+    return n, -1, 0
 
 
 @njit(cache=True, nogil=True, _nrt=False)
@@ -151,12 +132,4 @@ def tip(P, q, body, tip_p, out):
     return out
 
 
-__all__ = [
-    "edge_certified",
-    "edge_first_invalid",
-    "first_invalid",
-    "segments",
-    "tip",
-    "valid_many",
-    "valid_one",
-]
+__all__ = ["CERTIFIED", "EACH", "FIRST", "IN_ORDER", "edge", "segments", "states", "tip"]

@@ -374,18 +374,29 @@ def _segments(E1, E2):
 
 @njit(cache=True, nogil=True, _nrt=False)
 def _grade_d2(d2, r0, rg, eps, hu):
-    """(hit, unsure) bits updated with squared distances d2: hit when closer than the
-    plain radius r0 (less eps: certainly, in float64 too), unsure unless farther than the
-    grown radius rg (plus eps)."""
+    """The lane masks ``hu`` = (hit, unsure grown, unsure plain) updated with squared
+    distances d2: hit when closer than the plain radius r0 less eps (certainly, in
+    float64 too); unsure grown unless farther than the grown radius rg plus eps; unsure
+    plain unless farther than r0 plus eps."""
     lo = vmax(r0 - eps, splat(0.0))
-    hi = rg + eps
-    return hu[0] | mask_bits(d2 < lo * lo), hu[1] | mask_bits(d2 <= hi * hi)
+    hg = rg + eps
+    h0 = r0 + eps
+    return (
+        hu[0] | mask_bits(d2 < lo * lo),
+        hu[1] | mask_bits(d2 <= hg * hg),
+        hu[2] | mask_bits(d2 <= h0 * h0),
+    )
 
 
 @njit(cache=True, nogil=True, _nrt=False)
 def _grade_bounds(lo_d, hi_d, r0, rg, eps, hu):
-    """(hit, unsure) bits updated with a distance's bounds (as :func:`_grade_d2`)."""
-    return hu[0] | mask_bits(hi_d < r0 - eps), hu[1] | mask_bits(lo_d <= rg + eps)
+    """The lane masks (hit, unsure grown, unsure plain) updated with a distance's lower
+    and upper bounds (as :func:`_grade_d2`)."""
+    return (
+        hu[0] | mask_bits(hi_d < r0 - eps),
+        hu[1] | mask_bits(lo_d <= rg + eps),
+        hu[2] | mask_bits(lo_d <= r0 + eps),
+    )
 
 
 @njit(cache=True, nogil=True, _nrt=False)
@@ -455,7 +466,7 @@ def _place_cluster(F, X, K, c, tables, placed):
 
 
 @njit(cache=True, nogil=True, inline="always")
-def _stop(hit, plain, mode):
+def _stop(hit, mode):
     """The mode's stop: a lane has hit (ANY_HIT), or every lane has."""
     if mode == ANY_HIT:
         return hit != 0
@@ -463,9 +474,10 @@ def _stop(hit, plain, mode):
 
 
 @njit(cache=True, nogil=True, _nrt=False)
-def _scene_pass(m, Z, mode, plain, hit, unsure):
+def _scene_pass(m, Z, mode, hu):
     """Every moving capsule against every obstacle, behind its body's and its cluster's
-    gates: (hit, unsure, stopped)."""
+    gates: the lane masks ``hu`` (see :func:`_grade_d2`) updated, and whether the mode's
+    stop came."""
     O, kinds, caps, cls, gates = m.obs32, m.obs_kind, m.caps32, m.cls32, m.gates32
     F, G, K, X = Z.F, Z.G, Z.K, Z.X
     tables = (cls, caps, m.cl_caps, m.cl_body, m.cap_sphere, Z.placed)
@@ -479,7 +491,7 @@ def _scene_pass(m, Z, mode, plain, hit, unsure):
         rb = fma(grow, splat(Z.brate[b]), splat(gates[b, 3]) + eps)
         for o in range(kinds.shape[0]):
             kind = kinds[o]
-            if not _near(_point_d2(kind, O, o, gx, gy, gz), rb, _ALL & ~hit):
+            if not _near(_point_d2(kind, O, o, gx, gy, gz), rb, _ALL & ~hu[0]):
                 continue
             for c in range(m.body_cls[b], m.body_cls[b + 1]):
                 if cls[c, 3] < 0.0:
@@ -487,7 +499,7 @@ def _scene_pass(m, Z, mode, plain, hit, unsure):
                 _place_cluster(F, X, K, c, tables, 1)
                 kx, ky, kz = _slot3(K, c)
                 rc = fma(grow, splat(Z.crate[c]), splat(cls[c, 3]) + eps)
-                if not _near(_point_d2(kind, O, o, kx, ky, kz), rc, _ALL & ~hit):
+                if not _near(_point_d2(kind, O, o, kx, ky, kz), rc, _ALL & ~hu[0]):
                     continue
                 _place_cluster(F, X, K, c, tables, 2)
                 for l in range(m.cl_caps[c], m.cl_caps[c + 1]):
@@ -498,19 +510,19 @@ def _scene_pass(m, Z, mode, plain, hit, unsure):
                     if m.cap_sphere[l]:
                         o6 = 6 * l * W
                         d2 = _point_d2(kind, O, o, load(X, o6), load(X, o6 + W), load(X, o6 + 2 * W))
-                        hit, unsure = _grade_d2(d2, r0, r, eps, (hit, unsure))
+                        hu = _grade_d2(d2, r0, r, eps, hu)
                     else:
                         lo, hi_d = _segment_obstacle(kind, O, o, _ends(X, l))
-                        hit, unsure = _grade_bounds(lo, hi_d, r0, r, eps, (hit, unsure))
-            if _stop(hit, plain, mode):
-                return hit, unsure, True
-    return hit, unsure, False
+                        hu = _grade_bounds(lo, hi_d, r0, r, eps, hu)
+            if _stop(hu[0], mode):
+                return hu, True
+    return hu, False
 
 
 @njit(cache=True, nogil=True, _nrt=False)
-def _self_pass(m, Z, mode, plain, hit, unsure):
-    """Every checked link pair, behind its body pair's and cluster pair's gates: (hit,
-    unsure, stopped)."""
+def _self_pass(m, Z, mode, hu):
+    """Every checked link pair, behind its body pair's and cluster pair's gates: the lane
+    masks ``hu`` updated, and whether the mode's stop came."""
     caps, cls, gates = m.caps32, m.cls32, m.gates32
     F, G, K, X = Z.F, Z.G, Z.K, Z.X
     tables = (cls, caps, m.cl_caps, m.cl_body, m.cap_sphere, Z.placed)
@@ -521,7 +533,7 @@ def _self_pass(m, Z, mode, plain, hit, unsure):
         u, v = m.bpairs[p, 0], m.bpairs[p, 1]
         if u != v:
             r = fma(grow, splat(Z.brate[u] + Z.brate[v]), splat(gates[u, 4] + gates[v, 4]) + eps)
-            if not _near(_gap2(G, 3 * u * W, G, 3 * v * W), r, _ALL & ~hit):
+            if not _near(_gap2(G, 3 * u * W, G, 3 * v * W), r, _ALL & ~hu[0]):
                 continue
         for cp in range(m.bpair_start[p], m.bpair_start[p + 1]):
             cu, cv = m.clpairs[cp, 0], m.clpairs[cp, 1]
@@ -529,7 +541,7 @@ def _self_pass(m, Z, mode, plain, hit, unsure):
                 _place_cluster(F, X, K, cu, tables, 1)
                 _place_cluster(F, X, K, cv, tables, 1)
                 r = fma(grow, splat(Z.crate[cu] + Z.crate[cv]), splat(cls[cu, 4] + cls[cv, 4]) + eps)
-                if not _near(_gap2(K, 3 * cu * W, K, 3 * cv * W), r, _ALL & ~hit):
+                if not _near(_gap2(K, 3 * cu * W, K, 3 * cv * W), r, _ALL & ~hu[0]):
                     continue
             _place_cluster(F, X, K, cu, tables, 2)
             _place_cluster(F, X, K, cv, tables, 2)
@@ -539,15 +551,15 @@ def _self_pass(m, Z, mode, plain, hit, unsure):
                 r = fma(grow, splat(rate[i] + rate[j]), r0)
                 if sphere[i] and sphere[j]:
                     d2 = _gap2(X, 6 * i * W, X, 6 * j * W)
-                    hit, unsure = _grade_d2(d2, r0, r, eps, (hit, unsure))
+                    hu = _grade_d2(d2, r0, r, eps, hu)
                     continue
                 if sphere[i]:  # the first a segment (a sphere: one of zero length)
                     i, j = j, i
                 lo, hi_d = _segments(_ends(X, i), _ends(X, j))
-                hit, unsure = _grade_bounds(lo, hi_d, r0, r, eps, (hit, unsure))
-        if _stop(hit, plain, mode):
-            return hit, unsure, True
-    return hit, unsure, False
+                hu = _grade_bounds(lo, hi_d, r0, r, eps, hu)
+        if _stop(hu[0], mode):
+            return hu, True
+    return hu, False
 
 
 @njit(cache=True, nogil=True, _nrt=False)
@@ -556,39 +568,36 @@ def test_lanes(m, Z, mode):
 
     Returns ``(free, hit, confirmed)``, bit masks over the lanes and a count:
 
-    * ``free``: free with every capsule grown by the lane's growth (for a plain lane, the
-      exact float64 verdict);
-    * ``hit``: the lane's state itself (not grown) collides, certainly;
-    * a grown lane in neither is not proved free at its growth (and not known to hit);
-    * ``confirmed``: plain lanes the float64 confirmation decided.
+    * ``hit``: the lane's state itself (not grown) collides: the exact float64 verdict;
+      a lane not in it is free (not grown), exactly;
+    * ``free``: free even with every capsule grown by the lane's growth (proved; a lane
+      of growth 0 is in it exactly when it is not in ``hit``);
+    * ``confirmed``: lanes whose plain verdict the float64 confirmation decided.
 
-    With ``ANY_HIT`` it returns as soon as any lane has hit (its state is then invalid);
-    lanes not yet decided are in neither mask."""
+    With ``ANY_HIT`` it returns as soon as any lane has hit (its state is invalid); lanes
+    not yet decided are then in neither mask."""
     for c in range(Z.placed.shape[0]):
         Z.placed[c] = 0
-    plain = 0
-    for k in range(W):
-        if Z.grow[k] == 0.0:
-            plain |= 1 << k
     frames32(m, Z)
-    hit, unsure, stop = _scene_pass(m, Z, mode, plain, 0, 0)
+    hu, stop = _scene_pass(m, Z, mode, (0, 0, 0))
     if stop:
-        return 0, hit, 0
-    hit, unsure, stop = _self_pass(m, Z, mode, plain, hit, unsure)
+        return 0, hu[0], 0
+    hu, stop = _self_pass(m, Z, mode, hu)
+    hit, unsure_g, unsure_0 = hu
     if stop:
         return 0, hit, 0
     confirmed = 0
-    todo = unsure & ~hit & plain  # a grown lane near a surface is simply not proved
+    todo = unsure_0 & ~hit  # the plain state near a surface: float64 decides
     for k in range(W):
         if (todo >> k) & 1:
             confirmed += 1
-            if exact_state(m, Z, Z.Q64[k], 0.0):
-                unsure &= ~(1 << k)
-            else:
+            if not exact_state(m, Z, Z.Q64[k], 0.0):
                 hit |= 1 << k
                 if mode == ANY_HIT:
                     return 0, hit, confirmed
-    return _ALL & ~hit & ~unsure, hit, confirmed
+            elif Z.grow[k] == 0.0:
+                unsure_g &= ~(1 << k)  # a plain lane: free is its verdict
+    return _ALL & ~hit & ~unsure_g, hit, confirmed
 
 
 # ------------------------------------------------------------------ float64, exact
