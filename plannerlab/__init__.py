@@ -34,6 +34,7 @@ import importlib
 from typing import TYPE_CHECKING, Any
 
 if TYPE_CHECKING:
+    from plannerlab.collision.public import Checker, checker
     from plannerlab.comparison.report import markdown as markdown_report
     from plannerlab.comparison.runner import ComparisonRun, compare
     from plannerlab.comparison.statistics import summarise
@@ -54,6 +55,8 @@ if TYPE_CHECKING:
 #: public name -> "module:attribute", imported on first access
 _EXPORTS: dict[str, str] = {
     "load_problem": "plannerlab.problem.catalog:load_problem",
+    "checker": "plannerlab.collision.public:checker",
+    "Checker": "plannerlab.collision.public:Checker",
     "list_problems": "plannerlab.problem.catalog:list_problems",
     "problems_dir": "plannerlab.problem.catalog:problems_dir",
     "Problem": "plannerlab.problem.load:Problem",
@@ -80,6 +83,8 @@ _EXPORTS: dict[str, str] = {
 }
 
 __all__ = [
+    "Checker",
+    "checker",
     "Budget",
     "ComparisonRun",
     "Execution",
@@ -109,6 +114,7 @@ __all__ = [
 
 
 if TYPE_CHECKING:
+    from plannerlab.collision.public import Checker, checker
     from plannerlab.comparison.continuum import case_name as continuum_case_name
     from plannerlab.comparison.continuum import run_case as run_continuum_case
     from plannerlab.comparison.report import BUDGET_NOTE, machine_info, write_reports

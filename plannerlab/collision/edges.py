@@ -41,7 +41,14 @@ import math
 import numpy as np
 from numba import njit
 
-from plannerlab.collision.state_test import ANY_HIT, W, fill_lanes, load_state, set_rates, test_lanes
+from plannerlab.collision.state_test import (
+    ANY_HIT,
+    W,
+    fill_lanes,
+    load_state,
+    set_rates,
+    test_lanes,
+)
 
 #: an edge's status: every grid state is free
 FREE = 0
@@ -140,7 +147,7 @@ def edge_check(m, Z, qa, qb, joint_step, limit):
     """Check edge qa -> qb on the grid (see the module). Z: the state test's scratch
     (:func:`~plannerlab.collision.state_test.lanes`). Returns ``(status, checks, n)``:
     FREE, INVALID or LIMIT, the lanes tested, the grid's number of states."""
-    d, q, rate, stack, marks = Z.edge_d, Z.edge_q, Z.edge_rate, Z.edge_stack, Z.edge_marks
+    d, rate, stack, marks = Z.edge_d, Z.edge_rate, Z.edge_stack, Z.edge_marks
     los, mids, his = marks[0], marks[1], marks[2]
     edge_delta(qa, qb, m.continuous, d)
     n = edge_count(d, joint_step, m.edge_weights)

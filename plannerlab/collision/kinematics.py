@@ -108,9 +108,24 @@ def chain_frames(F, V, T0, pre, parent, slide):
             s, c = sincos(v)
         fb = 12 * parent[i] * w
         ob = 12 * (i + 1) * w
-        p00, p01, p02, p03 = like(F, pre[i, 0]), like(F, pre[i, 1]), like(F, pre[i, 2]), like(F, pre[i, 3])
-        p10, p11, p12, p13 = like(F, pre[i, 4]), like(F, pre[i, 5]), like(F, pre[i, 6]), like(F, pre[i, 7])
-        p20, p21, p22, p23 = like(F, pre[i, 8]), like(F, pre[i, 9]), like(F, pre[i, 10]), like(F, pre[i, 11])
+        p00, p01, p02, p03 = (
+            like(F, pre[i, 0]),
+            like(F, pre[i, 1]),
+            like(F, pre[i, 2]),
+            like(F, pre[i, 3]),
+        )
+        p10, p11, p12, p13 = (
+            like(F, pre[i, 4]),
+            like(F, pre[i, 5]),
+            like(F, pre[i, 6]),
+            like(F, pre[i, 7]),
+        )
+        p20, p21, p22, p23 = (
+            like(F, pre[i, 8]),
+            like(F, pre[i, 9]),
+            like(F, pre[i, 10]),
+            like(F, pre[i, 11]),
+        )
         for a in range(3):
             r = fb + 4 * a * w
             f0 = load(F, r)
@@ -140,11 +155,17 @@ def place(F, b, P, row, col):
     w = width(F)
     px, py, pz = like(F, P[row, col]), like(F, P[row, col + 1]), like(F, P[row, col + 2])
     o = 12 * b * w
-    x = fma(load(F, o), px, fma(load(F, o + w), py, fma(load(F, o + 2 * w), pz, load(F, o + 3 * w))))
+    x = fma(
+        load(F, o), px, fma(load(F, o + w), py, fma(load(F, o + 2 * w), pz, load(F, o + 3 * w)))
+    )
     o += 4 * w
-    y = fma(load(F, o), px, fma(load(F, o + w), py, fma(load(F, o + 2 * w), pz, load(F, o + 3 * w))))
+    y = fma(
+        load(F, o), px, fma(load(F, o + w), py, fma(load(F, o + 2 * w), pz, load(F, o + 3 * w)))
+    )
     o += 4 * w
-    z = fma(load(F, o), px, fma(load(F, o + w), py, fma(load(F, o + 2 * w), pz, load(F, o + 3 * w))))
+    z = fma(
+        load(F, o), px, fma(load(F, o + w), py, fma(load(F, o + 2 * w), pz, load(F, o + 3 * w)))
+    )
     return x, y, z
 
 

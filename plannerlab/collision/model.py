@@ -345,7 +345,9 @@ def build_model(
         obs32=_f(np.column_stack([cs, hs, Rs, np.zeros((n, 1))]).reshape(n, 16), np.float32),
         caps32=_f(np.column_stack([ca, cb, rad, rads, np.zeros((L, 0))]).reshape(L, 8), np.float32),
         gates32=_f(np.column_stack([gate_c, gate_r, gate_rs, np.zeros((nb, 3))]), np.float32),
-        cls32=_f(np.column_stack([cl_c, cl_r, cl_rs, np.zeros((ncl, 3))]).reshape(ncl, 8), np.float32),
+        cls32=_f(
+            np.column_stack([cl_c, cl_r, cl_rs, np.zeros((ncl, 3))]).reshape(ncl, 8), np.float32
+        ),
         lower=lower,
         upper=upper,
         continuous=_f(robot.continuous, np.bool_),

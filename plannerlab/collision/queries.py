@@ -1,9 +1,10 @@
 """The checker's compiled queries, called from Python on the packed model.
 
 Each takes ``P``: :func:`~plannerlab.collision.packing.pack` ``(model, lanes)`` as a tuple
-of its five arrays, and they are few (every compiled entry compiles the state test again
-into itself, numba linking and optimizing its callees with it), rebuilt into the named model and the state test's scratch inside
-(views: ~1 µs), so a call from Python unboxes five arrays, not seventy. Compiled
+of its five arrays, rebuilt into the named model and the state test's scratch inside
+(views: ~1 µs), so a call from Python unboxes five arrays, not seventy. They are few:
+every compiled entry compiles the state test again into itself (numba links its callees
+into it and optimizes them with it). Compiled
 consumers call :mod:`plannerlab.collision.state_test` and :mod:`plannerlab.collision.edges`
 with the named tuples directly.
 

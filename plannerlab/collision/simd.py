@@ -367,7 +367,12 @@ def _vec_cmp(pred):  # type: ignore[no-untyped-def]
     return op
 
 
-for _op, _pred in ((operator.lt, "<"), (operator.le, "<="), (operator.gt, ">"), (operator.ge, ">=")):
+for _op, _pred in (
+    (operator.lt, "<"),
+    (operator.le, "<="),
+    (operator.gt, ">"),
+    (operator.ge, ">="),
+):
 
     def _make_cmp(impl):  # type: ignore[no-untyped-def]
         def ov(a, b):  # type: ignore[no-untyped-def]
@@ -456,8 +461,6 @@ def select(typingctx, m, a, b):  # type: ignore[no-untyped-def]
         return builder.select(args[0], args[1], args[2])
 
     return sig, codegen
-
-
 
 
 # ------------------------------------------------------------------ either width

@@ -51,7 +51,6 @@ from plannerlab.collision.geometry import BOX, SPHERE, capsule_obstacle_hit, seg
 from plannerlab.collision.kinematics import chain_frames, chain_values, place
 from plannerlab.collision.simd import (
     LANES,
-    bits_mask,
     fma,
     load,
     mask_bits,
@@ -509,7 +508,9 @@ def _scene_pass(m, Z, mode, hu):
                     r = fma(grow, splat(Z.rate[l]), r0)
                     if m.cap_sphere[l]:
                         o6 = 6 * l * W
-                        d2 = _point_d2(kind, O, o, load(X, o6), load(X, o6 + W), load(X, o6 + 2 * W))
+                        d2 = _point_d2(
+                            kind, O, o, load(X, o6), load(X, o6 + W), load(X, o6 + 2 * W)
+                        )
                         hu = _grade_d2(d2, r0, r, eps, hu)
                     else:
                         lo, hi_d = _segment_obstacle(kind, O, o, _ends(X, l))
@@ -540,7 +541,9 @@ def _self_pass(m, Z, mode, hu):
             if cu != cv:
                 _place_cluster(F, X, K, cu, tables, 1)
                 _place_cluster(F, X, K, cv, tables, 1)
-                r = fma(grow, splat(Z.crate[cu] + Z.crate[cv]), splat(cls[cu, 4] + cls[cv, 4]) + eps)
+                r = fma(
+                    grow, splat(Z.crate[cu] + Z.crate[cv]), splat(cls[cu, 4] + cls[cv, 4]) + eps
+                )
                 if not _near(_gap2(K, 3 * cu * W, K, 3 * cv * W), r, _ALL & ~hu[0]):
                     continue
             _place_cluster(F, X, K, cu, tables, 2)
