@@ -39,8 +39,8 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit
 
+from plannerlab.collision.simd import kernel
 from plannerlab.collision.state_test import (
     ANY_HIT,
     W,
@@ -58,7 +58,7 @@ INVALID = 1
 LIMIT = 2
 
 
-@njit(cache=True, nogil=True, _nrt=False)
+@kernel
 def edge_delta(q_a, q_b, continuous, d):
     """d = q_b - q_a, continuous joints the short way round (``joint_difference``)."""
     for i in range(q_a.shape[0]):
@@ -68,7 +68,7 @@ def edge_delta(q_a, q_b, continuous, d):
         d[i] = x
 
 
-@njit(cache=True, nogil=True, _nrt=False)
+@kernel
 def edge_count(d, joint_step, edge_weights):
     """The grid's number of steps of an edge ``d``: at most ``joint_step`` per joint and
     ``ceil(Σ |d_i| · w_i)`` (``robots.paths.edge_counts``)."""
@@ -81,7 +81,7 @@ def edge_count(d, joint_step, edge_weights):
     return int(max(1.0, math.ceil(span / joint_step - 1e-12), math.ceil(metric - 1e-12)))
 
 
-@njit(cache=True, nogil=True, _nrt=False)
+@kernel
 def edge_state(q_a, d, j, n, out):
     """Grid state ``j`` (0..n) of the edge: ``q_a + t d``, ``t = j · (1 / n)`` (exactly 1
     at ``j = n``), the floats of ``densify``."""
@@ -90,7 +90,7 @@ def edge_state(q_a, d, j, n, out):
         out[i] = q_a[i] + t * d[i]
 
 
-@njit(cache=True, nogil=True, _nrt=False)
+@kernel
 def step_rates(m, d, n, out):
     """Per capsule (packed order), how far [m] it can move in one grid step of edge d
     with n steps: ``Σ_i |d_i| / n · link_rates[i, l]``."""
@@ -105,7 +105,7 @@ def step_rates(m, d, n, out):
             out[l] += a * R[i, l]
 
 
-@njit(cache=True, nogil=True, _nrt=False)
+@kernel
 def _push_pieces(stack, top, lo, hi, pieces):
     """Push [lo, hi] cut into at most ``pieces`` stretches (nothing when empty)."""
     s = hi - lo + 1
@@ -119,7 +119,7 @@ def _push_pieces(stack, top, lo, hi, pieces):
     return top
 
 
-@njit(cache=True, nogil=True, _nrt=False)
+@kernel
 def _load_stretches(m, Z, E, q_ad, stack, top):
     """Pop up to W stretches into the lanes (each its middle grid state, grown by its
     half-length): returns (lanes filled, top). ``E`` = (los, mids, his) the lanes'
@@ -142,7 +142,7 @@ def _load_stretches(m, Z, E, q_ad, stack, top):
     return k, top
 
 
-@njit(cache=True, nogil=True, _nrt=False)
+@kernel
 def edge_check(m, Z, qa, qb, joint_step, limit):
     """Check edge qa -> qb on the grid (see the module). Z: the state test's scratch
     (:func:`~plannerlab.collision.state_test.lanes`). Returns ``(status, checks, n)``:
@@ -178,7 +178,7 @@ def edge_check(m, Z, qa, qb, joint_step, limit):
     return FREE, checks, n
 
 
-@njit(cache=True, nogil=True, _nrt=False)
+@kernel
 def edge_rake(m, Z, qa, qb, joint_step, stride, limit):
     """The edge's coarse check: its grid cut into stretches of ``stride`` states, each
     stretch's middle state tested (eight a call) grown by the stretch's half-length.

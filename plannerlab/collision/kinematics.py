@@ -24,10 +24,20 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit
 from numba.extending import overload
 
-from plannerlab.collision.simd import f8, fma, like, load, select, splat, store, vfloor, width
+from plannerlab.collision.simd import (
+    f8,
+    fma,
+    kernel,
+    like,
+    load,
+    select,
+    splat,
+    store,
+    vfloor,
+    width,
+)
 
 _F4 = np.float32
 #: a bound of the float32 polynomial's error [1] on the angles the filter meets (states
@@ -36,16 +46,16 @@ _F4 = np.float32
 SINCOS32_ABS_ERR = 1e-6
 
 
-def sincos(x):  # type: ignore[no-untyped-def]
+def sincos(x):
     """(sin x, cos x): a lane vector in float32 arithmetic, or a float64 by ``math``."""
     raise NotImplementedError("numba only")
 
 
 @overload(sincos)
-def _ov_sincos(x):  # type: ignore[no-untyped-def]
+def _ov_sincos(x):
     if x == f8:
 
-        def vec(x):  # type: ignore[no-untyped-def]
+        def vec(x):
             # reduce to [-π, π], fold onto [-π/2, π/2], two Taylor polynomials (the terms
             # left out are below 6e-8 and 7e-9 there, under float32's rounding)
             k = vfloor(x * splat(1.0 / (2.0 * math.pi)) + splat(0.5))
@@ -70,13 +80,13 @@ def _ov_sincos(x):  # type: ignore[no-untyped-def]
 
         return vec
 
-    def scalar(x):  # type: ignore[no-untyped-def]
+    def scalar(x):
         return math.sin(x), math.cos(x)
 
     return scalar
 
 
-@njit(cache=True, nogil=True, _nrt=False)
+@kernel
 def chain_values(Q, cpl, V):
     """The chain's joint values V (flat, ``w`` lanes a joint) of the states Q (the same
     layout, ``dof`` joints): ``v_i = Σ cpl_val[k] · q[cpl_idx[k]]`` over ``cpl_start[i] :
@@ -91,7 +101,7 @@ def chain_values(Q, cpl, V):
         store(V, i * w, acc)
 
 
-@njit(cache=True, nogil=True, _nrt=False)
+@kernel
 def chain_frames(F, V, T0, pre, parent, slide):
     """Every body's frame F (flat, see the module) from the chain's joint values V: the
     base's pose T0 (12,), then per joint ``F[parent] · pre · Rz(v)`` (a turn) or ``F[parent]
@@ -148,7 +158,7 @@ def chain_frames(F, V, T0, pre, parent, slide):
             store(F, o + 2 * w, g2)
 
 
-@njit(cache=True, nogil=True, _nrt=False)
+@kernel
 def place(F, b, P, row, col):
     """The body-frame point ``P[row, col:col + 3]`` of body b in the world: (x, y, z),
     values of F's kind (lane vectors of float32, or float64 scalars)."""

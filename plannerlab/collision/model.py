@@ -173,6 +173,107 @@ class ChainGeometry(NamedTuple):
     hs: np.ndarray  # (n, 3)
 
 
+def _coupling(coupling: np.ndarray | None, m: int) -> tuple[list[int], list[int], list[float]]:
+    """The coupling, sparse: per chain joint its entries (state index, coefficient)."""
+    start: list[int] = []
+    idx: list[int] = []
+    val: list[float] = []
+    if coupling is not None:
+        start.append(0)
+        for i in range(m):
+            for col in np.flatnonzero(coupling[i]):
+                idx.append(int(col))
+                val.append(float(coupling[i, col]))
+            start.append(len(idx))
+    return start, idx, val
+
+
+def _folded(parent: Any, pre: Any, axes: Any) -> tuple[list[np.ndarray], np.ndarray]:
+    """Each joint's axis turned onto its frame's z axis: the rotations A (body b's frame
+    here is the robot's times A[b]) and the fixed transforms with them folded in (m, 3, 4)."""
+    m = len(parent)
+    A = [np.eye(3)] + [_align(axes[i]) for i in range(m)]
+    pre_f = np.empty((m, 3, 4))
+    for i in range(m):
+        Ap, Ai = np.eye(4), np.eye(4)
+        Ap[:3, :3], Ai[:3, :3] = A[int(parent[i])], A[i + 1]
+        pre_f[i] = (Ap.T @ np.asarray(pre[i], dtype=float) @ Ai)[:3]
+    return A, pre_f
+
+
+def _packed_order(cap_body: np.ndarray, mid: np.ndarray, nb: int) -> tuple[Any, ...]:
+    """The capsules by body, and within a body by cluster of at most ``_CLUSTER``
+    neighbours: (perm, cluster starts, each body's first cluster)."""
+    perm_l: list[int] = []
+    cl_start, body_cl = [0], [0]
+    for b in range(nb):
+        for members in _clusters(mid, np.flatnonzero(cap_body == b), _CLUSTER):
+            perm_l.extend(int(x) for x in members)
+            cl_start.append(len(perm_l))
+        body_cl.append(len(cl_start) - 1)
+    return np.array(perm_l, dtype=np.int64), cl_start, body_cl
+
+
+def _balls(
+    ends: tuple[np.ndarray, np.ndarray],
+    radii: tuple[np.ndarray, np.ndarray, np.ndarray],
+    ranges: list[tuple[int, int]],
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Per range of capsules (ends a, b; radii against the scene, between links, which
+    move): centre, radius against the scene (moving capsules only; -1: none) and between
+    links."""
+    ca, cb = ends
+    rad, rads, mov = radii
+    c, r, rs = np.zeros((len(ranges), 3)), np.full(len(ranges), -1.0), np.zeros(len(ranges))
+    for k, (k0, k1) in enumerate(ranges):
+        pts = np.concatenate([ca[k0:k1], cb[k0:k1]])
+        c[k], rs[k] = _ball(pts, np.tile(rads[k0:k1], 2))
+        mv = np.tile(mov[k0:k1], 2)
+        if mv.any():
+            d = np.linalg.norm(pts[mv] - c[k], axis=1) + np.tile(rad[k0:k1], 2)[mv]
+            r[k] = float(np.max(d)) + _BOUND_PAD_M
+    return c, r, rs
+
+
+def _pairs(allowed: Any, perm: np.ndarray, body: np.ndarray, cl_of: np.ndarray) -> tuple[Any, ...]:
+    """The checked pairs in the packed order (i < j), grouped by body pair, then cluster
+    pair: (bpairs, bpair_start, clpairs, clpair_start, cpairs) as arrays."""
+    a = np.asarray(allowed, dtype=bool)
+    sym = a | a.T
+    al = np.triu(sym[np.ix_(perm, perm)], 1)
+    ii, jj = np.nonzero(al)
+    keys = sorted(
+        (min(body[i], body[j]), max(body[i], body[j]), cl_of[i], cl_of[j], i, j)
+        for i, j in zip(ii.tolist(), jj.tolist(), strict=True)
+    )
+    bpairs: list[tuple[int, int]] = []
+    bpair_start: list[int] = []
+    clpairs: list[tuple[int, int]] = []
+    clpair_start: list[int] = []
+    cpairs: list[tuple[int, int]] = []
+    for u, v, cu, cv, i, j in keys:
+        if not bpairs or bpairs[-1] != (u, v):
+            bpairs.append((int(u), int(v)))
+            bpair_start.append(len(clpairs))
+        if not clpairs or clpairs[-1] != (cu, cv) or bpair_start[-1] == len(clpairs):
+            clpairs.append((int(cu), int(cv)))
+            clpair_start.append(len(cpairs))
+        cpairs.append((int(i), int(j)))
+    bpair_start.append(len(clpairs))
+    clpair_start.append(len(cpairs))
+
+    def rows(x: list[tuple[int, int]]) -> np.ndarray:
+        return _f(np.array(x, dtype=np.int64).reshape(-1, 2), np.int64)
+
+    return (
+        rows(bpairs),
+        _f(bpair_start, np.int64),
+        rows(clpairs),
+        _f(clpair_start, np.int64),
+        rows(cpairs),
+    )
+
+
 def build_model(
     robot: Any,
     geo: ChainGeometry,
@@ -205,89 +306,29 @@ def build_model(
         )
     parent, pre, axes, prismatic, cap_body, cap_a, cap_b, coupling = chain_parts(robot)
     m = len(parent)
-    dof = int(robot.dof)
     nb = m + 1
-    # the coupling, sparse: per chain joint its entries (state index, coefficient)
-    cpl_start: list[int] = []
-    cpl_idx: list[int] = []
-    cpl_val: list[float] = []
-    if coupling is not None:
-        cpl_start.append(0)
-        for i in range(m):
-            for col in np.flatnonzero(coupling[i]):
-                cpl_idx.append(int(col))
-                cpl_val.append(float(coupling[i, col]))
-            cpl_start.append(len(cpl_idx))
-    A = [np.eye(3)] + [_align(axes[i]) for i in range(m)]
-    pre_f = np.empty((m, 3, 4))
-    for i in range(m):
-        Ap, Ai = np.eye(4), np.eye(4)
-        Ap[:3, :3], Ai[:3, :3] = A[int(parent[i])], A[i + 1]
-        pre_f[i] = (Ap.T @ np.asarray(pre[i], dtype=float) @ Ai)[:3]
+    cpl_start, cpl_idx, cpl_val = _coupling(coupling, m)
+    A, pre_f = _folded(parent, pre, axes)
     cap_body = np.asarray(cap_body, dtype=np.int64)
     cap_a = np.asarray(cap_a, dtype=float).reshape(-1, 3)
     cap_b = np.asarray(cap_b, dtype=float).reshape(-1, 3)
-    # capsules by body, and within a body by cluster of at most _CLUSTER neighbours
-    mid = (cap_a + cap_b) / 2.0
-    perm_l: list[int] = []
-    cl_start, body_cl = [0], [0]
-    for b in range(nb):
-        for members in _clusters(mid, np.flatnonzero(cap_body == b), _CLUSTER):
-            perm_l.extend(int(x) for x in members)
-            cl_start.append(len(perm_l))
-        body_cl.append(len(cl_start) - 1)
-    perm = np.array(perm_l, dtype=np.int64)
+    perm, cl_start, body_cl = _packed_order(cap_body, (cap_a + cap_b) / 2.0, nb)
     body = cap_body[perm]
     L = len(perm)
     ca = np.array([A[int(b)].T @ p for b, p in zip(body, cap_a[perm], strict=True)]).reshape(-1, 3)
     cb = np.array([A[int(b)].T @ p for b, p in zip(body, cap_b[perm], strict=True)]).reshape(-1, 3)
-    sphere = np.all(cap_a[perm] == cap_b[perm], axis=1)
     rad = np.asarray(geo.radii, dtype=float)[perm]
     rads = np.asarray(geo.radii_self, dtype=float)[perm]
     mov = np.asarray(geo.moving, dtype=bool)[perm]
     body_caps = np.searchsorted(body, np.arange(nb + 1)).astype(np.int64)
-
-    def balls(ranges: list[tuple[int, int]]) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """Per range of capsules: centre, radius against the scene (moving capsules only;
-        -1: none) and between links."""
-        c, r, rs = np.zeros((len(ranges), 3)), np.full(len(ranges), -1.0), np.zeros(len(ranges))
-        for k, (k0, k1) in enumerate(ranges):
-            pts = np.concatenate([ca[k0:k1], cb[k0:k1]])
-            c[k], rs[k] = _ball(pts, np.tile(rads[k0:k1], 2))
-            mv = np.tile(mov[k0:k1], 2)
-            if mv.any():
-                d = np.linalg.norm(pts[mv] - c[k], axis=1) + np.tile(rad[k0:k1], 2)[mv]
-                r[k] = float(np.max(d)) + _BOUND_PAD_M
-        return c, r, rs
-
     ncl = len(cl_start) - 1
-    gate_c, gate_r, gate_rs = balls([(int(body_caps[b]), int(body_caps[b + 1])) for b in range(nb)])
-    cl_c, cl_r, cl_rs = balls([(cl_start[k], cl_start[k + 1]) for k in range(ncl)])
-    cl_of = np.repeat(np.arange(ncl), np.diff(cl_start))
-    # the checked pairs in the packed order (i < j), by body pair, then cluster pair
-    allowed = np.asarray(geo.allowed, dtype=bool)
-    sym = allowed | allowed.T
-    al = np.triu(sym[np.ix_(perm, perm)], 1)
-    ii, jj = np.nonzero(al)
-    keys = sorted(
-        (min(body[i], body[j]), max(body[i], body[j]), cl_of[i], cl_of[j], i, j)
-        for i, j in zip(ii.tolist(), jj.tolist(), strict=True)
+    body_ranges = [(int(body_caps[b]), int(body_caps[b + 1])) for b in range(nb)]
+    gate_c, gate_r, gate_rs = _balls((ca, cb), (rad, rads, mov), body_ranges)
+    cl_ranges = [(cl_start[k], cl_start[k + 1]) for k in range(ncl)]
+    cl_c, cl_r, cl_rs = _balls((ca, cb), (rad, rads, mov), cl_ranges)
+    bpairs, bpair_start, clpairs, clpair_start, cpairs = _pairs(
+        geo.allowed, perm, body, np.repeat(np.arange(ncl), np.diff(cl_start))
     )
-    bpairs: list[tuple[int, int]] = []
-    bpair_start: list[int] = []
-    clpairs: list[tuple[int, int]] = []
-    clpair_start: list[int] = []
-    cpairs: list[tuple[int, int]] = []
-    for u, v, cu, cv, i, j in keys:
-        if not bpairs or bpairs[-1] != (u, v):
-            bpairs.append((int(u), int(v)))
-            bpair_start.append(len(clpairs))
-        if not clpairs or clpairs[-1] != (cu, cv) or bpair_start[-1] == len(clpairs):
-            clpairs.append((int(cu), int(cv)))
-            clpair_start.append(len(cpairs))
-        cpairs.append((int(i), int(j)))
-    bpair_start.append(len(clpairs))
-    clpair_start.append(len(cpairs))
     order = np.arange(nb)[::-1] if body_order is None else np.asarray(body_order)
     kinds = np.asarray(geo.kinds, dtype=np.int64)
     n = len(kinds)
@@ -298,10 +339,8 @@ def build_model(
         from plannerlab.collision.reach import reach_bounds
 
         link_rates = reach_bounds(robot)[1]
-    rates = np.asarray(link_rates, dtype=float)[:, perm]
     T0 = np.asarray(robot.T_world_base, dtype=float)[:3].reshape(12)
-    lower = _f(robot.lower)
-    upper = _f(robot.upper)
+    lower, upper = _f(robot.lower), _f(robot.upper)
     eps = _float32_bound(T0, pre_f, ca, cb, cs, hs, kinds, lower, upper, robot.continuous)
     return CompiledModel(
         parent=_f(parent, np.int64),
@@ -318,7 +357,7 @@ def build_model(
         cap_body=_f(body, np.int64),
         cap_a=_f(ca),
         cap_b=_f(cb),
-        cap_sphere=_f(sphere, np.bool_),
+        cap_sphere=_f(np.all(cap_a[perm] == cap_b[perm], axis=1), np.bool_),
         cap_moving=_f(mov, np.bool_),
         r_scene=_f(rad),
         r_self=_f(rads),
@@ -333,17 +372,17 @@ def build_model(
         cl_r_scene=_f(cl_r),
         cl_r_self=_f(cl_rs),
         body_order=_f(order, np.int64),
-        bpairs=_f(np.array(bpairs, dtype=np.int64).reshape(-1, 2), np.int64),
-        bpair_start=_f(bpair_start, np.int64),
-        clpairs=_f(np.array(clpairs, dtype=np.int64).reshape(-1, 2), np.int64),
-        clpair_start=_f(clpair_start, np.int64),
-        cpairs=_f(np.array(cpairs, dtype=np.int64).reshape(-1, 2), np.int64),
+        bpairs=bpairs,
+        bpair_start=bpair_start,
+        clpairs=clpairs,
+        clpair_start=clpair_start,
+        cpairs=cpairs,
         obs_kind=_f(kinds, np.int64),
         obs_R=_f(Rs),
         obs_c=_f(cs),
         obs_h=_f(hs),
         obs32=_f(np.column_stack([cs, hs, Rs, np.zeros((n, 1))]).reshape(n, 16), np.float32),
-        caps32=_f(np.column_stack([ca, cb, rad, rads, np.zeros((L, 0))]).reshape(L, 8), np.float32),
+        caps32=_f(np.column_stack([ca, cb, rad, rads]).reshape(L, 8), np.float32),
         gates32=_f(np.column_stack([gate_c, gate_r, gate_rs, np.zeros((nb, 3))]), np.float32),
         cls32=_f(
             np.column_stack([cl_c, cl_r, cl_rs, np.zeros((ncl, 3))]).reshape(ncl, 8), np.float32
@@ -351,8 +390,8 @@ def build_model(
         lower=lower,
         upper=upper,
         continuous=_f(robot.continuous, np.bool_),
-        edge_weights=_f(np.zeros(dof) if edge_weights is None else edge_weights),
-        link_rates=_f(rates),
+        edge_weights=_f(np.zeros(int(robot.dof)) if edge_weights is None else edge_weights),
+        link_rates=_f(np.asarray(link_rates, dtype=float)[:, perm]),
         margin_m=float(margin_m),
         eps32_m=eps,
     )

@@ -66,7 +66,8 @@ def pack(*tuples: Any) -> Packed:
         np.concatenate(p) if p else np.zeros(0, dtype=d)
         for p, d in zip(parts, (np.float64, np.float32, np.int64, np.bool_), strict=True)
     ]
-    return Packed(*(np.ascontiguousarray(b) for b in bufs), head)
+    f64, f32, i64, b1 = (np.ascontiguousarray(b) for b in bufs)
+    return Packed(f64, f32, i64, b1, head)
 
 
 def unpack_source(cls: type, name: str, sample: Any, first: int = 0) -> str:

@@ -21,13 +21,14 @@ from numba import njit
 
 from plannerlab.collision._unpacked import unpack_lanes, unpack_model
 from plannerlab.collision.edges import edge_check, edge_count, edge_delta, edge_state
+from plannerlab.collision.exact import frames64
 from plannerlab.collision.kinematics import place
+from plannerlab.collision.simd import kernel
 from plannerlab.collision.state_test import (
     ANY_HIT,
     EVERY_LANE,
     W,
     fill_lanes,
-    frames64,
     load_state,
     set_plain,
     test_lanes,
@@ -46,7 +47,7 @@ EACH, FIRST = 0, 1
 CERTIFIED, IN_ORDER = 0, 1
 
 
-@njit(cache=True, nogil=True, _nrt=False)
+@kernel
 def states(P, Q, out, mode):
     """Validity of Q (k, dof), eight states a call (one compiled entry for every state
     query: each entry compiles the state test again into itself). ``EACH``: every verdict
@@ -71,7 +72,7 @@ def states(P, Q, out, mode):
     return -1 if mode == FIRST else confirmed
 
 
-@njit(cache=True, nogil=True, _nrt=False)
+@kernel
 def edge(P, qa, qb, joint_step, limits):
     """Edge qa -> qb on the grid, ``limits`` = (limit, mode). ``CERTIFIED``: (status,
     tests, n) of :func:`~plannerlab.collision.edges.edge_check` (the grid's verdict from
@@ -99,7 +100,7 @@ def edge(P, qa, qb, joint_step, limits):
     return n, -1, 0
 
 
-@njit(cache=True, nogil=True, _nrt=False)
+@kernel
 def segments(P, Q, out):
     """Capsule axes of a batch in the robot's capsule order, float64 (the one kinematics):
     Q (k, dof) -> out (k, L, 2, 3)."""
@@ -116,7 +117,7 @@ def segments(P, Q, out):
     return out
 
 
-@njit(cache=True, nogil=True, _nrt=False)
+@kernel
 def tip(P, q, body, tip_p, out):
     """The tip of one state q (dof,): ``tip_p`` (2, 3) the tip point and its normal in
     body ``body``'s frame (axes folded: see the model) -> out (2, 3): position [m], unit

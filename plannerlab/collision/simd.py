@@ -24,15 +24,23 @@ from __future__ import annotations
 
 import math
 import operator
+from typing import Any, cast
 
 import numpy as np
 from llvmlite import ir
-from numba import types
+from numba import njit, types
 from numba.core import cgutils
 from numba.extending import intrinsic, models, overload, register_model
 
 #: lanes in a vector
 LANES = 8
+
+#: the decorator of the collision core's and the compiled planners' hot kernels: compiled
+#: and cached, no GIL, and no reference counting (numba's NRT): they allocate nothing and
+#: take every array from their caller, so a named tuple of arrays passed on costs no
+#: increments and decrements of each array's count (measured ~2 000 cycles a call for the
+#: model). (``_nrt`` is numba's own keyword, outside its typed signature.)
+kernel: Any = cast(Any, njit)(cache=True, nogil=True, _nrt=False)
 _F32 = ir.FloatType()
 _VEC = ir.VectorType(_F32, LANES)
 _MASK = ir.VectorType(ir.IntType(1), LANES)
@@ -59,26 +67,26 @@ m8 = M8()
 
 @register_model(F8)
 class _F8Model(models.PrimitiveModel):
-    def __init__(self, dmm, fe_type):  # type: ignore[no-untyped-def]
+    def __init__(self, dmm, fe_type):
         super().__init__(dmm, fe_type, _VEC)
 
 
 @register_model(M8)
 class _M8Model(models.PrimitiveModel):
-    def __init__(self, dmm, fe_type):  # type: ignore[no-untyped-def]
+    def __init__(self, dmm, fe_type):
         super().__init__(dmm, fe_type, _MASK)
 
 
-def _is32(t) -> bool:  # type: ignore[no-untyped-def]
+def _is32(t) -> bool:
     return isinstance(t, types.Array) and t.dtype == types.float32
 
 
 # ------------------------------------------------------------------ memory
 @intrinsic
-def _vload(typingctx, arr, idx):  # type: ignore[no-untyped-def]
+def _vload(typingctx, arr, idx):
     sig = f8(arr, types.intp)
 
-    def codegen(context, builder, signature, args):  # type: ignore[no-untyped-def]
+    def codegen(context, builder, signature, args):
         ary = context.make_array(signature.args[0])(context, builder, args[0])
         ptr = builder.gep(ary.data, [args[1]])
         return builder.load(builder.bitcast(ptr, _VEC.as_pointer()), align=4)
@@ -87,10 +95,10 @@ def _vload(typingctx, arr, idx):  # type: ignore[no-untyped-def]
 
 
 @intrinsic
-def _vstore(typingctx, arr, idx, v):  # type: ignore[no-untyped-def]
+def _vstore(typingctx, arr, idx, v):
     sig = types.void(arr, types.intp, f8)
 
-    def codegen(context, builder, signature, args):  # type: ignore[no-untyped-def]
+    def codegen(context, builder, signature, args):
         ary = context.make_array(signature.args[0])(context, builder, args[0])
         ptr = builder.gep(ary.data, [args[1]])
         builder.store(args[2], builder.bitcast(ptr, _VEC.as_pointer()), align=4)
@@ -99,18 +107,18 @@ def _vstore(typingctx, arr, idx, v):  # type: ignore[no-untyped-def]
     return sig, codegen
 
 
-def load(a, i):  # type: ignore[no-untyped-def]
+def load(a, i):
     """Eight float32 lanes ``a[i:i + 8]`` (a float64 array: the one value ``a[i]``)."""
     raise NotImplementedError("numba only")
 
 
-def store(a, i, v):  # type: ignore[no-untyped-def]
+def store(a, i, v):
     """``a[i:i + 8] = v`` (a float64 array: ``a[i] = v``)."""
     raise NotImplementedError("numba only")
 
 
 @overload(load)
-def _ov_load(a, i):  # type: ignore[no-untyped-def]
+def _ov_load(a, i):
     if _is32(a):
         return lambda a, i: _vload(a, i)
     if isinstance(a, types.Array):
@@ -119,12 +127,12 @@ def _ov_load(a, i):  # type: ignore[no-untyped-def]
 
 
 @overload(store)
-def _ov_store(a, i, v):  # type: ignore[no-untyped-def]
+def _ov_store(a, i, v):
     if _is32(a) and v == f8:
         return lambda a, i, v: _vstore(a, i, v)
     if isinstance(a, types.Array) and isinstance(v, types.Float):
 
-        def impl(a, i, v):  # type: ignore[no-untyped-def]
+        def impl(a, i, v):
             a[i] = v
 
         return impl
@@ -132,10 +140,10 @@ def _ov_store(a, i, v):  # type: ignore[no-untyped-def]
 
 
 @intrinsic
-def _vsplat(typingctx, x):  # type: ignore[no-untyped-def]
+def _vsplat(typingctx, x):
     sig = f8(types.float32)
 
-    def codegen(context, builder, signature, args):  # type: ignore[no-untyped-def]
+    def codegen(context, builder, signature, args):
         v = ir.Constant(_VEC, ir.Undefined)
         v = builder.insert_element(v, args[0], ir.Constant(_I32, 0))
         zeros = ir.Constant(ir.VectorType(_I32, LANES), [0] * LANES)
@@ -144,47 +152,47 @@ def _vsplat(typingctx, x):  # type: ignore[no-untyped-def]
     return sig, codegen
 
 
-def splat(x):  # type: ignore[no-untyped-def]
+def splat(x):
     """A float32 scalar in every lane."""
     raise NotImplementedError("numba only")
 
 
 @overload(splat)
-def _ov_splat(x):  # type: ignore[no-untyped-def]
+def _ov_splat(x):
     if isinstance(x, types.Float | types.Integer):
         return lambda x: _vsplat(np.float32(x))
     return None
 
 
 @intrinsic
-def _vlane(typingctx, v, k):  # type: ignore[no-untyped-def]
+def _vlane(typingctx, v, k):
     sig = types.float32(f8, types.intp)
 
-    def codegen(context, builder, signature, args):  # type: ignore[no-untyped-def]
+    def codegen(context, builder, signature, args):
         return builder.extract_element(args[0], builder.trunc(args[1], _I32))
 
     return sig, codegen
 
 
-def lane(v, k):  # type: ignore[no-untyped-def]
+def lane(v, k):
     """Lane k's value (float32)."""
     raise NotImplementedError("numba only")
 
 
 @overload(lane)
-def _ov_lane(v, k):  # type: ignore[no-untyped-def]
+def _ov_lane(v, k):
     if v == f8:
         return lambda v, k: _vlane(v, k)
     return None
 
 
 # ------------------------------------------------------------------ arithmetic
-def _vec_binop(name):  # type: ignore[no-untyped-def]
+def _vec_binop(name):
     @intrinsic
-    def op(typingctx, a, b):  # type: ignore[no-untyped-def]
+    def op(typingctx, a, b):
         sig = f8(f8, f8)
 
-        def codegen(context, builder, signature, args):  # type: ignore[no-untyped-def]
+        def codegen(context, builder, signature, args):
             return getattr(builder, name)(args[0], args[1])
 
         return sig, codegen
@@ -201,8 +209,8 @@ for _op, _impl in (
     (operator.truediv, _vdiv),
 ):
 
-    def _make(impl):  # type: ignore[no-untyped-def]
-        def ov(a, b):  # type: ignore[no-untyped-def]
+    def _make(impl):
+        def ov(a, b):
             if a == f8 and b == f8:
                 return lambda a, b: impl(a, b)
             return None
@@ -213,33 +221,33 @@ for _op, _impl in (
 
 
 @intrinsic
-def _vneg(typingctx, a):  # type: ignore[no-untyped-def]
+def _vneg(typingctx, a):
     sig = f8(f8)
 
-    def codegen(context, builder, signature, args):  # type: ignore[no-untyped-def]
+    def codegen(context, builder, signature, args):
         return builder.fneg(args[0])
 
     return sig, codegen
 
 
 @overload(operator.neg)
-def _ov_neg(a):  # type: ignore[no-untyped-def]
+def _ov_neg(a):
     if a == f8:
         return lambda a: _vneg(a)
     return None
 
 
-def _call(builder, name, args):  # type: ignore[no-untyped-def]
+def _call(builder, name, args):
     fnty = ir.FunctionType(_VEC, [_VEC] * len(args))
     return builder.call(cgutils.get_or_insert_function(builder.module, fnty, name), args)
 
 
-def _vec_intrinsic(llvm_name, nargs):  # type: ignore[no-untyped-def]
+def _vec_intrinsic(llvm_name, nargs):
     if nargs == 1:
 
         @intrinsic
-        def op1(typingctx, a):  # type: ignore[no-untyped-def]
-            def codegen(context, builder, signature, args):  # type: ignore[no-untyped-def]
+        def op1(typingctx, a):
+            def codegen(context, builder, signature, args):
                 return _call(builder, llvm_name, args)
 
             return f8(f8), codegen
@@ -248,8 +256,8 @@ def _vec_intrinsic(llvm_name, nargs):  # type: ignore[no-untyped-def]
     if nargs == 2:
 
         @intrinsic
-        def op2(typingctx, a, b):  # type: ignore[no-untyped-def]
-            def codegen(context, builder, signature, args):  # type: ignore[no-untyped-def]
+        def op2(typingctx, a, b):
+            def codegen(context, builder, signature, args):
                 return _call(builder, llvm_name, args)
 
             return f8(f8, f8), codegen
@@ -257,8 +265,8 @@ def _vec_intrinsic(llvm_name, nargs):  # type: ignore[no-untyped-def]
         return op2
 
     @intrinsic
-    def op3(typingctx, a, b, c):  # type: ignore[no-untyped-def]
-        def codegen(context, builder, signature, args):  # type: ignore[no-untyped-def]
+    def op3(typingctx, a, b, c):
+        def codegen(context, builder, signature, args):
             return _call(builder, llvm_name, args)
 
         return f8(f8, f8, f8), codegen
@@ -274,33 +282,33 @@ _vsqrt = _vec_intrinsic("llvm.sqrt.v8f32", 1)
 _vfloor = _vec_intrinsic("llvm.floor.v8f32", 1)
 
 
-def fma(a, b, c):  # type: ignore[no-untyped-def]
+def fma(a, b, c):
     """``a * b + c`` (one rounding in the lanes; in float64 the plain expression)."""
     raise NotImplementedError("numba only")
 
 
-def vmin(a, b):  # type: ignore[no-untyped-def]
+def vmin(a, b):
     raise NotImplementedError("numba only")
 
 
-def vmax(a, b):  # type: ignore[no-untyped-def]
+def vmax(a, b):
     raise NotImplementedError("numba only")
 
 
-def vabs(a):  # type: ignore[no-untyped-def]
+def vabs(a):
     raise NotImplementedError("numba only")
 
 
-def vsqrt(a):  # type: ignore[no-untyped-def]
+def vsqrt(a):
     raise NotImplementedError("numba only")
 
 
-def vfloor(a):  # type: ignore[no-untyped-def]
+def vfloor(a):
     raise NotImplementedError("numba only")
 
 
 @overload(fma)
-def _ov_fma(a, b, c):  # type: ignore[no-untyped-def]
+def _ov_fma(a, b, c):
     if a == f8 and b == f8 and c == f8:
         return lambda a, b, c: _vfma(a, b, c)
     if all(isinstance(t, types.Float) for t in (a, b, c)):
@@ -309,7 +317,7 @@ def _ov_fma(a, b, c):  # type: ignore[no-untyped-def]
 
 
 @overload(vmin)
-def _ov_vmin(a, b):  # type: ignore[no-untyped-def]
+def _ov_vmin(a, b):
     if a == f8 and b == f8:
         return lambda a, b: _vmin(a, b)
     if isinstance(a, types.Float) and isinstance(b, types.Float):
@@ -318,7 +326,7 @@ def _ov_vmin(a, b):  # type: ignore[no-untyped-def]
 
 
 @overload(vmax)
-def _ov_vmax(a, b):  # type: ignore[no-untyped-def]
+def _ov_vmax(a, b):
     if a == f8 and b == f8:
         return lambda a, b: _vmax(a, b)
     if isinstance(a, types.Float) and isinstance(b, types.Float):
@@ -327,7 +335,7 @@ def _ov_vmax(a, b):  # type: ignore[no-untyped-def]
 
 
 @overload(vabs)
-def _ov_vabs(a):  # type: ignore[no-untyped-def]
+def _ov_vabs(a):
     if a == f8:
         return lambda a: _vabs(a)
     if isinstance(a, types.Float):
@@ -336,7 +344,7 @@ def _ov_vabs(a):  # type: ignore[no-untyped-def]
 
 
 @overload(vsqrt)
-def _ov_vsqrt(a):  # type: ignore[no-untyped-def]
+def _ov_vsqrt(a):
     if a == f8:
         return lambda a: _vsqrt(a)
     if isinstance(a, types.Float):
@@ -345,7 +353,7 @@ def _ov_vsqrt(a):  # type: ignore[no-untyped-def]
 
 
 @overload(vfloor)
-def _ov_vfloor(a):  # type: ignore[no-untyped-def]
+def _ov_vfloor(a):
     if a == f8:
         return lambda a: _vfloor(a)
     if isinstance(a, types.Float):
@@ -354,12 +362,12 @@ def _ov_vfloor(a):  # type: ignore[no-untyped-def]
 
 
 # ------------------------------------------------------------------ masks
-def _vec_cmp(pred):  # type: ignore[no-untyped-def]
+def _vec_cmp(pred):
     @intrinsic
-    def op(typingctx, a, b):  # type: ignore[no-untyped-def]
+    def op(typingctx, a, b):
         sig = m8(f8, f8)
 
-        def codegen(context, builder, signature, args):  # type: ignore[no-untyped-def]
+        def codegen(context, builder, signature, args):
             return builder.fcmp_ordered(pred, args[0], args[1])
 
         return sig, codegen
@@ -374,8 +382,8 @@ for _op, _pred in (
     (operator.ge, ">="),
 ):
 
-    def _make_cmp(impl):  # type: ignore[no-untyped-def]
-        def ov(a, b):  # type: ignore[no-untyped-def]
+    def _make_cmp(impl):
+        def ov(a, b):
             if a == f8 and b == f8:
                 return lambda a, b: impl(a, b)
             return None
@@ -385,12 +393,12 @@ for _op, _pred in (
     overload(_op)(_make_cmp(_vec_cmp(_pred)))
 
 
-def _mask_binop(name):  # type: ignore[no-untyped-def]
+def _mask_binop(name):
     @intrinsic
-    def op(typingctx, a, b):  # type: ignore[no-untyped-def]
+    def op(typingctx, a, b):
         sig = m8(m8, m8)
 
-        def codegen(context, builder, signature, args):  # type: ignore[no-untyped-def]
+        def codegen(context, builder, signature, args):
             return getattr(builder, name)(args[0], args[1])
 
         return sig, codegen
@@ -401,8 +409,8 @@ def _mask_binop(name):  # type: ignore[no-untyped-def]
 _mand, _mor = _mask_binop("and_"), _mask_binop("or_")
 for _op, _impl in ((operator.and_, _mand), (operator.or_, _mor)):
 
-    def _make_m(impl):  # type: ignore[no-untyped-def]
-        def ov(a, b):  # type: ignore[no-untyped-def]
+    def _make_m(impl):
+        def ov(a, b):
             if a == m8 and b == m8:
                 return lambda a, b: impl(a, b)
             return None
@@ -413,28 +421,28 @@ for _op, _impl in ((operator.and_, _mand), (operator.or_, _mor)):
 
 
 @intrinsic
-def _mnot(typingctx, a):  # type: ignore[no-untyped-def]
+def _mnot(typingctx, a):
     sig = m8(m8)
 
-    def codegen(context, builder, signature, args):  # type: ignore[no-untyped-def]
+    def codegen(context, builder, signature, args):
         return builder.not_(args[0])
 
     return sig, codegen
 
 
 @overload(operator.invert)
-def _ov_invert(a):  # type: ignore[no-untyped-def]
+def _ov_invert(a):
     if a == m8:
         return lambda a: _mnot(a)
     return None
 
 
 @intrinsic
-def mask_bits(typingctx, m):  # type: ignore[no-untyped-def]
+def _mask_bits(typingctx, m):
     """The mask as an integer: bit k set when lane k is."""
     sig = types.int64(m8)
 
-    def codegen(context, builder, signature, args):  # type: ignore[no-untyped-def]
+    def codegen(context, builder, signature, args):
         bits = builder.bitcast(args[0], ir.IntType(LANES))
         return builder.zext(bits, ir.IntType(64))
 
@@ -442,35 +450,35 @@ def mask_bits(typingctx, m):  # type: ignore[no-untyped-def]
 
 
 @intrinsic
-def bits_mask(typingctx, b):  # type: ignore[no-untyped-def]
+def _bits_mask(typingctx, b):
     """The mask of an integer's low bits (lane k set when bit k is)."""
     sig = m8(types.int64)
 
-    def codegen(context, builder, signature, args):  # type: ignore[no-untyped-def]
+    def codegen(context, builder, signature, args):
         return builder.bitcast(builder.trunc(args[0], ir.IntType(LANES)), _MASK)
 
     return sig, codegen
 
 
 @intrinsic
-def select(typingctx, m, a, b):  # type: ignore[no-untyped-def]
+def _select(typingctx, m, a, b):
     """Lane by lane: a where the mask is set, else b."""
     sig = f8(m8, f8, f8)
 
-    def codegen(context, builder, signature, args):  # type: ignore[no-untyped-def]
+    def codegen(context, builder, signature, args):
         return builder.select(args[0], args[1], args[2])
 
     return sig, codegen
 
 
 # ------------------------------------------------------------------ either width
-def width(a):  # type: ignore[no-untyped-def]
+def width(a):
     """Lanes a value of array a's kind holds: LANES for float32 (vectors), 1 for float64."""
     raise NotImplementedError("numba only")
 
 
 @overload(width)
-def _ov_width(a):  # type: ignore[no-untyped-def]
+def _ov_width(a):
     if _is32(a):
         return lambda a: LANES
     if isinstance(a, types.Array):
@@ -478,13 +486,13 @@ def _ov_width(a):  # type: ignore[no-untyped-def]
     return None
 
 
-def like(a, x):  # type: ignore[no-untyped-def]
+def like(a, x):
     """The scalar x as a value of array a's kind: splat for float32, x itself for float64."""
     raise NotImplementedError("numba only")
 
 
 @overload(like)
-def _ov_like(a, x):  # type: ignore[no-untyped-def]
+def _ov_like(a, x):
     if _is32(a):
         return lambda a, x: _vsplat(np.float32(x))
     if isinstance(a, types.Array):
@@ -492,8 +500,16 @@ def _ov_like(a, x):  # type: ignore[no-untyped-def]
     return None
 
 
+#: the mask as an integer: bit k set when lane k is
+mask_bits: Any = _mask_bits
+#: the mask of an integer's low bits (lane k set when bit k is)
+bits_mask: Any = _bits_mask
+#: lane by lane: ``select(mask, a, b)`` is a where the mask is set, else b
+select: Any = _select
+
 __all__ = [
     "LANES",
+    "kernel",
     "like",
     "width",
     "bits_mask",

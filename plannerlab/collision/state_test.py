@@ -47,11 +47,13 @@ from typing import NamedTuple
 import numpy as np
 from numba import njit
 
-from plannerlab.collision.geometry import BOX, SPHERE, capsule_obstacle_hit, seg_seg
+from plannerlab.collision.exact import exact_state
+from plannerlab.collision.geometry import BOX, SPHERE
 from plannerlab.collision.kinematics import chain_frames, chain_values, place
 from plannerlab.collision.simd import (
     LANES,
     fma,
+    kernel,
     load,
     mask_bits,
     select,
@@ -156,7 +158,7 @@ def lanes(m):
 
 
 # ------------------------------------------------------------------ loading the lanes
-@njit(cache=True, nogil=True, _nrt=False)
+@kernel
 def load_state(Z, k, q, continuous):
     """Lane k holds state q (dof,): its float64 copy, and in float32 with continuous
     joints wrapped into [-π, π] (the filter's kinematics stay accurate)."""
@@ -168,7 +170,7 @@ def load_state(Z, k, q, continuous):
         Z.Q[i * W + k] = np.float32(x)
 
 
-@njit(cache=True, nogil=True, _nrt=False)
+@kernel
 def fill_lanes(Z, n):
     """Lanes n..W-1 repeat lane 0 (a call tests W lanes whatever is asked; a copy is
     harmless and is not reported)."""
@@ -181,7 +183,7 @@ def fill_lanes(Z, n):
         Z.grow64[k] = Z.grow64[0]
 
 
-@njit(cache=True, nogil=True, _nrt=False)
+@kernel
 def set_plain(Z):
     """Every lane grows by nothing (the plain test)."""
     for k in range(W):
@@ -189,7 +191,7 @@ def set_plain(Z):
         Z.grow64[k] = 0.0
 
 
-@njit(cache=True, nogil=True, _nrt=False)
+@kernel
 def set_rates(m, Z, rate64):
     """Every capsule's rate [m] for grown lanes (packed order), and each cluster's and
     body's largest (their gates grow by it). The float32 copies are rounded up, so a
@@ -215,7 +217,7 @@ def set_rates(m, Z, rate64):
 # Helpers take tables and rows (``obs32``, ``caps32``, ...), never the model: a named
 # tuple handed to a function inlined by numba has every array in it counted in and out
 # (measured: ~2 000 cycles a call on the Panda's model).
-@njit(cache=True, nogil=True, _nrt=False)
+@kernel
 def _local(O, o, x, y, z):
     """Lane points in obstacle o's frame (O: ``obs32``)."""
     x = x - splat(O[o, 0])
@@ -227,7 +229,7 @@ def _local(O, o, x, y, z):
     return u, v, t
 
 
-@njit(cache=True, nogil=True, _nrt=False)
+@kernel
 def _point_d2(kind, O, o, x, y, z):
     """Squared distance of lane points to obstacle o (0 inside)."""
     zero = splat(0.0)
@@ -246,7 +248,7 @@ def _point_d2(kind, O, o, x, y, z):
     return fma(rr, rr, zz * zz)
 
 
-@njit(cache=True, nogil=True, _nrt=False)
+@kernel
 def _sd_grad(kind, O, o, x, y, z):
     """Signed distance of lane points to obstacle o, and its gradient (world)."""
     zero, one, tiny = splat(0.0), splat(1.0), splat(1e-20)
@@ -294,7 +296,7 @@ def _sd_grad(kind, O, o, x, y, z):
     return d, g0, g1, g2
 
 
-@njit(cache=True, nogil=True, _nrt=False)
+@kernel
 def _tangent_bounds(fa, sa, fb, sb):
     """The tangents' lower bound of a convex f on [0, 1] from f and its slope at both
     ends (see the module), and the t where they cross (where to look for an upper one)."""
@@ -309,7 +311,7 @@ def _tangent_bounds(fa, sa, fb, sb):
     return lo, t
 
 
-@njit(cache=True, nogil=True, _nrt=False)
+@kernel
 def _ends(X, l):
     """Capsule l's ends (a, b), three lane vectors each."""
     o = 6 * l * W
@@ -323,7 +325,7 @@ def _ends(X, l):
     )
 
 
-@njit(cache=True, nogil=True, _nrt=False)
+@kernel
 def _pt_seg(x0, x1, x2, S):
     """Distance from lane points x to segments p + u e (u in [0, 1]; S = p0, p1, p2, e0,
     e1, e2, e·e), and the vector to x from its closest point."""
@@ -336,7 +338,7 @@ def _pt_seg(x0, x1, x2, S):
     return vsqrt(fma(y0, y0, fma(y1, y1, y2 * y2))), y0, y1, y2
 
 
-@njit(cache=True, nogil=True, _nrt=False)
+@kernel
 def _segment_obstacle(kind, O, o, E):
     """Bounds of the signed distance from lane segments E = (a0, a1, a2, b0, b1, b2) to
     obstacle o: (lower, upper)."""
@@ -351,7 +353,7 @@ def _segment_obstacle(kind, O, o, E):
     return lo, vmin(vmin(fa, fb), fm)
 
 
-@njit(cache=True, nogil=True, _nrt=False)
+@kernel
 def _segments(E1, E2):
     """Bounds of the distance between lane segments E1 and E2 (six vectors each; a sphere
     is a segment of zero length): the distance from a point of the first to the second
@@ -371,7 +373,7 @@ def _segments(E1, E2):
     return lo, vmin(vmin(fa, fb), fm)
 
 
-@njit(cache=True, nogil=True, _nrt=False)
+@kernel
 def _grade_d2(d2, r0, rg, eps, hu):
     """The lane masks ``hu`` = (hit, unsure grown, unsure plain) updated with squared
     distances d2: hit when closer than the plain radius r0 less eps (certainly, in
@@ -387,7 +389,7 @@ def _grade_d2(d2, r0, rg, eps, hu):
     )
 
 
-@njit(cache=True, nogil=True, _nrt=False)
+@kernel
 def _grade_bounds(lo_d, hi_d, r0, rg, eps, hu):
     """The lane masks (hit, unsure grown, unsure plain) updated with a distance's lower
     and upper bounds (as :func:`_grade_d2`)."""
@@ -398,13 +400,13 @@ def _grade_bounds(lo_d, hi_d, r0, rg, eps, hu):
     )
 
 
-@njit(cache=True, nogil=True, _nrt=False)
+@kernel
 def _near(d2, r, live):
     """Some live lane has d2 within r (squared)."""
     return (mask_bits(d2 <= r * r) & live) != 0
 
 
-@njit(cache=True, nogil=True, _nrt=False)
+@kernel
 def _gap2(A, a, B, b):
     """Squared distance between the points in slots A[a:] and B[b:] (three each)."""
     x = load(A, a) - load(B, b)
@@ -413,14 +415,14 @@ def _gap2(A, a, B, b):
     return fma(x, x, fma(y, y, z * z))
 
 
-@njit(cache=True, nogil=True, _nrt=False)
+@kernel
 def _slot3(A, i):
     """The three vectors of slot i (x, y, z)."""
     return load(A, 3 * i * W), load(A, (3 * i + 1) * W), load(A, (3 * i + 2) * W)
 
 
 # ------------------------------------------------------------------ the filter's passes
-@njit(cache=True, nogil=True, _nrt=False)
+@kernel
 def frames32(m, Z):
     """Every body's frame in the eight lanes, and the body gates' centres."""
     if m.cpl_start.shape[0] > 0:
@@ -436,7 +438,7 @@ def frames32(m, Z):
         store(G, (3 * b + 2) * W, z)
 
 
-@njit(cache=True, nogil=True, _nrt=False)
+@kernel
 def _place_cluster(F, X, K, c, tables, placed):
     """Cluster c's gate centre (placed 1), or its capsules' ends too (placed 2: ``placed``
     asks which): tables = (cls32, caps32, cl_caps, cl_body, cap_sphere, state)."""
@@ -472,7 +474,7 @@ def _stop(hit, mode):
     return hit == _ALL
 
 
-@njit(cache=True, nogil=True, _nrt=False)
+@kernel
 def _scene_pass(m, Z, mode, hu):
     """Every moving capsule against every obstacle, behind its body's and its cluster's
     gates: the lane masks ``hu`` (see :func:`_grade_d2`) updated, and whether the mode's
@@ -520,7 +522,7 @@ def _scene_pass(m, Z, mode, hu):
     return hu, False
 
 
-@njit(cache=True, nogil=True, _nrt=False)
+@kernel
 def _self_pass(m, Z, mode, hu):
     """Every checked link pair, behind its body pair's and cluster pair's gates: the lane
     masks ``hu`` updated, and whether the mode's stop came."""
@@ -565,7 +567,7 @@ def _self_pass(m, Z, mode, hu):
     return hu, False
 
 
-@njit(cache=True, nogil=True, _nrt=False)
+@kernel
 def test_lanes(m, Z, mode):
     """Test the eight lanes' states (loaded by :func:`load_state`, grown by ``Z.grow``).
 
@@ -603,102 +605,6 @@ def test_lanes(m, Z, mode):
     return _ALL & ~hit & ~unsure_g, hit, confirmed
 
 
-# ------------------------------------------------------------------ float64, exact
-@njit(cache=True, nogil=True, _nrt=False)
-def _place64(m, Z, b):
-    for l in range(m.body_caps[b], m.body_caps[b + 1]):
-        x, y, z = place(Z.e_F, b, m.cap_a, l, 0)
-        Z.e_XA[l, 0], Z.e_XA[l, 1], Z.e_XA[l, 2] = x, y, z
-        x, y, z = place(Z.e_F, b, m.cap_b, l, 0)
-        Z.e_XB[l, 0], Z.e_XB[l, 1], Z.e_XB[l, 2] = x, y, z
-    Z.e_placed[b] = 1
-
-
-@njit(cache=True, nogil=True, _nrt=False)
-def _clear64(m, o, x, y, z, r):
-    """A ball (centre x, radius r) is clear of obstacle o by a rounding's margin."""
-    c, h, R = m.obs_c[o], m.obs_h[o], m.obs_R[o]
-    x0, x1, x2 = x - c[0], y - c[1], z - c[2]
-    kind = m.obs_kind[o]
-    if kind == SPHERE:
-        rr = r + h[0] + 1e-9
-        return x0 * x0 + x1 * x1 + x2 * x2 > rr * rr
-    u = R[0] * x0 + R[3] * x1 + R[6] * x2
-    v = R[1] * x0 + R[4] * x1 + R[7] * x2
-    w = R[2] * x0 + R[5] * x1 + R[8] * x2
-    if kind == BOX:
-        du = max(abs(u) - h[0], 0.0)
-        dv = max(abs(v) - h[1], 0.0)
-        dw = max(abs(w) - h[2], 0.0)
-    else:
-        du = max(math.sqrt(u * u + v * v) - h[0], 0.0)
-        dv = max(abs(w) - h[1], 0.0)
-        dw = 0.0
-    rr = r + 1e-9
-    return du * du + dv * dv + dw * dw > rr * rr
-
-
-@njit(cache=True, nogil=True, _nrt=False)
-def frames64(m, Z, q):
-    """Every body's frame of one state q (dof,) in float64 into Z.e_F (the one kinematics)."""
-    for i in range(q.shape[0]):
-        Z.e_Q[i] = q[i]
-    if m.cpl_start.shape[0] > 0:
-        chain_values(Z.e_Q, (m.cpl_start, m.cpl_idx, m.cpl_val), Z.e_V)
-        chain_frames(Z.e_F, Z.e_V, m.T0, m.pre, m.parent, m.slide)
-    else:
-        chain_frames(Z.e_F, Z.e_Q, m.T0, m.pre, m.parent, m.slide)
-
-
-@njit(cache=True, nogil=True, _nrt=False)
-def exact_state(m, Z, q, grow):
-    """One state q (dof,) is free with every capsule grown by ``grow · rate`` (float64,
-    the exact tests of ``geometry``: FCL's verdicts); ``Z.rate64``, ``Z.brate64``: the
-    capsules' and bodies' rates."""
-    rate, brate = Z.rate64, Z.brate64
-    frames64(m, Z, q)
-    for b in range(Z.e_placed.shape[0]):
-        Z.e_placed[b] = 0
-    for kb in range(m.body_order.shape[0]):
-        b = m.body_order[kb]
-        gr = m.gate_r_scene[b]
-        if gr < 0.0:
-            continue
-        x, y, z = place(Z.e_F, b, m.gate_c, b, 0)
-        gb = gr + grow * brate[b]
-        for o in range(m.obs_kind.shape[0]):
-            if _clear64(m, o, x, y, z, gb):
-                continue
-            if Z.e_placed[b] == 0:
-                _place64(m, Z, b)
-            for l in range(m.body_caps[b], m.body_caps[b + 1]):
-                if m.cap_moving[l] and capsule_obstacle_hit(
-                    m.obs_kind[o], Z.e_R[o], m.obs_c[o], m.obs_h[o], Z.e_XA[l], Z.e_XB[l],
-                    m.r_scene[l] + grow * rate[l], Z.e_w,
-                ):  # fmt: skip
-                    return False
-    for p in range(m.bpairs.shape[0]):
-        u, v = m.bpairs[p, 0], m.bpairs[p, 1]
-        if u != v:
-            xu, yu, zu = place(Z.e_F, u, m.gate_c, u, 0)
-            xv, yv, zv = place(Z.e_F, v, m.gate_c, v, 0)
-            rr = m.gate_r_self[u] + m.gate_r_self[v] + grow * (brate[u] + brate[v]) + 1e-9
-            dx, dy, dz = xu - xv, yu - yv, zu - zv
-            if dx * dx + dy * dy + dz * dz > rr * rr:
-                continue
-        if Z.e_placed[u] == 0:
-            _place64(m, Z, u)
-        if Z.e_placed[v] == 0:
-            _place64(m, Z, v)
-        for q2 in range(m.clpair_start[m.bpair_start[p]], m.clpair_start[m.bpair_start[p + 1]]):
-            i, j = m.cpairs[q2, 0], m.cpairs[q2, 1]
-            rr = m.r_self[i] + m.r_self[j] + grow * (rate[i] + rate[j])
-            d2, _, _ = seg_seg(Z.e_XA[i], Z.e_XB[i], Z.e_XA[j], Z.e_XB[j])
-            if d2 <= rr * rr:
-                return False
-    return True
-
-
 # ------------------------------------------------------------------ entry points
 @njit(cache=True, nogil=True)
 def valid_batch(m, Q, out):
@@ -719,7 +625,7 @@ def valid_batch(m, Q, out):
     return confirmed
 
 
-@njit(cache=True, nogil=True, _nrt=False)
+@kernel
 def valid_one(m, Z, q):
     """One state q (dof,) is valid (in lane 0; Z's growth must be plain)."""
     load_state(Z, 0, q, m.continuous)

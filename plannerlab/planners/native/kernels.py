@@ -46,6 +46,7 @@ from plannerlab.collision.edges import (
     edge_delta,
     edge_rake,
 )
+from plannerlab.collision.simd import kernel
 from plannerlab.planners.native.kdtree import DEAD, kd_catch_up, kd_insert, kd_nearest
 
 # ---------------------------------------------------------------------- return codes
@@ -130,7 +131,7 @@ def seed_state(rng: np.random.Generator) -> np.ndarray:
     return s
 
 
-@njit(cache=True, nogil=True, _nrt=False)
+@kernel
 def next_u64(s):
     """xoshiro256+: the next 64 bits; advances the state s (4,) uint64."""
     result = s[0] + s[3]
@@ -144,20 +145,20 @@ def next_u64(s):
     return result
 
 
-@njit(cache=True, nogil=True, _nrt=False)
+@kernel
 def uniform(s):
     """A double in [0, 1)."""
     return float(next_u64(s) >> _U11) * _INV53
 
 
-@njit(cache=True, nogil=True, _nrt=False)
+@kernel
 def randint(s, n):
     """An integer in [0, n)."""
     i = int(uniform(s) * n)
     return min(i, n - 1)
 
 
-@njit(cache=True, nogil=True, _nrt=False)
+@kernel
 def gauss(s):
     """A standard normal number (Box–Muller)."""
     u1 = 1.0 - uniform(s)  # (0, 1]
@@ -166,20 +167,20 @@ def gauss(s):
 
 
 # ---------------------------------------------------------------------- states
-@njit(cache=True, nogil=True, _nrt=False)
+@kernel
 def copy_row(dst, i, src, j):
     """dst[i] = src[j] (rows; a slice assignment needs numba's reference counting)."""
     for c in range(dst.shape[1]):
         dst[i, c] = src[j, c]
 
 
-@njit(cache=True, nogil=True, _nrt=False)
+@kernel
 def wrap(x):
     """An angle into [-π, π) (``wrap_to_pi``)."""
     return (x + math.pi) % _TWO_PI - math.pi
 
 
-@njit(cache=True, nogil=True, _nrt=False)
+@kernel
 def sample(s, lower, upper, continuous, guides, guide_bias, guide_sigma_rad, out):
     """A sample into out (dof,): with probability ``guide_bias`` (and guides (k, dof),
     k > 0) a guide state drawn uniformly plus Gaussian noise ``guide_sigma_rad`` per joint,
@@ -203,7 +204,7 @@ def sample(s, lower, upper, continuous, guides, guide_bias, guide_sigma_rad, out
             out[i] = lower[i] + (upper[i] - lower[i]) * u
 
 
-@njit(cache=True, nogil=True, _nrt=False)
+@kernel
 def distance2(a, b, continuous):
     """Squared joint distance, continuous joints the short way round."""
     acc = 0.0
@@ -215,7 +216,7 @@ def distance2(a, b, continuous):
     return acc
 
 
-@njit(cache=True, nogil=True, _nrt=False)
+@kernel
 def nearest(Q, n, q, continuous, any_continuous, F):
     """Index of the state of Q[:n] nearest to q, rows with ``F[r] == DEAD`` left out
     (brute force over contiguous rows, each row's sum abandoned once it exceeds the
@@ -250,7 +251,7 @@ def nearest(Q, n, q, continuous, any_continuous, F):
     return best_i
 
 
-@njit(cache=True, nogil=True, _nrt=False)
+@kernel
 def steer(q_from, q_to, range_rad, continuous, d, out):
     """out = the state at most ``range_rad`` from q_from towards q_to (q_to itself, copied,
     when it is that close); True when out is q_to. Uses d (dof,) as scratch."""
@@ -271,14 +272,14 @@ def steer(q_from, q_to, range_rad, continuous, d, out):
 
 
 # ---------------------------------------------------------------------- edges
-@njit(cache=True, nogil=True, _nrt=False)
+@kernel
 def edge_states(q_a, q_b, joint_step, m, d):
     """The grid's number of states of edge q_a -> q_b (its re-check's checks)."""
     edge_delta(q_a, q_b, m.continuous, d)
     return edge_count(d, joint_step, m.edge_weights)
 
 
-@njit(cache=True, nogil=True, _nrt=False)
+@kernel
 def _tree_edge(S, T, c, goal_tree, joint_step, limits):
     """The edge of node c to its parent, in the direction the path runs (start tree
     parent -> child, goal tree child -> parent). ``limits`` = (check limit, stride):
@@ -296,7 +297,7 @@ def _tree_edge(S, T, c, goal_tree, joint_step, limits):
     return status, checks, (CHECKED if proved else COARSE)
 
 
-@njit(cache=True, nogil=True, _nrt=False)
+@kernel
 def _kill(T, c, n):
     """Node c and its subtree are dead (parents come before their children)."""
     T.F[c] = DEAD
@@ -305,7 +306,7 @@ def _kill(T, c, n):
             T.F[i] = DEAD
 
 
-@njit(cache=True, nogil=True, _nrt=False)
+@kernel
 def _certify(S, A, B, ab, sizes, joint_step, limit):
     """Check in full the found path's edges known only at their coarse states (A's chain
     from a, B's from b; ``ab`` = (a, b)), each marked CHECKED when free; an invalid one
@@ -329,7 +330,7 @@ def _certify(S, A, B, ab, sizes, joint_step, limit):
 
 
 # ---------------------------------------------------------------------- RRT-Connect
-@njit(cache=True, nogil=True, _nrt=False)
+@kernel
 def _nearest(S, T, n, q):
     """The nearest live node of T[:n] to q (k-d tree, or a scan without split joints)."""
     if S.sd.shape[0] > 0:
@@ -337,7 +338,7 @@ def _nearest(S, T, n, q):
     return nearest(T.Q, n, q, S.m.continuous, S.m.continuous.any(), T.F)
 
 
-@njit(cache=True, nogil=True, _nrt=False)
+@kernel
 def _grow(S, T, n, goal_tree, near, q_to, O, limit):
     """Grow tree T of n nodes from node ``near`` (-1: the nearest live one; -2: the same
     without the dynamic domain) towards q_to: a
@@ -377,7 +378,7 @@ def _grow(S, T, n, goal_tree, near, q_to, O, limit):
     return (2 if reached else 1), checks, near
 
 
-@njit(cache=True, nogil=True, _nrt=False)
+@kernel
 def _added(S, T, sizes, t):
     """Node sizes[t] of tree t joins it (and its k-d tree); returns its index."""
     new = sizes[t]
@@ -387,7 +388,7 @@ def _added(S, T, sizes, t):
     return new
 
 
-@njit(cache=True, nogil=True, _nrt=False)
+@kernel
 def rrtc_run(S, A, B, sizes, O, counters, limits):
     """RRT-Connect iterations until a path, a limit, or a full tree.
 
@@ -474,13 +475,13 @@ def rrtc_run(S, A, B, sizes, O, counters, limits):
                 return CHUNK
 
 
-@njit(cache=True, nogil=True, _nrt=False)
+@kernel
 def rrtc_entry(P, aux, A, B, sizes, O, counters, limits):
     """:func:`rrtc_run` on the packed model (a call from Python)."""
     return rrtc_run(open_search(P, aux), A, B, sizes, O, counters, limits)
 
 
-@njit(cache=True, nogil=True, _nrt=False)
+@kernel
 def tree_path(A, a, B, b, out):
     """The path from A's root to node a (= B's node b), then from b's parent to B's
     root, into out (rows); returns its number of states."""
@@ -502,7 +503,7 @@ def tree_path(A, a, B, b, out):
 
 
 # ---------------------------------------------------------------------- shortcuts
-@njit(cache=True, nogil=True, _nrt=False)
+@kernel
 def _cut(P, k, i, j):
     """Remove the states strictly between i and j of P[:k]; returns the new length."""
     gap = j - i - 1
@@ -511,7 +512,7 @@ def _cut(P, k, i, j):
     return k - gap
 
 
-@njit(cache=True, nogil=True, _nrt=False)
+@kernel
 def _try_shortcut(S, P, k, ij, joint_step, limit):
     """Replace P[i..j] (``ij``) by the edge P[i] -> P[j] when it is free and its grid has
     no more states than the edges it replaces (the re-check never grows). Returns (k,
@@ -532,7 +533,7 @@ def _try_shortcut(S, P, k, ij, joint_step, limit):
     return _cut(P, k, i, j), 1, checks
 
 
-@njit(cache=True, nogil=True, _nrt=False)
+@kernel
 def shortcut_run(S, P, k, joint_step, tries, counters, limits):
     """Shorten the path P[:k] in place: ``tries`` random shortcuts (states i < j - 1
     drawn uniformly, the edge P[i] -> P[j] replacing those between when free; they end
@@ -578,7 +579,7 @@ def shortcut_run(S, P, k, joint_step, tries, counters, limits):
     return k, DONE
 
 
-@njit(cache=True, nogil=True, _nrt=False)
+@kernel
 def shortcut_entry(P, aux, path, joint_step, tries, counters, limits):
     """:func:`shortcut_run` on the packed model (a call from Python); ``path`` = (P, k)."""
     return shortcut_run(open_search(P, aux), path[0], path[1], joint_step, tries, counters, limits)

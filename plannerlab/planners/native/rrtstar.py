@@ -20,9 +20,9 @@ import math
 from typing import NamedTuple
 
 import numpy as np
-from numba import njit
 
 from plannerlab.collision.edges import FREE, LIMIT, edge_check
+from plannerlab.collision.simd import kernel
 from plannerlab.planners.base import PlanResult, Status
 from plannerlab.planners.native import kernels as K
 from plannerlab.planners.native.solve import (
@@ -38,7 +38,7 @@ from plannerlab.robots.paths import path_length
 K_MAX = 128
 
 
-@njit(cache=True, nogil=True, _nrt=False)
+@kernel
 def _k_nearest(Q, n, q, continuous, k, nb_idx, nb_d2):
     """The k nearest nodes of Q[:n] to q into nb_idx, nb_d2 (squared distances),
     nearest first; returns how many (min(k, n))."""
@@ -61,7 +61,7 @@ def _k_nearest(Q, n, q, continuous, k, nb_idx, nb_d2):
     return cnt
 
 
-@njit(cache=True, nogil=True, _nrt=False)
+@kernel
 def _unlink(child, sibling, p, c):
     """Remove c from p's children."""
     if child[p] == c:
@@ -73,7 +73,7 @@ def _unlink(child, sibling, p, c):
     sibling[i] = sibling[c]
 
 
-@njit(cache=True, nogil=True, _nrt=False)
+@kernel
 def _shift_costs(cost, child, sibling, root, delta, stack):
     """Add delta to the cost of root's subtree (root excluded)."""
     top = 0
@@ -120,7 +120,7 @@ class Star(NamedTuple):
     nb_d2: np.ndarray
 
 
-@njit(cache=True, nogil=True, _nrt=False)
+@kernel
 def _recheck_states(S, T, node, joint_step):
     """The re-check's checks of the path from the root to node (1 + its grid states)."""
     total = 1
@@ -130,7 +130,7 @@ def _recheck_states(S, T, node, joint_step):
     return total
 
 
-@njit(cache=True, nogil=True, _nrt=False)
+@kernel
 def _connect_goal(S, T, X, sizes, new, O, limit):
     """Try the edge from node ``new`` to its nearest goal state not yet in the tree, when
     it is within ``range_rad``: the goal state joins the tree. Returns (status, checks)
@@ -165,7 +165,7 @@ def _connect_goal(S, T, X, sizes, new, O, limit):
     return FREE, checks
 
 
-@njit(cache=True, nogil=True, _nrt=False)
+@kernel
 def _by_cost(cost, nb_idx, nb_d2, cnt):
     """The neighbours nb_idx[:cnt] (squared distances nb_d2) sorted by the cost through
     them (cost + distance), which nb_d2 then holds."""
@@ -179,7 +179,7 @@ def _by_cost(cost, nb_idx, nb_d2, cnt):
             j -= 1
 
 
-@njit(cache=True, nogil=True, _nrt=False)
+@kernel
 def _rewire(S, T, X, node, cnt, joint_step, limits):
     """Rewire the neighbours ``X.nb_idx[:cnt]`` through the new node (``node`` = (new,
     its parent, its cost)) when that is shorter and the edge new -> neighbour is free;
@@ -212,7 +212,7 @@ def _rewire(S, T, X, node, cnt, joint_step, limits):
     return 0, checks
 
 
-@njit(cache=True, nogil=True, _nrt=False)
+@kernel
 def _update_best(S, T, sizes, counters, hard_checks, joint_step):
     """The best path to a goal state whose re-check fits the checks left: its goal node
     into counters[2], its re-check's checks into counters[3]."""
@@ -231,7 +231,7 @@ def _update_best(S, T, sizes, counters, hard_checks, joint_step):
     counters[2] = b
 
 
-@njit(cache=True, nogil=True, _nrt=False)
+@kernel
 def _best_parent(S, T, X, target, near, cnt, limits):
     """The new node's parent: the neighbour of least cost through it whose edge is free
     (``near`` if none is cheaper). Returns (parent, cost, checks, code): code 0, or 2 the
@@ -259,7 +259,7 @@ def _best_parent(S, T, X, target, near, cnt, limits):
     return best_p, best_c, checks, 0
 
 
-@njit(cache=True, nogil=True, _nrt=False)
+@kernel
 def rrtstar_run(S, T, X, sizes, O, counters, limits):
     """RRT* iterations until a limit or a full tree.
 
@@ -352,13 +352,13 @@ def rrtstar_run(S, T, X, sizes, O, counters, limits):
     return K.CHUNK
 
 
-@njit(cache=True, nogil=True, _nrt=False)
+@kernel
 def rrtstar_entry(P, aux, T, X, sizes, O, counters, limits):
     """:func:`rrtstar_run` on the packed model (a call from Python)."""
     return rrtstar_run(K.open_search(P, aux), T, X, sizes, O, counters, limits)
 
 
-@njit(cache=True, nogil=True, _nrt=False)
+@kernel
 def chain(Q, parent, node, out):
     """The path from the root to node into out; returns its number of states."""
     k = 0
