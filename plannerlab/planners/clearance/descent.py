@@ -179,7 +179,7 @@ class ClearanceDescent(DescentStep, LegPlanner):
         field = ClearanceField(problem.robot, problem.scene, self.settings.margin_m, stop=stop)
         model: Model
         if self.backend_for(problem.robot) == "compiled":
-            model = CompiledModel(self, field, _compiled_model(checker))
+            model = CompiledModel(self, field)
         else:
             model = NumpyModel(self, field)
         self._model_cache = (problem, model)
@@ -634,17 +634,6 @@ class LegPath:
             escapes=self.escapes,
             extra=out,
         )
-
-
-def _compiled_model(checker: Any) -> Any:
-    """The checker's compiled robot–scene model, or None when it has none (no checker,
-    an FCL-only scene, a robot without a chain)."""
-    if checker is None:
-        return None
-    try:
-        return checker.model
-    except (AttributeError, ValueError, PlannerlabError):
-        return None
 
 
 def _within(goal: GoalRegion, point, fraction: float) -> bool:
