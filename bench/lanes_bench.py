@@ -32,7 +32,7 @@ from numba import njit
 from plannerlab.collision.chain_valid import _state_ok
 from plannerlab.collision.fcl_checker import problem_checker
 from plannerlab.collision.lanes import W, lanes_check, lanes_views, valid_states_lanes
-from plannerlab.collision.model import views
+from plannerlab.collision.model_old import views
 from plannerlab.problem.catalog import load_problem
 from plannerlab.problem.load import parse_problem
 

@@ -38,7 +38,7 @@ from numba import njit
 from plannerlab.collision.chain_valid import chain_state_valid
 from plannerlab.collision.fcl_checker import CollisionChecker, problem_checker
 from plannerlab.collision.kernels import valid_batch
-from plannerlab.collision.model import state_ok, valid_states, views
+from plannerlab.collision.model_old import state_ok, valid_states, views
 from plannerlab.problem.catalog import load_problem
 from plannerlab.problem.load import parse_problem
 

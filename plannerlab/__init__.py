@@ -26,9 +26,54 @@ cases, room variants, the IRb-6's analytic IK, MotionBenchMaker's importer) is i
 from __future__ import annotations
 
 import importlib
+import os
+import sys
 from typing import TYPE_CHECKING, Any
 
+
+def _numba_cache_dir() -> None:
+    """Point numba's cache at a folder named by a digest of the package's compiled code.
+
+    numba keeps a kernel's cached machine code until the kernel's *own* file changes;
+    a kernel that calls a function of another file (every planner's kernel calls the
+    collision core's) would go on running the old callee after an update. Named by a
+    digest of every source file that holds compiled code, the cache starts afresh
+    whenever any of them changes (``~/.cache/plannerlab/numba/<digest>``; the four most
+    recent folders are kept). A ``NUMBA_CACHE_DIR`` set by the user wins, and nothing is
+    done once numba was imported (its configuration is then read)."""
+    if "NUMBA_CACHE_DIR" in os.environ or "numba" in sys.modules:
+        return
+    import hashlib
+    from pathlib import Path
+
+    root = Path(__file__).resolve().parent
+    digest = hashlib.sha1(usedforsecurity=False)
+    for path in sorted(root.rglob("*.py")):
+        text = path.read_bytes()
+        if b"numba" in text:
+            digest.update(path.relative_to(root).as_posix().encode() + b"\0" + text)
+    base = Path(os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache") / "plannerlab"
+    folder = base / "numba" / digest.hexdigest()[:16]
+    try:
+        folder.mkdir(parents=True, exist_ok=True)
+        (folder / "stamp").touch()
+        old = sorted(
+            (p for p in folder.parent.iterdir() if p.is_dir() and p != folder),
+            key=lambda p: (p / "stamp").stat().st_mtime if (p / "stamp").exists() else 0.0,
+        )
+        import shutil
+
+        for stale in old[:-3]:
+            shutil.rmtree(stale, ignore_errors=True)
+    except OSError:
+        return  # not writable: numba's default (__pycache__ beside the sources)
+    os.environ["NUMBA_CACHE_DIR"] = str(folder)
+
+
+_numba_cache_dir()
+
 if TYPE_CHECKING:
+    from plannerlab.collision.public import Checker, checker
     from plannerlab.comparison.minima import local_minima
     from plannerlab.comparison.report import markdown as markdown_report
     from plannerlab.comparison.report import write_reports
@@ -65,6 +110,9 @@ _EXPORTS: dict[str, str] = {
     "planner_catalog": "plannerlab.run.planner_info:planner_catalog",
     "planner_info": "plannerlab.run.planner_info:planner_info",
     "make_planner": "plannerlab.planners:make_planner",
+    # the collision checker of a problem
+    "checker": "plannerlab.collision.public:checker",
+    "Checker": "plannerlab.collision.public:Checker",
     # plans and their execution
     "solve": "plannerlab.run.pipeline:solve_legs",
     "execute": "plannerlab.run.pipeline:execute_plan",
@@ -99,6 +147,7 @@ _EXPORTS: dict[str, str] = {
 
 __all__ = [
     "Budget",
+    "Checker",
     "ComparisonRun",
     "Execution",
     "ExecutionFile",
@@ -114,6 +163,7 @@ __all__ = [
     "TrialStore",
     "Viewer",
     "animate_plan",
+    "checker",
     "compare",
     "execute",
     "load_problem",

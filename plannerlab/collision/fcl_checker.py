@@ -32,7 +32,7 @@ from plannerlab.collision.core import Core, PairDistances
 from plannerlab.collision.core import supports as core_supports
 from plannerlab.collision.reach import joint_reach_m, reach_bounds
 from plannerlab.problem.scene import Box, Cylinder, Mesh, Scene, Sphere
-from plannerlab.robots.base import Array, Robot
+from plannerlab.robots.base import Array, Robot, joint_difference
 from plannerlab.robots.paths import densify, edge_counts
 
 #: :meth:`CollisionChecker.check_path` without ``stop``: no limit on a kernel call's states
@@ -93,8 +93,10 @@ class CollisionChecker:
     ) -> None:
         if backend not in ("auto", "core", "fcl"):
             raise ValueError(f"backend must be 'auto', 'core' or 'fcl', got {backend!r}")
-        if edge_check not in ("auto", "grid", "advance"):
-            raise ValueError(f"edge_check must be 'auto', 'grid' or 'advance', got {edge_check!r}")
+        if edge_check not in ("auto", "grid", "certified"):
+            raise ValueError(
+                f"edge_check must be 'auto', 'grid' or 'certified', got {edge_check!r}"
+            )
         if backend == "core" and not core_supports(scene):
             raise ValueError("backend 'core' covers boxes, cylinders and spheres only")
         if not (margin_m >= 0.0 and np.isfinite(margin_m)):
@@ -102,36 +104,33 @@ class CollisionChecker:
         #: clearance margin [m]: capsules are inflated by it against the scene, by half of
         #: it against each other (a pair of links keeps one margin between them)
         self.margin_m = float(margin_m)
+        use_core = (backend == "core" or (backend == "auto" and core_supports(scene))) and (
+            callable(getattr(robot, "chain_data", None))
+        )
+        if backend == "core" and not use_core:
+            raise ValueError("backend 'core' needs a robot that gives its chain (chain_data())")
         #: per joint, how fast the geometry moves [m per rad or m] (see reach.py); with a
         #: margin, edges are checked so that no point moves more than the margin between
         #: two checked states (on top of the radian step asked for)
-        use_core = backend == "core" or (backend == "auto" and core_supports(scene))
-        advance = margin_m > 0 and use_core and edge_check in ("auto", "advance")
-        rates: tuple[np.ndarray, np.ndarray] | None = None
         self.reach_m: np.ndarray | None = None
-        if advance:
-            self.reach_m, W, rigid = reach_bounds(robot)
-            rates = (W, rigid)
+        link_rates: np.ndarray | None = None
+        if use_core:
+            self.reach_m, link_rates, _ = reach_bounds(robot)
         elif margin_m > 0:
             self.reach_m = joint_reach_m(robot)
         self.edge_weights: np.ndarray | None = (
-            None if self.reach_m is None else self.reach_m / self.margin_m
+            None if self.reach_m is None or margin_m == 0 else self.reach_m / self.margin_m
         )
-        if edge_check == "advance" and not advance:
-            raise ValueError("edge_check 'advance' needs a margin > 0 and the core backend")
-        #: how edges and paths are checked: "grid" (every state of :meth:`densify`) or
-        #: "advance" (conservative advancement on the core, see core.Core.path_advance:
-        #: fewer states, the same guarantee, at most as many checks as the grid)
-        self.edge_check = "advance" if advance else "grid"
+        if edge_check == "certified" and not use_core:
+            raise ValueError("edge_check 'certified' needs the core backend")
+        #: how edges and paths are checked: "grid" (every state of :meth:`densify`, in
+        #: order) or "certified" (the same grid's verdict from a few certified stretches
+        #: on the core, see collision/edges.py: far fewer states, never more than the grid
+        #: and a few percent)
+        self.edge_check = "grid" if edge_check == "grid" or not use_core else "certified"
         self._core: Core | None = None
         if use_core:
-            self._core = Core(
-                robot,
-                scene,
-                self.margin_m,
-                self.edge_weights,
-                rates,
-            )
+            self._core = Core(robot, scene, self.margin_m, self.edge_weights, link_rates)
         #: which backend answers the queries: "core" or "fcl"
         self.backend = "core" if self._core is not None else "fcl"
         self.robot = robot
@@ -334,10 +333,17 @@ class CollisionChecker:
         Returns (n, bad): the edge's number of states and the index of the first invalid
         one among those checked (None if none). Counts the states looked at, as
         :meth:`first_invalid` does. On the core, interpolation, kinematics and checks are
-        one compiled call.
+        one compiled call. With ``edge_check == "certified"`` the verdict is the same and
+        n counts the state tests made (``max_states + 1`` when ``max_states`` came first:
+        the edge unfinished), bad the last of them when the edge is invalid.
         """
-        if self.edge_check == "advance":
-            return self._check_edge_advance(q_a, q_b, joint_step, max_states)
+        if self.edge_check == "certified":
+            assert self._core is not None
+            status, tests, _ = self._core.edge_certified(q_a, q_b, joint_step, max_states)
+            self.checks += tests
+            if status == 2:
+                return (max(int(max_states or 0), tests) + 1), None
+            return tests, (tests - 1 if status == 1 else None)
         if self._core is not None:
             n, bad = self._core.edge_first_invalid(q_a, q_b, joint_step, max_states)
             m = n if max_states is None else min(n, max(int(max_states), 0))
@@ -346,22 +352,6 @@ class CollisionChecker:
         states = self.densify(np.array([q_a, q_b], dtype=float), joint_step)[0][1:]
         m = len(states) if max_states is None else min(len(states), max(int(max_states), 0))
         return len(states), (self.first_invalid(states[:m]) if m > 0 else None)
-
-    def _check_edge_advance(
-        self, q_a: Array, q_b: Array, joint_step: float, max_states: int | None
-    ) -> tuple[int, int | None]:
-        """:meth:`check_edge` by conservative advancement: n is the number of queries made
-        (q_a's measurement included when a step needs it), or ``max_states + 1`` when
-        ``max_states`` did not suffice (the edge is then unfinished)."""
-        assert self._core is not None
-        path = np.empty((2, self.robot.dof))
-        path[0] = q_a
-        path[1] = q_b
-        q, status, _, _ = self._core.path_advance(path, 0, joint_step, max_states)
-        self.checks += q
-        if status == 2:
-            return (max(int(max_states or 0), q) + 1), None
-        return q, (q - 1 if status == 1 else None)
 
     def colliding_pairs(self, q: Array) -> tuple[tuple[str, str], ...]:
         """Every colliding pair at q: (link name, obstacle name) or (link name, link name)."""
@@ -459,7 +449,7 @@ class CollisionChecker:
 
     def grid_states(self, path: Array, joint_step: float) -> int:
         """``len(self.densify(path, joint_step)[0])``, without making the states: the most
-        checks :meth:`check_path` makes on the path (the grid's; conservative advancement
+        checks :meth:`check_path` makes on the path (the grid's; certified edges make
         makes at most as many)."""
         path = np.atleast_2d(np.asarray(path, dtype=float))
         if len(path) < 2:
@@ -489,6 +479,21 @@ class CollisionChecker:
             )
         return self._core.model
 
+    @property
+    def packed_model(self) -> tuple[np.ndarray, ...]:
+        """The compiled model and the state test's scratch, packed (five arrays:
+        :mod:`plannerlab.collision.packing`), what compiled kernels called from Python
+        take.
+
+        Raises:
+            ValueError: the checker has no compiled core.
+        """
+        if self._core is None:
+            raise ValueError(
+                "the compiled model needs the core backend (boxes, cylinders, spheres)"
+            )
+        return self._core.packed
+
     def check_path(
         self,
         path: Array,
@@ -503,18 +508,18 @@ class CollisionChecker:
         True the check ends, incomplete (``complete`` False). The same states are checked,
         and counted, as without it.
 
-        With ``edge_check == "advance"`` the states are those of conservative advancement
-        (:meth:`~plannerlab.collision.core.Core.path_advance`), at most as many as
-        :meth:`densify` gives (the reserve planners keep for this check stays sound).
-        ``mode`` "grid" checks the grid's states whatever ``edge_check`` says (the states a
-        compiled planner checked its edges on: its path passes by construction).
+        With ``edge_check == "certified"`` each edge's grid is proved by a few certified
+        stretches (:meth:`~plannerlab.collision.core.Core.edge_certified`: the grid's
+        verdict, far fewer tests); an invalid edge's first invalid grid state is then found
+        in order. ``mode`` "grid" checks the grid's states one by one whatever
+        ``edge_check`` says.
         """
-        if mode not in (None, "grid", "advance"):
-            raise ValueError(f"mode must be None, 'grid' or 'advance', got {mode!r}")
-        if (mode or self.edge_check) == "advance":
-            if self.edge_check != "advance":
-                raise ValueError("mode 'advance' needs a checker with edge_check 'advance'")
-            return self._check_path_advance(path, joint_step, stop, chunk)
+        if mode not in (None, "grid", "certified"):
+            raise ValueError(f"mode must be None, 'grid' or 'certified', got {mode!r}")
+        if (mode or self.edge_check) == "certified":
+            if self.edge_check != "certified":
+                raise ValueError("mode 'certified' needs a checker with edge_check 'certified'")
+            return self._check_path_certified(path, joint_step, stop)
         states, owners = self.densify(path, joint_step)
         step = len(states) if stop is None else max(int(chunk), 1)
         bad = None
@@ -539,51 +544,42 @@ class CollisionChecker:
             backend=self.backend,
         )
 
-    def _check_path_advance(
-        self, path: Array, joint_step: float, stop: Callable[[], bool] | None, chunk: int
+    def _check_path_certified(
+        self, path: Array, joint_step: float, stop: Callable[[], bool] | None
     ) -> PathCheck:
-        """:meth:`check_path` by conservative advancement, in pieces of whole edges of
-        at most ``chunk`` grid states when ``stop`` is given."""
+        """:meth:`check_path` with certified edges, ``stop`` asked before each edge."""
         assert self._core is not None
         P = np.atleast_2d(np.asarray(path, dtype=float))
-        if len(P) == 1:
-            ok = self.is_valid(P[0])
+        done = 0
+        ok = self.is_valid(P[0])
+        done += 1
+        if not ok:
             return PathCheck(
-                valid=ok,
-                states_checked=1,
-                first_invalid_edge=None if ok else 0,
-                first_invalid_state=None if ok else P[0].copy(),
-                pairs=() if ok else self.colliding_pairs(P[0]),
+                valid=False,
+                states_checked=done,
+                first_invalid_edge=0,
+                first_invalid_state=P[0].copy(),
+                pairs=self.colliding_pairs(P[0]),
                 backend=self.backend,
             )
-        d, n = self._edge_counts(P, joint_step)
-        pieces = [(0, len(d))]
-        if stop is not None:  # edges grouped so that a piece's grid holds ≤ chunk states
-            pieces, a, acc = [], 0, 0
-            for e, k in enumerate(n):
-                if acc and acc + k > max(int(chunk), 1):
-                    pieces.append((a, e))
-                    a, acc = e, 0
-                acc += int(k)
-            pieces.append((a, len(d)))
-        done = 0
-        for a, b in pieces:
+        for e in range(len(P) - 1):
             if stop is not None and stop():
                 return PathCheck(
                     valid=False, states_checked=done, backend=self.backend, complete=False
                 )
-            q, status, e, t = self._core.path_advance(
-                P[a : b + 1], 1 if a == 0 else 2, joint_step, None
-            )
-            self.checks += q
-            done += q
+            status, tests, n = self._core.edge_certified(P[e], P[e + 1], joint_step)
+            self.checks += tests
+            done += tests
             if status == 1:
-                edge = a + e
-                q_bad = P[edge] + t * d[edge] if t > 0.0 else P[edge].copy()
+                _, bad = self._core.edge_first_invalid(P[e], P[e + 1], joint_step)
+                d = joint_difference(P[e + 1], P[e], self.robot.continuous)
+                j = bad + 1
+                t = 1.0 if j == n else j * (1.0 / n)
+                q_bad = P[e] + t * d
                 return PathCheck(
                     valid=False,
                     states_checked=done,
-                    first_invalid_edge=edge,
+                    first_invalid_edge=e,
                     first_invalid_state=q_bad,
                     pairs=self.colliding_pairs(q_bad),
                     backend=self.backend,

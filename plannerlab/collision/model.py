@@ -1,55 +1,54 @@
-"""The compiled robot–scene model: one typed object that compiled consumers share.
+"""The compiled robot–scene model: one typed object that every compiled consumer shares.
 
 A :class:`CompiledModel` is a named tuple of arrays (numba passes it as one argument and
-loads kernels that take it from its cache) built once per (robot, scene, margin) from a
-robot's serial chain (``robot.chain_data()``: per joint its parent body, fixed transform,
-axis and kind; per capsule its body and end points) and the scene's obstacles. It holds
-what a compiled planner needs without calling back into Python:
+loads the kernels that take it from its cache), built once per (robot, scene, margin) by
+:func:`build_model` from the robot's serial chain (``robot.chain_data()``, the format of
+:mod:`plannerlab.collision.chain`: every robot family gives it) and the scene's
+obstacles. Its fields are named; no consumer indexes packed arrays by position.
 
-* ``P``, ``M``, ``idat``: the chain, its capsules (inflated by the margin against the
-  scene, by half of it between links), the checked link pairs and the scene, packed as
-  :mod:`plannerlab.collision.chain_valid` packs them (its fused validity test is the
-  model's state test);
-* ``lower``, ``upper``, ``continuous``: the joint bounds and which joints wrap;
-* ``edge_weights``: per joint how far [m] the robot's points move per radian (or metre),
-  divided by the margin (zeros without a margin): an edge ``Δq`` is cut into at least
-  ``ceil(Σ |Δq_i| · edge_weights_i)`` steps, so no point moves more than the margin
-  between two checked states (the checker's grid, :meth:`~plannerlab.collision.
-  fcl_checker.CollisionChecker.densify`);
-* ``margin_m``;
-* ``perm``: the capsules' packed order (capsule ``perm[k]`` of the robot is the ``k``-th
-  packed one; :func:`segments` gives them back in the robot's order).
-
-Every robot's model is built by the generic serial-chain builder :func:`model_of_core`
-from the robot's own data, its ``chain_data()`` (:mod:`plannerlab.collision.chain`:
-parents, fixed transforms, axes, sliding joints, capsules, and an optional linear coupling
-of the joints), so a new family takes the compiled road without a special case and without
-naming this module in its registry entry; a robot without a chain gets a
-:class:`ModelError` naming its kind.
-
-The kernels below are the model's queries in compiled code: one state, a batch, and an
-edge checked on the checker's grid (the very states of ``densify``, bit for bit) in an
-order that finds a collision early (coarse to fine, the way VAMP checks a whole edge).
+* **Kinematics** (``parent``, ``slide``, ``T0``, ``pre``, the coupling ``cpl_*``, and
+  ``fold``: a point ``p`` of body ``b``'s own frame is ``fold[b]ᵀ p`` here): each
+  joint's axis is turned onto its frame's z axis once (with ``A e_z = u``, a turn about
+  ``u`` is ``A Rz(q) Aᵀ``: body frames are kept as ``B · A`` and ``A`` is folded into the
+  fixed transforms and the capsules' points), so the one kinematics of
+  :mod:`plannerlab.collision.kinematics` turns about z only. ``*_32`` fields are the same
+  numbers in float32 for the state test's filter.
+* **Capsules** (``cap_*``), sorted by body: body ``b`` holds ``body_caps[b]`` to
+  ``body_caps[b + 1]``; ``perm[k]`` is the robot's index of packed capsule ``k``. A
+  capsule of zero length is a sphere (``cap_sphere``). Radii against the scene carry the
+  whole margin (``r_scene``), between links half of it each (``r_self``: a pair keeps one
+  margin).
+* **Gates**: a ball per body around its capsules (``gate_c`` in the body's frame,
+  ``gate_r_scene``, ``-1`` for a body with no moving capsule, ``gate_r_self``), and the
+  checked link pairs by body pair (``bpairs``, their capsule pairs ``cpairs`` from
+  ``bpair_start``).
+* **The scene** (``obs_*``): kind (``geometry.BOX``, ``CYLINDER``, ``SPHERE``), rotation
+  (9,), centre, half sizes (a box), radius and half length (a cylinder), radius (a
+  sphere).
+* **Motion bounds**: ``lower``, ``upper``, ``continuous``; ``edge_weights`` (per joint,
+  how far [m] the robot's points move per radian or metre, divided by the margin: the
+  grid of the checker's ``densify``); ``link_rates`` (dof, L): per joint and packed
+  capsule the same bound for that capsule alone (:func:`~plannerlab.collision.reach.
+  reach_bounds`), with which certified edges grow each capsule by how far it can move.
+* ``eps32_m``: a bound of how far the float32 kinematics and tests can be off [m]; the
+  filter grows every radius by it, so that "free" in float32 is free in float64
+  (:mod:`plannerlab.collision.state_test`).
 """
 
 from __future__ import annotations
 
-import math
 from typing import Any, NamedTuple
 
 import numpy as np
-from numba import njit
 
-from plannerlab.collision.chain_pack import _pack
-from plannerlab.collision.chain_valid import (
-    _body_frames,
-    _place_body,
-    _scratch,
-    _state_ok,
-    _unpack,
-)
-from plannerlab.collision.lanes import valid_states_lanes
+from plannerlab.collision.chain import chain_parts
+from plannerlab.collision.geometry import BOX, CYLINDER, SPHERE
+from plannerlab.collision.kinematics import SINCOS32_ABS_ERR
 from plannerlab.errors import PlannerlabError
+
+_F32_UNIT = 2.0**-24
+#: grows every bounding ball beyond rounding: a ball clear is clear
+_BOUND_PAD_M = 1e-9
 
 
 class ModelError(PlannerlabError):
@@ -57,17 +56,62 @@ class ModelError(PlannerlabError):
 
 
 class CompiledModel(NamedTuple):
-    """One robot in one scene with a margin, as arrays (see the module docstring)."""
+    """One robot in one scene with a margin, as named arrays (see the module docstring)."""
 
-    P: np.ndarray
-    M: np.ndarray
-    idat: np.ndarray
-    lower: np.ndarray
-    upper: np.ndarray
-    continuous: np.ndarray
-    edge_weights: np.ndarray
+    # kinematics: chain joints m, bodies m + 1
+    parent: np.ndarray  # (m,) int64
+    slide: np.ndarray  # (m,) bool
+    T0: np.ndarray  # (12,) float64
+    pre: np.ndarray  # (m, 12) float64
+    fold: np.ndarray  # (m + 1, 3, 3): a point p of body b's own frame is fold[b]ᵀ p here
+    T0_32: np.ndarray  # (12,) float32
+    pre_32: np.ndarray  # (m, 12) float32
+    cpl_start: np.ndarray  # (m + 1,) int64, or (0,): no coupling
+    cpl_idx: np.ndarray  # (c,) int64
+    cpl_val: np.ndarray  # (c,) float64
+    # capsules, by body
+    body_caps: np.ndarray  # (m + 2,) int64
+    cap_body: np.ndarray  # (L,) int64
+    cap_a: np.ndarray  # (L, 3) float64, body frame (axes folded)
+    cap_b: np.ndarray  # (L, 3)
+    cap_sphere: np.ndarray  # (L,) bool
+    cap_moving: np.ndarray  # (L,) bool
+    r_scene: np.ndarray  # (L,) float64
+    r_self: np.ndarray  # (L,) float64
+    perm: np.ndarray  # (L,) int64
+    # gates: a ball per body, then per cluster of a few neighbouring capsules
+    gate_c: np.ndarray  # (m + 1, 3) float64, body frame
+    gate_r_scene: np.ndarray  # (m + 1,) float64, -1: no moving capsule
+    gate_r_self: np.ndarray  # (m + 1,) float64
+    body_cls: np.ndarray  # (m + 2,) int64: clusters of body b
+    cl_caps: np.ndarray  # (K + 1,) int64: capsules of cluster c
+    cl_body: np.ndarray  # (K,) int64
+    cl_c: np.ndarray  # (K, 3) float64, body frame
+    cl_r_scene: np.ndarray  # (K,) float64, -1: no moving capsule
+    cl_r_self: np.ndarray  # (K,) float64
+    body_order: np.ndarray  # (m + 1,) int64: bodies against the scene, in this order
+    bpairs: np.ndarray  # (P, 2) int64 body pairs (u <= v) holding a checked capsule pair
+    bpair_start: np.ndarray  # (P + 1,) int64 into clpairs
+    clpairs: np.ndarray  # (CP, 2) int64 cluster pairs holding a checked capsule pair
+    clpair_start: np.ndarray  # (CP + 1,) int64 into cpairs
+    cpairs: np.ndarray  # (Q, 2) int64 packed capsule pairs (i < j)
+    # the scene
+    obs_kind: np.ndarray  # (n,) int64
+    obs_R: np.ndarray  # (n, 9) float64, row-major world <- obstacle
+    obs_c: np.ndarray  # (n, 3)
+    obs_h: np.ndarray  # (n, 3)
+    obs32: np.ndarray  # (n, 16) float32: centre (0:3), half sizes (3:6), rotation (6:15)
+    caps32: np.ndarray  # (L, 8) float32: end a (0:3), end b (3:6), r_scene, r_self
+    gates32: np.ndarray  # (m + 1, 8) float32: centre (0:3), r_scene, r_self
+    cls32: np.ndarray  # (K, 8) float32: centre (0:3), r_scene, r_self
+    # bounds and motion
+    lower: np.ndarray  # (dof,)
+    upper: np.ndarray  # (dof,)
+    continuous: np.ndarray  # (dof,) bool
+    edge_weights: np.ndarray  # (dof,) [1 / rad or 1 / m]: reach / margin (zeros: none)
+    link_rates: np.ndarray  # (dof, L) [m / rad or m / m], packed capsule order
     margin_m: float
-    perm: np.ndarray
+    eps32_m: float
 
 
 def has_chain(robot: Any) -> bool:
@@ -75,216 +119,337 @@ def has_chain(robot: Any) -> bool:
     return callable(getattr(robot, "chain_data", None))
 
 
-def model_of_core(core: Any) -> CompiledModel:
-    """The model of a built :class:`~plannerlab.collision.core.Core` (its capsules with
-    the margin, checked pairs, scene arrays and edge weights)."""
-    robot = core.robot
-    if not has_chain(robot):
-        raise ModelError(
-            f"robot type {getattr(robot, 'kind', type(robot).__name__)!r} gives no serial "
-            "chain (chain_data()) and its family registers no model builder: a compiled "
-            "consumer (native planners, the fused checks) cannot run it; give the robot a "
-            "chain_data() (docs/extending.md)"
-        )
-    P, M, idat, perm = core.packed()  # the fused validity's arrays, packed once
+def _align(u: np.ndarray) -> np.ndarray:
+    """A rotation A (3, 3) with A e_z = u (the identity for u = e_z)."""
+    z = np.asarray(u, dtype=float)
+    if np.array_equal(z, [0.0, 0.0, 1.0]):
+        return np.eye(3)
+    e = np.eye(3)[int(np.argmin(np.abs(z)))]
+    x = np.cross(e, z)
+    x /= np.linalg.norm(x)
+    return np.column_stack([x, np.cross(z, x), z])
 
-    def f(a: Any, dtype: Any) -> np.ndarray:
-        # a writable C-ordered copy: numba types read-only arrays (a robot's bounds may
-        # be read-only views) apart, and every kernel taking the model would be compiled
-        # and cached twice
-        return np.array(a, dtype=dtype, order="C", copy=True)
 
-    return CompiledModel(
-        P=P,
-        M=M,
-        idat=idat,
-        lower=f(robot.lower, dtype=np.float64),
-        upper=f(robot.upper, dtype=np.float64),
-        continuous=f(robot.continuous, dtype=np.bool_),
-        edge_weights=f(core.edge_weights, dtype=np.float64),
-        margin_m=float(core.margin_m),
-        perm=f(perm, dtype=np.int64),
+def _ball(points: np.ndarray, reach: np.ndarray) -> tuple[np.ndarray, float]:
+    """A ball around points each grown by its own reach: (centre, radius), -1 for none."""
+    if len(points) == 0:
+        return np.zeros(3), -1.0
+    c = (points.min(axis=0) + points.max(axis=0)) / 2.0
+    return c, float(np.max(np.linalg.norm(points - c, axis=1) + reach)) + _BOUND_PAD_M
+
+
+#: capsules per cluster at most (a cluster's ball gates its capsules)
+_CLUSTER = 4
+
+
+def _clusters(points: np.ndarray, idx: np.ndarray, size: int) -> list[np.ndarray]:
+    """idx cut into groups of at most ``size`` neighbours (halved along the widest axis of
+    their points, recursively)."""
+    if len(idx) <= size:
+        return [idx] if len(idx) else []
+    p = points[idx]
+    axis = int(np.argmax(p.max(axis=0) - p.min(axis=0)))
+    by = idx[np.argsort(p[:, axis], kind="stable")]
+    half = len(by) // 2
+    return _clusters(points, by[:half], size) + _clusters(points, by[half:], size)
+
+
+def _f(a: Any, dtype: Any = np.float64) -> np.ndarray:
+    # a writable C-ordered copy: numba types read-only arrays apart, and every kernel
+    # taking the model would be compiled and cached twice
+    return np.array(a, dtype=dtype, order="C", copy=True)
+
+
+class ChainGeometry(NamedTuple):
+    """What :func:`build_model` needs of a collision core (its arrays, by name)."""
+
+    radii: np.ndarray  # (L,) capsule radii against the scene, margin included
+    radii_self: np.ndarray  # (L,) against each other, half the margin included
+    moving: np.ndarray  # (L,) bool
+    allowed: np.ndarray  # (L, L) bool, upper triangle: the checked link pairs
+    kinds: np.ndarray  # (n,) obstacle kinds
+    Rs: np.ndarray  # (n, 3, 3)
+    cs: np.ndarray  # (n, 3)
+    hs: np.ndarray  # (n, 3)
+
+
+def _coupling(coupling: np.ndarray | None, m: int) -> tuple[list[int], list[int], list[float]]:
+    """The coupling, sparse: per chain joint its entries (state index, coefficient)."""
+    start: list[int] = []
+    idx: list[int] = []
+    val: list[float] = []
+    if coupling is not None:
+        start.append(0)
+        for i in range(m):
+            for col in np.flatnonzero(coupling[i]):
+                idx.append(int(col))
+                val.append(float(coupling[i, col]))
+            start.append(len(idx))
+    return start, idx, val
+
+
+def _folded(parent: Any, pre: Any, axes: Any) -> tuple[list[np.ndarray], np.ndarray]:
+    """Each joint's axis turned onto its frame's z axis: the rotations A (body b's frame
+    here is the robot's times A[b]) and the fixed transforms with them folded in (m, 3, 4)."""
+    m = len(parent)
+    A = [np.eye(3)] + [_align(axes[i]) for i in range(m)]
+    pre_f = np.empty((m, 3, 4))
+    for i in range(m):
+        Ap, Ai = np.eye(4), np.eye(4)
+        Ap[:3, :3], Ai[:3, :3] = A[int(parent[i])], A[i + 1]
+        pre_f[i] = (Ap.T @ np.asarray(pre[i], dtype=float) @ Ai)[:3]
+    return A, pre_f
+
+
+def _packed_order(cap_body: np.ndarray, mid: np.ndarray, nb: int) -> tuple[Any, ...]:
+    """The capsules by body, and within a body by cluster of at most ``_CLUSTER``
+    neighbours: (perm, cluster starts, each body's first cluster)."""
+    perm_l: list[int] = []
+    cl_start, body_cl = [0], [0]
+    for b in range(nb):
+        for members in _clusters(mid, np.flatnonzero(cap_body == b), _CLUSTER):
+            perm_l.extend(int(x) for x in members)
+            cl_start.append(len(perm_l))
+        body_cl.append(len(cl_start) - 1)
+    return np.array(perm_l, dtype=np.int64), cl_start, body_cl
+
+
+def _balls(
+    ends: tuple[np.ndarray, np.ndarray],
+    radii: tuple[np.ndarray, np.ndarray, np.ndarray],
+    ranges: list[tuple[int, int]],
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Per range of capsules (ends a, b; radii against the scene, between links, which
+    move): centre, radius against the scene (moving capsules only; -1: none) and between
+    links."""
+    ca, cb = ends
+    rad, rads, mov = radii
+    c, r, rs = np.zeros((len(ranges), 3)), np.full(len(ranges), -1.0), np.zeros(len(ranges))
+    for k, (k0, k1) in enumerate(ranges):
+        pts = np.concatenate([ca[k0:k1], cb[k0:k1]])
+        c[k], rs[k] = _ball(pts, np.tile(rads[k0:k1], 2))
+        mv = np.tile(mov[k0:k1], 2)
+        if mv.any():
+            d = np.linalg.norm(pts[mv] - c[k], axis=1) + np.tile(rad[k0:k1], 2)[mv]
+            r[k] = float(np.max(d)) + _BOUND_PAD_M
+    return c, r, rs
+
+
+def _pairs(allowed: Any, perm: np.ndarray, body: np.ndarray, cl_of: np.ndarray) -> tuple[Any, ...]:
+    """The checked pairs in the packed order (i < j), grouped by body pair, then cluster
+    pair: (bpairs, bpair_start, clpairs, clpair_start, cpairs) as arrays."""
+    a = np.asarray(allowed, dtype=bool)
+    sym = a | a.T
+    al = np.triu(sym[np.ix_(perm, perm)], 1)
+    ii, jj = np.nonzero(al)
+    keys = sorted(
+        (min(body[i], body[j]), max(body[i], body[j]), cl_of[i], cl_of[j], i, j)
+        for i, j in zip(ii.tolist(), jj.tolist(), strict=True)
+    )
+    bpairs: list[tuple[int, int]] = []
+    bpair_start: list[int] = []
+    clpairs: list[tuple[int, int]] = []
+    clpair_start: list[int] = []
+    cpairs: list[tuple[int, int]] = []
+    for u, v, cu, cv, i, j in keys:
+        if not bpairs or bpairs[-1] != (u, v):
+            bpairs.append((int(u), int(v)))
+            bpair_start.append(len(clpairs))
+        if not clpairs or clpairs[-1] != (cu, cv) or bpair_start[-1] == len(clpairs):
+            clpairs.append((int(cu), int(cv)))
+            clpair_start.append(len(cpairs))
+        cpairs.append((int(i), int(j)))
+    bpair_start.append(len(clpairs))
+    clpair_start.append(len(cpairs))
+
+    def rows(x: list[tuple[int, int]]) -> np.ndarray:
+        return _f(np.array(x, dtype=np.int64).reshape(-1, 2), np.int64)
+
+    return (
+        rows(bpairs),
+        _f(bpair_start, np.int64),
+        rows(clpairs),
+        _f(clpair_start, np.int64),
+        rows(cpairs),
     )
 
 
-def chain_model(robot: Any) -> CompiledModel:
-    """The model of a robot's chain alone (no scene, no margin, no checked pairs): its
-    kinematics and capsules packed as :func:`model_of_core` packs them, for a consumer
-    that needs only those (the clearance field's spheres,
-    :mod:`plannerlab.collision.spheres`) when no checker's model is at hand.
+def build_model(
+    robot: Any,
+    geo: ChainGeometry,
+    margin_m: float = 0.0,
+    edge_weights: np.ndarray | None = None,
+    link_rates: np.ndarray | None = None,
+    body_order: np.ndarray | None = None,
+) -> CompiledModel:
+    """The compiled model of a robot's chain in a scene (see the module docstring).
+
+    Args:
+        robot: a robot that gives ``chain_data()``.
+        geo: the capsules' radii, which move, the checked pairs and the obstacles (a
+            :class:`~plannerlab.collision.core.Core` gives them).
+        margin_m: the clearance margin the radii carry [m].
+        edge_weights: (dof,) the grid's metric weights (None: radian steps only).
+        link_rates: (dof, L) per joint and capsule (the robot's order) how fast the
+            capsule moves [m per rad or per m] (None: taken from :func:`~plannerlab.
+            collision.reach.reach_bounds`).
+        body_order: the order in which bodies meet the scene (default: the last first).
 
     Raises:
-        ModelError: the robot gives no serial chain (``chain_data()``).
+        ModelError: the robot gives no serial chain.
     """
     if not has_chain(robot):
         raise ModelError(
             f"robot type {getattr(robot, 'kind', type(robot).__name__)!r} gives no serial "
-            "chain (chain_data()): its kinematics cannot be compiled"
+            "chain (chain_data()): a compiled consumer (native planners, the state test) "
+            "cannot run it; give the robot a chain_data() (docs/extending.md)"
         )
-    L = len(np.asarray(robot.link_radii_m))
-    zeros = np.zeros(L)
-    P, M, idat, perm = _pack(
-        robot,
-        zeros,
-        zeros,
-        np.ones(L, dtype=bool),
-        np.zeros((L, L), dtype=bool),
-        np.zeros(0, dtype=np.int64),
-        np.zeros((0, 3, 3)),
-        np.zeros((0, 3)),
-        np.zeros((0, 3)),
-        None,
+    parent, pre, axes, prismatic, cap_body, cap_a, cap_b, coupling = chain_parts(robot)
+    m = len(parent)
+    nb = m + 1
+    cpl_start, cpl_idx, cpl_val = _coupling(coupling, m)
+    A, pre_f = _folded(parent, pre, axes)
+    cap_body = np.asarray(cap_body, dtype=np.int64)
+    cap_a = np.asarray(cap_a, dtype=float).reshape(-1, 3)
+    cap_b = np.asarray(cap_b, dtype=float).reshape(-1, 3)
+    perm, cl_start, body_cl = _packed_order(cap_body, (cap_a + cap_b) / 2.0, nb)
+    body = cap_body[perm]
+    L = len(perm)
+    ca = np.array([A[int(b)].T @ p for b, p in zip(body, cap_a[perm], strict=True)]).reshape(-1, 3)
+    cb = np.array([A[int(b)].T @ p for b, p in zip(body, cap_b[perm], strict=True)]).reshape(-1, 3)
+    rad = np.asarray(geo.radii, dtype=float)[perm]
+    rads = np.asarray(geo.radii_self, dtype=float)[perm]
+    mov = np.asarray(geo.moving, dtype=bool)[perm]
+    body_caps = np.searchsorted(body, np.arange(nb + 1)).astype(np.int64)
+    ncl = len(cl_start) - 1
+    body_ranges = [(int(body_caps[b]), int(body_caps[b + 1])) for b in range(nb)]
+    gate_c, gate_r, gate_rs = _balls((ca, cb), (rad, rads, mov), body_ranges)
+    cl_ranges = [(cl_start[k], cl_start[k + 1]) for k in range(ncl)]
+    cl_c, cl_r, cl_rs = _balls((ca, cb), (rad, rads, mov), cl_ranges)
+    bpairs, bpair_start, clpairs, clpair_start, cpairs = _pairs(
+        geo.allowed, perm, body, np.repeat(np.arange(ncl), np.diff(cl_start))
     )
-    dof = int(robot.dof)
+    order = np.arange(nb)[::-1] if body_order is None else np.asarray(body_order)
+    kinds = np.asarray(geo.kinds, dtype=np.int64)
+    n = len(kinds)
+    Rs = np.asarray(geo.Rs, dtype=float).reshape(n, 9)
+    cs = np.asarray(geo.cs, dtype=float).reshape(n, 3)
+    hs = np.asarray(geo.hs, dtype=float).reshape(n, 3)
+    if link_rates is None:
+        from plannerlab.collision.reach import reach_bounds
+
+        link_rates = reach_bounds(robot)[1]
+    T0 = np.asarray(robot.T_world_base, dtype=float)[:3].reshape(12)
+    lower, upper = _f(robot.lower), _f(robot.upper)
+    eps = _float32_bound(T0, pre_f, ca, cb, cs, hs, kinds, lower, upper, robot.continuous)
     return CompiledModel(
-        P=P,
-        M=M,
-        idat=idat,
-        lower=np.array(robot.lower, dtype=np.float64, order="C", copy=True),
-        upper=np.array(robot.upper, dtype=np.float64, order="C", copy=True),
-        continuous=np.array(robot.continuous, dtype=np.bool_, order="C", copy=True),
-        edge_weights=np.zeros(dof),
-        margin_m=0.0,
-        perm=np.array(perm, dtype=np.int64, order="C", copy=True),
+        parent=_f(parent, np.int64),
+        slide=_f(prismatic, np.bool_),
+        T0=_f(T0),
+        pre=_f(pre_f.reshape(m, 12)),
+        fold=_f(np.array(A).reshape(nb, 3, 3)),
+        T0_32=_f(T0, np.float32),
+        pre_32=_f(pre_f.reshape(m, 12), np.float32),
+        cpl_start=_f(cpl_start, np.int64),
+        cpl_idx=_f(cpl_idx, np.int64),
+        cpl_val=_f(cpl_val),
+        body_caps=_f(body_caps, np.int64),
+        cap_body=_f(body, np.int64),
+        cap_a=_f(ca),
+        cap_b=_f(cb),
+        cap_sphere=_f(np.all(cap_a[perm] == cap_b[perm], axis=1), np.bool_),
+        cap_moving=_f(mov, np.bool_),
+        r_scene=_f(rad),
+        r_self=_f(rads),
+        perm=_f(perm, np.int64),
+        gate_c=_f(gate_c),
+        gate_r_scene=_f(gate_r),
+        gate_r_self=_f(gate_rs),
+        body_cls=_f(body_cl, np.int64),
+        cl_caps=_f(cl_start, np.int64),
+        cl_body=_f(body[np.array(cl_start[:-1], dtype=np.int64)] if ncl else [], np.int64),
+        cl_c=_f(cl_c),
+        cl_r_scene=_f(cl_r),
+        cl_r_self=_f(cl_rs),
+        body_order=_f(order, np.int64),
+        bpairs=bpairs,
+        bpair_start=bpair_start,
+        clpairs=clpairs,
+        clpair_start=clpair_start,
+        cpairs=cpairs,
+        obs_kind=_f(kinds, np.int64),
+        obs_R=_f(Rs),
+        obs_c=_f(cs),
+        obs_h=_f(hs),
+        obs32=_f(np.column_stack([cs, hs, Rs, np.zeros((n, 1))]).reshape(n, 16), np.float32),
+        caps32=_f(np.column_stack([ca, cb, rad, rads]).reshape(L, 8), np.float32),
+        gates32=_f(np.column_stack([gate_c, gate_r, gate_rs, np.zeros((nb, 3))]), np.float32),
+        cls32=_f(
+            np.column_stack([cl_c, cl_r, cl_rs, np.zeros((ncl, 3))]).reshape(ncl, 8), np.float32
+        ),
+        lower=lower,
+        upper=upper,
+        continuous=_f(robot.continuous, np.bool_),
+        edge_weights=_f(np.zeros(int(robot.dof)) if edge_weights is None else edge_weights),
+        link_rates=_f(np.asarray(link_rates, dtype=float)[:, perm]),
+        margin_m=float(margin_m),
+        eps32_m=eps,
     )
 
 
-def build_model(core: Any) -> CompiledModel:
-    """The model of a built core: the generic serial-chain :func:`model_of_core`, from the
-    robot's ``chain_data()``.
+def _float32_bound(
+    T0: np.ndarray,
+    pre: np.ndarray,
+    ca: np.ndarray,
+    cb: np.ndarray,
+    cs: np.ndarray,
+    hs: np.ndarray,
+    kinds: np.ndarray,
+    lower: np.ndarray,
+    upper: np.ndarray,
+    continuous: Any,
+) -> float:
+    """A bound [m] of how far the float32 state test's distances can be from float64's.
 
-    Raises:
-        ModelError: the robot gives no chain.
-    """
-    return model_of_core(core)
+    The kinematics: ``m`` joints, each a product of 3 x 4 frames (a rotation entry off by
+    a few units of float32's last place per product, ``u = 2^-24``) and a turn whose sine
+    and cosine are off by at most ``SINCOS32_ABS_ERR`` plus the joint value's own rounding
+    to float32 (``|q| u``; continuous joints are wrapped into [-π, π] first). A rotation
+    error ``δR`` grows by at most that much per joint, and moves every point behind the
+    joint by ``δR`` times its distance from the joint; a translation picks up a few ``u``
+    of its size per product. Summed over the chain with ``S`` the sum of every fixed
+    offset's length and capsule end's distance from its body, and ``P`` the largest world
+    coordinate the chain or the scene reaches:
 
+        ε_fk ≤ (m + 1) δ S + 8 (m + 1) u P,   δ = SINCOS32_ABS_ERR + (|q|_max + 8) u
 
-# ---------------------------------------------------------------------- compiled queries
-@njit(cache=True, nogil=True)
-def views(m):
-    """The model's views and a scratch for :func:`state_ok` (made once per search)."""
-    return _unpack(m.P, m.M, m.idat), _scratch(m.idat)
-
-
-#: One state q (dof,) is valid (``V``, ``S`` from :func:`views`): chain_valid's own
-#: kernel under the model's name (a wrapper that passes ``V`` and ``S`` on, even inlined
-#: at numba's level, costs ~0.35 µs a call: ``bench/model_bench.py``)
-state_ok = _state_ok
-
-
-@njit(cache=True, nogil=True)
-def segments(Q, m, out):
-    """Capsule axes of a batch in the robot's capsule order, the model's kinematics:
-    Q (k, dof) -> out (k, L, 2, 3) (``robot.link_segments``' numbers to rounding)."""
-    V, S = views(m)
-    (parent, prism, body_cl, cl_start, _, _, issph) = V[0][:7]
-    (T0, pre, cap_a, cap_b) = V[1][:4]
-    cl_c = V[1][9]
-    Bf, _, Kw, X, Y, v, _ = S
-    for s in range(Q.shape[0]):
-        _body_frames(Q[s], T0, parent, prism, pre, Bf, V[2], v)
-        for b in range(Bf.shape[0]):
-            _place_body(Bf, cap_a, cap_b, issph, body_cl, cl_start, cl_c, b, X, Y, Kw)
-        for k in range(X.shape[0]):
-            l = m.perm[k]
-            for a in range(3):
-                out[s, l, 0, a] = X[k, a]
-                out[s, l, 1, a] = X[k, a] if issph[k] else Y[k, a]
-    return out
-
-
-def valid_states(Q: np.ndarray, m: CompiledModel, out: np.ndarray) -> np.ndarray:
-    """Validity of a batch Q (k, dof) -> out (k,) bool, in vector lanes (the verdicts of
-    :func:`state_ok`, state by state)."""
-    return valid_states_lanes(Q, m, out)
+    The tests then compute a distance from coordinates of size ``P`` with a few more
+    roundings (``16 u P``). The sum, doubled, is the bound: far above what the kinematics
+    show in practice (``tests/collision/test_state_test.py`` measures the worst seen), far
+    below any radius."""
+    u = _F32_UNIT
+    m = len(pre)
+    cont = np.asarray(continuous, dtype=bool)
+    qmax = np.where(cont, np.pi, np.maximum(np.abs(lower), np.abs(upper)))
+    qmax = np.where(np.isfinite(qmax), qmax, 64.0)
+    offs = np.linalg.norm(pre[:, :, 3], axis=1) if m else np.zeros(0)
+    caps = float(np.max(np.linalg.norm(np.concatenate([ca, cb]), axis=1), initial=0.0))
+    S = float(np.sum(offs)) + caps
+    d = SINCOS32_ABS_ERR + (float(np.max(qmax, initial=0.0)) + 8.0) * u
+    scene = float(np.max(np.abs(cs) + np.abs(hs).max(axis=1, keepdims=True), initial=0.0))
+    P = float(np.abs(T0[[3, 7, 11]]).max()) + S + scene
+    eps_fk = (m + 1) * d * S + 8.0 * (m + 1) * u * P
+    del kinds  # every kind's test rounds alike
+    return float(2.0 * (eps_fk + 16.0 * u * P))
 
 
-@njit(cache=True, nogil=True)
-def edge_delta(q_a, q_b, continuous, d):
-    """d = q_b - q_a, continuous joints the short way round (``joint_difference``)."""
-    for i in range(q_a.shape[0]):
-        x = q_b[i] - q_a[i]
-        if continuous[i]:
-            x = (x + np.pi) % (2.0 * np.pi) - np.pi
-        d[i] = x
-
-
-@njit(cache=True, nogil=True)
-def edge_count(d, joint_step, edge_weights):
-    """The grid's number of steps of an edge ``d``: at most ``joint_step`` per joint and
-    ``ceil(Σ |d_i| · w_i)`` (``robots.paths.edge_counts``)."""
-    span = 0.0
-    metric = 0.0
-    for i in range(d.shape[0]):
-        a = abs(d[i])
-        span = max(span, a)
-        metric += edge_weights[i] * a
-    return int(max(1.0, math.ceil(span / joint_step - 1e-12), math.ceil(metric - 1e-12)))
-
-
-@njit(cache=True, nogil=True)
-def edge_state(q_a, d, j, n, out):
-    """State ``j`` (1..n) of the edge's grid: ``q_a + t d``, ``t = j · (1 / n)`` (exactly
-    1 at ``j = n``), the floats of ``densify``."""
-    t = 1.0 if j == n else j * (1.0 / n)
-    for i in range(q_a.shape[0]):
-        out[i] = q_a[i] + t * d[i]
-
-
-@njit(cache=True, nogil=True, inline="always")
-def _edge_visit(q_a, q_b, joint_step, m, V, S, d, q, limit, rec):
-    """:func:`edge_ok`'s loop; ``rec`` (non-empty) records the grid indices j visited, in
-    order (the test's window on the very loop the planners run)."""
-    edge_delta(q_a, q_b, m.continuous, d)
-    n = edge_count(d, joint_step, m.edge_weights)
-    keep = rec.shape[0] > 0
-    checks = 0
-    # j = n first (the state the edge reaches), then j in van der Corput order over 1..n-1
-    edge_state(q_a, d, n, n, q)
-    if limit < 1:
-        return 2, checks
-    if keep:
-        rec[checks] = n
-    checks += 1
-    if not _state_ok(q, V, S):
-        return 1, checks
-    if n == 1:
-        return 0, checks
-    step = 1
-    while step < n:
-        step *= 2
-    # visit j = step/2, step/4, 3 step/4, ... (skipping j >= n): every j in 1..n-1 once
-    h = step // 2
-    while h >= 1:
-        j = h
-        while j < n:
-            if checks >= limit:
-                return 2, checks
-            edge_state(q_a, d, j, n, q)
-            if keep:
-                rec[checks] = j
-            checks += 1
-            if not _state_ok(q, V, S):
-                return 1, checks
-            j += 2 * h
-        h //= 2
-    return 0, checks
-
-
-@njit(cache=True, nogil=True)
-def edge_ok(q_a, q_b, joint_step, m, V, S, d, q, limit):
-    """Check the grid states 1..n of edge q_a -> q_b, coarse to fine (the end state, then
-    the midpoints of ever finer halvings), stopping at the first invalid one or after
-    ``limit`` checks. Returns (status, checks): status 0 all valid, 1 a state is invalid,
-    2 the limit came first (nothing proved)."""
-    return _edge_visit(q_a, q_b, joint_step, m, V, S, d, q, limit, np.empty(0, dtype=np.int64))
-
-
-@njit(cache=True, nogil=True)
-def edge_visits(q_a, q_b, joint_step, m, limit, rec):
-    """:func:`edge_ok` with the grid indices it checks written to ``rec`` (at least the
-    edge's count long) in the order it checks them: returns (status, checks)."""
-    V, S = views(m)
-    d = np.empty(q_a.shape[0])
-    q = np.empty(q_a.shape[0])
-    return _edge_visit(q_a, q_b, joint_step, m, V, S, d, q, limit, rec)
+__all__ = [
+    "BOX",
+    "CYLINDER",
+    "SPHERE",
+    "ChainGeometry",
+    "CompiledModel",
+    "ModelError",
+    "build_model",
+    "has_chain",
+]

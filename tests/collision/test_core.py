@@ -7,8 +7,8 @@ import pytest
 
 from plannerlab.collision.agreement import KINDS, compare, sample_states
 from plannerlab.collision.core import Core
+from plannerlab.collision.edges import edge_count, edge_delta, edge_state
 from plannerlab.collision.fcl_checker import CollisionChecker
-from plannerlab.collision.kernels import edge_states
 from plannerlab.errors import PlannerlabError
 from plannerlab.problem.catalog import load_problem
 from plannerlab.problem.scene import Box, Cylinder, Scene, Sphere
@@ -24,9 +24,11 @@ def test_armz_kinematics_match_the_numpy_model_to_1e12(n_modules):
     robot = ArmZ(n_modules=n_modules, T_world_base=pose_matrix([1.0, -2.0, 0.5], [0.1, -0.2, 0.3]))
     core = Core(robot, Scene())
     Q = np.random.default_rng(3).uniform(-np.pi, np.pi, (50, robot.dof))
-    assert np.abs(core.fk(Q) - robot.fk(Q)).max() < 1e-12
-    assert np.abs(core.fk(Q[7]) - robot.fk(Q[7])).max() < 1e-12
     assert np.abs(core.segments(Q) - robot.link_segments(Q)).max() < 1e-12
+    for q in Q[:10]:  # the tip from the same frames
+        p, n = core.tip(q)
+        p_ref, n_ref = robot.tip(q)
+        assert np.abs(p - p_ref).max() < 1e-12 and np.abs(n - n_ref).max() < 1e-12
 
 
 @pytest.mark.parametrize("name", SCENES)
@@ -168,7 +170,9 @@ def test_checker_picks_the_core_by_default_and_refuses_unknown_backends():
 def test_one_call_edge_check_equals_interpolating_then_checking(name):
     p = load_problem(name)
     r = p.robot
-    core = CollisionChecker(r, p.scene, backend="core")
+    core = CollisionChecker(r, p.scene, backend="core", edge_check="grid")
+    certified = CollisionChecker(r, p.scene, backend="core")
+    assert certified.edge_check == "certified"
     ref = CollisionChecker(r, p.scene, backend="fcl")
     rng = np.random.default_rng(4)
     bad_seen = 0
@@ -186,6 +190,10 @@ def test_one_call_edge_check_equals_interpolating_then_checking(name):
         assert ref.check_edge(a, b, 0.05, limit) == (n, bad)
         core.check_edge(a, b, 0.05, limit)
         assert core.checks - c0 == ref.checks - f0 == (m if bad is None else bad + 1)
+        if limit is None:  # certified: the same verdict, fewer tests
+            tests, cbad = certified.check_edge(a, b, 0.05)
+            assert (cbad is None) == (bad is None)
+            assert tests <= 1.3 * n + 8
         bad_seen += bad is not None
     assert bad_seen > 0
 
@@ -197,7 +205,12 @@ def test_edge_states_are_bit_identical_to_interpolate_edge():
         a, b = rng.uniform(-4.0, 4.0, (2, dof))
         cont = rng.random(dof) < 0.5
         step = float(rng.choice([0.05, 0.3, 2.0]))
-        n, Q = edge_states(a, b, step, cont, 2**62, 2**62, np.zeros(dof))
+        d = np.empty(dof)
+        edge_delta(a, b, cont, d)
+        n = edge_count(d, step, np.zeros(dof))
+        Q = np.empty((n, dof))
+        for j in range(1, n + 1):
+            edge_state(a, d, j, n, Q[j - 1])
         ref = interpolate_edge(a, b, step, cont)[1:]
         assert n == len(ref) and np.array_equal(Q, ref)
 

@@ -1,8 +1,9 @@
-"""The compiled robot–scene model (collision/model.py) for every robot family: its chain
-gives the robot's capsules, its verdicts are FCL's (random, near-contact and
-self-colliding states) and the generic kernels' (the road IRb-6 and the continuum chain
-took before), its edge check visits exactly the checker's grid, and a robot without a
-chain gets a clear error."""
+"""The compiled robot–scene model (collision/model.py) and its one state test
+(collision/state_test.py) for every robot family: its one kinematics gives the robot's
+capsules, its verdicts are FCL's (random, near-contact and self-colliding states), the
+float32 filter's verdicts are the float64 test's alone (near contact included: the
+filter's bound holds), its certified edges give the grid's verdicts, and a robot
+without a chain gets a clear error."""
 
 from __future__ import annotations
 
@@ -14,18 +15,8 @@ from conftest import PROBLEMS
 
 from plannerlab.collision.core import Core
 from plannerlab.collision.fcl_checker import CollisionChecker, problem_checker
-from plannerlab.collision.kernels import valid_batch
-from plannerlab.collision.model import (
-    CompiledModel,
-    ModelError,
-    edge_ok,
-    edge_state,
-    edge_visits,
-    segments,
-    state_ok,
-    valid_states,
-    views,
-)
+from plannerlab.collision.model import ModelError
+from plannerlab.collision.state_test import exact_batch
 from plannerlab.problem.catalog import load_problem
 from plannerlab.problem.load import parse_problem
 from plannerlab.problem.scene import Scene
@@ -48,9 +39,14 @@ def _problem(kind: str):
     return parse_problem(PANDA) if name == "panda" else load_problem(name)
 
 
-def _model_valid(m: CompiledModel, Q: np.ndarray) -> np.ndarray:
-    kernel = valid_states
-    return kernel(np.ascontiguousarray(Q), m, np.empty(len(Q), dtype=np.bool_))
+def _model_valid(core: Core, Q: np.ndarray) -> np.ndarray:
+    """The state test's verdicts (the float32 filter, float64 confirming)."""
+    return core.valid(Q)
+
+
+def _exact_valid(core: Core, Q: np.ndarray) -> np.ndarray:
+    """The float64 test's verdicts alone (no filter)."""
+    return exact_batch(core.model, np.ascontiguousarray(Q), np.empty(len(Q), dtype=np.bool_))
 
 
 # ---------------------------------------------------------------------- chains
@@ -72,8 +68,6 @@ def test_every_familys_chain_gives_its_capsules_to_1e12(which):
     core = Core(robot, Scene(), margin_m=0.01)
     Q = np.random.default_rng(5).uniform(robot.lower, robot.upper, (300, robot.dof))
     ref = robot.link_segments(Q)
-    out = np.empty_like(ref)
-    assert np.abs(segments(Q, core.model, out) - ref).max() < 1e-12
     assert np.abs(core.segments(Q) - ref).max() < 1e-12
 
 
@@ -89,8 +83,7 @@ def test_the_panda_model_gives_its_capsules_to_1e12():
     robot = problem.robot
     Q = np.random.default_rng(6).uniform(robot.lower, robot.upper, (200, robot.dof))
     ref = robot.link_segments(Q)
-    out = np.empty_like(ref)
-    assert np.abs(segments(Q, problem_checker(problem).model, out) - ref).max() < 1e-12
+    assert np.abs(problem_checker(problem)._core.segments(Q) - ref).max() < 1e-12
 
 
 # ---------------------------------------------------------------------- registry
@@ -107,12 +100,21 @@ class _NoChain:
         return getattr(self.inner, name)
 
 
-def test_a_chainless_robot_is_refused():
+def test_a_chainless_robot_is_refused_by_name_and_checked_by_fcl():
+    from plannerlab.collision.model import ChainGeometry, build_model
+
     robot = _NoChain(ArmZ(n_modules=6))
-    core = Core(robot, Scene())  # the checks still run, on the robot's numpy kinematics
-    assert core.is_valid(np.zeros(5))
+    checker = CollisionChecker(robot, Scene())  # no chain: FCL answers
+    assert checker.backend == "fcl" and checker.is_valid(np.zeros(5))
+    with pytest.raises(ValueError, match="compiled model needs the core"):
+        _ = checker.model
+    L = len(robot.link_radii_m)
+    geo = ChainGeometry(
+        np.ones(L), np.ones(L), np.ones(L, bool), np.zeros((L, L), bool),
+        np.zeros(0, np.int64), np.zeros((0, 3, 3)), np.zeros((0, 3)), np.zeros((0, 3)),
+    )  # fmt: skip
     with pytest.raises(ModelError, match="'lab_arm'.*chain_data"):
-        _ = core.model
+        build_model(robot, geo)
 
 
 # ---------------------------------------------------------------------- verdicts
@@ -161,26 +163,24 @@ def test_the_models_verdicts_are_fcls_on_random_and_near_contact_states(kind):
     problem = _problem(kind)
     robot, margin = problem.robot, float(problem.safety_margin_m)
     checker = problem_checker(problem)
-    m = checker.model
+    m = checker._core
     fcl = CollisionChecker(robot, problem.scene, backend="fcl", margin_m=margin)
     rng = np.random.default_rng(17)
     Q = _sample(m, robot, problem.q_start, 1500, rng)
     v = _model_valid(m, Q)
     assert 0.02 < v.mean() < 0.98  # both verdicts are there
     assert np.array_equal(v, fcl.valid_batch(Q))
-    V, S = views(m)
-    assert [state_ok(q, V, S) for q in Q[:300]] == v[:300].tolist()
-    # the generic kernels on the robot's own numpy capsules (the road before the model)
-    old = valid_batch(
-        np.ascontiguousarray(robot.link_segments(Q)), *checker._core._geo, np.empty(len(Q), bool)
-    )
-    assert np.array_equal(v, old)
+    assert np.array_equal(v, _exact_valid(m, Q))  # the filter says what float64 says
+    assert [m.is_valid(q) for q in Q[:300]] == v[:300].tolist()  # one state: the same
     inside, outside = _near_contact(m, robot.lower, robot.upper, Q, 60, rng)
     assert len(inside) == 60
     assert _model_valid(m, inside).all() and not _model_valid(m, outside).any()
     assert fcl.valid_batch(inside).all() and not fcl.valid_batch(outside).any()
-    # the batch runs in vector lanes (collision/lanes.py): the one-state test agrees
-    assert all(state_ok(q, V, S) for q in inside) and not any(state_ok(q, V, S) for q in outside)
+    # right at the boundary (1e-6 rad apart): the filter leaves it to float64, and agrees
+    lo_side, hi_side = _near_contact(m, robot.lower, robot.upper, Q, 60, rng, offset=0.0)
+    both = np.vstack([lo_side, hi_side])
+    assert np.array_equal(_model_valid(m, both), _exact_valid(m, both))
+    assert all(m.is_valid(q) == e for q, e in zip(both, _exact_valid(m, both), strict=True))
 
 
 def _coiled(lo, hi, n, rng, centre_rad, spread_rad):
@@ -216,52 +216,127 @@ def test_the_models_verdicts_are_fcls_on_self_colliding_states(kind):
     rng = np.random.default_rng(23)
     lo, hi = robot.lower, robot.upper
     Q = rng.uniform(lo, hi, (3000, robot.dof)) if sampler is None else sampler(lo, hi, 3000, rng)
-    m = CollisionChecker(robot, Scene(), margin_m=margin).model
+    m = CollisionChecker(robot, Scene(), margin_m=margin)._core
     fcl = CollisionChecker(robot, Scene(), backend="fcl", margin_m=margin)
     v = _model_valid(m, Q)
     assert np.array_equal(v, fcl.valid_batch(Q))
     assert 0.02 < (~v).mean() < 0.98  # self-colliding states are there (the scene is empty)
-    V, S = views(m)  # the lanes' verdicts are the one-state test's
-    assert [state_ok(q, V, S) for q in Q] == v.tolist()
+    assert np.array_equal(v, _exact_valid(m, Q))
+    assert [m.is_valid(q) for q in Q] == v.tolist()  # one state at a time: the same
     inside, outside = _near_contact(m, lo, hi, Q, 30, rng)
     assert len(inside) == 30
     assert fcl.valid_batch(inside).all() and not fcl.valid_batch(outside).any()
 
 
 # ---------------------------------------------------------------------- edges
-@pytest.mark.parametrize("kind", ["armz", "urdf"])
-def test_edge_ok_checks_exactly_the_checkers_grid_once_each(kind):
+@pytest.mark.parametrize("kind", ["armz", "urdf", "irb6"])
+def test_certified_edges_give_the_grids_verdict_in_fewer_tests(kind):
+    """The certified edge check says what checking every grid state says, on edges free
+    and blocked, and never tests more states than the grid has (a few percent more at
+    most, on edges near a surface all along)."""
     problem = _problem(kind)
     robot = problem.robot
     checker = problem_checker(problem)
-    m = checker.model
-    V, S = views(m)
+    core = checker._core
     rng = np.random.default_rng(29)
-    step = 0.05
+    step = problem.joint_step / 4
+    lo = np.where(np.isfinite(robot.lower), robot.lower, -np.pi)
+    hi = np.where(np.isfinite(robot.upper), robot.upper, np.pi)
+    Q = rng.uniform(lo, hi, (4000, robot.dof))
+    V = Q[core.valid(Q)][:161]
     seen = {0: 0, 1: 0}
-    for _ in range(40):
-        q_a = rng.uniform(robot.lower, robot.upper)
-        q_b = np.clip(q_a + rng.normal(0.0, 0.3, robot.dof), robot.lower, robot.upper)
-        states, _ = checker.densify(np.vstack([q_a, q_b]), step)
-        n = len(states) - 1
-        rec = np.full(n + 1, -1, dtype=np.int64)
-        status, checks = edge_visits(q_a, q_b, step, m, 1 << 40, rec)
-        grid_ok = _model_valid(m, states[1:])
-        if status == 0:
-            # every grid state once, the end first
-            assert checks == n and rec[0] == n and sorted(rec[:n]) == list(range(1, n + 1))
-            assert grid_ok.all()
-        else:
-            assert status == 1 and not grid_ok[rec[checks - 1] - 1]
-            assert grid_ok[rec[: checks - 1] - 1].all() and len(set(rec[:checks])) == checks
+    tests = grid = 0
+    for k in range(160):
+        q_a = V[k]
+        q_b = q_a + (V[k + 1] - q_a) * (0.1 if k % 3 == 0 else 0.5 if k % 3 == 1 else 1.0)
+        n, bad = core.edge_first_invalid(q_a, q_b, step)
+        status, made, n2 = core.edge_certified(q_a, q_b, step)
+        assert n2 == n
+        assert status == (0 if bad < 0 else 1)
         seen[status] += 1
-        # its states are densify's, bit for bit, and edge_ok says what edge_visits says
-        d, q = np.empty(robot.dof), np.empty(robot.dof)
-        assert edge_ok(q_a, q_b, step, m, V, S, d, q, 1 << 40) == (status, checks)
-        for j in rec[:checks]:
-            edge_state(q_a, d, j, n, q)
-            assert np.array_equal(q, states[j])
-        if status == 0 and n > 1:
-            # a limit below the count stops it without a verdict
-            assert edge_visits(q_a, q_b, step, m, n - 1, rec) == (2, n - 1)
-    assert seen[0] >= 5 and seen[1] >= 5  # both outcomes were exercised
+        if status == 0:
+            tests += made
+            grid += n
+        # a limit below what it needs stops it without a verdict
+        if made > 1:
+            assert core.edge_certified(q_a, q_b, step, made - 1)[0] == 2
+    assert seen[0] >= 3 and seen[1] >= 3  # both outcomes were exercised
+    assert tests <= 1.3 * grid
+
+
+def _frame(p_world: np.ndarray, x_axis: np.ndarray) -> np.ndarray:
+    """A pose at p_world whose x axis is x_axis (unit)."""
+    e = np.eye(3)[int(np.argmin(np.abs(x_axis)))]
+    u = np.cross(x_axis, e)
+    u /= np.linalg.norm(u)
+    T = np.eye(4)
+    T[:3, 0], T[:3, 1], T[:3, 2], T[:3, 3] = x_axis, u, np.cross(x_axis, u), p_world
+    return T
+
+
+@pytest.mark.parametrize("thickness_m", [0.002, 0.02])
+def test_a_thin_wall_is_never_tunnelled_with_a_margin(thickness_m):
+    """A thin Arm-Z (4 cm capsules) swings its tip through a sheet of 2 mm or 2 cm placed
+    between two states of a 0.3 rad grid: that grid's states are all clear of the sheet
+    (checking radian steps alone would pass through it), FCL finds the swing crossing it,
+    and with a 2 cm margin the grid steps so that no point moves more than the margin:
+    the certified edge (the grid's verdict) finds the sheet, as does the re-check."""
+    from plannerlab.problem.scene import Box
+    from plannerlab.robots.paths import interpolate_edge
+
+    robot = ArmZ(n_modules=6, collision_radius_m=0.04)
+    q_a = np.full(robot.dof, np.pi)
+    q_a[1] -= 1.2
+    q_b = q_a.copy()
+    q_a[0] -= 0.5
+    q_b[0] += 0.5  # the base twist swings the bent arm's tip about 0.6 m
+    coarse = interpolate_edge(q_a, q_b, 0.3, robot.continuous)
+    t_mid = 1.5 / (len(coarse) - 1)  # halfway between the coarse states 1 and 2
+    ts = (t_mid - 1e-3, t_mid, t_mid + 1e-3)
+    tips = np.array([robot.tip(q_a + s * (q_b - q_a))[0] for s in ts])
+    direction = (tips[2] - tips[0]) / np.linalg.norm(tips[2] - tips[0])
+    sheet = Box("sheet", _frame(tips[1], direction), (thickness_m, 0.2, 0.2))
+    scene = Scene((sheet,))
+    checker = CollisionChecker(robot, scene, margin_m=0.02)
+    assert checker.is_valid(q_a) and checker.is_valid(q_b)
+    radian = CollisionChecker(robot, scene, margin_m=0.0)
+    assert radian.valid_batch(coarse).all()  # radian steps alone pass through the sheet
+    fcl = CollisionChecker(robot, scene, backend="fcl")
+    assert not fcl.valid_batch(np.linspace(q_a, q_b, 20001)).all()  # the swing crosses it
+    status, _, n = checker._core.edge_certified(q_a, q_b, 0.3)
+    assert status == 1 and n > 10 * len(coarse)
+    assert not checker.check_path(np.vstack([q_a, q_b]), 0.3).valid
+    assert not checker.check_path(np.vstack([q_a, q_b]), 0.3, mode="grid").valid
+
+
+def test_float32s_bound_covers_what_the_kinematics_show():
+    """The model's float32 bound is far above the float32 kinematics' worst error seen on
+    random states of every family (and far below any radius)."""
+    from plannerlab.collision.kinematics import chain_frames
+    from plannerlab.collision.state_test import W, frames32, lanes, load_state
+
+    for kind in sorted(FAMILY_PROBLEMS):
+        problem = _problem(kind)
+        robot = problem.robot
+        core = problem_checker(problem)._core
+        m = core.model
+        Z = lanes(m)
+        rng = np.random.default_rng(31)
+        lo = np.where(np.isfinite(robot.lower), robot.lower, -np.pi)
+        hi = np.where(np.isfinite(robot.upper), robot.upper, np.pi)
+        worst = 0.0
+        for _ in range(40):
+            Q = rng.uniform(lo, hi, (W, robot.dof))
+            for k in range(W):
+                load_state(Z, k, Q[k], m.continuous)
+            frames32(m, Z)
+            F32 = Z.F.reshape(-1, 12, W)
+            for k in range(W):
+                F64 = np.zeros(len(F32) * 12)
+                V = Q[k] if len(m.cpl_start) == 0 else robot.chain_data()[7] @ Q[k]
+                chain_frames(F64, np.ascontiguousarray(V), m.T0, m.pre, m.parent, m.slide)
+                pos64 = F64.reshape(-1, 12)[:, [3, 7, 11]]
+                pos32 = F32[:, [3, 7, 11], k]
+                worst = max(worst, float(np.abs(pos32 - pos64).max()))
+        assert worst < m.eps32_m / 4, (kind, worst, m.eps32_m)
+        assert m.eps32_m < 0.15 * float(np.min(robot.link_radii_m))  # far below a radius

@@ -9,8 +9,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from plannerlab.collision.fcl_checker import CollisionChecker
-from plannerlab.collision.model import chain_model
+from plannerlab.collision.model_old import chain_model
 from plannerlab.collision.spheres import (
     frames,
     kin,
@@ -85,17 +84,6 @@ def test_gradients_through_the_chain_are_the_derivatives(robot):
         tm, tnm = robot.tip(q[None] - E)
         np.testing.assert_allclose(Jp, ((tp - tm) / (2 * h)).T, atol=1e-6)
         np.testing.assert_allclose(Jn, ((tn - tnm) / (2 * h)).T, atol=1e-6)
-
-
-def test_a_checkers_model_gives_the_chain_packed_alone():
-    """The descent's spheres ride on the checker's model when there is one, else on the
-    robot's chain packed alone: the same arrays, so the same paths."""
-    problem = load_problem("armz_pocket")
-    checker = CollisionChecker(problem.robot, problem.scene, margin_m=0.05)
-    a = sphere_chain(checker.model, problem.robot)
-    b = sphere_chain(chain_model(problem.robot), problem.robot)
-    for name, x, y in zip(a._fields, a, b, strict=True):
-        assert np.array_equal(np.asarray(x), np.asarray(y)), name
 
 
 def test_a_chain_whose_capsules_are_not_its_links_is_refused():

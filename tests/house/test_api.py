@@ -40,12 +40,31 @@ def test_import_plannerlab_loads_no_engine_and_no_submodule():
     assert json.loads(out.stdout) == []
 
 
+def test_the_api_pages_checker_example_runs(tmp_path):
+    """docs/api.md's ``pl.checker`` example, as a user copies it."""
+    page = (ROOT / "docs" / "api.md").read_text(encoding="utf-8")
+    (example,) = [
+        b for b in re.findall(r"```python\n(.*?)```", page, flags=re.S) if "checker(" in b
+    ]
+    out = subprocess.run(
+        [sys.executable, "-c", example + "\nprint(check.valid(q), int(ok.sum()))\n"],
+        capture_output=True,
+        text=True,
+        cwd=tmp_path,
+        timeout=600,
+        env={**os.environ, "MPLBACKEND": "Agg", "PYTHONPATH": str(ROOT)},
+    )
+    assert out.returncode == 0, out.stderr[-2000:]
+    first, count = out.stdout.split()[-2:]
+    assert first == "True" and 0 < int(count) < 100_000
+
+
 def test_the_api_page_example_runs_as_a_script(tmp_path):
     """docs/api.md's example (the README links it), pasted into a file and run as a script,
     with no ``if __name__ == "__main__":``: the comparison's trial processes must not run
     the script again (they did, and every trial died in its bootstrapping, issue 36)."""
     page = (ROOT / "docs" / "api.md").read_text(encoding="utf-8")
-    (example,) = re.findall(r"```python\n(.*?)```", page, flags=re.S)
+    example = re.findall(r"```python\n(.*?)```", page, flags=re.S)[0]
     assert len(example.strip().splitlines()) <= 14
     assert "__main__" not in example
     script = tmp_path / "example.py"

@@ -71,8 +71,8 @@ def thin_plate_problem() -> Problem:
 
 
 def _path_problem(problem: Problem, K: int, substeps: int = 1) -> PathProblem:
-    checker = problem_checker(problem)
-    geometry = PathGeometry(problem.robot, problem.scene, checker.model)
+    problem_checker(problem)
+    geometry = PathGeometry(problem.robot, problem.scene)
     return PathProblem(
         geometry, problem.robot, problem.goals[0], K, substeps, problem.safety_margin_m,
         0.05, 1.0, 10.0, 0.5,

@@ -508,7 +508,7 @@ class CompiledField:
     """
 
     def __init__(self, field: ClearanceField, far_m: float, model: Any = None) -> None:
-        from plannerlab.collision.model import chain_model
+        from plannerlab.collision.model_old import chain_model
 
         robot = field.robot
         if not callable(getattr(robot, "tip_data", None)):

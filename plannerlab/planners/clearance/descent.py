@@ -180,7 +180,7 @@ class ClearanceDescent(DescentStep, LegPlanner):
         field = ClearanceField(problem.robot, problem.scene, self.settings.influence_m, stop=stop)
         model: Model
         if self.backend_for(problem.robot) == "compiled":
-            model = CompiledModel(self, field, _compiled_model(checker))
+            model = CompiledModel(self, field)
         else:
             model = NumpyModel(self, field)
         self._model_cache = (problem, model)
@@ -637,17 +637,6 @@ class ClearanceDescent(DescentStep, LegPlanner):
                     Status.SOLVED,
                     f"descent stalled {minima} times; escaped from the stall by {how}",
                 )
-
-
-def _compiled_model(checker: Any) -> Any:
-    """The checker's compiled robot–scene model, or None when it has none (no checker,
-    an FCL-only scene, a robot without a chain)."""
-    if checker is None:
-        return None
-    try:
-        return checker.model
-    except (AttributeError, ValueError, PlannerlabError):
-        return None
 
 
 def _within(goal: GoalRegion, point, fraction: float) -> bool:

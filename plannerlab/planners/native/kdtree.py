@@ -69,20 +69,27 @@ def kd_catch_up(Q, n, Kd, sd):
             kd_insert(Q, Kd, r, sd)
 
 
+#: a row's flag when it is dead (left out of the search)
+DEAD = 2
+
+
 @njit(cache=True, nogil=True)
-def kd_nearest(Q, q, continuous, F, dead, Kd, sd, stack, bounds, offs):
-    """:func:`~plannerlab.planners.native.kernels.nearest` over the rows in the k-d tree
-    ``Kd`` (:func:`kd_insert`): the same row, the lowest index among the live rows
-    (``F[r] != dead``) at the least squared distance, each row's sum made as ``nearest``
-    makes it (the same terms in the same order, ties to the lower index).
+def kd_nearest(T, q, continuous, sd, KS):
+    """:func:`~plannerlab.planners.native.kernels.nearest` over the rows of tree T
+    (``T.Q`` its states, ``T.F`` flags, ``T.Kd`` its k-d tree: :func:`kd_insert`): the same
+    row, the lowest index among the live rows (``F[r] != DEAD``) at the least squared
+    distance, each row's sum made as ``nearest`` makes it (the same terms in the same
+    order, ties to the lower index).
 
     A subtree is skipped when its cell is farther than the best row: the cell's squared
     distance is the sum of q's squared gaps to it on the split joints (the incremental
     distance of Arya and Mount; ``offs`` keeps each pending cell's gaps). The test keeps a
     relative margin of ``CELL_MARGIN`` over the best sum, far beyond the rounding of
     these sums (a few ulps), so a cell holding a row that ties or beats the best in
-    floating point is never skipped. ``stack``, ``bounds`` (at least the tree's depth + 2)
-    and ``offs`` (as many rows, dof columns) scratch. -1 when every row is dead."""
+    floating point is never skipped. ``KS = (stack, bounds, offs)`` scratch (at least the
+    tree's depth + 2 rows; offs dof columns). -1 when every row is dead."""
+    Q, F, Kd = T.Q, T.F, T.Kd
+    stack, bounds, offs = KS
     best = np.inf
     best_i = -1
     dof = q.shape[0]
@@ -97,7 +104,7 @@ def kd_nearest(Q, q, continuous, F, dead, Kd, sd, stack, bounds, offs):
         b = bounds[top]
         if b > best * CELL_MARGIN:
             continue
-        if F[node] != dead:
+        if F[node] != DEAD:
             acc = 0.0
             for i in range(dof):
                 x = q[i] - Q[node, i]
@@ -140,4 +147,4 @@ def kd_nearest(Q, q, continuous, F, dead, Kd, sd, stack, bounds, offs):
     return best_i
 
 
-__all__ = ["kd_catch_up", "kd_insert", "kd_nearest", "split_dims"]
+__all__ = ["DEAD", "kd_catch_up", "kd_insert", "kd_nearest", "split_dims"]

@@ -61,7 +61,6 @@ from plannerlab.planners.native.solve import (
     FIRST_ROWS,
     KD_ROW_BYTES,
     UNLIMITED,
-    K_views,
     NativeSolve,
     space_extent,
 )
@@ -336,7 +335,6 @@ class LeaderSolve(NativeSolve):
         self.guides = np.ascontiguousarray(g.guides)
         self.run.progress.note(float(np.min(self.goal.distance(self.robot, g.start_states))))
         rng_state = K.seed_state(self.rng)
-        V, S = K_views(model)
         dof = len(q0)
         range_rad = self.s.range_rad or 0.2 * space_extent(model)
         self.extra["range_rad"] = range_rad
@@ -358,49 +356,31 @@ class LeaderSolve(NativeSolve):
             counters[3], counters[4] = g.reached_node, 0
             self.iterations = g.iterations
             self.extra["nodes"] = [na, nb]
-            return self._finish(trees, counters, na + nb, model, V, S, rng_state)
+            return self._finish(trees, counters, na + nb, rng_state)
         b = self.budget
         max_it = UNLIMITED if b.max_iterations is None else max(b.max_iterations - g.iterations, 1)
-        code = self.search(
-            model,
-            V,
-            S,
-            trees,
-            sizes,
-            counters,
-            rng_state,
-            range_rad,
-            need_free,
-            cap,
-            max_it,
-            iterations0=g.iterations,
-        )
+        O = self.options(range_rad, max_it, need_free)
+        code = self.search(trees, sizes, counters, rng_state, O, cap, iterations0=g.iterations)
         self.extra["planning_checks"] = int(counters[1])
         self.extra["search_iterations"] = int(counters[0])
         self.extra["nodes"] = [int(sizes[0]), int(sizes[1])]
         if code != K.DONE:
             return self.stopped(code, f"{int(sizes[0])} + {int(sizes[1])} tree nodes")
-        self.extra["paths_failing_fine_check"] = int(counters[5])
-        return self._finish(trees, counters, int(sizes.sum()), model, V, S, rng_state)
+        return self._finish(trees, counters, int(sizes.sum()), rng_state)
 
     def _finish(
-        self,
-        trees: list[np.ndarray],
-        counters: np.ndarray,
-        rows: int,
-        model: Any,
-        V: Any,
-        S: Any,
-        rng_state: Array,
+        self, trees: list[np.ndarray], counters: np.ndarray, rows: int, rng_state: Array
     ) -> PlanResult:
         """The path through the meeting nodes (``counters[3]`` in A, ``counters[4]`` in
         B), shortcut and re-checked."""
         out = np.empty((rows, trees[0].shape[1]))
-        k = K.tree_path(trees[0], trees[1], counters[3], trees[4], trees[5], counters[4], out)
+        A = K.Tree(trees[0], trees[1], trees[2], trees[3], trees[8])
+        B = K.Tree(trees[4], trees[5], trees[6], trees[7], trees[9])
+        k = K.tree_path(A, counters[3], B, counters[4], out)
         path = out[:k].copy()
         self.extra["waypoints_raw"] = k
         if self.s.simplify:
-            path = self.simplify(path, model, V, S, rng_state)
+            path = self.simplify(path, rng_state)
         return self.checked(path)
 
 

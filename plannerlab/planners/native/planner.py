@@ -41,8 +41,8 @@ def _check_settings(name: str, s: NativeSettings) -> None:
     if not (math.isfinite(s.max_tree_mb) and s.max_tree_mb > 0.0):
         raise PlannerlabError(f"{name}: max_tree_mb must be > 0, got {s.max_tree_mb!r}")
     every = getattr(s, "lazy_every", 1)
-    if every < 1 or every & (every - 1):
-        raise PlannerlabError(f"{name}: lazy_every must be a power of two >= 1, got {every!r}")
+    if every < 1:
+        raise PlannerlabError(f"{name}: lazy_every must be an integer >= 1, got {every!r}")
     if s.goal_samples < 1 or s.max_goal_attempts < 1 or s.shortcut_tries < 0:
         raise PlannerlabError(
             f"{name}: goal_samples and max_goal_attempts must be >= 1 and shortcut_tries "

@@ -17,17 +17,18 @@ taken only if its re-check fits), and stops when the time left is that re-check'
 from __future__ import annotations
 
 import math
+from typing import NamedTuple
 
 import numpy as np
-from numba import njit
 
+from plannerlab.collision.edges import FREE, LIMIT, edge_check
+from plannerlab.collision.simd import kernel
 from plannerlab.planners.base import PlanResult, Status
 from plannerlab.planners.native import kernels as K
 from plannerlab.planners.native.solve import (
     FIRST_ROWS,
     RESERVE_FACTOR,
     UNLIMITED,
-    K_views,
     NativeSolve,
     space_extent,
 )
@@ -37,7 +38,7 @@ from plannerlab.robots.paths import path_length
 K_MAX = 128
 
 
-@njit(cache=True, nogil=True)
+@kernel
 def _k_nearest(Q, n, q, continuous, k, nb_idx, nb_d2):
     """The k nearest nodes of Q[:n] to q into nb_idx, nb_d2 (squared distances),
     nearest first; returns how many (min(k, n))."""
@@ -60,7 +61,7 @@ def _k_nearest(Q, n, q, continuous, k, nb_idx, nb_d2):
     return cnt
 
 
-@njit(cache=True, nogil=True)
+@kernel
 def _unlink(child, sibling, p, c):
     """Remove c from p's children."""
     if child[p] == c:
@@ -72,7 +73,7 @@ def _unlink(child, sibling, p, c):
     sibling[i] = sibling[c]
 
 
-@njit(cache=True, nogil=True)
+@kernel
 def _shift_costs(cost, child, sibling, root, delta, stack):
     """Add delta to the cost of root's subtree (root excluded)."""
     top = 0
@@ -92,53 +93,79 @@ def _shift_costs(cost, child, sibling, root, delta, stack):
             c = sibling[c]
 
 
-@njit(cache=True, nogil=True)
-def _recheck_states(Q, parent, node, joint_step, m, d):
+class StarTree(NamedTuple):
+    """RRT*'s tree: Q (cap, dof) states, ``parent`` (-1 at the root, the start), ``cost``
+    (joint-space length from the root), children lists (``child`` first child,
+    ``sibling`` next sibling, -1 ends), ``goal_nodes`` the nodes that are goal states,
+    ``stack`` scratch, ``flags`` (cap,) int8 zeros (the nearest-node search's)."""
+
+    Q: np.ndarray
+    parent: np.ndarray
+    cost: np.ndarray
+    child: np.ndarray
+    sibling: np.ndarray
+    goal_nodes: np.ndarray
+    stack: np.ndarray
+    flags: np.ndarray
+
+
+class Star(NamedTuple):
+    """RRT*'s own settings and scratch: the goal states (g, dof) and the node of each
+    (-1: not in the tree), ``f`` = (goal_bias, k_factor), the neighbours' scratch."""
+
+    goals: np.ndarray
+    goal_node_of: np.ndarray
+    f: np.ndarray
+    nb_idx: np.ndarray
+    nb_d2: np.ndarray
+
+
+@kernel
+def _recheck_states(S, T, node, joint_step):
     """The re-check's checks of the path from the root to node (1 + its grid states)."""
     total = 1
-    while parent[node] >= 0:
-        total += K.edge_states(Q[parent[node]], Q[node], joint_step, m, d)
-        node = parent[node]
+    while T.parent[node] >= 0:
+        total += K.edge_states(T.Q[T.parent[node]], T.Q[node], joint_step, S.m, S.buf[2])
+        node = T.parent[node]
     return total
 
 
-@njit(cache=True, nogil=True)
-def _connect_goal(Q, parent, cost, child, sibling, goal_nodes, goal_node_of, sizes, new, goals,
-                  range_rad, joint_step, m, V, S, buf, limit):  # fmt: skip
+@kernel
+def _connect_goal(S, T, X, sizes, new, O, limit):
     """Try the edge from node ``new`` to its nearest goal state not yet in the tree, when
     it is within ``range_rad``: the goal state joins the tree. Returns (status, checks)
-    as :func:`~plannerlab.planners.native.kernels.edge_free` (0 also when nothing was
+    as :func:`~plannerlab.collision.edges.edge_check` (FREE also when nothing was
     tried)."""
+    Q, goals, goal_node_of = T.Q, X.goals, X.goal_node_of
+    range_rad = O.f[2]
     best = -1
     best_d2 = range_rad * range_rad
     for g in range(goals.shape[0]):
         if goal_node_of[g] < 0:
-            d2 = K.distance2(Q[new], goals[g], m.continuous)
+            d2 = K.distance2(Q[new], goals[g], S.m.continuous)
             if d2 <= best_d2:
                 best_d2 = d2
                 best = g
     if best < 0:
-        return 0, 0
-    status, checks = K.edge_free(
-        Q[new], goals[best], joint_step, m, V, S, buf[2], buf[3], limit, False
-    )
-    if status != 0:
+        return FREE, 0
+    status, checks, _ = edge_check(S.m, S.Z, Q[new], goals[best], O.f[3], limit)
+    if status != FREE:
         return status, checks
     v = sizes[0]
-    Q[v] = goals[best]
-    parent[v] = new
-    cost[v] = cost[new] + math.sqrt(best_d2)
-    child[v] = -1
-    sibling[v] = child[new]
-    child[new] = v
+    K.copy_row(Q, v, goals, best)
+    T.parent[v] = new
+    T.cost[v] = T.cost[new] + math.sqrt(best_d2)
+    T.child[v] = -1
+    T.sibling[v] = T.child[new]
+    T.child[new] = v
     sizes[0] += 1
-    goal_nodes[sizes[1]] = v
+    T.goal_nodes[sizes[1]] = v
     sizes[1] += 1
     goal_node_of[best] = v
-    return 0, checks
+    return FREE, checks
 
 
-@njit(cache=True, nogil=True)
+@kernel
 def _by_cost(cost, nb_idx, nb_d2, cnt):
     """The neighbours nb_idx[:cnt] (squared distances nb_d2) sorted by the cost through
     them (cost + distance), which nb_d2 then holds."""
@@ -152,205 +179,186 @@ def _by_cost(cost, nb_idx, nb_d2, cnt):
             j -= 1
 
 
-@njit(cache=True, nogil=True)
-def _rewire(Q, parent, cost, child, sibling, stack, new, best_p, best_c, nb_idx, cnt,
-            joint_step, m, V, S, buf, limit, soft):  # fmt: skip
-    """Rewire the neighbours nb_idx[:cnt] through node ``new`` (of cost best_c) when that
-    is shorter and the edge new -> neighbour is free; their subtrees' costs follow.
-    Returns (status, checks): 0 done, 2 a limit (``limit`` hard, ``soft`` the chunk's,
-    both counted from here) ended it."""
+@kernel
+def _rewire(S, T, X, node, cnt, joint_step, limits):
+    """Rewire the neighbours ``X.nb_idx[:cnt]`` through the new node (``node`` = (new,
+    its parent, its cost)) when that is shorter and the edge new -> neighbour is free;
+    their subtrees' costs follow. Returns (status, checks): 0 done, 2 a limit (``limits``
+    = (hard, soft), both counted from here) ended it."""
+    new, best_p, best_c = node
+    limit, soft = limits
+    Q, parent, cost, child, sibling = T.Q, T.parent, T.cost, T.child, T.sibling
     checks = 0
     for a in range(cnt):
-        v = nb_idx[a]
+        v = X.nb_idx[a]
         if v == best_p or parent[v] < 0:
             continue
-        through = best_c + math.sqrt(K.distance2(Q[new], Q[v], m.continuous))
+        through = best_c + math.sqrt(K.distance2(Q[new], Q[v], S.m.continuous))
         if through >= cost[v]:
             continue
         if checks >= soft:
             return 2, checks
-        status, c = K.edge_free(
-            Q[new], Q[v], joint_step, m, V, S, buf[2], buf[3], limit - checks, False
-        )
+        status, c, _ = edge_check(S.m, S.Z, Q[new], Q[v], joint_step, limit - checks)
         checks += c
-        if status == 2:
+        if status == LIMIT:
             return 2, checks
-        if status == 0:
+        if status == FREE:
             _unlink(child, sibling, parent[v], v)
             parent[v] = new
             sibling[v] = child[new]
             child[new] = v
-            _shift_costs(cost, child, sibling, v, through - cost[v], stack)
+            _shift_costs(cost, child, sibling, v, through - cost[v], T.stack)
             cost[v] = through
     return 0, checks
 
 
-@njit(cache=True, nogil=True)
-def _update_best(Q, parent, cost, goal_nodes, sizes, counters, hard_checks, joint_step, m, buf):
+@kernel
+def _update_best(S, T, sizes, counters, hard_checks, joint_step):
     """The best path to a goal state whose re-check fits the checks left: its goal node
     into counters[2], its re-check's checks into counters[3]."""
     if sizes[1] == 0:
         return
     b = counters[2]
     for g in range(sizes[1]):
-        v = goal_nodes[g]
-        if v != b and (b < 0 or cost[v] < cost[b]):
-            held = _recheck_states(Q, parent, v, joint_step, m, buf[2])
+        v = T.goal_nodes[g]
+        if v != b and (b < 0 or T.cost[v] < T.cost[b]):
+            held = _recheck_states(S, T, v, joint_step)
             if counters[1] + held <= hard_checks:
                 b = v
                 counters[3] = held
     if b >= 0 and b == counters[2]:
-        counters[3] = _recheck_states(Q, parent, b, joint_step, m, buf[2])
+        counters[3] = _recheck_states(S, T, b, joint_step)
     counters[2] = b
 
 
-@njit(cache=True, nogil=True)
-def rrtstar_run(
-    m,
-    V,
-    S,
-    Q,
-    parent,
-    cost,
-    child,
-    sibling,
-    goal_nodes,
-    goal_node_of,
-    flags,
-    sizes,
-    counters,
-    rng,
-    goals,
-    goal_bias,
-    guides,
-    guide_bias,
-    guide_sigma_rad,
-    range_rad,
-    joint_step,
-    k_factor,
-    max_iterations,
-    soft_checks,
-    hard_checks,
-    buf,
-    nb_idx,
-    nb_d2,
-    stack,
-):
+@kernel
+def _best_parent(S, T, X, target, near, cnt, limits):
+    """The new node's parent: the neighbour of least cost through it whose edge is free
+    (``near`` if none is cheaper). Returns (parent, cost, checks, code): code 0, or 2 the
+    hard limit came (the node is dropped). ``limits`` = (hard, soft, joint_step)."""
+    hard, soft, joint_step = limits
+    Q, cost, continuous = T.Q, T.cost, S.m.continuous
+    best_p = near
+    best_c = cost[near] + math.sqrt(K.distance2(Q[near], target, continuous))
+    _by_cost(cost, X.nb_idx, X.nb_d2, cnt)  # nb_d2 now: the cost through each, cheapest first
+    checks = 0
+    for a in range(cnt):
+        p = X.nb_idx[a]
+        if X.nb_d2[a] >= best_c:
+            break
+        if p == near:
+            continue
+        if checks >= soft:  # the chunk's end: the best parent so far
+            break
+        status, c, _ = edge_check(S.m, S.Z, Q[p], target, joint_step, hard - checks)
+        checks += c
+        if status == LIMIT:
+            return best_p, best_c, checks, 2
+        if status == FREE:
+            return p, X.nb_d2[a], checks, 0
+    return best_p, best_c, checks, 0
+
+
+@kernel
+def rrtstar_run(S, T, X, sizes, O, counters, limits):
     """RRT* iterations until a limit or a full tree.
 
-    The tree: Q (cap, dof) states, ``parent`` (-1 at the root, the start), ``cost``
-    (joint-space length from the root), children lists (``child`` first child,
-    ``sibling`` next sibling, -1 ends), ``goal_nodes`` the nodes that are goal states
-    (``sizes`` (2,): nodes, goal nodes), ``goal_node_of`` (g,) the node of each goal
-    state (-1: not in the tree), ``flags`` (cap,) int8 zeros (the nearest-node search's
-    flags; RRT* checks its edges in full). A new node within ``range_rad`` of a goal state not in
-    the tree tries the edge to it (the start too, first). ``counters`` (4,) int64:
+    The tree T (:class:`StarTree`, ``sizes`` (2,): nodes, goal nodes), RRT*'s own
+    settings X (:class:`Star`). A new node within ``range_rad`` of a goal state not in the
+    tree tries the edge to it (the start too, first). ``counters`` (4,) int64:
     iterations, checks, the best goal node (-1: none yet), the held re-check checks of
-    its path (never spent: the hard limit of an edge is ``hard_checks`` less them).
-    ``goals`` (g, dof): the goal states, sampled with probability ``goal_bias``. Other
-    limits and codes as :func:`~plannerlab.planners.native.kernels.rrtc_run` (``FULL``:
-    fewer than 3 free rows)."""
-    q_rand = buf[0]
-    target = buf[1]
+    its path (never spent: the hard limit of an edge is the hard limit less them). Goal
+    states are sampled with probability ``goal_bias``. Other limits and codes as
+    :func:`~plannerlab.planners.native.kernels.rrtc_run` (``FULL``: fewer than 3 free
+    rows)."""
+    m = S.m
+    q_rand = S.buf[0]
+    target = S.buf[1]
+    Q, goals = T.Q, X.goals
+    soft_checks, hard_checks = limits[0], limits[1]
+    range_rad, joint_step = O.f[2], O.f[3]
+    goal_bias, k_factor = X.f[0], X.f[1]
     while True:
         hard = hard_checks - counters[3]  # the best path's re-check is not spent
-        if counters[0] >= max_iterations:
+        if counters[0] >= O.i[0]:
             return K.ITERATIONS
         if counters[1] >= hard:
             return K.HARD
         if counters[1] >= soft_checks:
             return K.CHUNK
-        if Q.shape[0] - sizes[0] < 3 or goal_nodes.shape[0] - sizes[1] < 2:
+        if Q.shape[0] - sizes[0] < 3 or T.goal_nodes.shape[0] - sizes[1] < 2:
             return K.FULL
         if counters[0] == 0:  # the start straight to a goal state
-            status, c = _connect_goal(
-                Q, parent, cost, child, sibling, goal_nodes, goal_node_of, sizes, 0, goals,
-                range_rad, joint_step, m, V, S, buf, hard - counters[1],
-            )  # fmt: skip
+            status, c = _connect_goal(S, T, X, sizes, 0, O, hard - counters[1])
             counters[1] += c
-            if status == 2:
+            if status == LIMIT:
                 return K.HARD
         counters[0] += 1
-        to_goal = goals.shape[0] > 0 and K.uniform(rng) < goal_bias
+        to_goal = goals.shape[0] > 0 and K.uniform(S.rng) < goal_bias
         if to_goal:
-            q_rand[:] = goals[K.randint(rng, goals.shape[0])]
+            g = K.randint(S.rng, goals.shape[0])
+            for i in range(q_rand.shape[0]):
+                q_rand[i] = goals[g, i]
         else:
-            K.sample(
-                rng, m.lower, m.upper, m.continuous, guides, guide_bias, guide_sigma_rad, q_rand
-            )
+            K.sample(S.rng, m.lower, m.upper, m.continuous, O.guides, O.f[0], O.f[1], q_rand)
         n = sizes[0]
-        near = K.nearest(Q, n, q_rand, m.continuous, m.continuous.any(), flags)
+        near = K.nearest(Q, n, q_rand, m.continuous, m.continuous.any(), T.flags)
         if K.distance2(Q[near], q_rand, m.continuous) == 0.0:
             continue
-        reached = K.steer(Q[near], q_rand, range_rad, m.continuous, buf[2], target)
-        status, c = K.edge_free(
-            Q[near], target, joint_step, m, V, S, buf[2], buf[3], hard - counters[1], False,
+        reached = K.steer(Q[near], q_rand, range_rad, m.continuous, S.buf[2], target)
+        status, c, _ = edge_check(m, S.Z, Q[near], target, joint_step, hard - counters[1])
+        counters[1] += c
+        if status == LIMIT:
+            return K.HARD
+        if status != FREE:
+            continue
+        k = min(int(math.ceil(k_factor * math.log(n + 1.0))), X.nb_idx.shape[0])
+        cnt = _k_nearest(Q, n, target, m.continuous, k, X.nb_idx, X.nb_d2)
+        best_p, best_c, c, code = _best_parent(
+            S, T, X, target, near, cnt,
+            (hard - counters[1], soft_checks - counters[1], joint_step),
         )  # fmt: skip
         counters[1] += c
-        if status == 2:
+        if code == 2:  # the new node is dropped
             return K.HARD
-        if status == 1:
-            continue
-        # the parent: the neighbour of least cost through it whose edge is free
-        k = min(int(math.ceil(k_factor * math.log(n + 1.0))), nb_idx.shape[0])
-        cnt = _k_nearest(Q, n, target, m.continuous, k, nb_idx, nb_d2)
-        best_p = near
-        best_c = cost[near] + math.sqrt(K.distance2(Q[near], target, m.continuous))
-        _by_cost(cost, nb_idx, nb_d2, cnt)  # nb_d2 now: the cost through each, cheapest first
-        for a in range(cnt):
-            p = nb_idx[a]
-            if nb_d2[a] >= best_c:
-                break
-            if p == near:
-                continue
-            if counters[1] >= soft_checks:  # the chunk's end: the best parent so far
-                break
-            status, c = K.edge_free(
-                Q[p], target, joint_step, m, V, S, buf[2], buf[3], hard - counters[1], False,
-            )  # fmt: skip
-            counters[1] += c
-            if status == 2:  # the new node is dropped
-                return K.HARD
-            if status == 0:
-                best_p = p
-                best_c = nb_d2[a]
-                break
         new = n
-        Q[new] = target
-        parent[new] = best_p
-        cost[new] = best_c
-        child[new] = -1
-        sibling[new] = child[best_p]
-        child[best_p] = new
+        for i in range(target.shape[0]):
+            Q[new, i] = target[i]
+        T.parent[new] = best_p
+        T.cost[new] = best_c
+        T.child[new] = -1
+        T.sibling[new] = T.child[best_p]
+        T.child[best_p] = new
         sizes[0] += 1
         if to_goal and reached:
             for g in range(goals.shape[0]):
-                if goal_node_of[g] < 0 and K.distance2(goals[g], target, m.continuous) == 0.0:
-                    goal_node_of[g] = new
-                    goal_nodes[sizes[1]] = new
+                if X.goal_node_of[g] < 0 and K.distance2(goals[g], target, m.continuous) == 0.0:
+                    X.goal_node_of[g] = new
+                    T.goal_nodes[sizes[1]] = new
                     sizes[1] += 1
                     break
         else:  # the new node straight to a goal state within range
-            status, c = _connect_goal(
-                Q, parent, cost, child, sibling, goal_nodes, goal_node_of, sizes, new, goals,
-                range_rad, joint_step, m, V, S, buf, hard - counters[1],
-            )  # fmt: skip
+            status, c = _connect_goal(S, T, X, sizes, new, O, hard - counters[1])
             counters[1] += c
-            if status == 2:
+            if status == LIMIT:
                 return K.HARD
         # rewire the neighbours through the new node (a limit ends the rewiring)
-        status, c = _rewire(Q, parent, cost, child, sibling, stack, new, best_p, best_c, nb_idx,
-                            cnt, joint_step, m, V, S, buf, hard - counters[1],
-                            soft_checks - counters[1])  # fmt: skip
+        status, c = _rewire(S, T, X, (new, best_p, best_c), cnt, joint_step,
+                            (hard - counters[1], soft_checks - counters[1]))  # fmt: skip
         counters[1] += c
-        _update_best(Q, parent, cost, goal_nodes, sizes, counters, hard_checks, joint_step, m,
-                     buf)  # fmt: skip
+        _update_best(S, T, sizes, counters, hard_checks, joint_step)
         if status == 2:
             return K.HARD if counters[1] >= hard_checks - counters[3] else K.CHUNK
     return K.CHUNK
 
 
-@njit(cache=True, nogil=True)
+@kernel
+def rrtstar_entry(P, aux, T, X, sizes, O, counters, limits):
+    """:func:`rrtstar_run` on the packed model (a call from Python)."""
+    return rrtstar_run(K.open_search(P, aux), T, X, sizes, O, counters, limits)
+
+
+@kernel
 def chain(Q, parent, node, out):
     """The path from the root to node into out; returns its number of states."""
     k = 0
@@ -360,7 +368,7 @@ def chain(Q, parent, node, out):
         i = parent[i]
     i = node
     for r in range(k - 1, -1, -1):
-        out[r] = Q[i]
+        K.copy_row(out, r, Q, i)
         i = parent[i]
     return k
 
@@ -377,7 +385,6 @@ def rrtstar(solve: NativeSolve) -> PlanResult:
     if failed is not None:
         return failed
     rng_state = K.seed_state(solve.rng)
-    V, S = K_views(model)
     dof = len(q0)
     extent = space_extent(model)
     range_rad = s.range_rad or 0.2 * extent
@@ -399,24 +406,23 @@ def rrtstar(solve: NativeSolve) -> PlanResult:
     tree["Q"][0] = q0
     sizes = np.array([1, 0], dtype=np.int64)
     counters = np.array([0, 0, -1, 0], dtype=np.int64)
-    goal_node_of = np.full(len(G), -1, dtype=np.int64)
-    buf = np.empty((4, dof))
-    nb_idx = np.empty(K_MAX, dtype=np.int64)
-    nb_d2 = np.empty(K_MAX)
     b = solve.budget
     max_it = UNLIMITED if b.max_iterations is None else b.max_iterations
-    goal_bias = s.goal_bias  # type: ignore[attr-defined]
+    X = Star(
+        G,
+        np.full(len(G), -1, dtype=np.int64),
+        np.array([s.goal_bias, k_factor]),  # type: ignore[attr-defined]
+        np.empty(K_MAX, dtype=np.int64),
+        np.empty(K_MAX),
+    )
+    O = solve.options(range_rad, max_it, 3)
     solve._charged = 0
     seen = [math.inf]
 
     def call(soft: int, hard: int) -> int:
-        t = tree
-        code = rrtstar_run(
-            model, V, S, t["Q"], t["parent"], t["cost"], t["child"], t["sibling"],
-            t["goal_nodes"], goal_node_of, t["flags"], sizes, counters, rng_state, G, goal_bias,
-            solve.guides, s.guide_bias, s.guide_sigma_rad, range_rad, solve.step, k_factor, max_it,
-            soft, hard, buf, nb_idx, nb_d2, t["stack"],
-        )  # fmt: skip
+        aux = solve.aux(rng_state, len(tree["Q"]))
+        limits = np.array([soft, hard], dtype=np.int64)
+        code = rrtstar_entry(solve.packed, aux, StarTree(**tree), X, sizes, O, counters, limits)
         best = int(counters[2])
         if best >= 0 and tree["cost"][best] < seen[0]:
             seen[0] = float(tree["cost"][best])
@@ -453,8 +459,8 @@ def rrtstar(solve: NativeSolve) -> PlanResult:
     solve.extra["length_raw"] = path_length(path, robot.continuous)
     solve.extra["reserve_checks"] = int(counters[3])
     if s.simplify:
-        path = solve.simplify(path, model, V, S, rng_state)
+        path = solve.simplify(path, rng_state)
     return solve.checked(path)
 
 
-__all__ = ["RESERVE_FACTOR", "rrtstar", "rrtstar_run"]
+__all__ = ["RESERVE_FACTOR", "Star", "StarTree", "rrtstar", "rrtstar_entry", "rrtstar_run"]

@@ -52,12 +52,13 @@ class RRTConnectSettings(NativeSettings):
     """RRT-Connect.
 
     Attributes:
-        lazy_every: a tree edge is checked, when it is added, on its coarse states only:
-            its ends and every ``lazy_every``-th state of its grid (a power of two); the
-            others only when a path through it is found (a failure there drops the
-            edge's subtree and the search goes on). Most tree edges are never on a path,
-            so most of their states are never checked; the returned path's are all. 1:
-            every edge in full at once.
+        lazy_every: a tree edge is checked, when it is added, on its coarse states: its
+            grid cut into stretches of ``lazy_every`` states, each stretch's middle state
+            tested grown by the stretch's half-length, eight at a time (the whole edge is
+            then proved when every grown state is free); an edge not proved so is checked
+            in full only when a path through it is found (a failure there drops the
+            edge's subtree and the search goes on). Most tree edges are never on a path.
+            1: every edge in full at once.
         dynamic_domain: the dynamic domain of the extension step (Yershova et al. 2005;
             VAMP's RRT-Connect has it on): a sample farther from its nearest node than
             that node's radius is dropped unchecked; a failed extension gives its node a

@@ -27,6 +27,7 @@ from plannerlab.planners.base import BudgetTracker, PlanResult, Status
 from plannerlab.planners.context import PlanningContext
 from plannerlab.planners.goal_pool import fill_goal_pool
 from plannerlab.planners.native import kernels as K
+from plannerlab.planners.native.kdtree import split_dims
 from plannerlab.planners.native.settings import NativeSettings
 from plannerlab.robots.base import Array, wrap_to_pi
 from plannerlab.robots.paths import path_length
@@ -189,7 +190,7 @@ class NativeSolve:
         by_memory = int(self.s.max_tree_mb * 1e6 / 2 / (8 * dof + 8 + index_bytes))
         return max(min(by_memory, hard + roots + 1), roots + 1)
 
-    def simplify(self, P: Array, model: Any, V: Any, S: Any, rng_state: np.ndarray) -> Array:
+    def simplify(self, P: Array, rng_state: np.ndarray) -> Array:
         """The path shortened in compiled code (:func:`~plannerlab.planners.native.
         kernels.shortcut_run`), keeping back the checks and the time of its re-check."""
         P = np.ascontiguousarray(P.copy())
@@ -198,17 +199,18 @@ class NativeSolve:
         tries = self.s.shortcut_tries or max(32, 4 * k)
         counters = np.zeros(4, dtype=np.int64)
         self._charged = 0
-        buf = np.empty((4, P.shape[1]))
         left = self.tracker.checks_left()
         hard = UNLIMITED if left is None else left - cost
         if hard <= 0 or self._time_reserve_reached(cost):
             self.extra["simplify_checks"] = 0
             return P
         box = [k]
+        aux = self.aux(rng_state, k)
 
         def call(soft: int, _hard: int) -> int:
-            box[0], code = K.shortcut_run(
-                P, box[0], model, V, S, self.step, rng_state, tries, counters, soft, hard, buf
+            limits = np.array([soft, hard], dtype=np.int64)
+            box[0], code = K.shortcut_entry(
+                self.packed, aux, (P, box[0]), self.step, tries, counters, limits
             )
             return int(code)
 
@@ -216,6 +218,32 @@ class NativeSolve:
         self.extra["simplify_checks"] = int(counters[1])
         self.extra["shortcut_tries"] = int(counters[0])
         return P[: box[0]].copy()
+
+    @property
+    def packed(self) -> tuple[np.ndarray, ...]:
+        """The checker's packed compiled model (what the kernels' entries take)."""
+        return self.checker.packed_model
+
+    def aux(self, rng_state: np.ndarray, rows: int) -> tuple[Any, ...]:
+        """The kernels' scratch for trees of ``rows`` rows: (generator state, scratch
+        states, the k-d trees' split joints, their search's scratch)."""
+        dof = len(self.q0)
+        depth = rows + 2
+        ks = (np.empty(depth, dtype=np.int64), np.empty(depth), np.empty((depth, dof)))
+        return (rng_state, np.empty((4, dof)), split_dims(self.checker.model.continuous), ks)
+
+    def options(self, range_rad: float, max_it: int, need_free: int) -> K.Options:
+        """The search's options (:class:`~plannerlab.planners.native.kernels.Options`)."""
+        s = self.s
+        dd = np.zeros(3)
+        if getattr(s, "dynamic_domain", False):
+            dd[:] = (2.0 * range_rad, 0.5 * range_rad, 1e-4)  # VAMP's 4, 1 for its range 2
+        return K.Options(
+            self.guides,
+            np.array([s.guide_bias, s.guide_sigma_rad, range_rad, self.step]),
+            dd,
+            np.array([max_it, need_free, int(getattr(s, "lazy_every", 1))], dtype=np.int64),
+        )
 
     def _time_reserve_reached(self, recheck_checks: int) -> bool:
         """The time left is the re-check's (at the search's rate, with a margin)."""
@@ -314,64 +342,25 @@ class NativeSolve:
 
     def search(
         self,
-        model: Any,
-        V: Any,
-        S: Any,
         trees: list[np.ndarray],
         sizes: np.ndarray,
         counters: np.ndarray,
         rng_state: np.ndarray,
-        range_rad: float,
-        need_free: int,
+        O: K.Options,
         cap: int,
-        max_it: int,
         iterations0: int = 0,
     ) -> int:
         """The compiled RRT-Connect on ``trees`` in chunks (:meth:`run_chunks`), the trees
         grown (up to ``cap`` rows) when full; ``iterations`` counts from ``iterations0``.
         Returns the kernel's last code."""
-        dof = trees[0].shape[1]
-        dd = np.zeros(3)
-        if getattr(self.s, "dynamic_domain", False):
-            dd[:] = (2.0 * range_rad, 0.5 * range_rad, 1e-4)  # VAMP's 4, 1 for its range 2
-        every = int(getattr(self.s, "lazy_every", 1))
-        buf = np.empty((4, dof))
         self._charged = 0
-        s = self.s
 
         def call(soft: int, hard: int) -> int:
-            return int(
-                K.rrtc_run(
-                    model,
-                    V,
-                    S,
-                    trees[0],
-                    trees[1],
-                    trees[2],
-                    trees[3],
-                    trees[4],
-                    trees[5],
-                    trees[6],
-                    trees[7],
-                    trees[8],
-                    trees[9],
-                    sizes,
-                    counters,
-                    rng_state,
-                    self.guides,
-                    s.guide_bias,
-                    s.guide_sigma_rad,
-                    range_rad,
-                    self.step,
-                    every,
-                    dd,
-                    max_it,
-                    soft,
-                    hard,
-                    need_free,
-                    buf,
-                )
-            )
+            A = K.Tree(trees[0], trees[1], trees[2], trees[3], trees[8])
+            B = K.Tree(trees[4], trees[5], trees[6], trees[7], trees[9])
+            aux = self.aux(rng_state, max(len(trees[0]), len(trees[4])))
+            limits = np.array([soft, hard], dtype=np.int64)
+            return int(K.rrtc_entry(self.packed, aux, A, B, sizes, O, counters, limits))
 
         while True:
             code = self.run_chunks(call, counters)
@@ -396,7 +385,6 @@ class NativeSolve:
         if failed is not None:
             return failed
         rng_state = K.seed_state(self.rng)
-        V, S = K_views(model)
         dof = len(q0)
         range_rad = self.s.range_rad or 0.2 * space_extent(model)
         self.extra["range_rad"] = range_rad
@@ -409,26 +397,20 @@ class NativeSolve:
         sizes = np.array([1, len(G)], dtype=np.int64)
         counters = np.zeros(6, dtype=np.int64)
         max_it = UNLIMITED if self.budget.max_iterations is None else self.budget.max_iterations
-        code = self.search(
-            model, V, S, trees, sizes, counters, rng_state, range_rad, need_free, cap, max_it
-        )
+        O = self.options(range_rad, max_it, need_free)
+        code = self.search(trees, sizes, counters, rng_state, O, cap)
         self.extra["planning_checks"] = int(counters[1])
         self.extra["nodes"] = [int(sizes[0]), int(sizes[1])]
         self.extra["paths_failing_fine_check"] = int(counters[5])
         if code != K.DONE:
             return self.stopped(code, f"{int(sizes[0])} + {int(sizes[1])} tree nodes")
         out = np.empty((int(sizes.sum()), dof))
-        k = K.tree_path(trees[0], trees[1], counters[3], trees[4], trees[5], counters[4], out)
+        A = K.Tree(trees[0], trees[1], trees[2], trees[3], trees[8])
+        B = K.Tree(trees[4], trees[5], trees[6], trees[7], trees[9])
+        k = K.tree_path(A, counters[3], B, counters[4], out)
         path = out[:k].copy()
         self.extra["waypoints_raw"] = k
         self.extra["length_raw"] = path_length(path, self.robot.continuous)
         if self.s.simplify:
-            path = self.simplify(path, model, V, S, rng_state)
+            path = self.simplify(path, rng_state)
         return self.checked(path)
-
-
-def K_views(model: Any) -> tuple[Any, Any]:  # noqa: N802
-    """The model's views for the kernels (:func:`plannerlab.collision.model.views`)."""
-    from plannerlab.collision.model import views
-
-    return views(model)

@@ -1,5 +1,5 @@
 """Loading the compiled planners' kernels (from numba's cache, or compiling them) before
-a leg's clock starts: each kernel is run once on a tiny model of its own types."""
+a leg's clock starts: each kernel entry is run once on a tiny model of its own types."""
 
 from __future__ import annotations
 
@@ -8,49 +8,48 @@ from typing import Any
 import numpy as np
 
 
-def warm_up(model: Any | None = None) -> None:
-    """Run every kernel entry point once, doing no work of note (``model``: a compiled
-    model to run them on; default: a two-joint chain in an empty room)."""
-    from plannerlab.collision.model import views
+def warm_up(checker: Any | None = None) -> None:
+    """Run every kernel entry point once, doing no work of note (``checker``: a collision
+    checker whose compiled model to run them on; default: a three-module Arm-Z beside a
+    sphere)."""
     from plannerlab.planners.native import kernels as K
     from plannerlab.planners.native import rrtstar as R
+    from plannerlab.planners.native.kdtree import split_dims
 
-    entries = (views, K.rrtc_run, K.tree_path, K.shortcut_run, R.rrtstar_run, R.chain)
-    if model is None and all(getattr(f, "signatures", True) for f in entries):
+    entries = (K.rrtc_entry, K.tree_path, K.shortcut_entry, R.rrtstar_entry, R.chain)
+    if checker is None and all(getattr(f, "signatures", True) for f in entries):
         return  # loaded in this process already
-    if model is None:
-        model = _tiny_model()
-    V, S = views(model)
-    dof = model.lower.shape[0]
-    Q = np.zeros((4, dof))
-    P = np.full(4, -1, dtype=np.int64)
-    sizes = np.array([1, 1], dtype=np.int64)
-    counters = np.zeros(6, dtype=np.int64)
+    if checker is None:
+        checker = _tiny_checker()
+    P = checker.packed_model
+    dof = checker.robot.dof
     rng = np.array([1, 2, 3, 4], dtype=np.uint64)
-    buf = np.empty((4, dof))
-    guides = np.zeros((0, dof))
-    F = np.ones(4, dtype=np.int8)
+    ks = (np.empty(6, dtype=np.int64), np.empty(6), np.empty((6, dof)))
+    aux = (rng, np.empty((4, dof)), split_dims(checker.model.continuous), ks)
+    Q = np.zeros((4, dof))
+    P0 = np.full(4, -1, dtype=np.int64)
+    F = np.zeros(4, dtype=np.int8)
     radii = np.full(4, np.inf)
     Kd = np.full((4, 3), -1, dtype=np.int64)
-    K.rrtc_run(
-        model, V, S, Q, P, F, radii, Q, P, F, radii, Kd, Kd.copy(), sizes, counters, rng,
-        guides, 0.0, 0.1,
-        1.0, 0.1, 8, np.zeros(3), 0, 0, 0, 1, buf,
+    A = K.Tree(Q, P0, F, radii, Kd)
+    B = K.Tree(Q.copy(), P0.copy(), F.copy(), radii.copy(), Kd.copy())
+    O = K.Options(
+        np.zeros((0, dof)), np.array([0.0, 0.1, 1.0, 0.1]), np.zeros(3),
+        np.array([0, 1, 1], dtype=np.int64),
     )  # fmt: skip
-    K.tree_path(Q, P, 0, Q, P, 0, Q.copy())
-    K.shortcut_run(Q, 1, model, V, S, 0.1, rng, 0, np.zeros(4, dtype=np.int64), 0, 0, buf)
-    cost = np.zeros(4)
-    R.rrtstar_run(
-        model, V, S, Q, P, cost, P.copy(), P.copy(), P.copy(), P.copy(), F,
-        np.array([1, 0], dtype=np.int64),
-        np.array([0, 0, -1, 0], dtype=np.int64), rng, guides, 0.0, guides, 0.0, 0.1, 1.0, 0.1,
-        1.0, 0, 0, 0, buf, np.empty(4, dtype=np.int64), np.empty(4), np.empty(4, dtype=np.int64),
-    )  # fmt: skip
-    R.chain(Q, P, 0, Q.copy())
+    limits = np.zeros(2, dtype=np.int64)
+    K.rrtc_entry(P, aux, A, B, np.array([1, 1]), O, np.zeros(6, dtype=np.int64), limits)
+    K.tree_path(A, 0, B, 0, Q.copy())
+    K.shortcut_entry(P, aux, (Q, 1), 0.1, 0, np.zeros(4, dtype=np.int64), limits)
+    T = R.StarTree(Q, P0, np.zeros(4), P0.copy(), P0.copy(), P0.copy(), P0.copy(), F)
+    X = R.Star(np.zeros((0, dof)), np.zeros(0, dtype=np.int64), np.array([0.0, 1.0]),
+               np.empty(4, dtype=np.int64), np.empty(4))  # fmt: skip
+    R.rrtstar_entry(P, aux, T, X, np.array([1, 0]), O, np.array([0, 0, -1, 0]), limits)
+    R.chain(Q, P0, 0, Q.copy())
 
 
-def _tiny_model() -> Any:
-    """The compiled model of a three-module Arm-Z beside one small sphere."""
+def _tiny_checker() -> Any:
+    """A checker of a three-module Arm-Z beside one small sphere."""
     from plannerlab.collision.fcl_checker import CollisionChecker
     from plannerlab.problem.scene import Scene, Sphere
     from plannerlab.robots.armz.model import ArmZ
@@ -58,4 +57,4 @@ def _tiny_model() -> Any:
 
     scene = Scene((Sphere("far", trans(5.0, 0.0, 0.0), 0.1),))
     robot: Any = ArmZ(n_modules=3)
-    return CollisionChecker(robot, scene, margin_m=0.01).model
+    return CollisionChecker(robot, scene, margin_m=0.01)

@@ -142,8 +142,9 @@ class _Solve:
         try:
             from plannerlab.planners.trajopt.geometry import PathGeometry
 
-            model = self.checker.model
-            self.geometry = PathGeometry(self.robot, self.ctx.scene, model, self.tracker.time_up)
+            # the sphere field rides on the robot's chain packed alone (the checker's own
+            # model is the state test's, in another layout)
+            self.geometry = PathGeometry(self.robot, self.ctx.scene, None, self.tracker.time_up)
         except ValueError as e:
             raise PlannerlabError(
                 f"{self.planner.name}: no compiled model of this problem: {e}"

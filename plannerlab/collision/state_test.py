@@ -1,0 +1,644 @@
+"""The state test: is the robot free at these states? One test per robot, in vector lanes.
+
+Every planner spends its time here. :func:`test_lanes` tests up to eight states side by
+side (the *lanes* of :mod:`plannerlab.collision.simd`: one float32 vector per quantity)
+on the compiled model (:class:`~plannerlab.collision.model.CompiledModel`), in two stages:
+
+1. **A float32 filter in the lanes**: the kinematics of
+   :mod:`plannerlab.collision.kinematics`, then per body a gate (a ball around its
+   capsules) against each obstacle and each other body's gate, then the gates of the
+   body's clusters (a few neighbouring capsules each), then the capsules behind a gate
+   that is not clear. Every radius is grown by the model's bound ``eps32_m`` of how far
+   float32 can be off: a lane whose every pair is clear by more than that is **free**
+   (certainly: in float64 too), a lane with a pair closer than its radius by more than
+   that has **hit** (certainly), and a lane in the thin band between is **unsure**.
+2. **A float64 confirmation** of the unsure lanes, state by state (:func:`exact_state`):
+   the same kinematics in float64 and the exact tests of
+   :mod:`plannerlab.collision.geometry` (FCL's verdicts to 1e-6 m). The verdicts are the
+   exact float64 ones; the filter decides quickly where deciding is easy.
+
+**Distances in the lanes.** A sphere (a capsule of zero length) against an obstacle or
+another sphere is a point's distance, exact up to rounding (squared, no root). A
+capsule's segment against a convex shape (a box, a cylinder, a sphere, another segment):
+the distance from ``x(t) = a + t (b − a)`` to a convex set is convex in ``t``, so its
+tangents at ``t = 0`` and ``t = 1`` (from the distance and its gradient at the ends) bound
+it from below on ``[0, 1]``: the smaller end is the minimum when the slope there points
+outward, else the tangents' crossing is a lower bound. That bound decides "free"; the
+distance at the ends and at the crossing (real points of the segment) decides "hit". Both
+are exact when the closest point is an end or the segment runs parallel to a face;
+elsewhere the band between them is confirmed in float64.
+
+**Growth for certified edges.** Each lane carries a growth ``grow[k]`` [1] and each
+capsule a rate ``rate[l]`` [m]: lane ``k`` tests capsule ``l`` with its radius grown by
+``grow[k] · rate[l]`` (a link pair by both). A state free with every capsule grown by how
+far it can move along a stretch of an edge proves the whole stretch free
+(:mod:`plannerlab.collision.edges`). ``grow = 0`` is the plain test.
+
+**Modes.** ``ANY_HIT`` stops at the first lane of growth 0 that has certainly hit (an edge
+is then invalid: nothing else need be known); ``EVERY_LANE`` gives every lane's verdict.
+Lane verdicts travel as bit masks (bit k: lane k), so a pass returns two integers.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import NamedTuple
+
+import numpy as np
+from numba import njit
+
+from plannerlab.collision.exact import exact_state
+from plannerlab.collision.geometry import BOX, SPHERE
+from plannerlab.collision.kinematics import chain_frames, chain_values, place
+from plannerlab.collision.simd import (
+    LANES,
+    fma,
+    kernel,
+    load,
+    mask_bits,
+    select,
+    splat,
+    store,
+    vabs,
+    vmax,
+    vmin,
+    vsqrt,
+)
+
+#: lanes of one call
+W = LANES
+#: mode: every lane's verdict
+EVERY_LANE = 0
+#: mode: stop once a lane of growth 0 has certainly hit
+ANY_HIT = 1
+_ALL = (1 << LANES) - 1
+_F4 = np.float32
+
+
+class Lanes(NamedTuple):
+    """The scratch of the state test and the edge check (made once per search by
+    :func:`lanes`); flat float32 arrays of 8-lane slots, then the float64 confirmation's
+    one state (``e_*``), then the edge check's (``edge_*``)."""
+
+    Q: np.ndarray  # (dof * W,) the states, continuous joints wrapped
+    V: np.ndarray  # (m * W,) the chain's joint values (a coupled chain)
+    F: np.ndarray  # (nb * 12 * W,) body frames
+    G: np.ndarray  # (nb * 3 * W,) body gate centres
+    K: np.ndarray  # (ncl * 3 * W,) cluster gate centres
+    X: np.ndarray  # (L * 6 * W,) capsule ends a (xyz), b (xyz)
+    placed: np.ndarray  # (ncl,) int64: 0 nothing, 1 the cluster's centre, 2 its capsules
+    grow: np.ndarray  # (W,) float32: each lane's growth
+    rate: np.ndarray  # (L,) float32: each capsule's rate [m] (packed order)
+    crate: np.ndarray  # (ncl,) float32: each cluster's largest rate
+    brate: np.ndarray  # (nb,) float32: each body's largest rate
+    Q64: np.ndarray  # (W, dof) float64: the states as given (the confirmation's)
+    grow64: np.ndarray  # (W,) float64
+    rate64: np.ndarray  # (L,) float64
+    brate64: np.ndarray  # (nb,) float64
+    e_Q: np.ndarray  # (dof,) the confirmation's state
+    e_V: np.ndarray  # (m,)
+    e_F: np.ndarray  # (nb * 12,) its frames
+    e_XA: np.ndarray  # (L, 3) its capsule ends
+    e_XB: np.ndarray  # (L, 3)
+    e_placed: np.ndarray  # (nb,) int64
+    e_w: np.ndarray  # (64,) the exact tests' scratch
+    e_R: np.ndarray  # (n, 3, 3) the obstacles' rotations as matrices
+    edge_d: np.ndarray  # (dof,) an edge's direction
+    edge_q: np.ndarray  # (dof,) a grid state
+    edge_rate: np.ndarray  # (L,) the capsules' motion per grid step [m]
+    edge_stack: np.ndarray  # (S, 2) int64 stretches still to prove
+    edge_marks: np.ndarray  # (3, W) int64 the stretches of one call
+
+
+@njit(cache=True, nogil=True)
+def lanes(m):
+    """The scratch of the state test and the edge check for the model m."""
+    dof = m.lower.shape[0]
+    nj = m.parent.shape[0]
+    nb = nj + 1
+    L = max(m.cap_body.shape[0], 1)
+    ncl = max(m.cl_body.shape[0], 1)
+    n = m.obs_kind.shape[0]
+    R = np.empty((n, 3, 3))
+    for o in range(n):
+        for a in range(3):
+            for b in range(3):
+                R[o, a, b] = m.obs_R[o, 3 * a + b]
+    f4 = np.float32
+    return Lanes(
+        np.zeros(dof * W, dtype=f4),
+        np.zeros(max(nj, 1) * W, dtype=f4),
+        np.zeros(nb * 12 * W, dtype=f4),
+        np.zeros(nb * 3 * W, dtype=f4),
+        np.zeros(ncl * 3 * W, dtype=f4),
+        np.zeros(L * 6 * W, dtype=f4),
+        np.zeros(ncl, dtype=np.int64),
+        np.zeros(W, dtype=f4),
+        np.zeros(L, dtype=f4),
+        np.zeros(ncl, dtype=f4),
+        np.zeros(nb, dtype=f4),
+        np.zeros((W, dof)),
+        np.zeros(W),
+        np.zeros(L),
+        np.zeros(nb),
+        np.zeros(dof),
+        np.zeros(max(nj, 1)),
+        np.zeros(nb * 12),
+        np.zeros((L, 3)),
+        np.zeros((L, 3)),
+        np.zeros(nb, dtype=np.int64),
+        np.zeros(64),
+        R,
+        np.zeros(dof),
+        np.zeros(dof),
+        np.zeros(L),
+        np.zeros((4096, 2), dtype=np.int64),
+        np.zeros((3, W), dtype=np.int64),
+    )
+
+
+# ------------------------------------------------------------------ loading the lanes
+@kernel
+def load_state(Z, k, q, continuous):
+    """Lane k holds state q (dof,): its float64 copy, and in float32 with continuous
+    joints wrapped into [-π, π] (the filter's kinematics stay accurate)."""
+    for i in range(q.shape[0]):
+        x = q[i]
+        Z.Q64[k, i] = x
+        if continuous[i]:
+            x = x - 2.0 * math.pi * math.floor(x / (2.0 * math.pi) + 0.5)
+        Z.Q[i * W + k] = np.float32(x)
+
+
+@kernel
+def fill_lanes(Z, n):
+    """Lanes n..W-1 repeat lane 0 (a call tests W lanes whatever is asked; a copy is
+    harmless and is not reported)."""
+    dof = Z.Q64.shape[1]
+    for k in range(n, W):
+        for i in range(dof):
+            Z.Q64[k, i] = Z.Q64[0, i]
+            Z.Q[i * W + k] = Z.Q[i * W]
+        Z.grow[k] = Z.grow[0]
+        Z.grow64[k] = Z.grow64[0]
+
+
+@kernel
+def set_plain(Z):
+    """Every lane grows by nothing (the plain test)."""
+    for k in range(W):
+        Z.grow[k] = 0.0
+        Z.grow64[k] = 0.0
+
+
+@kernel
+def set_rates(m, Z, rate64):
+    """Every capsule's rate [m] for grown lanes (packed order), and each cluster's and
+    body's largest (their gates grow by it). The float32 copies are rounded up, so a
+    grown radius is never short."""
+    up = np.float32(1.0 + 2.0**-20)
+    for b in range(Z.brate.shape[0]):
+        Z.brate[b] = 0.0
+        Z.brate64[b] = 0.0
+    for c in range(m.cl_body.shape[0]):
+        Z.crate[c] = 0.0
+        for l in range(m.cl_caps[c], m.cl_caps[c + 1]):
+            r = rate64[l]
+            r32 = np.float32(r) * up
+            Z.rate64[l] = r
+            Z.rate[l] = r32
+            b = m.cap_body[l]
+            Z.crate[c] = max(Z.crate[c], r32)
+            Z.brate[b] = max(Z.brate[b], r32)
+            Z.brate64[b] = max(Z.brate64[b], r)
+
+
+# ------------------------------------------------------------------ geometry in the lanes
+# Helpers take tables and rows (``obs32``, ``caps32``, ...), never the model: a named
+# tuple handed to a function inlined by numba has every array in it counted in and out
+# (measured: ~2 000 cycles a call on the Panda's model).
+@kernel
+def _local(O, o, x, y, z):
+    """Lane points in obstacle o's frame (O: ``obs32``)."""
+    x = x - splat(O[o, 0])
+    y = y - splat(O[o, 1])
+    z = z - splat(O[o, 2])
+    u = fma(splat(O[o, 6]), x, fma(splat(O[o, 9]), y, splat(O[o, 12]) * z))
+    v = fma(splat(O[o, 7]), x, fma(splat(O[o, 10]), y, splat(O[o, 13]) * z))
+    t = fma(splat(O[o, 8]), x, fma(splat(O[o, 11]), y, splat(O[o, 14]) * z))
+    return u, v, t
+
+
+@kernel
+def _point_d2(kind, O, o, x, y, z):
+    """Squared distance of lane points to obstacle o (0 inside)."""
+    zero = splat(0.0)
+    if kind == SPHERE:
+        dx, dy, dz = x - splat(O[o, 0]), y - splat(O[o, 1]), z - splat(O[o, 2])
+        d = vmax(vsqrt(fma(dx, dx, fma(dy, dy, dz * dz))) - splat(O[o, 3]), zero)
+        return d * d
+    u, v, t = _local(O, o, x, y, z)
+    if kind == BOX:
+        u = vmax(vabs(u) - splat(O[o, 3]), zero)
+        v = vmax(vabs(v) - splat(O[o, 4]), zero)
+        t = vmax(vabs(t) - splat(O[o, 5]), zero)
+        return fma(u, u, fma(v, v, t * t))
+    rr = vmax(vsqrt(fma(u, u, v * v)) - splat(O[o, 3]), zero)
+    zz = vmax(vabs(t) - splat(O[o, 4]), zero)
+    return fma(rr, rr, zz * zz)
+
+
+@kernel
+def _sd_grad(kind, O, o, x, y, z):
+    """Signed distance of lane points to obstacle o, and its gradient (world)."""
+    zero, one, tiny = splat(0.0), splat(1.0), splat(1e-20)
+    if kind == SPHERE:
+        dx, dy, dz = x - splat(O[o, 0]), y - splat(O[o, 1]), z - splat(O[o, 2])
+        d = vsqrt(fma(dx, dx, fma(dy, dy, dz * dz)))
+        inv = one / vmax(d, tiny)
+        return d - splat(O[o, 3]), dx * inv, dy * inv, dz * inv
+    u, v, t = _local(O, o, x, y, z)
+    su = select(u >= zero, one, -one)
+    sv = select(v >= zero, one, -one)
+    st = select(t >= zero, one, -one)
+    if kind == BOX:
+        qu = vabs(u) - splat(O[o, 3])
+        qv = vabs(v) - splat(O[o, 4])
+        qt = vabs(t) - splat(O[o, 5])
+        ou, ov, ot = vmax(qu, zero), vmax(qv, zero), vmax(qt, zero)
+        out = vsqrt(fma(ou, ou, fma(ov, ov, ot * ot)))
+        inv = one / vmax(out, tiny)
+        iu = (qu >= qv) & (qu >= qt)
+        iv = (~iu) & (qv >= qt)
+        it = ~(iu | iv)
+        outside = out > zero
+        gu = select(outside, su * ou * inv, select(iu, su, zero))
+        gv = select(outside, sv * ov * inv, select(iv, sv, zero))
+        gt = select(outside, st * ot * inv, select(it, st, zero))
+        d = out + vmin(vmax(qu, vmax(qv, qt)), zero)
+    else:  # a cylinder along its z: radius O[o, 3], half length O[o, 4]
+        rho = vsqrt(fma(u, u, v * v))
+        qr = rho - splat(O[o, 3])
+        qz = vabs(t) - splat(O[o, 4])
+        orr, oz = vmax(qr, zero), vmax(qz, zero)
+        out = vsqrt(fma(orr, orr, oz * oz))
+        inv = one / vmax(out, tiny)
+        inv_rho = one / vmax(rho, tiny)
+        radial = qr >= qz
+        outside = out > zero
+        gr = select(outside, orr * inv, select(radial, one, zero))
+        gu, gv = gr * u * inv_rho, gr * v * inv_rho
+        gt = select(outside, oz * inv * st, select(radial, zero, st))
+        d = out + vmin(vmax(qr, qz), zero)
+    g0 = fma(splat(O[o, 6]), gu, fma(splat(O[o, 7]), gv, splat(O[o, 8]) * gt))
+    g1 = fma(splat(O[o, 9]), gu, fma(splat(O[o, 10]), gv, splat(O[o, 11]) * gt))
+    g2 = fma(splat(O[o, 12]), gu, fma(splat(O[o, 13]), gv, splat(O[o, 14]) * gt))
+    return d, g0, g1, g2
+
+
+@kernel
+def _tangent_bounds(fa, sa, fb, sb):
+    """The tangents' lower bound of a convex f on [0, 1] from f and its slope at both
+    ends (see the module), and the t where they cross (where to look for an upper one)."""
+    zero, one = splat(0.0), splat(1.0)
+    den = sb - sa  # > 0 when the minimum is inside: the tangents cross at t
+    ok = den > splat(1e-20)
+    t = select(ok, (fa + sb - fb) / select(ok, den, one), zero)
+    t = vmin(vmax(t, zero), one)
+    lo = fma(sa, t, fa)
+    lo = select(sa >= zero, fa, lo)
+    lo = select(sb <= zero, fb, lo)
+    return lo, t
+
+
+@kernel
+def _ends(X, l):
+    """Capsule l's ends (a, b), three lane vectors each."""
+    o = 6 * l * W
+    return (
+        load(X, o),
+        load(X, o + W),
+        load(X, o + 2 * W),
+        load(X, o + 3 * W),
+        load(X, o + 4 * W),
+        load(X, o + 5 * W),
+    )
+
+
+@kernel
+def _pt_seg(x0, x1, x2, S):
+    """Distance from lane points x to segments p + u e (u in [0, 1]; S = p0, p1, p2, e0,
+    e1, e2, e·e), and the vector to x from its closest point."""
+    p0, p1, p2, e0, e1, e2, ee = S
+    u = fma(x0 - p0, e0, fma(x1 - p1, e1, (x2 - p2) * e2)) / ee
+    u = vmin(vmax(u, splat(0.0)), splat(1.0))
+    y0 = x0 - fma(u, e0, p0)
+    y1 = x1 - fma(u, e1, p1)
+    y2 = x2 - fma(u, e2, p2)
+    return vsqrt(fma(y0, y0, fma(y1, y1, y2 * y2))), y0, y1, y2
+
+
+@kernel
+def _segment_obstacle(kind, O, o, E):
+    """Bounds of the signed distance from lane segments E = (a0, a1, a2, b0, b1, b2) to
+    obstacle o: (lower, upper)."""
+    a0, a1, a2, b0, b1, b2 = E
+    fa, ga0, ga1, ga2 = _sd_grad(kind, O, o, a0, a1, a2)
+    fb, gb0, gb1, gb2 = _sd_grad(kind, O, o, b0, b1, b2)
+    d0, d1, d2 = b0 - a0, b1 - a1, b2 - a2
+    sa = fma(ga0, d0, fma(ga1, d1, ga2 * d2))
+    sb = fma(gb0, d0, fma(gb1, d1, gb2 * d2))
+    lo, t = _tangent_bounds(fa, sa, fb, sb)
+    fm, _, _, _ = _sd_grad(kind, O, o, fma(t, d0, a0), fma(t, d1, a1), fma(t, d2, a2))
+    return lo, vmin(vmin(fa, fb), fm)
+
+
+@kernel
+def _segments(E1, E2):
+    """Bounds of the distance between lane segments E1 and E2 (six vectors each; a sphere
+    is a segment of zero length): the distance from a point of the first to the second
+    is convex along the first (the tangents' bound, as against an obstacle)."""
+    a0, a1, a2, b0, b1, b2 = E1
+    p0, p1, p2, q0, q1, q2 = E2
+    d0, d1, d2 = b0 - a0, b1 - a1, b2 - a2
+    e0, e1, e2 = q0 - p0, q1 - p1, q2 - p2
+    tiny = splat(1e-20)
+    S = (p0, p1, p2, e0, e1, e2, vmax(fma(e0, e0, fma(e1, e1, e2 * e2)), tiny))
+    fa, y0, y1, y2 = _pt_seg(a0, a1, a2, S)
+    sa = fma(y0, d0, fma(y1, d1, y2 * d2)) / vmax(fa, tiny)
+    fb, y0, y1, y2 = _pt_seg(b0, b1, b2, S)
+    sb = fma(y0, d0, fma(y1, d1, y2 * d2)) / vmax(fb, tiny)
+    lo, t = _tangent_bounds(fa, sa, fb, sb)
+    fm, _, _, _ = _pt_seg(fma(t, d0, a0), fma(t, d1, a1), fma(t, d2, a2), S)
+    return lo, vmin(vmin(fa, fb), fm)
+
+
+@kernel
+def _grade_d2(d2, r0, rg, eps, hu):
+    """The lane masks ``hu`` = (hit, unsure grown, unsure plain) updated with squared
+    distances d2: hit when closer than the plain radius r0 less eps (certainly, in
+    float64 too); unsure grown unless farther than the grown radius rg plus eps; unsure
+    plain unless farther than r0 plus eps."""
+    lo = vmax(r0 - eps, splat(0.0))
+    hg = rg + eps
+    h0 = r0 + eps
+    return (
+        hu[0] | mask_bits(d2 < lo * lo),
+        hu[1] | mask_bits(d2 <= hg * hg),
+        hu[2] | mask_bits(d2 <= h0 * h0),
+    )
+
+
+@kernel
+def _grade_bounds(lo_d, hi_d, r0, rg, eps, hu):
+    """The lane masks (hit, unsure grown, unsure plain) updated with a distance's lower
+    and upper bounds (as :func:`_grade_d2`)."""
+    return (
+        hu[0] | mask_bits(hi_d < r0 - eps),
+        hu[1] | mask_bits(lo_d <= rg + eps),
+        hu[2] | mask_bits(lo_d <= r0 + eps),
+    )
+
+
+@kernel
+def _near(d2, r, live):
+    """Some live lane has d2 within r (squared)."""
+    return (mask_bits(d2 <= r * r) & live) != 0
+
+
+@kernel
+def _gap2(A, a, B, b):
+    """Squared distance between the points in slots A[a:] and B[b:] (three each)."""
+    x = load(A, a) - load(B, b)
+    y = load(A, a + W) - load(B, b + W)
+    z = load(A, a + 2 * W) - load(B, b + 2 * W)
+    return fma(x, x, fma(y, y, z * z))
+
+
+@kernel
+def _slot3(A, i):
+    """The three vectors of slot i (x, y, z)."""
+    return load(A, 3 * i * W), load(A, (3 * i + 1) * W), load(A, (3 * i + 2) * W)
+
+
+# ------------------------------------------------------------------ the filter's passes
+@kernel
+def frames32(m, Z):
+    """Every body's frame in the eight lanes, and the body gates' centres."""
+    if m.cpl_start.shape[0] > 0:
+        chain_values(Z.Q, (m.cpl_start, m.cpl_idx, m.cpl_val), Z.V)
+        chain_frames(Z.F, Z.V, m.T0_32, m.pre_32, m.parent, m.slide)
+    else:
+        chain_frames(Z.F, Z.Q, m.T0_32, m.pre_32, m.parent, m.slide)
+    F, G, gates = Z.F, Z.G, m.gates32
+    for b in range(gates.shape[0]):
+        x, y, z = place(F, b, gates, b, 0)
+        store(G, 3 * b * W, x)
+        store(G, (3 * b + 1) * W, y)
+        store(G, (3 * b + 2) * W, z)
+
+
+@kernel
+def _place_cluster(F, X, K, c, tables, placed):
+    """Cluster c's gate centre (placed 1), or its capsules' ends too (placed 2: ``placed``
+    asks which): tables = (cls32, caps32, cl_caps, cl_body, cap_sphere, state)."""
+    cls, caps, cl_caps, cl_body, sphere, state = tables
+    b = cl_body[c]
+    if state[c] == 0:
+        x, y, z = place(F, b, cls, c, 0)
+        store(K, 3 * c * W, x)
+        store(K, (3 * c + 1) * W, y)
+        store(K, (3 * c + 2) * W, z)
+        state[c] = 1
+    if placed < 2 or state[c] == 2:
+        return
+    for l in range(cl_caps[c], cl_caps[c + 1]):
+        x, y, z = place(F, b, caps, l, 0)
+        o = 6 * l * W
+        store(X, o, x)
+        store(X, o + W, y)
+        store(X, o + 2 * W, z)
+        if not sphere[l]:
+            x, y, z = place(F, b, caps, l, 3)
+        store(X, o + 3 * W, x)
+        store(X, o + 4 * W, y)
+        store(X, o + 5 * W, z)
+    state[c] = 2
+
+
+@njit(cache=True, nogil=True, inline="always")
+def _stop(hit, mode):
+    """The mode's stop: a lane has hit (ANY_HIT), or every lane has."""
+    if mode == ANY_HIT:
+        return hit != 0
+    return hit == _ALL
+
+
+@kernel
+def _scene_pass(m, Z, mode, hu):
+    """Every moving capsule against every obstacle, behind its body's and its cluster's
+    gates: the lane masks ``hu`` (see :func:`_grade_d2`) updated, and whether the mode's
+    stop came."""
+    O, kinds, caps, cls, gates = m.obs32, m.obs_kind, m.caps32, m.cls32, m.gates32
+    F, G, K, X = Z.F, Z.G, Z.K, Z.X
+    tables = (cls, caps, m.cl_caps, m.cl_body, m.cap_sphere, Z.placed)
+    grow = load(Z.grow, 0)
+    eps = splat(m.eps32_m)
+    for kb in range(m.body_order.shape[0]):
+        b = m.body_order[kb]
+        if gates[b, 3] < 0.0:
+            continue
+        gx, gy, gz = _slot3(G, b)
+        rb = fma(grow, splat(Z.brate[b]), splat(gates[b, 3]) + eps)
+        for o in range(kinds.shape[0]):
+            kind = kinds[o]
+            if not _near(_point_d2(kind, O, o, gx, gy, gz), rb, _ALL & ~hu[0]):
+                continue
+            for c in range(m.body_cls[b], m.body_cls[b + 1]):
+                if cls[c, 3] < 0.0:
+                    continue
+                _place_cluster(F, X, K, c, tables, 1)
+                kx, ky, kz = _slot3(K, c)
+                rc = fma(grow, splat(Z.crate[c]), splat(cls[c, 3]) + eps)
+                if not _near(_point_d2(kind, O, o, kx, ky, kz), rc, _ALL & ~hu[0]):
+                    continue
+                _place_cluster(F, X, K, c, tables, 2)
+                for l in range(m.cl_caps[c], m.cl_caps[c + 1]):
+                    if not m.cap_moving[l]:
+                        continue
+                    r0 = splat(caps[l, 6])
+                    r = fma(grow, splat(Z.rate[l]), r0)
+                    if m.cap_sphere[l]:
+                        o6 = 6 * l * W
+                        d2 = _point_d2(
+                            kind, O, o, load(X, o6), load(X, o6 + W), load(X, o6 + 2 * W)
+                        )
+                        hu = _grade_d2(d2, r0, r, eps, hu)
+                    else:
+                        lo, hi_d = _segment_obstacle(kind, O, o, _ends(X, l))
+                        hu = _grade_bounds(lo, hi_d, r0, r, eps, hu)
+            if _stop(hu[0], mode):
+                return hu, True
+    return hu, False
+
+
+@kernel
+def _self_pass(m, Z, mode, hu):
+    """Every checked link pair, behind its body pair's and cluster pair's gates: the lane
+    masks ``hu`` updated, and whether the mode's stop came."""
+    caps, cls, gates = m.caps32, m.cls32, m.gates32
+    F, G, K, X = Z.F, Z.G, Z.K, Z.X
+    tables = (cls, caps, m.cl_caps, m.cl_body, m.cap_sphere, Z.placed)
+    grow = load(Z.grow, 0)
+    eps = splat(m.eps32_m)
+    sphere, rate = m.cap_sphere, Z.rate
+    for p in range(m.bpairs.shape[0]):
+        u, v = m.bpairs[p, 0], m.bpairs[p, 1]
+        if u != v:
+            r = fma(grow, splat(Z.brate[u] + Z.brate[v]), splat(gates[u, 4] + gates[v, 4]) + eps)
+            if not _near(_gap2(G, 3 * u * W, G, 3 * v * W), r, _ALL & ~hu[0]):
+                continue
+        for cp in range(m.bpair_start[p], m.bpair_start[p + 1]):
+            cu, cv = m.clpairs[cp, 0], m.clpairs[cp, 1]
+            if cu != cv:
+                _place_cluster(F, X, K, cu, tables, 1)
+                _place_cluster(F, X, K, cv, tables, 1)
+                r = fma(
+                    grow, splat(Z.crate[cu] + Z.crate[cv]), splat(cls[cu, 4] + cls[cv, 4]) + eps
+                )
+                if not _near(_gap2(K, 3 * cu * W, K, 3 * cv * W), r, _ALL & ~hu[0]):
+                    continue
+            _place_cluster(F, X, K, cu, tables, 2)
+            _place_cluster(F, X, K, cv, tables, 2)
+            for q in range(m.clpair_start[cp], m.clpair_start[cp + 1]):
+                i, j = m.cpairs[q, 0], m.cpairs[q, 1]
+                r0 = splat(caps[i, 7] + caps[j, 7])
+                r = fma(grow, splat(rate[i] + rate[j]), r0)
+                if sphere[i] and sphere[j]:
+                    d2 = _gap2(X, 6 * i * W, X, 6 * j * W)
+                    hu = _grade_d2(d2, r0, r, eps, hu)
+                    continue
+                if sphere[i]:  # the first a segment (a sphere: one of zero length)
+                    i, j = j, i
+                lo, hi_d = _segments(_ends(X, i), _ends(X, j))
+                hu = _grade_bounds(lo, hi_d, r0, r, eps, hu)
+        if _stop(hu[0], mode):
+            return hu, True
+    return hu, False
+
+
+@kernel
+def test_lanes(m, Z, mode):
+    """Test the eight lanes' states (loaded by :func:`load_state`, grown by ``Z.grow``).
+
+    Returns ``(free, hit, confirmed)``, bit masks over the lanes and a count:
+
+    * ``hit``: the lane's state itself (not grown) collides: the exact float64 verdict;
+      a lane not in it is free (not grown), exactly;
+    * ``free``: free even with every capsule grown by the lane's growth (proved; a lane
+      of growth 0 is in it exactly when it is not in ``hit``);
+    * ``confirmed``: lanes whose plain verdict the float64 confirmation decided.
+
+    With ``ANY_HIT`` it returns as soon as any lane has hit (its state is invalid); lanes
+    not yet decided are then in neither mask."""
+    for c in range(Z.placed.shape[0]):
+        Z.placed[c] = 0
+    frames32(m, Z)
+    hu, stop = _scene_pass(m, Z, mode, (0, 0, 0))
+    if stop:
+        return 0, hu[0], 0
+    hu, stop = _self_pass(m, Z, mode, hu)
+    hit, unsure_g, unsure_0 = hu
+    if stop:
+        return 0, hit, 0
+    confirmed = 0
+    todo = unsure_0 & ~hit  # the plain state near a surface: float64 decides
+    for k in range(W):
+        if (todo >> k) & 1:
+            confirmed += 1
+            if not exact_state(m, Z, Z.Q64[k], 0.0):
+                hit |= 1 << k
+                if mode == ANY_HIT:
+                    return 0, hit, confirmed
+            elif Z.grow[k] == 0.0:
+                unsure_g &= ~(1 << k)  # a plain lane: free is its verdict
+    return _ALL & ~hit & ~unsure_g, hit, confirmed
+
+
+# ------------------------------------------------------------------ entry points
+@njit(cache=True, nogil=True)
+def valid_batch(m, Q, out):
+    """Validity of states Q (k, dof) -> out (k,) bool, eight a call. Returns the number of
+    states the float64 confirmation decided."""
+    Z = lanes(m)
+    set_plain(Z)
+    confirmed = 0
+    for s0 in range(0, Q.shape[0], W):
+        nn = min(W, Q.shape[0] - s0)
+        for j in range(nn):
+            load_state(Z, j, Q[s0 + j], m.continuous)
+        fill_lanes(Z, nn)
+        free, _, c = test_lanes(m, Z, EVERY_LANE)
+        confirmed += c
+        for j in range(nn):
+            out[s0 + j] = (free >> j) & 1
+    return confirmed
+
+
+@kernel
+def valid_one(m, Z, q):
+    """One state q (dof,) is valid (in lane 0; Z's growth must be plain)."""
+    load_state(Z, 0, q, m.continuous)
+    fill_lanes(Z, 1)
+    free, _, _ = test_lanes(m, Z, ANY_HIT)
+    return (free & 1) != 0
+
+
+@njit(cache=True, nogil=True)
+def exact_batch(m, Q, out):
+    """The float64 verdicts alone (no filter) of Q (k, dof) -> out (k,): the reference the
+    filter's verdicts equal."""
+    Z = lanes(m)
+    for s in range(Q.shape[0]):
+        out[s] = exact_state(m, Z, Q[s], 0.0)
+    return out
