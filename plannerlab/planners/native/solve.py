@@ -78,6 +78,19 @@ def space_extent(model: Any) -> float:
     return float(np.sqrt(np.sum(span**2)))
 
 
+def range_ladder(settings: Any, range_rad: float) -> list[float]:
+    """The lengths the extension's range cycles over (``range_levels``, default one: the
+    range itself), longest first."""
+    levels = max(1, int(getattr(settings, "range_levels", 1)))
+    return [range_rad / 2.0**k for k in range(levels)]
+
+
+def free_rows(model: Any, settings: Any, range_rad: float) -> int:
+    """Free rows a tree needs before an iteration (a connection adds at most one node per
+    step of the shortest range over the space's extent, plus the extension's)."""
+    return 2 + math.ceil(space_extent(model) / range_ladder(settings, range_rad)[-1])
+
+
 class NativeSolve:
     """One compiled solve of the leg of ``ctx`` (see the module docstring).
 
@@ -329,7 +342,10 @@ class NativeSolve:
     ) -> int:
         """The compiled RRT-Connect on ``trees`` in chunks (:meth:`run_chunks`), the trees
         grown (up to ``cap`` rows) when full; ``iterations`` counts from ``iterations0``.
-        Returns the kernel's last code."""
+        The range cycles over :func:`range_ladder`, ``level_checks`` checks at each (a
+        chunk ends at a level's end: the ladder depends on counted checks only, so the
+        same seed and check budget give the same search anywhere). ``need_free`` must be
+        :func:`free_rows`'. Returns the kernel's last code."""
         dof = trees[0].shape[1]
         dd = np.zeros(3)
         if getattr(self.s, "dynamic_domain", False):
@@ -338,8 +354,14 @@ class NativeSolve:
         buf = np.empty((4, dof))
         self._charged = 0
         s = self.s
+        ladder = range_ladder(s, range_rad)
+        per_level = max(1, int(getattr(s, "level_checks", 0))) if len(ladder) > 1 else UNLIMITED
+        c0 = int(counters[1])
 
         def call(soft: int, hard: int) -> int:
+            level = (int(counters[1]) - c0) // per_level
+            if len(ladder) > 1:
+                soft = min(soft, c0 + (level + 1) * per_level)
             return int(
                 K.rrtc_run(
                     model,
@@ -361,7 +383,7 @@ class NativeSolve:
                     self.guides,
                     s.guide_bias,
                     s.guide_sigma_rad,
-                    range_rad,
+                    ladder[level % len(ladder)],
                     self.step,
                     every,
                     dd,
@@ -400,7 +422,7 @@ class NativeSolve:
         dof = len(q0)
         range_rad = self.s.range_rad or 0.2 * space_extent(model)
         self.extra["range_rad"] = range_rad
-        need_free = 2 + math.ceil(space_extent(model) / range_rad)
+        need_free = free_rows(model, self.s, range_rad)
         hard0 = self.hard_checks()
         cap = max(self.tree_rows(hard0, len(G), dof, KD_ROW_BYTES), need_free + len(G) + 1)
         self.extra["tree_rows"] = cap
