@@ -154,6 +154,15 @@ def test_a_ur5_goal_in_self_collision_of_the_spherized_model_is_found(tmp_path):
     assert pairs and all(
         {a.split("#")[0], b.split("#")[0]} == {"forearm_link", "wrist_2_link"} for a, b in pairs
     )
+    # the native planner refuses it naming the links (not their spheres), before any search
+    from plannerlab.planners import make_planner
+
+    r = make_planner("native.rrtconnect").solve(
+        p, 0, Budget(max_collision_checks=1000), np.random.default_rng(0)
+    )
+    assert r.status.name == "INVALID_GOAL"
+    assert r.reason == "the goal state collides: forearm_link x wrist_2_link"
+    assert r.collision_checks == 6  # the start, the goal state (goal_samples = 4 tries), its pairs
 
 
 def test_a_request_for_another_planning_group_is_refused(tmp_path):

@@ -332,7 +332,9 @@ class LeaderSolve(NativeSolve):
         need_free = free_rows(model, self.s, range_rad)
         seeded = max(len(g.start_states), len(g.goal_states))
         hard0 = self.hard_checks()
-        cap = max(self.tree_rows(hard0, seeded, dof, KD_ROW_BYTES), need_free + seeded + 1)
+        cap = max(
+            self.tree_rows(hard0 + need_free, seeded, dof, KD_ROW_BYTES), need_free + seeded + 1
+        )
         self.extra["tree_rows"] = cap
         rows = min(cap, max(FIRST_ROWS, need_free + seeded + 1))
         # the trees as the leader seeded them (the start's branches, the goal states'

@@ -188,17 +188,31 @@ class NativeSolve:
                 "larger budget",
                 q0,
             )
-        return q0, self.result(
-            Status.INVALID_GOAL,
-            f"no valid goal state: the goal is in collision or IK found none in "
-            f"{self.s.max_goal_attempts} attempts",
-            q0,
-        )
+        return q0, self.result(Status.INVALID_GOAL, self._no_goal_reason(), q0)
+
+    def _no_goal_reason(self) -> str:
+        """Why the pool is empty: a goal state's colliding links (a joint goal), or the IK
+        found no valid state."""
+        q_goal = getattr(self.goal, "q_rad", None)
+        if q_goal is None or len(q_goal) != len(self.q0):
+            return (
+                f"no valid goal state: the goal is in collision or IK found none in "
+                f"{self.s.max_goal_attempts} attempts"
+            )
+        q_goal = np.asarray(q_goal, dtype=float)
+        if np.any(q_goal < self.robot.lower) or np.any(q_goal > self.robot.upper):
+            return "the goal state is outside the joint limits"
+        pairs = self.checker.colliding_pairs(q_goal)
+        links = dict.fromkeys(
+            " x ".join(name.split("#", 1)[0] for name in pair) for pair in pairs
+        )  # a checker's body names carry their sphere's number: ``link#3``
+        return "the goal state collides: " + (", ".join(links) or "(no pair named)")
 
     def tree_rows(self, hard: int, roots: int, dof: int, index_bytes: int = 0) -> int:
         """Rows a tree may have: the memory cap (``max_tree_mb`` for both trees: states,
         parents and ``index_bytes`` a row of the nearest-node index) and, with a check
-        budget, the nodes its checks can add (each costs at least one check)."""
+        budget, the nodes its checks can add (each costs at least one check; callers add
+        the free rows an iteration needs, :func:`free_rows`, to ``hard``)."""
         by_memory = int(self.s.max_tree_mb * 1e6 / 2 / (8 * dof + 8 + index_bytes))
         return max(min(by_memory, hard + roots + 1), roots + 1)
 
@@ -424,7 +438,9 @@ class NativeSolve:
         self.extra["range_rad"] = range_rad
         need_free = free_rows(model, self.s, range_rad)
         hard0 = self.hard_checks()
-        cap = max(self.tree_rows(hard0, len(G), dof, KD_ROW_BYTES), need_free + len(G) + 1)
+        cap = max(
+            self.tree_rows(hard0 + need_free, len(G), dof, KD_ROW_BYTES), need_free + len(G) + 1
+        )
         self.extra["tree_rows"] = cap
         rows = min(cap, max(FIRST_ROWS, need_free + len(G) + 1))
         trees = self.new_trees(((q0[None], None), (G, None)), rows, dof)
