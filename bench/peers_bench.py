@@ -91,17 +91,17 @@ def _serve(handle: Any) -> None:
             print(json.dumps(handle(json.loads(line))), flush=True)
 
 
-def vamp_worker(sdist: str) -> None:
-    """In VAMP's venv: RRT-Connect with its Panda defaults and its simplification on
-    VAMP's own copy of each problem (scenario, index)."""
+def vamp_worker(sdist: str, robot: str) -> None:
+    """In VAMP's venv: RRT-Connect with its defaults for ``robot`` and its simplification
+    on VAMP's own copy of each problem (scenario, index)."""
     import pickle
 
     import vamp
 
-    with open(Path(sdist) / "resources" / "panda" / "problems.pkl", "rb") as f:
+    with open(Path(sdist) / "resources" / robot / "problems.pkl", "rb") as f:
         problems = pickle.load(f)["problems"]
     module, planner, plan_settings, simp_settings = vamp.configure_robot_and_planner_with_kwargs(
-        "panda", "rrtc"
+        robot, "rrtc"
     )
     sampler = module.halton()
 
@@ -317,15 +317,20 @@ def start_workers(
     workers: dict[str, Worker] = {}
     notes: list[str] = []
     vamp_py = Path(args.vamp_python).expanduser()
-    if vamp_py.exists():
+    if "vamp" not in args.planners:
+        pass
+    elif vamp_py.exists():
         workers["VAMP 0.6.4 rrtc"] = Worker(
             "VAMP",
-            [str(vamp_py), __file__, "--vamp-worker", str(Path(args.vamp_sdist).expanduser())],
-        )
+            [str(vamp_py), __file__, "--vamp-worker", str(Path(args.vamp_sdist).expanduser()),
+             "--robot", args.robot],
+        )  # fmt: skip
     else:
         notes.append(f"VAMP skipped: {vamp_py} not found (see the module's docstring)")
     pm_py = Path(args.plainmp_python).expanduser()
-    if pm_py.exists():
+    if "plainmp" not in args.planners:
+        pass
+    elif pm_py.exists():
         workers["plainmp 0.3.6 RRTConnect"] = Worker(
             "plainmp", [str(pm_py), __file__, "--plainmp-worker", str(robot_json)]
         )
@@ -346,8 +351,9 @@ def run(args: argparse.Namespace) -> list[str]:
     files = select(args)
     problems = [parse_problem(f) for f in files]
     budget = Budget(time_limit_s=args.time_limit)
-    planners = {n: make_planner(n) for n in PLANNERLAB}
-    for n in PLANNERLAB:  # warm-up, untimed
+    ours = [n for n in PLANNERLAB if n in args.planners]
+    planners = {n: make_planner(n) for n in ours}
+    for n in ours:  # warm-up, untimed
         planners[n].solve(problems[0], 0, budget, np.random.default_rng(10**6))
     tmp = Path(tempfile.mkdtemp(prefix="peers_bench_"))
     robot_json = tmp / "robot.json"
@@ -356,7 +362,7 @@ def run(args: argparse.Namespace) -> list[str]:
     plainmp_modes = [("box", args.plainmp_box_rad)]
     if args.plainmp_euclidean:
         plainmp_modes.append(("euclidean", args.plainmp_euclidean))
-    labels = list(PLANNERLAB)
+    labels = list(ours)
     for w in workers:
         if w.startswith("plainmp"):
             labels += [f"{w} ({v} {r if r else 'joint_step/4'})" for v, r in plainmp_modes]
@@ -368,7 +374,7 @@ def run(args: argparse.Namespace) -> list[str]:
     try:
         for i, p in enumerate(problems):
             scenario, index = p.name.rsplit("_", 1)
-            for n in PLANNERLAB:
+            for n in ours:
                 t0 = time.perf_counter()
                 r = planners[n].solve(p, 0, budget, np.random.default_rng(i))
                 row = {"solved": r.status.value == "solved", "plan_s": r.time_s,
@@ -423,9 +429,14 @@ def report(
 ) -> list[str]:
     invalid = {
         r["name"]
-        for r in rows["ompl.rrtconnect"]
+        for k in PLANNERLAB
+        for r in rows.get(k, [])
         if r["status"] in ("invalid_start", "invalid_goal")
     }
+    vamp_rows = next((v for k, v in rows.items() if k.startswith("VAMP")), [])
+    vamp_invalid = {r["name"] for r in vamp_rows if not r["valid"]}
+    if not any(k in rows for k in PLANNERLAB):
+        invalid = vamp_invalid
     valid = len(problems) - len(invalid)
     out = [
         f"### MotionBenchMaker Panda: {len(problems)} problems, {args.time_limit:g} s each",
@@ -433,7 +444,13 @@ def report(
         f"load average {load0[0]:.1f} / {load0[1]:.1f} (1 / 5 min) at the start, "
         f"{os.getloadavg()[0]:.1f} / {os.getloadavg()[1]:.1f} at the end, "
         f"{os.cpu_count()} cores; problems: {problems[0].name} … {problems[-1].name}; "
-        f"{len(invalid)} invalid in the spherized model ({', '.join(sorted(invalid)) or 'none'})",
+        f"{len(invalid)} invalid in the spherized model ({', '.join(sorted(invalid)) or 'none'})"
+        + (
+            f"; VAMP's own flags: {len(vamp_invalid)} invalid, the same problems: "
+            f"{vamp_invalid == invalid}"
+            if vamp_rows
+            else ""
+        ),
         "",
         "| planner | solved, re-checked | refused by the re-check | median planning | p95 "
         "| median whole call | p95 | planning / VAMP (median) | whole call / VAMP |",
@@ -460,7 +477,7 @@ def report(
             out.append(f"- {k}: " + "; ".join(bad))
     both = [
         (a["plan_s"], b["plan_s"])
-        for a, b in zip(rows["native.rrtconnect"], rows["ompl.rrtconnect"], strict=True)
+        for a, b in zip(rows.get("native.rrtconnect", []), rows.get("ompl.rrtconnect", []))
         if a["ok"] and b["ok"]
     ]
     if both:
@@ -491,17 +508,26 @@ def main() -> None:
         help="also plainmp on its euclidean validator at this resolution (VAMP's 1/32); 0: not",
     )  # fmt: skip
     ap.add_argument("--log", type=Path, help="one JSON line per planner and problem (appended)")
+    ap.add_argument(
+        "--robot", default="panda", choices=("panda", "ur5", "fetch"),
+        help="whose problems the folder holds (VAMP's module and problems.pkl)",
+    )  # fmt: skip
+    ap.add_argument(
+        "--planners", default="native.rrtconnect,ompl.rrtconnect,vamp,plainmp",
+        help="which of the four to run (comma-separated)",
+    )  # fmt: skip
     ap.add_argument("--vamp-worker", help=argparse.SUPPRESS)
     ap.add_argument("--plainmp-worker", help=argparse.SUPPRESS)
     args = ap.parse_args()
     if args.vamp_worker:
-        vamp_worker(args.vamp_worker)
+        vamp_worker(args.vamp_worker, args.robot)
         return
     if args.plainmp_worker:
         plainmp_worker(args.plainmp_worker)
         return
     if args.folder is None:
         ap.error("the folder of imported problem files is needed")
+    args.planners = args.planners.split(",")
     print("\n".join(run(args)))
 
 
