@@ -92,8 +92,10 @@ def run(args: argparse.Namespace) -> None:
                     done.add(json.loads(line)["name"])
     todo = [(i, f) for i, f in enumerate(files) if f.stem not in done]
     print(f"{len(files)} problems, {len(done)} done, {len(todo)} to go", flush=True)
-    planner = make_planner(args.planner, {})
-    budget = Budget(time_limit_s=args.time_limit)
+    overrides = {k: json.loads(v) for k, v in (kv.split("=", 1) for kv in args.set)}
+    planner = make_planner(args.planner, overrides)
+    clock = time.process_time if args.cpu_clock else None
+    budget = Budget(time_limit_s=args.time_limit, clock=clock)
     warm = parse_problem(files[0])
     planner.solve(warm, 0, budget, np.random.default_rng(10**6))  # untimed warm-up
     index = {f: i for i, f in enumerate(sorted(files))}
@@ -133,6 +135,10 @@ def run(args: argparse.Namespace) -> None:
                 "checks": r.collision_checks,
                 "reason": r.reason,
                 "load": os.getloadavg()[0],
+                "overrides": overrides,
+                "clock": "cpu" if args.cpu_clock else "wall",
+                "iterations": r.iterations,
+                **{k: r.extra[k] for k in ("nodes", "goal_pool", "range_rad") if k in r.extra},
             }
             if not rec["solved"]:
                 rec["start_why"] = state_why(p, p.q_start)
@@ -201,6 +207,16 @@ def main() -> None:
         help="also skip the problems of these logs (a second process from the other end)",
     )
     ap.add_argument("--time-limit", type=float, default=10.0, help="per problem [s]")
+    ap.add_argument(
+        "--cpu-clock",
+        action="store_true",
+        help="read the time limit on the process's CPU time (time.process_time): on a "
+        "shared machine, about what the limit gives on an idle core",
+    )
+    ap.add_argument(
+        "--set", action="append", default=[], metavar="KEY=JSON",
+        help="a planner setting overridden (repeatable), e.g. --set range_rad=1.0",
+    )  # fmt: skip
     ap.add_argument("--recheck-step", type=float, default=0.0025, help="[rad]")
     ap.add_argument("--report", type=Path, nargs="*", help="summarise these logs")
     args = ap.parse_args()

@@ -154,6 +154,15 @@ def test_a_ur5_goal_in_self_collision_of_the_spherized_model_is_found(tmp_path):
     assert pairs and all(
         {a.split("#")[0], b.split("#")[0]} == {"forearm_link", "wrist_2_link"} for a, b in pairs
     )
+    # the native planner refuses it naming the links (not their spheres), before any search
+    from plannerlab.planners import make_planner
+
+    r = make_planner("native.rrtconnect").solve(
+        p, 0, Budget(max_collision_checks=1000), np.random.default_rng(0)
+    )
+    assert r.status.name == "INVALID_GOAL"
+    assert r.reason == "the goal state collides: forearm_link x wrist_2_link"
+    assert r.collision_checks == 6  # the start, the goal state (goal_samples = 4 tries), its pairs
 
 
 def test_a_request_for_another_planning_group_is_refused(tmp_path):
@@ -235,3 +244,31 @@ def test_rrtconnect_solves_each_robot_and_the_path_passes_a_finer_recheck(tmp_pa
     assert np.max(np.abs(P[-1] - p.goal(0).q_rad)) <= p.goal(0).tol_rad
     checker = CollisionChecker(p.robot, p.scene, backend="core", margin_m=0.0)
     assert checker.check_path(P, p.joint_step / 8).valid
+
+
+def test_the_range_ladder_grows_the_goal_tree_out_of_a_fetch_shelf(tmp_path):
+    """MotionBenchMaker's Fetch reaching deep into a bookshelf (``bookshelf_small`` 20):
+    from its goal no straight motion of ``native.rrtconnect``'s default range is free.
+    With one range (``range_levels = 1``, OMPL's RRT-Connect) the goal tree never grows
+    beyond its root and 150 000 checks run out; with the ladder of ranges (the default)
+    the same seeds solve it within them, and the path passes an eighth of the
+    ``joint_step`` (issue 35, item 3; ``results/mbm_fetch.md``)."""
+    from plannerlab.planners import make_planner
+
+    out, _ = imported(tmp_path, "fetch", "fetch_shelf")
+    p = parse_problem(out)
+    budget = Budget(max_collision_checks=150_000)
+    one = make_planner("native.rrtconnect", {"range_levels": 1})
+    ladder = make_planner("native.rrtconnect", {})
+    checker = CollisionChecker(p.robot, p.scene, backend="core", margin_m=0.0)
+    for seed in (1, 3):
+        r1 = one.solve(p, 0, budget, np.random.default_rng(seed))
+        assert r1.status.name == "BUDGET_EXHAUSTED", r1.reason
+        assert r1.extra["nodes"][1] == 1  # the goal tree: its root only
+        r = ladder.solve(p, 0, budget, np.random.default_rng(seed))
+        assert r.status.name == "SOLVED", r.reason
+        assert r.extra["nodes"][1] > 1
+        P = np.asarray(r.path)
+        assert np.max(np.abs(P[0] - p.q_start)) < 1e-9
+        assert np.max(np.abs(P[-1] - p.goal(0).q_rad)) <= p.goal(0).tol_rad
+        assert checker.check_path(P, p.joint_step / 8).valid

@@ -41,7 +41,6 @@ are different runs.
 
 from __future__ import annotations
 
-import math
 from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import Any
@@ -62,6 +61,7 @@ from plannerlab.planners.native.solve import (
     KD_ROW_BYTES,
     UNLIMITED,
     NativeSolve,
+    free_rows,
     space_extent,
 )
 from plannerlab.robots.base import Array, wrap_to_pi
@@ -338,10 +338,12 @@ class LeaderSolve(NativeSolve):
         dof = len(q0)
         range_rad = self.s.range_rad or 0.2 * space_extent(model)
         self.extra["range_rad"] = range_rad
-        need_free = 2 + math.ceil(space_extent(model) / range_rad)
+        need_free = free_rows(model, self.s, range_rad)
         seeded = max(len(g.start_states), len(g.goal_states))
         hard0 = self.hard_checks()
-        cap = max(self.tree_rows(hard0, seeded, dof, KD_ROW_BYTES), need_free + seeded + 1)
+        cap = max(
+            self.tree_rows(hard0 + need_free, seeded, dof, KD_ROW_BYTES), need_free + seeded + 1
+        )
         self.extra["tree_rows"] = cap
         rows = min(cap, max(FIRST_ROWS, need_free + seeded + 1))
         # the trees as the leader seeded them (the start's branches, the goal states'

@@ -64,10 +64,23 @@ class RRTConnectSettings(NativeSettings):
             that node's radius is dropped unchecked; a failed extension gives its node a
             radius of 2 ``range_rad`` and shrinks it slowly to ``range_rad`` / 2. Off:
             OMPL's RRT-Connect (``ompl.rrtconnect``'s algorithm).
+        range_levels: the longest motion added at once cycles over a ladder of this many
+            lengths, the range and its halves (``range_rad``, ``range_rad`` / 2, ...,
+            ``range_rad`` / 2^(levels - 1)), ``level_checks`` collision checks at each,
+            the full range first; both trees keep what they grew at every level. Long
+            steps cross open space in few nodes; short ones grow a tree out of a pocket
+            from which no long straight motion is free (a grasp deep in a shelf: from the
+            median goal state of MotionBenchMaker's Fetch in a bookshelf none of 48
+            motions of the default range is free, 8 % of those of a quarter of it;
+            ``results/mbm_fetch.md``). A problem solved within the first ``level_checks``
+            checks is planned exactly as with one range. 1: one range (OMPL's RRT-Connect).
+        level_checks: collision checks spent at each level of the ladder before the next.
     """
 
     lazy_every: int = 16
     dynamic_domain: bool = False
+    range_levels: int = 5
+    level_checks: int = 16384
 
 
 @dataclass(frozen=True)

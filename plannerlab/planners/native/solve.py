@@ -79,6 +79,19 @@ def space_extent(model: Any) -> float:
     return float(np.sqrt(np.sum(span**2)))
 
 
+def range_ladder(settings: Any, range_rad: float) -> list[float]:
+    """The lengths the extension's range cycles over (``range_levels``, default one: the
+    range itself), longest first."""
+    levels = max(1, int(getattr(settings, "range_levels", 1)))
+    return [range_rad / 2.0**k for k in range(levels)]
+
+
+def free_rows(model: Any, settings: Any, range_rad: float) -> int:
+    """Free rows a tree needs before an iteration (a connection adds at most one node per
+    step of the shortest range over the space's extent, plus the extension's)."""
+    return 2 + math.ceil(space_extent(model) / range_ladder(settings, range_rad)[-1])
+
+
 class NativeSolve:
     """One compiled solve of the leg of ``ctx`` (see the module docstring).
 
@@ -176,17 +189,31 @@ class NativeSolve:
                 "larger budget",
                 q0,
             )
-        return q0, self.result(
-            Status.INVALID_GOAL,
-            f"no valid goal state: the goal is in collision or IK found none in "
-            f"{self.s.max_goal_attempts} attempts",
-            q0,
-        )
+        return q0, self.result(Status.INVALID_GOAL, self._no_goal_reason(), q0)
+
+    def _no_goal_reason(self) -> str:
+        """Why the pool is empty: a goal state's colliding links (a joint goal), or the IK
+        found no valid state."""
+        q_goal = getattr(self.goal, "q_rad", None)
+        if q_goal is None or len(q_goal) != len(self.q0):
+            return (
+                f"no valid goal state: the goal is in collision or IK found none in "
+                f"{self.s.max_goal_attempts} attempts"
+            )
+        q_goal = np.asarray(q_goal, dtype=float)
+        if np.any(q_goal < self.robot.lower) or np.any(q_goal > self.robot.upper):
+            return "the goal state is outside the joint limits"
+        pairs = self.checker.colliding_pairs(q_goal)
+        links = dict.fromkeys(
+            " x ".join(name.split("#", 1)[0] for name in pair) for pair in pairs
+        )  # a checker's body names carry their sphere's number: ``link#3``
+        return "the goal state collides: " + (", ".join(links) or "(no pair named)")
 
     def tree_rows(self, hard: int, roots: int, dof: int, index_bytes: int = 0) -> int:
         """Rows a tree may have: the memory cap (``max_tree_mb`` for both trees: states,
         parents and ``index_bytes`` a row of the nearest-node index) and, with a check
-        budget, the nodes its checks can add (each costs at least one check)."""
+        budget, the nodes its checks can add (each costs at least one check; callers add
+        the free rows an iteration needs, :func:`free_rows`, to ``hard``)."""
         by_memory = int(self.s.max_tree_mb * 1e6 / 2 / (8 * dof + 8 + index_bytes))
         return max(min(by_memory, hard + roots + 1), roots + 1)
 
@@ -352,10 +379,23 @@ class NativeSolve:
     ) -> int:
         """The compiled RRT-Connect on ``trees`` in chunks (:meth:`run_chunks`), the trees
         grown (up to ``cap`` rows) when full; ``iterations`` counts from ``iterations0``.
-        Returns the kernel's last code."""
+        The range cycles over :func:`range_ladder`, ``level_checks`` checks at each (a
+        chunk ends at a level's end: the ladder depends on counted checks only, so the
+        same seed and check budget give the same search anywhere; ``O``'s range is set for
+        each call). ``O``'s ``need_free`` must be :func:`free_rows`'. Returns the kernel's
+        last code."""
         self._charged = 0
+        ladder = range_ladder(self.s, float(O.f[2]))
+        per_level = (
+            max(1, int(getattr(self.s, "level_checks", 0))) if len(ladder) > 1 else UNLIMITED
+        )
+        c0 = int(counters[1])
 
         def call(soft: int, hard: int) -> int:
+            level = (int(counters[1]) - c0) // per_level
+            if len(ladder) > 1:
+                soft = min(soft, c0 + (level + 1) * per_level)
+                O.f[2] = ladder[level % len(ladder)]
             A = K.Tree(trees[0], trees[1], trees[2], trees[3], trees[8])
             B = K.Tree(trees[4], trees[5], trees[6], trees[7], trees[9])
             aux = self.aux(rng_state, max(len(trees[0]), len(trees[4])))
@@ -388,9 +428,11 @@ class NativeSolve:
         dof = len(q0)
         range_rad = self.s.range_rad or 0.2 * space_extent(model)
         self.extra["range_rad"] = range_rad
-        need_free = 2 + math.ceil(space_extent(model) / range_rad)
+        need_free = free_rows(model, self.s, range_rad)
         hard0 = self.hard_checks()
-        cap = max(self.tree_rows(hard0, len(G), dof, KD_ROW_BYTES), need_free + len(G) + 1)
+        cap = max(
+            self.tree_rows(hard0 + need_free, len(G), dof, KD_ROW_BYTES), need_free + len(G) + 1
+        )
         self.extra["tree_rows"] = cap
         rows = min(cap, max(FIRST_ROWS, need_free + len(G) + 1))
         trees = self.new_trees(((q0[None], None), (G, None)), rows, dof)
