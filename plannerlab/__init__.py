@@ -24,8 +24,9 @@ the package but its records), so whatever a command does is here too: plan files
 (:func:`problem_catalog`, :func:`planner_catalog`, :func:`planner_info`), comparisons
 (:class:`ComparisonSpec`, :func:`run_spec`, :class:`TrialStore`, :func:`write_reports`),
 the continuum paper's cases (:func:`run_continuum_case`), room variants
-(:func:`generate_variants`), the IRb-6's analytic IK (:func:`irb6_ik`) and
-MotionBenchMaker's importer (``pl.mbm``).
+(:func:`generate_variants`), the IRb-6's analytic IK (:func:`irb6_ik`),
+MotionBenchMaker's importer (``pl.mbm``) and OMPL's KinematicChain benchmark
+(``pl.kinematic_chain``).
 """
 
 from __future__ import annotations
@@ -121,7 +122,7 @@ if TYPE_CHECKING:
     from plannerlab.plot.continuum import save as save_figure
     from plannerlab.plot.continuum import thickness_figure as continuum_thickness_figure
     from plannerlab.plot.plans import plot_plan
-    from plannerlab.problem import mbm
+    from plannerlab.problem import kinematic_chain, mbm
     from plannerlab.problem.catalog import problem_catalog, problem_origin, resolve_problem_path
     from plannerlab.problem.load import parse_problem
     from plannerlab.problem.variants import VariantError, write_variants
@@ -141,6 +142,7 @@ _EXPORTS |= {
     "problem_origin": "plannerlab.problem.catalog:problem_origin",
     "problem_catalog": "plannerlab.problem.catalog:problem_catalog",
     "mbm": "plannerlab.problem.mbm",
+    "kinematic_chain": "plannerlab.problem.kinematic_chain",
     # planners
     "planner_catalog": "plannerlab.run.planner_info:planner_catalog",
     "planner_info": "plannerlab.run.planner_info:planner_info",
@@ -190,6 +192,7 @@ __all__ += [
     "execute_results",
     "generate_variants",
     "irb6_ik",
+    "kinematic_chain",
     "legs_from_spec",
     "machine_info",
     "mbm",
