@@ -13,9 +13,12 @@ def warm_up(model: Any | None = None) -> None:
     model to run them on; default: a two-joint chain in an empty room)."""
     from plannerlab.collision.model import views
     from plannerlab.planners.native import kernels as K
+    from plannerlab.planners.native import kpiece as KP
     from plannerlab.planners.native import rrtstar as R
 
-    entries = (views, K.rrtc_run, K.tree_path, K.shortcut_run, R.rrtstar_run, R.chain)
+    entries = (
+        views, K.rrtc_run, K.tree_path, K.shortcut_run, R.rrtstar_run, R.chain, KP.kpiece_run
+    )  # fmt: skip
     if model is None and all(getattr(f, "signatures", True) for f in entries):
         return  # loaded in this process already
     if model is None:
@@ -47,6 +50,29 @@ def warm_up(model: Any | None = None) -> None:
         1.0, 0, 0, 0, buf, np.empty(4, dtype=np.int64), np.empty(4), np.empty(4, dtype=np.int64),
     )  # fmt: skip
     R.chain(Q, P, 0, Q.copy())
+    _warm_kpiece(model)
+
+
+def _warm_kpiece(model: Any) -> None:
+    """``native.kpiece``'s kernels (:mod:`~plannerlab.planners.native.kpiece`), on a
+    search that stops before its first iteration."""
+    from plannerlab.planners.native import kpiece as KP
+    from plannerlab.planners.native import shim
+
+    dof = model.lower.shape[0]
+    T, C = KP.new_motions(4, dof), KP.new_cells(4, 2)
+    proj = KP.Projection(matrix=np.zeros((2, dof)), cell_size=np.ones(2))
+    counters = np.zeros(KP.N_COUNTERS, dtype=np.int64)
+    counters[KP.C_DISC_ITER] = 1
+    q = np.zeros(dof)
+    goals = np.zeros((1, dof))
+    KP.add_motion(T, C, proj, counters, q, -1, 1, 0.0, np.empty(2, dtype=np.int64))
+    rng = np.array([1, 2, 3, 4], dtype=np.uint64)
+    prm = np.zeros(KP.N_PARAMS)
+    prm[KP.P_STRIDE] = 1
+    KP.kpiece_run(shim.bundle(model), T, C, proj, goals, prm, counters, rng)
+    KP.rehash(C, 1)
+    KP.tree_path(T, 0, np.empty((4, dof)))
 
 
 def _tiny_model() -> Any:
