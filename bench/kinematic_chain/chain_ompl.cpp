@@ -554,7 +554,8 @@ int main(int argc, char **argv)
         {
             raw = ss.getSolutionPath().getStateCount();
             auto t1 = std::chrono::steady_clock::now();
-            ss.simplifySolution();
+            // within what is left of the time limit (as plannerlab's shortcuts are)
+            ss.simplifySolution(std::max(time_s - solve_s, 1e-3));
             simplify_s = seconds(t1);
             const auto &p = ss.getSolutionPath();
             path << "[";
