@@ -19,8 +19,8 @@ view in the browser (or inline in a notebook) with ``view``. ``docs/api.md`` lis
 name with what it does.
 
 What only the command line needs (store paths, report notes, the continuum paper's
-cases, room variants, the IRb-6's analytic IK, MotionBenchMaker's importer) is in
-:mod:`plannerlab.extras`, not here.
+cases, room variants, the IRb-6's analytic IK, MotionBenchMaker's importer, OMPL's
+KinematicChain benchmark) is in :mod:`plannerlab.extras`, not here.
 """
 
 from __future__ import annotations

@@ -19,7 +19,8 @@ These are the names a user rarely needs, kept out of the top-level ``plannerlab`
   their figures :func:`continuum_case_figure`, :func:`continuum_thickness_figure`,
   :func:`save_figure`); room variants of the paper's task (:func:`generate_variants`,
   :func:`write_variants`, :class:`VariantError`); the IRb-6's analytic IK
-  (:func:`irb6_ik`); MotionBenchMaker's importer (``mbm``, a module);
+  (:func:`irb6_ik`); MotionBenchMaker's importer (``mbm``, a module); OMPL's
+  KinematicChain benchmark as problem files (``kinematic_chain``, a module);
 * what plannerlab makes of a URDF (:func:`robot_report`, ``plannerlab robot``) and its
   view in the browser (:func:`serve_robot`).
 
@@ -45,7 +46,7 @@ if TYPE_CHECKING:
     from plannerlab.plot.continuum import save as save_figure
     from plannerlab.plot.continuum import thickness_figure as continuum_thickness_figure
     from plannerlab.plot.view import serve_robot
-    from plannerlab.problem import mbm
+    from plannerlab.problem import kinematic_chain, mbm
     from plannerlab.problem.catalog import problem_origin, problems_dir, resolve_problem_path
     from plannerlab.problem.variants import VariantError, write_variants
     from plannerlab.problem.variants import generate as generate_variants
@@ -88,6 +89,7 @@ _EXPORTS: dict[str, str] = {
     "write_variants": "plannerlab.problem.variants:write_variants",
     "VariantError": "plannerlab.problem.variants:VariantError",
     "irb6_ik": "plannerlab.robots.irb6.report:irb6_ik",
+    "kinematic_chain": "plannerlab.problem.kinematic_chain",
     "robot_report": "plannerlab.run.robot_info:robot_report",
     "serve_robot": "plannerlab.plot.view:serve_robot",
     "mbm": "plannerlab.problem.mbm",
@@ -109,6 +111,7 @@ __all__ = [
     "execute_results",
     "generate_variants",
     "irb6_ik",
+    "kinematic_chain",
     "legs_from_spec",
     "machine_info",
     "mbm",

@@ -1,5 +1,6 @@
 """`plannerlab import mbm`: MotionBenchMaker problems (MoveIt scene + request YAML) as
-plannerlab problem files (:mod:`plannerlab.problem.mbm`)."""
+plannerlab problem files (:mod:`plannerlab.problem.mbm`); `plannerlab import
+kinematic-chain`: OMPL's KinematicChain benchmark (:mod:`plannerlab.problem.kinematic_chain`)."""
 
 from __future__ import annotations
 
@@ -79,6 +80,54 @@ def cmd_import_mbm(args: argparse.Namespace, console: Console) -> int:
     return 0
 
 
+def cmd_import_kinematic_chain(args: argparse.Namespace, console: Console) -> int:
+    import plannerlab.extras as px
+
+    kc = px.kinematic_chain
+
+    for n in args.links:
+        target = kc.write_problem(
+            n,
+            args.out,
+            link_radius_m=args.link_radius_m,
+            wall_thickness_m=args.wall_thickness_m,
+            safety_margin_m=args.margin_m,
+            joint_step_rad=args.joint_step,
+            time_limit_s=args.time_limit,
+        )
+        console.print(f"{target} (and its URDF)", highlight=False)
+    return 0
+
+
+def _add_kinematic_chain(kinds: Any) -> None:
+    k = kinds.add_parser(
+        "kinematic-chain",
+        help="OMPL's KinematicChain benchmark (the horn, N links) -> problem files",
+        description=(
+            "OMPL's KinematicChain benchmark (demos/KinematicChain.h): a planar chain of N "
+            "links, each 1/N m, every joint a full turn, from inside the horn out to the "
+            "left. Writes kinematic_chain_N.urdf (links as thin capsules) and "
+            "kinematic_chain_N.toml (the horn's walls as thin boxes, the demo's start and "
+            "goal) per N into --out."
+        ),
+    )
+    k.add_argument("--links", type=int, nargs="+", default=[10, 20, 30], help="N (each)")
+    k.add_argument("--out", type=Path, default=Path("problems/kinematic_chain"))
+    k.add_argument("--link-radius-m", type=float, default=1e-3, help="the links' radius [m]")
+    k.add_argument("--wall-thickness-m", type=float, default=2e-3, help="the walls' [m]")
+    k.add_argument(
+        "--margin-m", type=float, default=0.0, help="[planning] safety_margin_m of the files"
+    )
+    k.add_argument(
+        "--joint-step",
+        type=float,
+        default=0.05,
+        help="[checking] joint_step [rad] (paths re-checked at a quarter of it)",
+    )
+    k.add_argument("--time-limit", type=float, default=10.0, help="[budget] time_limit_s [s]")
+    k.set_defaults(func=cmd_import_kinematic_chain)
+
+
 def mbm_default_joint_step() -> float:
 
     return px.mbm.DEFAULT_JOINT_STEP_RAD
@@ -143,3 +192,4 @@ def add_parser(sub: Any) -> None:
         help="cache folder for --fetch (default $PLANNERLAB_CACHE/mbm or ~/.cache/plannerlab/mbm)",
     )
     m.set_defaults(func=cmd_import_mbm)
+    _add_kinematic_chain(kinds)

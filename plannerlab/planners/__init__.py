@@ -89,6 +89,8 @@ NATIVE_PLANNERS: Mapping[str, str] = MappingProxyType(
         "edges on the re-check's grid and shortcuts in compiled code",
         "rrtstar": "RRT* compiled end to end (numba): k-nearest rewiring, goal-biased, "
         "shortens its best path until the budget is spent",
+        "kpiece": "KPIECE compiled end to end (numba): a tree grown from the frontier of a "
+        "grid over a random projection, for long chains where RRT-Connect fails",
     }
 )
 

@@ -18,6 +18,7 @@ from plannerlab.planners.context import LegPlanner, PlanningContext
 from plannerlab.planners.native.rrtstar import rrtstar
 from plannerlab.planners.native.settings import (
     GOAL_SELECTIONS,
+    KPIECESettings,
     NativeSettings,
     RRTConnectSettings,
     RRTstarSettings,
@@ -43,11 +44,34 @@ def _check_settings(name: str, s: NativeSettings) -> None:
     every = getattr(s, "lazy_every", 1)
     if every < 1:
         raise PlannerlabError(f"{name}: lazy_every must be an integer >= 1, got {every!r}")
+    if isinstance(s, KPIECESettings):
+        _check_kpiece(name, s)
     if s.goal_samples < 1 or s.max_goal_attempts < 1 or s.shortcut_tries < 0:
         raise PlannerlabError(
             f"{name}: goal_samples and max_goal_attempts must be >= 1 and shortcut_tries "
             f">= 0, got {s.goal_samples}, {s.max_goal_attempts}, {s.shortcut_tries}"
         )
+
+
+def _check_kpiece(name: str, s: KPIECESettings) -> None:
+    def bad(key: str, want: str) -> PlannerlabError:
+        return PlannerlabError(f"{name}: {key} must be {want}, got {getattr(s, key)!r}")
+
+    if not 0.0 <= s.goal_bias <= 1.0:
+        raise bad("goal_bias", "in [0, 1]")
+    for key in ("border_fraction", "failed_score_factor"):
+        if not 0.0 < getattr(s, key) <= 1.0:
+            raise bad(key, "in (0, 1]")
+    if not 0.0 < s.min_valid_fraction < 1.0:
+        raise bad("min_valid_fraction", "in (0, 1)")
+    if isinstance(s.projection_dims, bool) or s.projection_dims != int(s.projection_dims):
+        raise bad("projection_dims", "an integer >= 0")
+    if s.projection_dims < 0:
+        raise bad("projection_dims", "an integer >= 0")
+    if not (math.isfinite(s.cell_size_sd) and s.cell_size_sd > 0.0):
+        raise bad("cell_size_sd", "a finite number > 0")
+    if not (math.isfinite(s.range_octaves) and 0.0 <= s.range_octaves <= 30.0):
+        raise bad("range_octaves", "in [0, 30]")
 
 
 @dataclass(frozen=True)
@@ -122,6 +146,10 @@ class NativePlanner(LegPlanner):
         solve = NativeSolve(self.name, self.settings, ctx, rng, self.guide_states(ctx, rng))
         if self.algorithm == "rrtstar":
             return rrtstar(solve)
+        if self.algorithm == "kpiece":
+            from plannerlab.planners.native.kpiece_solve import kpiece
+
+            return kpiece(solve)
         return solve.rrtconnect()
 
 
@@ -129,6 +157,7 @@ class NativePlanner(LegPlanner):
 SETTINGS: Mapping[str, type[NativeSettings]] = {
     "rrtconnect": RRTConnectSettings,
     "rrtstar": RRTstarSettings,
+    "kpiece": KPIECESettings,
 }
 
 

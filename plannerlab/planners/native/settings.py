@@ -95,3 +95,30 @@ class RRTstarSettings(NativeSettings):
 
     goal_bias: float = 0.05
     rewire_factor: float = 1.1
+
+
+@dataclass(frozen=True)
+class KPIECESettings(NativeSettings):
+    """KPIECE (:mod:`~plannerlab.planners.native.kpiece`; OMPL's ``KPIECE1``, its defaults).
+
+    Attributes:
+        goal_bias: probability that a motion heads for a goal state of the pool.
+        border_fraction: the least probability of expanding an exterior cell.
+        failed_score_factor: a cell's score is multiplied by it when a motion from it
+            is refused, in (0, 1].
+        min_valid_fraction: a motion is kept when more than this fraction of it is free,
+            in (0, 1].
+        projection_dims: the projection's dimensions; 0: max(2, ceil(ln dof)).
+        cell_size_sd: a cell's width, in standard deviations of the projected coordinate
+            of states uniform in the joint box (0.275: the width OMPL infers, 1/20 of
+            the spread of 100 such states grown by 10 %, in expectation).
+    """
+
+    goal_bias: float = 0.05
+    border_fraction: float = 0.9
+    failed_score_factor: float = 0.5
+    min_valid_fraction: float = 0.2
+    projection_dims: int = 0
+    cell_size_sd: float = 0.275
+    range_octaves: float = 3.0
+    lazy_every: int = 1

@@ -13,10 +13,13 @@ def warm_up(checker: Any | None = None) -> None:
     checker whose compiled model to run them on; default: a three-module Arm-Z beside a
     sphere)."""
     from plannerlab.planners.native import kernels as K
+    from plannerlab.planners.native import kpiece as KP
     from plannerlab.planners.native import rrtstar as R
     from plannerlab.planners.native.kdtree import split_dims
 
-    entries = (K.rrtc_entry, K.tree_path, K.shortcut_entry, R.rrtstar_entry, R.chain)
+    entries = (
+        K.rrtc_entry, K.tree_path, K.shortcut_entry, R.rrtstar_entry, R.chain, KP.kpiece_run
+    )  # fmt: skip
     if checker is None and all(getattr(f, "signatures", True) for f in entries):
         return  # loaded in this process already
     if checker is None:
@@ -46,6 +49,29 @@ def warm_up(checker: Any | None = None) -> None:
                np.empty(4, dtype=np.int64), np.empty(4))  # fmt: skip
     R.rrtstar_entry(P, aux, T, X, np.array([1, 0]), O, np.array([0, 0, -1, 0]), limits)
     R.chain(Q, P0, 0, Q.copy())
+    _warm_kpiece(checker)
+
+
+def _warm_kpiece(checker: Any) -> None:
+    """``native.kpiece``'s kernels (:mod:`~plannerlab.planners.native.kpiece`), on a
+    search that stops before its first iteration."""
+    from plannerlab.planners.native import kpiece as KP
+    from plannerlab.planners.native import shim
+
+    dof = checker.robot.dof
+    T, C = KP.new_motions(4, dof), KP.new_cells(4, 2)
+    proj = KP.Projection(matrix=np.zeros((2, dof)), cell_size=np.ones(2))
+    counters = np.zeros(KP.N_COUNTERS, dtype=np.int64)
+    counters[KP.C_DISC_ITER] = 1
+    q = np.zeros(dof)
+    goals = np.zeros((1, dof))
+    KP.add_motion(T, C, proj, counters, q, -1, 1, 0.0, np.empty(2, dtype=np.int64))
+    rng = np.array([1, 2, 3, 4], dtype=np.uint64)
+    prm = np.zeros(KP.N_PARAMS)
+    prm[KP.P_STRIDE] = 1
+    KP.kpiece_run(shim.bundle(checker), T, C, proj, goals, prm, counters, rng)
+    KP.rehash(C, 1)
+    KP.tree_path(T, 0, np.empty((4, dof)))
 
 
 def _tiny_checker() -> Any:
