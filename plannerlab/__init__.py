@@ -37,7 +37,8 @@ def _numba_cache_dir() -> None:
     numba keeps a kernel's cached machine code until the kernel's *own* file changes;
     a kernel that calls a function of another file (every planner's kernel calls the
     collision core's) would go on running the old callee after an update. Named by a
-    digest of every source file that holds compiled code, the cache starts afresh
+    digest of every source file that holds compiled code (naming numba, ``njit`` or
+    ``@kernel``), the cache starts afresh
     whenever any of them changes (``~/.cache/plannerlab/numba/<digest>``; the four most
     recent folders are kept). A ``NUMBA_CACHE_DIR`` set by the user wins, and nothing is
     done once numba was imported (its configuration is then read)."""
@@ -50,7 +51,7 @@ def _numba_cache_dir() -> None:
     digest = hashlib.sha1(usedforsecurity=False)
     for path in sorted(root.rglob("*.py")):
         text = path.read_bytes()
-        if b"numba" in text:
+        if b"numba" in text or b"@kernel" in text or b"njit" in text:
             digest.update(path.relative_to(root).as_posix().encode() + b"\0" + text)
     base = Path(os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache") / "plannerlab"
     folder = base / "numba" / digest.hexdigest()[:16]

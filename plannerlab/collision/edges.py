@@ -120,15 +120,15 @@ def _push_pieces(stack, top, lo, hi, pieces):
 
 
 @kernel
-def _load_stretches(m, Z, E, q_ad, stack, top):
-    """Pop up to W stretches into the lanes (each its middle grid state, grown by its
-    half-length): returns (lanes filled, top). ``E`` = (los, mids, his) the lanes'
-    stretches; ``q_ad`` = (qa, d, n)."""
+def _load_stretches(m, Z, E, q_ad, stack, top, most):
+    """Pop up to ``most`` (at most W) stretches into the lanes (each its middle grid
+    state, grown by its half-length): returns (lanes filled, top). ``E`` = (los, mids,
+    his) the lanes' stretches; ``q_ad`` = (qa, d, n)."""
     los, mids, his = E
     qa, d, n = q_ad
     q = Z.edge_q
     k = 0
-    while k < W and top > 0:
+    while k < most and top > 0:
         top -= 1
         lo, hi = stack[top, 0], stack[top, 1]
         mid = (lo + hi) // 2
@@ -157,9 +157,12 @@ def edge_check(m, Z, qa, qb, joint_step, limit):
     top = _push_pieces(stack, 0, 1, n, W)
     checks = 0
     while top > 0:
-        k, top = _load_stretches(m, Z, (los, mids, his), (qa, d, n), stack, top)
-        if checks + k > limit:
+        if checks >= limit:
             return LIMIT, checks, n
+        # the last call of a budget tests only the lanes it has left: a budget is used
+        # to its last check
+        most = min(W, limit - checks)
+        k, top = _load_stretches(m, Z, (los, mids, his), (qa, d, n), stack, top, most)
         fill_lanes(Z, k)
         free, hit, _ = test_lanes(m, Z, ANY_HIT)
         checks += k
@@ -200,7 +203,9 @@ def edge_rake(m, Z, qa, qb, joint_step, stride, limit):
     while done < pieces:
         # up to W stretches, the far end's first (an extension's new node): pushed
         # nearest first, popped from the top
-        b = min(W, pieces - done)
+        if checks >= limit:
+            return LIMIT, checks, n, False
+        b = min(W, pieces - done, limit - checks)
         top = 0
         for r in range(b):
             p = pieces - done - b + r
@@ -208,9 +213,7 @@ def edge_rake(m, Z, qa, qb, joint_step, stride, limit):
             stack[top, 1] = ((p + 1) * n) // pieces
             top += 1
         done += b
-        k, _ = _load_stretches(m, Z, (los, mids, his), (qa, d, n), stack, top)
-        if checks + k > limit:
-            return LIMIT, checks, n, False
+        k, _ = _load_stretches(m, Z, (los, mids, his), (qa, d, n), stack, top, b)
         fill_lanes(Z, k)
         free, hit, _ = test_lanes(m, Z, ANY_HIT)
         checks += k

@@ -48,8 +48,16 @@ class TrajOptSettings:
             collision hinge's (both grow with the penalty weight).
         goal_depth: ρ, how deep in the region (fraction of each tolerance) the last
             waypoint's tip is drawn.
-        penalty_start, penalty_growth, max_penalty, feasible_fraction, rel_tol,
-            max_inner: the penalty loop's (:class:`~.solvers.PenaltySettings`).
+        penalty_start: μ, the penalty weight of the first inner solve.
+        penalty_growth: the factor μ grows by after an inner solve that left the path
+            infeasible.
+        max_penalty: the largest μ tried before the seed is given up.
+        feasible_fraction: a path is feasible when every evaluated state is at least the
+            margin plus this fraction of the buffer δ from everything (and the goal is
+            reached).
+        rel_tol: an inner solve has converged when the merit fell by less than this
+            fraction in a step.
+        max_inner: the most steps of one inner solve.
         max_refines: re-optimisations after the re-check refuses an edge (its
             neighbourhood split into shorter edges each time).
         seed_share: the share of the collision checks and time the leg has left that a
