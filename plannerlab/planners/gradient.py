@@ -132,8 +132,9 @@ class GradientPlanner(LegPlanner):
 
         The step is cut into states ``joint_step`` apart; the move goes through them up to
         the last one before the first invalid state. With a margin, the checker checks
-        edges in metres (conservative advancement: no point of the robot moves further
-        than the margin between two checked states): then the stretch kept is confirmed
+        edges in metres (certified edges on the re-check's grid: no point of the robot
+        moves further than the margin between two checked states): then the stretch kept
+        is confirmed
         as one such edge, and, if it is not clear, cut back to the states whose edges from
         their predecessor are (a joint-space grid alone misses an obstacle a long arm's
         tip sweeps through between two states: the paper's 0.02 rad grid moves the
@@ -147,7 +148,7 @@ class GradientPlanner(LegPlanner):
             states = states[:max_states]
         bad = checker.first_invalid(states)
         end = len(states) if bad is None else bad  # states[:end] are valid
-        if end and checker.edge_check == "advance":
+        if end and checker.edge_check == "certified":
             end = self._clear_prefix(checker, q, states[:end], problem.joint_step)
         blocked = cut or bad is not None or end < len(states)
         return (states[end - 1] if end > 0 else q), blocked

@@ -257,9 +257,12 @@ def test_certified_edges_give_the_grids_verdict_in_fewer_tests(kind):
         if status == 0:
             tests += made
             grid += n
-        # a limit below what it needs stops it without a verdict
-        if made > 1:
+        # a free edge needs every one of its tests: one fewer stops it without a verdict;
+        # a blocked one gives its verdict again within the tests it made
+        if status == 0 and made > 1:
             assert core.edge_certified(q_a, q_b, step, made - 1)[0] == 2
+        if status == 1:
+            assert core.edge_certified(q_a, q_b, step, made)[:2] == (1, made)
     assert seen[0] >= 3 and seen[1] >= 3  # both outcomes were exercised
     assert tests <= 1.3 * grid
 

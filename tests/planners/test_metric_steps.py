@@ -42,7 +42,7 @@ def _plate_problem():
 def test_a_step_through_a_plate_between_its_grid_states_is_blocked():
     problem, q_a, q_b = _plate_problem()
     checker = problem_checker(problem)
-    assert checker.edge_check == "advance"
+    assert checker.edge_check == "certified"
     grid = interpolate_edge(q_a, q_b, problem.joint_step, problem.robot.continuous)
     assert len(grid) == 2 and checker.first_invalid(grid) is None  # the grid sees nothing
     assert checker.check_edge(q_a, q_b, problem.joint_step)[1] is not None  # metres do
