@@ -15,8 +15,9 @@ from plannerlab.cli.common import add_renamed_flag
 
 
 def cmd_import_mbm(args: argparse.Namespace, console: Console) -> int:
-    from plannerlab import mbm
     from plannerlab.errors import PlannerlabError
+
+    mbm = px.mbm
 
     urdf, srdf = args.urdf, args.srdf
     robot = mbm.mbm_robot(args.robot)
@@ -81,8 +82,6 @@ def cmd_import_mbm(args: argparse.Namespace, console: Console) -> int:
 
 
 def cmd_import_kinematic_chain(args: argparse.Namespace, console: Console) -> int:
-    import plannerlab.extras as px
-
     kc = px.kinematic_chain
 
     for n in args.links:
