@@ -34,6 +34,12 @@ def bundle(checker: Any) -> tuple[Any, ...]:
     return tuple(checker.packed_model)
 
 
+def opened(checker: Any) -> tuple[Any, Any]:
+    """The opened bundle, (model, scratch), for calling the queries below from Python
+    (tests and benches; a search opens :func:`bundle`'s inside its entry)."""
+    return open_bundle(bundle(checker))  # type: ignore[no-any-return]
+
+
 @njit(cache=True, nogil=True, inline="always")
 def open_bundle(P):
     """The bundle the queries take, (model, scratch), from :func:`bundle`'s."""
@@ -141,6 +147,7 @@ __all__ = [
     "LIMIT",
     "bundle",
     "open_bundle",
+    "opened",
     "edge_reach",
     "edge_valid",
     "grid_count",
