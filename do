@@ -2,7 +2,8 @@
 # One entry point for set-up and the two jobs. Creates .venv (Python 3.11+) if it is
 # missing or if pyproject.toml changed since it was made, then runs the job.
 #   ./do main    the main job: the paper's gradient method against the clearance family,
-#                OMPL, compiled sampling and follow-the-leader on the Arm-Z paper's task,
+#                OMPL, compiled sampling, follow-the-leader and trajectory optimisation on
+#                the Arm-Z paper's task,
 #                executed (a few minutes; results/runs/main/, a rerun resumes and only
 #                prints the table), ending with which planner escaped which local minimum
 #   ./do test    the test suite (what CI runs)
@@ -34,7 +35,8 @@ case "$job" in
   main)
     # the mission (issue 36, item 5): on the Arm-Z paper's task (enter, A-E, leave) the
     # paper's gradient method against the best of the clearance family, OMPL, compiled
-    # sampling and follow-the-leader, with the same budget of collision checks per leg for
+    # sampling, follow-the-leader and trajectory optimisation (trajopt.leader: the
+    # leader-guided sampler's path optimised whole), with the same budget of collision checks per leg for
     # every planner (iterations lifted, a time limit only as a guard), solved legs executed
     # in PyBullet; one table, then which planner escaped which local minimum. First the
     # compiled kernels are loaded: a fresh clone compiles them (the core, then the clearance
@@ -48,7 +50,7 @@ case "$job" in
     wait "$clearance"
     wait "$native"
     exec "$VENV/bin/plannerlab" compare armz_inspection \
-      --planners gradient,gradient.clearance+detour,ompl.rrtconnect,ompl.kpiece1,native.rrtconnect,gradient.follow_leader,native.rrtconnect+leader \
+      --planners gradient,gradient.clearance+detour,ompl.rrtconnect,ompl.kpiece1,native.rrtconnect,gradient.follow_leader,native.rrtconnect+leader,trajopt.leader \
       --seeds 0 --max-checks 300000 --max-iterations 1000000000 --time-limit 60 \
       --execute --jobs 2 --minima --out results/runs --name main "$@" ;;
   test)
