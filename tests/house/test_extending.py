@@ -150,11 +150,11 @@ def test_the_compiled_planner_finds_a_via_state_and_keeps_its_budget(planar, tmp
     assert len(leg.path) == 3 and checker.check_path(leg.path, problem.joint_step / 4).valid
     # its compiled checks are charged: more than the goal state's and the re-check's
     assert leg.collision_checks > checker.grid_states(leg.path, problem.joint_step / 4) + 1
-    pocket = pl.load_problem("armz_pocket")  # no via state is free within 3000 checks
+    # a budget that cannot find a via state round the post: used to its last check
     (leg,) = pl.solve(
-        pocket, "via", 0, budget=pocket.budget.replace(max_collision_checks=3000)
+        problem, "via", 0, budget=problem.budget.replace(max_collision_checks=20)
     ).legs
-    assert leg.status is Status.BUDGET_EXHAUSTED and leg.collision_checks == 3000
+    assert leg.status is Status.BUDGET_EXHAUSTED and leg.collision_checks == 20
 
 
 # ---------------------------------------------------------------------- the robots
@@ -198,3 +198,34 @@ def test_the_urdf_robot_example_plans_with_rrtconnect(tmp_path):
     assert leg.status is Status.SOLVED, leg.reason
     np.testing.assert_allclose(leg.path[-1], [2.0, 0.5], atol=1e-3)
     assert problem_checker(problem).check_path(leg.path, problem.joint_step / 4).valid
+
+
+# ---------------------------------------------------------------------- the optimiser
+def test_the_trajectory_optimiser_smooths_its_seed_and_keeps_the_re_check(
+    monkeypatch, planar, tmp_path
+):
+    import plannerlab as pl
+    import plannerlab.planners as registry
+    from plannerlab.collision.fcl_checker import problem_checker
+    from plannerlab.record.leg import Status
+    from plannerlab.robots.paths import roughness
+
+    python = _blocks("python")
+    _module(monkeypatch, "plannerlab.planners.smooth", python["plannerlab/planners/smooth.py"])
+    entry = _entry("smooth", "ENTRY")
+    monkeypatch.setattr(
+        registry, "REGISTRY", MappingProxyType({**registry.REGISTRY, "smooth": entry})
+    )
+    problem = pl.parse_problem(_write(tmp_path)["planar.toml"])
+    (leg,) = pl.solve(problem, "smooth", 0).legs
+    assert leg.status is Status.SOLVED, leg.reason
+    checker = problem_checker(problem)
+    assert checker.check_path(leg.path, problem.joint_step / 4).valid  # no tunnelling
+    seed = np.array(leg.extra["seed_path"])
+    assert checker.check_path(seed, problem.joint_step / 4).valid
+    cont = problem.robot.continuous
+    assert roughness(leg.path, cont) < roughness(seed, cont)  # it bends less than its seed
+    np.testing.assert_allclose(leg.path[0], problem.q_start)
+    assert problem.goal(0).contains(problem.robot, leg.path[-1])
+    # the seed's checks are the leg's, and the smoothing's re-checks come on top
+    assert leg.collision_checks > leg.extra["seed_checks"] > 0
