@@ -37,7 +37,7 @@ def bundle(checker: Any) -> tuple[Any, ...]:
 def opened(checker: Any) -> tuple[Any, Any]:
     """The opened bundle, (model, scratch), for calling the queries below from Python
     (tests and benches; a search opens :func:`bundle`'s inside its entry)."""
-    return open_bundle(bundle(checker))  # type: ignore[no-any-return]
+    return open_bundle(bundle(checker))
 
 
 @njit(cache=True, nogil=True, inline="always")
