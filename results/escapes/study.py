@@ -231,8 +231,7 @@ def load(out: Path) -> list[Any]:
     """The study's trial records (typed, ``TrialRecord``); the last record of a key wins."""
     from plannerlab import TrialStore
 
-    recs = TrialStore(out / "trials.jsonl").load()
-    return list({r.key: r for r in recs}.values())
+    return list(TrialStore(out / "trials.jsonl").load().values())
 
 
 def clean(r: Any) -> bool:
