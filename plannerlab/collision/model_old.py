@@ -1,6 +1,6 @@
 """The compiled robot–scene model: one typed object that compiled consumers share.
 
-A :class:`CompiledModel` is a named tuple of arrays (numba passes it as one argument and
+A :class:`ChainModel` is a named tuple of arrays (numba passes it as one argument and
 loads kernels that take it from its cache) built once per (robot, scene, margin) from a
 robot's serial chain (``robot.chain_data()``: per joint its parent body, fixed transform,
 axis and kind; per capsule its body and end points) and the scene's obstacles. It holds
@@ -56,7 +56,7 @@ class ModelError(PlannerlabError):
     """A compiled consumer asked for the model of a robot that cannot give one."""
 
 
-class CompiledModel(NamedTuple):
+class ChainModel(NamedTuple):
     """One robot in one scene with a margin, as arrays (see the module docstring)."""
 
     P: np.ndarray
@@ -75,7 +75,7 @@ def has_chain(robot: Any) -> bool:
     return callable(getattr(robot, "chain_data", None))
 
 
-def model_of_core(core: Any) -> CompiledModel:
+def model_of_core(core: Any) -> ChainModel:
     """The model of a built :class:`~plannerlab.collision.core.Core` (its capsules with
     the margin, checked pairs, scene arrays and edge weights)."""
     robot = core.robot
@@ -94,7 +94,7 @@ def model_of_core(core: Any) -> CompiledModel:
         # and cached twice
         return np.array(a, dtype=dtype, order="C", copy=True)
 
-    return CompiledModel(
+    return ChainModel(
         P=P,
         M=M,
         idat=idat,
@@ -107,7 +107,7 @@ def model_of_core(core: Any) -> CompiledModel:
     )
 
 
-def chain_model(robot: Any) -> CompiledModel:
+def chain_model(robot: Any) -> ChainModel:
     """The model of a robot's chain alone (no scene, no margin, no checked pairs): its
     kinematics and capsules packed as :func:`model_of_core` packs them, for a consumer
     that needs only those (the clearance field's spheres,
@@ -136,7 +136,7 @@ def chain_model(robot: Any) -> CompiledModel:
         None,
     )
     dof = int(robot.dof)
-    return CompiledModel(
+    return ChainModel(
         P=P,
         M=M,
         idat=idat,
@@ -149,7 +149,7 @@ def chain_model(robot: Any) -> CompiledModel:
     )
 
 
-def build_model(core: Any) -> CompiledModel:
+def build_model(core: Any) -> ChainModel:
     """The model of a built core: the generic serial-chain :func:`model_of_core`, from the
     robot's ``chain_data()``.
 
@@ -193,7 +193,7 @@ def segments(Q, m, out):
     return out
 
 
-def valid_states(Q: np.ndarray, m: CompiledModel, out: np.ndarray) -> np.ndarray:
+def valid_states(Q: np.ndarray, m: ChainModel, out: np.ndarray) -> np.ndarray:
     """Validity of a batch Q (k, dof) -> out (k,) bool, in vector lanes (the verdicts of
     :func:`state_ok`, state by state)."""
     return valid_states_lanes(Q, m, out)

@@ -1,9 +1,11 @@
-"""Spheres on a robot's links, placed by the compiled robot–scene model's kinematics
-(numba, cached): the compiled geometry of the clearance field
-(:mod:`plannerlab.planners.clearance`), which owns none of its own.
+"""Spheres on a robot's links, placed by the robot's chain as the previous compiled model
+packed it (numba, cached): the compiled geometry of the clearance field
+(:mod:`plannerlab.planners.clearance`) and of ``trajopt.*``, which own none of their own.
+Still on :mod:`plannerlab.collision.model_old`'s chain, not yet on
+:mod:`plannerlab.collision.kinematics` (the state test's one kinematics).
 
-A :class:`SphereChain` is the model's chain (:class:`~plannerlab.collision.model.
-CompiledModel`: its base, fixed transforms with the joints' axes folded onto z, sliding
+A :class:`SphereChain` is the chain (:class:`~plannerlab.collision.model_old.
+ChainModel`: its base, fixed transforms with the joints' axes folded onto z, sliding
 joints and coupling, as :func:`~plannerlab.collision.chain_pack._pack` packs them) with
 each link's capsule axis in its body's folded frame, in the robot's link order, and the
 tip (body, point, normal: ``robot.tip_data()``). The kernels below:
@@ -79,8 +81,8 @@ def _chain_views(m):
 
 def sphere_chain(model: Any, robot: Any) -> SphereChain:
     """The :class:`SphereChain` of ``robot`` from its compiled ``model``
-    (:class:`~plannerlab.collision.model.CompiledModel`, or one packed by
-    :func:`~plannerlab.collision.model.chain_model`): the model's kinematics, its
+    (:class:`~plannerlab.collision.model_old.ChainModel`, as
+    :func:`~plannerlab.collision.model_old.chain_model` packs it): the model's kinematics, its
     capsules back in the robot's link order, and the robot's tip (``tip_data()``).
 
     Raises:

@@ -25,7 +25,7 @@ def _models(problem, **overrides):
         problem
     )
     assert type(numpy_model).__name__ == "NumpyModel"
-    assert type(compiled).__name__ == "CompiledModel"
+    assert type(compiled).__name__ == "CompiledStep"
     return numpy_model, compiled
 
 

@@ -76,7 +76,7 @@ from plannerlab.planners.base import (
 )
 from plannerlab.planners.clearance.field import ClearanceField, SetupStopped
 from plannerlab.planners.clearance.legpath import LegPath
-from plannerlab.planners.clearance.models import CompiledModel, Model, NumpyModel
+from plannerlab.planners.clearance.models import CompiledStep, Model, NumpyModel
 from plannerlab.planners.clearance.settings import ClearanceSettings, robot_size
 from plannerlab.planners.clearance.slide import Slide, deep_inside, sight_clearance_m, slide_out
 from plannerlab.planners.clearance.step import DescentStep
@@ -180,7 +180,7 @@ class ClearanceDescent(DescentStep, LegPlanner):
         field = ClearanceField(problem.robot, problem.scene, self.settings.influence_m, stop=stop)
         model: Model
         if self.backend_for(problem.robot) == "compiled":
-            model = CompiledModel(self, field)
+            model = CompiledStep(self, field)
         else:
             model = NumpyModel(self, field)
         self._model_cache = (problem, model)

@@ -1,7 +1,7 @@
 """The clearance descent's field and step at one state, on one of two engines (its
 ``backend`` setting): :class:`NumpyModel` (the reference, :mod:`plannerlab.planners.
 clearance.field` and :class:`~plannerlab.planners.clearance.step.DescentStep`) or
-:class:`CompiledModel` (numba, :mod:`plannerlab.planners.clearance.compiled`; the planners
+:class:`CompiledStep` (numba, :mod:`plannerlab.planners.clearance.compiled`; the planners
 run it on Arm-Z): the same iterates to rounding."""
 
 from __future__ import annotations
@@ -109,7 +109,7 @@ class NumpyModel:
         """Nothing to load."""
 
 
-class CompiledModel:
+class CompiledStep:
     """The field and the step compiled (:mod:`plannerlab.planners.clearance.compiled`): one
     call per state gives F, f, the tip errors, the distances and the step direction."""
 
@@ -149,7 +149,7 @@ class CompiledModel:
         self.hold(goal, q, self.point(goal, q).direction)
 
 
-Model = NumpyModel | CompiledModel
+Model = NumpyModel | CompiledStep
 
 
-__all__ = ["CompiledModel", "Model", "NumpyModel", "NumpyPoint"]
+__all__ = ["CompiledStep", "Model", "NumpyModel", "NumpyPoint"]
