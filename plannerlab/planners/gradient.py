@@ -146,25 +146,35 @@ class GradientPlanner(LegPlanner):
         cut = max_states is not None and len(states) > max_states
         if cut:
             states = states[:max_states]
+        c0 = checker.checks
         bad = checker.first_invalid(states)
         end = len(states) if bad is None else bad  # states[:end] are valid
         if end and checker.edge_check == "certified":
-            end = self._clear_prefix(checker, q, states[:end], problem.joint_step)
+            left = None if max_states is None else max(max_states - (checker.checks - c0), 0)
+            end = self._clear_prefix(checker, q, states[:end], problem.joint_step, left)
         blocked = cut or bad is not None or end < len(states)
         return (states[end - 1] if end > 0 else q), blocked
 
     @staticmethod
-    def _clear_prefix(checker: CollisionChecker, q: Array, states: Array, joint_step: float) -> int:
+    def _clear_prefix(
+        checker: CollisionChecker, q: Array, states: Array, joint_step: float, left: int | None
+    ) -> int:
         """How many of ``states`` (valid, in order from q) are reached by edges clear in
         metres: the whole stretch in one check, else edge by edge up to the first that is
-        not."""
-        _, bad = checker.check_edge(q, states[-1], joint_step)
-        if bad is None:
+        not, within ``left`` checks (None: no limit; an edge the limit cut short is not
+        clear)."""
+        c0 = checker.checks
+
+        def clear(a: Array, b: Array) -> bool:
+            limit = None if left is None else max(left - (checker.checks - c0), 0)
+            n, bad = checker.check_edge(a, b, joint_step, limit)
+            return bad is None and (limit is None or n <= limit)
+
+        if clear(q, states[-1]):
             return len(states)
         prev = q
         for k, qk in enumerate(states):
-            _, bad = checker.check_edge(prev, qk, joint_step)
-            if bad is not None:
+            if not clear(prev, qk):
                 return k
             prev = qk
         return len(states)
