@@ -137,7 +137,7 @@ def test_hinge_gradient_and_tip_match_the_robot() -> None:
     normal, Jacobians) against the robot's own."""
     problem = thin_plate_problem()
     robot = problem.robot
-    geometry = PathGeometry(robot, problem.scene, problem_checker(problem).model)
+    geometry = PathGeometry(robot, problem.scene)
     X = _through_the_plate(problem, 7)
     c, g, H, dmin = geometry.hinge(X, 0.1, True)
     assert np.count_nonzero(c) >= 3 and dmin.min() < 0.0
@@ -258,9 +258,13 @@ def test_a_seed_planners_settings_are_passed_on() -> None:
 GOLDEN = {
     ("trajopt.line", "toy", 20_000, 5, ""): ("solved", 490, 17, 0),
     ("trajopt.line", "toy_joint", 20_000, 5, ""): ("solved", 447, 17, 0),
-    ("trajopt.rrtconnect", "toy", 20_000, 5, ""): ("solved", 1204, 21, 0),
+    # re-pinned on the certified edges (issue 32): 1 204 checks (its seed's edges); on the
+    # Panda (margin 0) the checker now gives its reach (the certificates' bounds), so the
+    # waypoints are spaced by it, not by the sphere field's speeds: 30 of them where there
+    # were 12 (1 052 checks, 21 evaluations)
+    ("trajopt.rrtconnect", "toy", 20_000, 5, ""): ("solved", 719, 21, 0),
     ("trajopt.line", "thin_plate", 50_000, 0, "tunnel"): ("solved", 1739, 36, 2),
-    ("trajopt.line", "panda_bookshelf", 200_000, 0, ""): ("solved", 1052, 21, 0),
+    ("trajopt.line", "panda_bookshelf", 200_000, 0, ""): ("solved", 1880, 22, 0),
 }
 OVERRIDES = {"": {}, "tunnel": {"substeps": 0, "min_waypoints": 3}}
 
