@@ -17,7 +17,7 @@ PACKAGE = Path(__file__).resolve().parents[2] / "plannerlab"
 
 #: engine -> the only place (a module path prefix, relative to the package) that may import it
 ENGINE_ROOMS = {
-    "fcl": ("collision/",),
+    "fcl": ("collision/", "robots/urdf/approx.py"),  # covers: a point's distance to a mesh
     "ompl": ("planners/ompl/",),
     "pybullet": ("sim/",),
     "matplotlib": ("plot/",),
