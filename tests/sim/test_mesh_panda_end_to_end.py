@@ -27,7 +27,10 @@ def test_mesh_panda_tip_goal_over_the_table_is_solved_executed_and_clean_on_the_
     problem = load_problem(TABLE)
     robot = problem.robot
     covers = robot.mesh_covers  # type: ignore[attr-defined]
-    assert len(covers) == 11 and max(c.max_excess_m for c in covers) <= 0.01
+    # within the budget of 32 primitives a link (COVER_VERSION 5) the covers reach up to
+    # 24 mm outside the meshes (10 mm before the budget; every mesh point still covered)
+    assert len(covers) == 11 and max(c.max_excess_m for c in covers) <= 0.025
+    assert all(c.points_verified > 0 for c in covers)
     assert robot.links_without_geometry == ("panda_link8", "panda_grasptarget")  # type: ignore[attr-defined]
     plan = solve_legs(
         problem, "ompl.rrtconnect", 0, legs=[0], budget=Budget(max_collision_checks=200_000)
