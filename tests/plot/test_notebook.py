@@ -38,3 +38,4 @@ def test_compare_notebook_runs_headless(tmp_path, monkeypatch):
     assert panda.startswith(" bookshelf_small_panda/scene0001")
     assert "solved - RRTConnect: Exact solution" in panda
     assert "without contact" in panda
+    assert "certified free: True" in panda  # pl.checker on the Panda's plan
