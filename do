@@ -6,7 +6,7 @@
 #                the Arm-Z paper's task,
 #                executed (a few minutes; results/runs/main/, a rerun resumes and only
 #                prints the table), ending with which planner escaped which local minimum
-#   ./do test    the test suite (what CI runs)
+#   ./do test    the test suite (what CI runs), in two processes
 #   ./do bench   the speed benchmarks (bench/)
 #   ./do jupyter Jupyter Lab on notebooks/compare.ipynb (installs jupyterlab into .venv once)
 set -euo pipefail
@@ -54,7 +54,10 @@ case "$job" in
       --seeds 0 --max-checks 300000 --max-iterations 1000000000 --time-limit 60 \
       --execute --jobs 2 --minima --out results/runs --name main "$@" ;;
   test)
-    exec "$VENV/bin/python" -m pytest -q "$@" ;;
+    # two test processes (pytest-xdist; PLANNERLAB_TEST_JOBS=0: in this process alone),
+    # each taking the next test when it is free (worksteal: a few tests take a minute);
+    # on a fresh clone they share numba's cache, so a kernel one compiles the other loads
+    exec "$VENV/bin/python" -m pytest -q -n "${PLANNERLAB_TEST_JOBS:-2}" --dist worksteal "$@" ;;
   bench)
     for b in bench/*.py; do "$VENV/bin/python" "$b" "$@"; done ;;
   jupyter)

@@ -22,6 +22,17 @@ ROOT = Path(__file__).resolve().parents[1]
 PROBLEMS = ROOT / "problems"
 
 
+@pytest.fixture(autouse=True)
+def _fixed_terminal_width(monkeypatch: pytest.MonkeyPatch) -> None:
+    """The CLI sizes its tables by ``COLUMNS`` (else the terminal's width, else 100).
+    pytest-xdist's workers set ``COLUMNS=80`` and a terminal may set anything, so every
+    test sees the width of a pipe: what a test reads from a table does not depend on the
+    terminal that runs the suite."""
+    from plannerlab.cli.tables import PIPE_WIDTH
+
+    monkeypatch.setenv("COLUMNS", str(PIPE_WIDTH))
+
+
 #: the one small valid problem file of the tests: a 6-module Arm-Z (5 joints) at the
 #: straight column, a wall beside it, one goal ("up") above it; every table a test may edit
 #: is present (use :func:`tiny_problem_text` to change one thing, ``+`` to add a table)

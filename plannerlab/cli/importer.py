@@ -82,8 +82,16 @@ def cmd_import_mbm(args: argparse.Namespace, console: Console) -> int:
 
 
 def cmd_import_kinematic_chain(args: argparse.Namespace, console: Console) -> int:
-    kc = px.kinematic_chain
+    from plannerlab.errors import PlannerlabError
 
+    kc = px.kinematic_chain
+    # every N checked before any file is written: "--links 10 1" writes nothing
+    bad = [n for n in args.links if not kc.MIN_LINKS <= n <= kc.MAX_LINKS]
+    if bad:
+        raise PlannerlabError(
+            f"--links: each N must be in {kc.MIN_LINKS} … {kc.MAX_LINKS} links, got "
+            f"{', '.join(map(str, bad))}"
+        )
     for n in args.links:
         target = kc.write_problem(
             n,

@@ -146,8 +146,10 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def _error_console() -> Console:
-    """stderr, printing messages as written (they name keys in brackets: "[goals[0].n]")."""
-    return Console(stderr=True, markup=False)
+    """stderr, printing messages as written (they name keys in brackets: "[goals[0].n]"),
+    one line each: a file path is never broken by an inserted line break (soft wrap; the
+    terminal folds long lines itself)."""
+    return Console(stderr=True, markup=False, soft_wrap=True)
 
 
 def _show_renamed(

@@ -68,7 +68,9 @@ def solve_and_save(args: argparse.Namespace, console: Console, out: Path | None 
 
     problem = pl.load_problem(args.problem)
     if not getattr(args, "json", False):
-        console.print(f"problem {problem.name} from {problem.source}", highlight=False)
+        console.print(
+            f"problem {problem.name} from {problem.source}", highlight=False, soft_wrap=True
+        )
     overrides = parse_overrides(args.set)
     legs = px.legs_from_spec(problem, args.legs)
     n_legs = len(legs) if legs is not None else problem.legs

@@ -62,8 +62,10 @@ def make_console(stderr: bool = False, stream: TextIO | None = None) -> Console:
 
     stream = stream or (sys.stderr if stderr else sys.stdout)
     # markup off: user text (paths, names, messages with "[table]" keys) prints as written;
-    # styles are given as rich Text or style=, never as markup in a string
-    return Console(stderr=stderr, width=output_width(stream), markup=False)
+    # styles are given as rich Text or style=, never as markup in a string. soft_wrap:
+    # a line of text is never broken by an inserted newline (a path stays one run of
+    # characters to copy; the terminal folds it); tables are laid out to the width
+    return Console(stderr=stderr, width=output_width(stream), markup=False, soft_wrap=True)
 
 
 def table(

@@ -112,6 +112,23 @@ def test_terminal_output_prints_user_text_literally(capsys, tmp_path):
     assert code == 2 and "[missing].toml" in err
 
 
+def test_a_long_path_is_printed_whole_on_a_narrow_terminal(capsys, tmp_path, monkeypatch):
+    """On a 40-column terminal an error and the problem's source line still carry the
+    path as one run of characters, to copy and paste (rich used to break it with a line
+    break at the console's width: ``.../plan.jso`` + newline + ``n``)."""
+    monkeypatch.setenv("COLUMNS", "40")
+    folder = tmp_path / ("a_folder_name_longer_than_the_terminal_is_wide" * 2)
+    folder.mkdir()
+    problem = folder / "tiny.toml"
+    problem.write_text(TINY, encoding="utf-8")
+    code, out, _ = run(capsys, "solve", str(problem), "--planner", "gradient.clearance",
+                       "--out", str(folder / "plan.json"))  # fmt: skip
+    assert code == 0 and f"from {problem}" in out
+    (folder / "bad.json").write_text("{", encoding="utf-8")
+    code, _, err = run(capsys, "execute", str(folder / "bad.json"))
+    assert code == 2 and str(folder / "bad.json") in err
+
+
 # ---------------------------------------------------------------------- help texts
 def _help_texts(capsys) -> dict[str, str]:
     parser = build_parser()

@@ -121,3 +121,32 @@ def test_the_urdf_and_problem_file_are_written_atomically_and_bad_input_is_refus
     (tmp_path / "file").write_text("")
     with pytest.raises(PlannerlabError, match="folder"):
         kc.write_problem(10, tmp_path / "file")
+
+
+@pytest.mark.parametrize(
+    ("argv", "message"),
+    [
+        (["--links", "10", "1"], "--links: each N must be in 2 … 200 links, got 1"),
+        (["--links", "201"], "--links: each N must be in 2 … 200 links, got 201"),
+        (["--links", "x"], "argument --links: invalid int value: 'x'"),
+        (["--links", "10", "--time-limit", "-1"], "time_limit_s must be a finite number > 0"),
+        (["--links", "10", "--joint-step", "nan"], "joint_step"),
+    ],
+)
+def test_the_import_command_refuses_bad_input_naming_the_flag_and_writes_nothing(
+    tmp_path, capsys, argv, message
+):
+    """``plannerlab import kinematic-chain``: a bad N, time limit or step is refused with
+    exit code 2 and a message naming what was expected; no file is written, not even the
+    good N's before a bad one."""
+    from plannerlab.cli import main
+
+    out = tmp_path / "out"
+    try:
+        code = main(["import", "kinematic-chain", *argv, "--out", str(out)])
+    except SystemExit as stop:  # argparse's own refusals
+        code = stop.code
+    err = " ".join(capsys.readouterr().err.split())
+    assert code == 2
+    assert message in err
+    assert not out.exists() or not any(out.iterdir())
