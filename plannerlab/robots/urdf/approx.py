@@ -513,8 +513,15 @@ def _greedy_spheres(
             pick = rng.choice(len(cand), size=max(keep_n, 16), replace=False)
             cand, depth, reach = cand[pick], depth[pick], reach[pick]
         lists = tree.query_ball_point(cand, reach)
-        rows = np.repeat(np.arange(len(cand)), [len(x) for x in lists])
-        cols = np.fromiter((i for x in lists for i in x), dtype=np.int64, count=len(rows))
+        lengths = np.fromiter(map(len, lists), dtype=np.int64, count=len(lists))
+        rows = np.repeat(np.arange(len(cand)), lengths)
+        # flattened in C (one list of ints per candidate; a generator over tens of
+        # millions of ints took most of a robot's cover time)
+        cols = (
+            np.concatenate([np.asarray(x, dtype=np.int64) for x in lists])
+            if len(rows)
+            else np.zeros(0, dtype=np.int64)
+        )
         keep = uncovered[cols]
         cov = csr_matrix(
             (np.ones(int(keep.sum()), dtype=np.int32), (rows[keep], cols[keep])),
