@@ -132,7 +132,7 @@ def cmd_execute(args: argparse.Namespace, console: Console) -> int:
         if changed:
             logging.getLogger(__name__).warning("%s: %s", plan_file, changed)
             if not args.json:
-                console.print(Text.assemble(("warning:", "yellow"), f" {changed}"))
+                console.print(Text.assemble(("warning:", "yellow"), f" {changed}"), soft_wrap=True)
     else:
         if not args.planner:
             raise PlannerlabError("execute PROBLEM needs --planner NAME (or give a PLAN.json)")
@@ -152,7 +152,7 @@ def cmd_execute(args: argparse.Namespace, console: Console) -> int:
         return 1 if args.strict and not record.success else 0
     console.print(leg_table(plan, f"{plan.planner} on {plan.problem}, seed {plan.seed}: plan"))
     print_execution_tables(console, plan.legs, executions)
-    console.print(f"execution written to {out} (plan: {plan_file})")
+    console.print(f"execution written to {out} (plan: {plan_file})", soft_wrap=True)
     return 1 if args.strict and not all(e.success for e in executions) else 0
 
 

@@ -77,7 +77,7 @@ def cmd_import_mbm(args: argparse.Namespace, console: Console) -> int:
             joint_step_rad=args.joint_step,
         )
         target.write_text(text, encoding="utf-8")
-    console.print(f"{len(pairs)} problem files written to {out}", highlight=False)
+    console.print(f"{len(pairs)} problem files written to {out}", highlight=False, soft_wrap=True)
     return 0
 
 
@@ -102,7 +102,7 @@ def cmd_import_kinematic_chain(args: argparse.Namespace, console: Console) -> in
             joint_step_rad=args.joint_step,
             time_limit_s=args.time_limit,
         )
-        console.print(f"{target} (and its URDF)", highlight=False)
+        console.print(f"{target} (and its URDF)", highlight=False, soft_wrap=True)
     return 0
 
 

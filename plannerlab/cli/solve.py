@@ -109,7 +109,7 @@ def cmd_solve(args: argparse.Namespace, console: Console) -> int:
         print(dumps(plan.to_dict(out)))
     else:
         console.print(leg_table(plan, f"{plan.planner} on {plan.problem}, seed {plan.seed}"))
-        console.print(f"plan written to {out}")
+        console.print(f"plan written to {out}", soft_wrap=True)
     return 1 if args.strict and not plan.solved else 0
 
 

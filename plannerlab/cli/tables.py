@@ -62,10 +62,9 @@ def make_console(stderr: bool = False, stream: TextIO | None = None) -> Console:
 
     stream = stream or (sys.stderr if stderr else sys.stdout)
     # markup off: user text (paths, names, messages with "[table]" keys) prints as written;
-    # styles are given as rich Text or style=, never as markup in a string. soft_wrap:
-    # a line of text is never broken by an inserted newline (a path stays one run of
-    # characters to copy; the terminal folds it); tables are laid out to the width
-    return Console(stderr=stderr, width=output_width(stream), markup=False, soft_wrap=True)
+    # styles are given as rich Text or style=, never as markup in a string. A line that
+    # names a path prints with soft_wrap=True (never broken by an inserted newline)
+    return Console(stderr=stderr, width=output_width(stream), markup=False)
 
 
 def table(

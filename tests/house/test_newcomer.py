@@ -124,6 +124,13 @@ def test_a_long_path_is_printed_whole_on_a_narrow_terminal(capsys, tmp_path, mon
     code, out, _ = run(capsys, "solve", str(problem), "--planner", "gradient.clearance",
                        "--out", str(folder / "plan.json"))  # fmt: skip
     assert code == 0 and f"from {problem}" in out
+    plan = folder / "plan.json"
+    problem.write_text(TINY + "\n# changed\n", encoding="utf-8")
+    code, out, _ = run(capsys, "execute", str(plan), "--allow-changed-problem",
+                       "--out", str(folder / "e.json"))  # fmt: skip
+    assert code == 0
+    assert f"the problem file {problem} changed since planning" in out
+    assert f"execution written to {folder / 'e.json'} (plan: {plan})" in out
     (folder / "bad.json").write_text("{", encoding="utf-8")
     code, _, err = run(capsys, "execute", str(folder / "bad.json"))
     assert code == 2 and str(folder / "bad.json") in err

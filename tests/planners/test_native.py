@@ -362,3 +362,27 @@ def test_kd_tree_nearest_is_the_brute_force_nearest():
     T = K.Tree(Q, np.full(4, -1, dtype=np.int64), F, np.full(4, np.inf), Kd)
     KS = (np.empty(6, dtype=np.int64), np.empty(6), np.empty((6, 2)))
     assert KD.kd_nearest(T, np.ones(2), np.zeros(2, dtype=np.bool_), sd, KS) == -1
+
+
+def test_a_search_without_a_path_restarts_at_doubling_points_and_still_plans() -> None:
+    """``restart_cycles``: a run that has found no path after its share of checks drops
+    both trees and starts again from the start and the goal states; each run is twice as
+    long as the one before. With a ladder of 5 × 64 checks, ``armz_window`` (which takes
+    thousands of checks) restarts several times, still plans a valid path, and the same
+    seed gives the same path; without restarts it makes none."""
+    p = problem("armz_window")
+    budget = Budget(max_collision_checks=200_000)
+    small = {"level_checks": 64, "restart_cycles": 1}
+    r = make_planner("native.rrtconnect", small).solve(p, 0, budget, np.random.default_rng(4))
+    assert r.status is Status.SOLVED, r.reason
+    checks = int(r.extra["planning_checks"])
+    # runs of 320, 640, 1280, ... checks: k restarts need at least 320 (2^k - 1) checks
+    k = int(r.extra["restarts"])
+    assert k >= 2 and 320 * (2**k - 1) <= checks < 320 * (2 ** (k + 2) - 1)
+    checker = CollisionChecker(p.robot, p.scene)
+    assert checker.check_path(r.path, p.joint_step / 4).valid
+    again = make_planner("native.rrtconnect", small).solve(p, 0, budget, np.random.default_rng(4))
+    assert np.array_equal(again.path, r.path) and again.extra["restarts"] == k
+    never = {"level_checks": 64, "restart_cycles": 0}
+    r0 = make_planner("native.rrtconnect", never).solve(p, 0, budget, np.random.default_rng(4))
+    assert r0.extra["restarts"] == 0

@@ -376,25 +376,45 @@ class NativeSolve:
         O: K.Options,
         cap: int,
         iterations0: int = 0,
+        fresh: Any = None,
     ) -> int:
         """The compiled RRT-Connect on ``trees`` in chunks (:meth:`run_chunks`), the trees
         grown (up to ``cap`` rows) when full; ``iterations`` counts from ``iterations0``.
         The range cycles over :func:`range_ladder`, ``level_checks`` checks at each (a
         chunk ends at a level's end: the ladder depends on counted checks only, so the
         same seed and check budget give the same search anywhere; ``O``'s range is set for
-        each call). ``O``'s ``need_free`` must be :func:`free_rows`'. Returns the kernel's
-        last code."""
+        each call). ``O``'s ``need_free`` must be :func:`free_rows`'. ``fresh()``: the
+        trees and sizes to restart from (``restart_cycles``; None: no restarts): a run
+        without a path ends at its restart point, counted in checks like the ladder, and
+        the next starts from ``fresh()`` with the ladder's first level. Returns the
+        kernel's last code."""
         self._charged = 0
         ladder = range_ladder(self.s, float(O.f[2]))
         per_level = (
             max(1, int(getattr(self.s, "level_checks", 0))) if len(ladder) > 1 else UNLIMITED
         )
-        c0 = int(counters[1])
+        cycles = int(getattr(self.s, "restart_cycles", 0)) if fresh is not None else 0
+        first_run = (
+            cycles * len(ladder) * max(1, int(getattr(self.s, "level_checks", 0)))
+            if cycles > 0
+            else UNLIMITED
+        )
+        run = [int(counters[1]), first_run]  # this run's first check, its length
+        self.extra.setdefault("restarts", 0)
 
         def call(soft: int, hard: int) -> int:
-            level = (int(counters[1]) - c0) // per_level
+            if int(counters[1]) >= run[0] + run[1]:
+                new_trees, new_sizes = fresh()
+                trees[:] = new_trees
+                sizes[:] = new_sizes
+                counters[2] = 0  # the first tree extends first, as in the first run
+                run[0], run[1] = int(counters[1]), 2 * run[1]
+                self.extra["restarts"] += 1
+            if run[1] < UNLIMITED:
+                soft = min(soft, run[0] + run[1])
+            level = (int(counters[1]) - run[0]) // per_level
             if len(ladder) > 1:
-                soft = min(soft, c0 + (level + 1) * per_level)
+                soft = min(soft, run[0] + (level + 1) * per_level)
                 O.f[2] = ladder[level % len(ladder)]
             A = K.Tree(trees[0], trees[1], trees[2], trees[3], trees[8])
             B = K.Tree(trees[4], trees[5], trees[6], trees[7], trees[9])
@@ -435,12 +455,17 @@ class NativeSolve:
         )
         self.extra["tree_rows"] = cap
         rows = min(cap, max(FIRST_ROWS, need_free + len(G) + 1))
-        trees = self.new_trees(((q0[None], None), (G, None)), rows, dof)
-        sizes = np.array([1, len(G)], dtype=np.int64)
+
+        def fresh() -> tuple[list[np.ndarray], np.ndarray]:
+            """The trees as the search starts them: the start, and every goal state."""
+            trees = self.new_trees(((q0[None], None), (G, None)), rows, dof)
+            return trees, np.array([1, len(G)], dtype=np.int64)
+
+        trees, sizes = fresh()
         counters = np.zeros(6, dtype=np.int64)
         max_it = UNLIMITED if self.budget.max_iterations is None else self.budget.max_iterations
         O = self.options(range_rad, max_it, need_free)
-        code = self.search(trees, sizes, counters, rng_state, O, cap)
+        code = self.search(trees, sizes, counters, rng_state, O, cap, fresh=fresh)
         self.extra["planning_checks"] = int(counters[1])
         self.extra["nodes"] = [int(sizes[0]), int(sizes[1])]
         self.extra["paths_failing_fine_check"] = int(counters[5])
