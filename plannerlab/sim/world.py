@@ -546,9 +546,13 @@ class SimWorld:
         """Put the joints at q (dof,) kinematically (no motor command, no physics step):
         for closest-point queries of a probe world (:mod:`plannerlab.sim.measure`)."""
         q = self._q(q_rad)
-        c = self.client
-        for j, v in zip(self._joints, self._to_urdf(q), strict=True):
-            c.resetJointState(self.body, j, float(v), 0.0)
+        # one call for every joint (a probe is set thousands of times an execution)
+        self.client.resetJointStatesMultiDof(
+            self.body,
+            self._joints,
+            [[float(v)] for v in self._to_urdf(q)],
+            [[0.0]] * len(self._joints),
+        )
 
     def link_distances(self, max_distance_m: float) -> tuple[Array, list[str], Array]:
         """Closest distances of the robot's current state, from PyBullet's closest points
