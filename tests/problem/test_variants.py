@@ -1,10 +1,13 @@
 """Variants of the paper's task (``plannerlab.problem.variants``): the generator is deterministic,
 every committed variant's witnesses are collision-free with their stated clearance and
-inside their goals, and one variant is solved and executed end to end."""
+inside their goals, the first 40 are unchanged, the rooms of more kinds are what they say,
+and one variant is solved and executed end to end."""
 
 from __future__ import annotations
 
+import hashlib
 import tomllib
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -12,6 +15,7 @@ from conftest import PROBLEMS
 
 from plannerlab.collision.fcl_checker import CollisionChecker
 from plannerlab.problem.catalog import list_problems, load_problem
+from plannerlab.problem.variant_rooms import LAYOUTS, MODULES_MAX
 from plannerlab.problem.variants import (
     MODULES_RANGE,
     ORDERS,
@@ -27,26 +31,79 @@ from plannerlab.record.leg import Status
 SEED_KEPT_FIRST = 5
 
 VARIANTS = sorted((PROBLEMS / "variants").glob("*.toml"))
+#: the kinds of v40-v79, in turn (the command in results/variants.md)
+MORE_KINDS = ("side", "roof", "heights", "two_windows", "deep", "deep_far", "reverse", "shuffled")
+DIGESTS = Path(__file__).resolve().parents[1] / "data" / "variants_v00_v39.sha256"
 
 
-def test_forty_variants_are_committed_and_not_in_the_catalogue():
-    assert len(VARIANTS) == 40
+def _index(path: Path) -> int:
+    return int(path.stem.rsplit("_v", 1)[1])
+
+
+def _kind(index: int) -> str:
+    if index < 20:
+        return "paper"
+    if index < 40:
+        return ("far_ltr", "far_rtl")[index % 2]
+    return MORE_KINDS[(index - 40) % len(MORE_KINDS)]
+
+
+def test_eighty_variants_are_committed_and_not_in_the_catalogue():
+    assert [_index(p) for p in VARIANTS] == list(range(80))
     listed = {p.resolve() for p in list_problems()}
     assert not listed & {p.resolve() for p in VARIANTS}
 
 
+def test_the_first_forty_are_unchanged_byte_for_byte():
+    """v00-v39 are the files of issues 17 and 26 (their SHA-256 pinned in tests/data):
+    the rooms of more kinds left them alone."""
+    pinned = dict(line.split()[::-1] for line in DIGESTS.read_text().splitlines())
+    assert len(pinned) == 40
+    for name, digest in pinned.items():
+        data = (PROBLEMS / "variants" / name).read_bytes()
+        assert hashlib.sha256(data).hexdigest() == digest, name
+
+
+def test_the_generator_still_makes_the_first_variant():
+    """The generator's paper kind is unchanged: seed 0's first kept draw is v00 (its
+    rooms, goals and witnesses within 1e-5; the header names the module's old path)."""
+    kept = generate(1, 0)[0]
+    made = tomllib.loads(kept.text)
+    committed = tomllib.loads((PROBLEMS / "variants" / "armz_inspection_v00.toml").read_text())
+    made["witness"].pop("note"), committed["witness"].pop("note")
+
+    def close(a, b) -> bool:
+        if isinstance(a, dict):
+            return a.keys() == b.keys() and all(close(a[k], b[k]) for k in a)
+        if isinstance(a, list):
+            return len(a) == len(b) and all(close(x, y) for x, y in zip(a, b, strict=True))
+        if isinstance(a, float):
+            return abs(a - b) <= 1e-5
+        return a == b
+
+    assert close(made, committed)
+
+
 def test_the_committed_kinds_and_their_orders():
     """v00-v19 visit A-E in the paper's order; v20-v39 end on the far wall, left to
-    right (v20, v22, ...) and right to left (v21, v23, ...)."""
+    right (v20, v22, ...) and right to left (v21, v23, ...); v40-v79 are the rooms of
+    more kinds in turn, in their orders (two_windows and shuffled: an order drawn, each
+    of A-E once)."""
     for path in VARIANTS:
-        index = int(path.stem[-2:])
+        kind = _kind(_index(path))
         order = tuple(g.name for g in load_problem(path).goals)
-        kind = "paper" if index < 20 else ("far_ltr", "far_rtl")[index % 2]
-        assert order == ORDERS[kind], path.stem
+        if kind in ORDERS:
+            assert order == ORDERS[kind], path.stem
+            continue
+        visits = {"paper": "ABCDE", "reverse": "EDCBA", "far_rtl": "EDCAB"}.get(LAYOUTS[kind][1])
+        assert order[0] == "enter" and order[-1] == "leave", path.stem
+        assert sorted(order[1:-1]) == list("ABCDE"), path.stem
+        if visits is not None:
+            assert "".join(order[1:-1]) == visits, path.stem
 
 
 def test_far_kinds_end_on_the_far_wall_far_from_the_window():
-    for path in VARIANTS[20:]:
+    for path in [p for p in VARIANTS if _kind(_index(p)) in ("far_ltr", "far_rtl", "deep_far")]:
         problem = load_problem(path)
         boxes = {o.name: o for o in problem.scene.obstacles}
         far = boxes["wall_far"]
@@ -73,13 +130,71 @@ def test_each_witness_is_free_with_its_clearance_and_inside_its_goal(path):
     clearance_m = float(witness["clearance_floor_m"])
     assert clearance_m >= 0.04
     assert states.shape == (problem.legs, problem.robot.dof)
-    assert MODULES_RANGE[0] <= problem.robot.n_modules <= MODULES_RANGE[1]
+    most = MODULES_RANGE[1] if _kind(_index(path)) in ORDERS else MODULES_MAX
+    assert MODULES_RANGE[0] <= problem.robot.n_modules <= most
     checker = CollisionChecker(problem.robot, problem.scene)
     for goal, q in zip(problem.goals, states, strict=True):
         assert checker.is_valid(q), goal.name
         # 0.1 mm: the stored states are rounded to 6 digits
         assert checker.clearance(q) >= clearance_m - 1e-4, goal.name
         assert goal.contains(problem.robot, q), goal.name
+
+
+def _walls(problem) -> dict[str, list]:
+    """The room's walls by name, each the boxes it was cut into (one when it has no
+    window)."""
+    out: dict[str, list] = {}
+    for o in problem.scene.obstacles:
+        if o.name == "ground":
+            continue
+        base = o.name.rstrip("0123456789").rstrip("_") if o.name[-1].isdigit() else o.name
+        out.setdefault(base, []).append(o)
+    return out
+
+
+def _span(boxes, axis: int) -> tuple[float, float]:
+    lo = min(float(b.T_world_obstacle[axis, 3] - b.size_m[axis] / 2) for b in boxes)
+    hi = max(float(b.T_world_obstacle[axis, 3] + b.size_m[axis] / 2) for b in boxes)
+    return lo, hi
+
+
+@pytest.mark.parametrize("path", [p for p in VARIANTS if _index(p) >= 40], ids=lambda p: p.stem)
+def test_the_rooms_of_more_kinds_are_what_they_say(path):
+    """side: the near wall closed, a side wall cut, ``enter`` looks along ±x; roof: the
+    near wall closed, the ceiling cut, ``enter`` looks down; heights: the near wall's
+    window 0.2-0.6 m from the floor or the ceiling; two_windows: the near wall and one
+    more cut; deep, deep_far: the far wall 8-10 m in from the near wall. Every
+    ``enter`` lies 1.5 m inside a window: the straight line from it 2.5 m back along
+    its normal crosses the wall's plane inside the opening (no box in the way)."""
+    problem = load_problem(path)
+    kind = _kind(_index(path))
+    walls = _walls(problem)
+    cut = {name for name, boxes in walls.items() if len(boxes) > 1}
+    enter = problem.goals[0]
+    n = enter.n_world
+    if kind == "side":
+        assert "wall_near" in walls and len(cut) == 1 and cut <= {"wall_left", "wall_right"}
+        assert abs(abs(n[0]) - 1.0) < 1e-9
+    elif kind == "roof":
+        assert "wall_near" in walls and cut == {"room_ceiling"}
+        assert n[2] == pytest.approx(-1.0)
+    elif kind == "two_windows":
+        assert "wall_near" in cut and len(cut) == 2
+    else:  # a near-wall window, its four boxes named as the paper kinds' are
+        assert {"wall_near_below", "wall_near_above"} <= set(walls) and not cut
+        if kind == "heights":
+            sill = _span(walls["wall_near_below"], 2)
+            lintel = _span(walls["wall_near_above"], 2)
+            assert min(sill[1] - sill[0], lintel[1] - lintel[0]) <= 0.6 + 1e-6
+        if kind in ("deep", "deep_far"):
+            near = _span(walls["wall_near_below"], 1)[1]
+            far = _span(walls["wall_far"], 1)[0]
+            assert 8.0 - 1e-6 <= far - near <= 10.0 + 1e-6
+    points = enter.p_world_m - np.linspace(0.0, 2.5, 251)[:, None] * n
+    from plannerlab.planners.clearance.slide import scene_distance_m
+
+    assert scene_distance_m(problem.scene, points).min() > 0.75
+    assert scene_distance_m(problem.scene, enter.p_world_m - 2.5 * n).min() > 0.75
 
 
 def test_goals_sit_relative_to_the_walls_as_in_the_paper():
@@ -90,8 +205,9 @@ def test_goals_sit_relative_to_the_walls_as_in_the_paper():
         goals = {g.name: g for g in problem.goals}
 
         def face(name: str, axis: int, sign: float, boxes=boxes) -> float:
-            box = boxes[name]
-            return float(box.T_world_obstacle[axis, 3] + sign * box.size_m[axis] / 2)
+            # a wall cut round a window is several boxes sharing their inner face
+            pieces = [b for n, b in boxes.items() if n == name or n.startswith(name + "_")]
+            return float(pieces[0].T_world_obstacle[axis, 3] + sign * pieces[0].size_m[axis] / 2)
 
         left_x, right_x = face("wall_left", 0, 1.0), face("wall_right", 0, -1.0)
         far_y = face("wall_far", 1, -1.0)
