@@ -9,8 +9,15 @@ kinds of this module keep the paper's room, its goals placed relative to the wal
 - ``side``: the near wall is closed; the window is in the side wall that faces the base
   (the room stands beside the base, its right wall 1.55-2.55 m to the left of it before
   mirroring): the arm reaches forward past the room's corner and turns into the room.
+  A-E are placed as in the paper with the window's wall as the near wall (the paper's
+  frame turned about z): placed in the world's frame, D and E would look back at the
+  wall the arm comes in through, a U-turn no witness was found for (3 of 4 draws dropped
+  at D).
 - ``roof``: the near wall is closed; the window is in the ceiling near the near wall: the
-  arm reaches over the near wall and comes down into the room.
+  arm reaches over the near wall and comes down into the room. Not witnessed yet: the
+  clearance-aware IK stalls with the body against the window's edge when the tip, hung
+  down through the ceiling, is led 5-8 m sideways to A or B (0 of 8 draws kept); no
+  committed variant is of this kind.
 - ``heights``: the near wall's window sits low (its sill 0.2-0.6 m above the floor) or
   high (its lintel 0.2-0.6 m below the ceiling); A-E visited in reverse.
 - ``two_windows``: the near wall's window as in the paper, and a second one in a side
@@ -47,8 +54,8 @@ LAYOUTS: dict[str, tuple[str, str]] = {
 }
 #: what each kind is, in words (the files' headers)
 NOTES: dict[str, str] = {
-    "side": "the window in the side wall facing the base (the near wall closed), A-E in the "
-    "paper's order",
+    "side": "the window in the side wall facing the base (the near wall closed), A-E placed "
+    "with the window's wall as the near wall, in the paper's order",
     "roof": "the window in the ceiling by the near wall (the near wall closed), A-E in the "
     "paper's order",
     "heights": "the near wall's window low or high, A-E in reverse (E, D, C, B, A)",
@@ -61,6 +68,8 @@ NOTES: dict[str, str] = {
 }
 #: the most modules a variant of these kinds gets (a deep room needs a longer arm)
 MODULES_MAX = 40
+#: an Arm-Z module's collision radius [m] (the paper's)
+MODULE_RADIUS_M = 0.75
 #: an Arm-Z module's chord [m] (the paper's: sqrt(δy² + δz²))
 CHORD_M = 0.716
 #: the walls a window may be cut in; each wall's plane coordinates (u, v)

@@ -145,6 +145,8 @@ def find_witness(
     rng: np.random.Generator,
     min_clearance_m: float,
     attempts: int = 12,
+    interior: tuple[Array, Array] | None = None,
+    step_m: float = 1.0,
 ) -> WitnessResult | None:
     """A witness state for ``goal``: collision-free, inside both tolerances, at least
     ``min_clearance_m`` from the scene and between modules; or None.
@@ -153,6 +155,13 @@ def find_witness(
     rad, at most 1 rad, from the second round of seeds on), descends by
     :func:`clearance_ik` first to the approach point 2.5 m back along the goal's normal,
     then to the goal. A seed already inside the goal with the clearance is taken as is.
+
+    With ``interior`` (a convex free box, lower and upper corners [m]: a room's inside)
+    and the attempt's tip and the approach point both in it, the tip is first led to the
+    approach point along the straight segment between them (free for the tip, the box
+    being convex), a loose target (0.5 m, any normal) at most ``step_m`` ahead at a time
+    (:func:`_route`): one descent across a room 8-14 m wide or deep pulls the body
+    straight at a wall or out through the window it came in by, and stalls there.
     """
     for q0 in seeds:
         pos_e, ang_e = (float(v) for v in goal.errors(robot, q0))
@@ -165,7 +174,10 @@ def find_witness(
         q0 = np.array(seeds[k % len(seeds)], dtype=float)
         if k >= len(seeds):
             q0 = q0 + rng.normal(0.0, min(0.05 * 1.5**k, 1.0), robot.dof)
-        first = clearance_ik(robot, checker, _approach(goal, 2.5), q0, min_clearance_m)
+        approach = _approach(goal, 2.5)
+        for target in _route(robot, q0, approach.p_world_m, interior, step_m):
+            q0 = clearance_ik(robot, checker, target, q0, min_clearance_m).q
+        first = clearance_ik(robot, checker, approach, q0, min_clearance_m)
         result = clearance_ik(robot, checker, goal, first.q, min_clearance_m)
         if result.success:
             # the final word is the checker's: collision-free and the clearance kept
@@ -174,14 +186,36 @@ def find_witness(
     return None
 
 
+def _route(
+    robot: Any,
+    q: Array,
+    to_m: Array,
+    interior: tuple[Array, Array] | None,
+    step_m: float,
+) -> list[GoalRegion]:
+    """Loose targets (0.5 m, any normal) every ``step_m`` or less along the straight
+    segment from ``q``'s tip to ``to_m``, short of ``to_m``; none unless ``interior`` is
+    given and holds both ends."""
+    if interior is None:
+        return []
+    lo, hi = (np.asarray(c, dtype=float) for c in interior)
+    a = np.asarray(robot.fk(q)[-1, :3, 3], dtype=float)
+    b = np.asarray(to_m, dtype=float)
+    if not all(bool(np.all((lo <= p) & (p <= hi))) for p in (a, b)):
+        return []
+    n = int(math.ceil(float(np.linalg.norm(b - a)) / step_m))
+    return [GoalRegion("route", a + (i / n) * (b - a), b - a, 0.5, 360.0) for i in range(1, n)]
+
+
 def witness_states(
     problem: Problem,
     rng: np.random.Generator,
     min_clearance_m: float,
     checker: CollisionChecker | None = None,
+    interior: tuple[Array, Array] | None = None,
 ) -> tuple[list[Array], list[float]] | str:
     """One witness per goal (in leg order) and its clearance [m], or the reason there is
-    none (a string naming the goal)."""
+    none (a string naming the goal); ``interior``: as :func:`find_witness`'s."""
     robot = problem.robot
     checker = checker or CollisionChecker(robot, problem.scene)
     if checker.clearance(problem.q_start) < min_clearance_m:
@@ -191,7 +225,7 @@ def witness_states(
     for goal in problem.goals:
         previous = found[-1] if found else problem.q_start
         seeds = [previous, *found[:-1][::-1], problem.q_start]
-        w = find_witness(robot, checker, goal, seeds, rng, min_clearance_m)
+        w = find_witness(robot, checker, goal, seeds, rng, min_clearance_m, interior=interior)
         if w is None:
             return f"no witness for goal {goal.name}"
         found.append(w.q)

@@ -308,6 +308,17 @@ def rest_tip(n_modules: int) -> tuple[list[float], list[float]]:
     return [float(v) for v in p], [float(v) for v in n]
 
 
+def _goal_frame(spec: VariantSpec) -> tuple[Array, Array]:
+    """The horizontal axes (across, inward) of the frame the goals A-E are placed in: the
+    world's x and y, or, for a window in a side wall (kind ``side``), turned about z so
+    that the window's wall is the near wall (its inward normal the frame's y)."""
+    wall = spec.windows[0].wall if spec.windows else "near"
+    if wall not in ("left", "right"):
+        return np.array([1.0, 0.0, 0.0]), np.array([0.0, 1.0, 0.0])
+    ey = np.array(spec.windows[0].inward(), dtype=float)
+    return np.cross(ey, [0.0, 0.0, 1.0]), ey
+
+
 def goal_tables(spec: VariantSpec) -> list[dict[str, Any]]:
     """The seven ``[[goals]]`` tables, placed relative to the walls as in the paper, in
     the order of the spec's kind (:data:`ORDERS`; rooms of more kinds: ``enter`` inside
@@ -331,12 +342,24 @@ def goal_tables(spec: VariantSpec) -> list[dict[str, Any]]:
             "pos_tol_m": 0.3,
             "angle_tol_deg": 30.0,
         },
-        {"name": "A", "p_m": [r.x0 + RHO_M, r.y0 + RHO_M, zc], "n": [-1.0, 0.0, 0.0]},
-        {"name": "B", "p_m": [r.x0 + RHO_M, r.y1 - RHO_M, zc], "n": [-s2, s2, 0.0]},
-        {"name": "C", "p_m": [0.5 * (r.x0 + r.x1), r.y1 - RHO_M, zc], "n": [0.0, 1.0, 0.0]},
-        {"name": "D", "p_m": [r.x1 - RHO_M, r.y1 - RHO_M, zc], "n": [s2, s2, 0.0]},
-        {"name": "E", "p_m": [r.x1 - 1.1, r.y0 + 1.0, zc], "n": [1.0, 0.0, 0.0]},
     ]
+    # A-E in the frame whose near wall is the window's wall (the paper's own frame unless
+    # the window is in a side wall): u across, w inward, then back to the world
+    ex, ey = _goal_frame(spec)
+    u0, u1 = sorted(float(np.dot(ex[:2], c)) for c in ((r.x0, r.y0), (r.x1, r.y1)))
+    w0, w1 = sorted(float(np.dot(ey[:2], c)) for c in ((r.x0, r.y0), (r.x1, r.y1)))
+
+    def world(u: float, w: float, z: float) -> list[float]:
+        return [float(v) for v in u * ex + w * ey + np.array([0.0, 0.0, z])]
+
+    for name, (u, w), (nu, nw) in (
+        ("A", (u0 + RHO_M, w0 + RHO_M), (-1.0, 0.0)),
+        ("B", (u0 + RHO_M, w1 - RHO_M), (-s2, s2)),
+        ("C", (0.5 * (u0 + u1), w1 - RHO_M), (0.0, 1.0)),
+        ("D", (u1 - RHO_M, w1 - RHO_M), (s2, s2)),
+        ("E", (u1 - 1.1, w0 + 1.0), (1.0, 0.0)),
+    ):
+        goals.append({"name": name, "p_m": world(u, w, zc), "n": world(nu, nw, 0.0)})
     for g in goals[1:]:
         g["pos_tol_m"] = 0.1
         g["angle_tol_deg"] = 10.0
@@ -482,7 +505,9 @@ def _header(spec: VariantSpec, name: str, command: str, min_clearance_m: float) 
         f"Room interior (before mirroring) x in [{r.x0:.3f}, {r.x1:.3f}], y in [{r.y0:.3f}, "
         f"{r.y1:.3f}], z in [{r.z0:.3f}, {r.z1:.3f}]; walls {WALL_M} m thick; "
         + _windows_words(spec)
-        + f"Goals as in the paper: enter 1.5 m inside the window's centre; A, B, D at rho = "
+        + "Goals as in the paper"
+        + ("" if spec.kind != "side" else " (the window's wall taken as the near wall)")
+        + f": enter 1.5 m inside the window's centre; A, B, D at rho = "
         f"{RHO_M} m from two walls;\nC mid far wall; E 1.1 m from the right wall, 1 m "
         "inside "
         f"the near wall; leave at the rest pose's tip.\n"
@@ -491,6 +516,20 @@ def _header(spec: VariantSpec, name: str, command: str, min_clearance_m: float) 
         f"collision-free with at least {min_clearance_m} m of clearance (collision checker's "
         f"signed distances)."
     )
+
+
+def _interior(spec: VariantSpec) -> tuple[Array, Array] | None:
+    """Rooms of more kinds: the room's inside less the module radius (world frame, after
+    mirroring), where the witness search leads the tip along straight segments
+    (:func:`~plannerlab.problem.variant_witness.find_witness`); None for the kinds of
+    :data:`ORDERS`, whose witnesses are searched as before they existed."""
+    if spec.kind in ORDERS:
+        return None
+    r, m = spec.room, rooms.MODULE_RADIUS_M
+    xs = sorted((-r.x0, -r.x1) if spec.mirrored else (r.x0, r.x1))
+    lo = np.array([xs[0] + m, r.y0 + m, r.z0 + m])
+    hi = np.array([xs[1] - m, r.y1 - m, r.z1 - m])
+    return lo, hi
 
 
 def make_variant(
@@ -506,7 +545,7 @@ def make_variant(
     name = f"armz_inspection_v{index:02d}"
     doc = problem_document(spec, name)
     problem = problem_from_dict(doc, f"<variant {name}>")
-    found = witness_states(problem, rng, min_clearance_m)
+    found = witness_states(problem, rng, min_clearance_m, interior=_interior(spec))
     if isinstance(found, str):
         return found
     states, clear = found
@@ -575,12 +614,16 @@ def generate(
         draw += 1
         if isinstance(v, str):
             if progress:
-                progress(f"draw {draw}: variant {len(kept)} dropped: {v}")
+                progress(
+                    f"draw {draw}: variant {len(kept)} "
+                    f"({kinds[len(kept) % len(kinds)]}) dropped: {v}"
+                )
             continue
         kept.append(v)
         if progress:
             progress(
-                f"draw {draw}: kept {v.name} ({len(kept)}/{count}): {v.spec.n_modules} modules, "
+                f"draw {draw}: kept {v.name} ({len(kept)}/{count}, {v.spec.kind}): "
+                f"{v.spec.n_modules} modules, "
                 f"smallest witness clearance {min(v.clearances_m) * 100:.1f} cm"
             )
     return kept
