@@ -352,14 +352,14 @@ def goal_tables(spec: VariantSpec) -> list[dict[str, Any]]:
     def world(u: float, w: float, z: float) -> list[float]:
         return [float(v) for v in u * ex + w * ey + np.array([0.0, 0.0, z])]
 
-    for name, (u, w), (nu, nw) in (
+    for name, (gu, gw), (nu, nw) in (
         ("A", (u0 + RHO_M, w0 + RHO_M), (-1.0, 0.0)),
         ("B", (u0 + RHO_M, w1 - RHO_M), (-s2, s2)),
         ("C", (0.5 * (u0 + u1), w1 - RHO_M), (0.0, 1.0)),
         ("D", (u1 - RHO_M, w1 - RHO_M), (s2, s2)),
         ("E", (u1 - 1.1, w0 + 1.0), (1.0, 0.0)),
     ):
-        goals.append({"name": name, "p_m": world(u, w, zc), "n": world(nu, nw, 0.0)})
+        goals.append({"name": name, "p_m": world(gu, gw, zc), "n": world(nu, nw, 0.0)})
     for g in goals[1:]:
         g["pos_tol_m"] = 0.1
         g["angle_tol_deg"] = 10.0
