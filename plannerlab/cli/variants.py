@@ -3,8 +3,13 @@
     plannerlab variants armz_inspection --count 20 --seed 0 --out problems/variants/
     plannerlab variants armz_inspection --count 20 --seed 1 --kind far_ltr,far_rtl \
         --first-index 20 --out problems/variants/
+    plannerlab variants armz_inspection --count 40 --seed 2 \
+        --kind side,heights,two_windows,deep,deep_far,reverse,shuffled \
+        --first-index 40 --max-draws 200 --out problems/variants/
 
-Draws rooms (scaled, shifted, mirrored; the window moved and resized; 20-32 modules),
+Draws rooms (scaled, shifted, mirrored; the window moved and resized; 20-32 modules;
+rooms of more kinds: windows in other walls and at other heights, two windows, deep rooms
+with up to 40 modules, visits reversed or shuffled),
 places the goals relative to the walls as in the paper, finds a collision-free witness
 state with ``--clearance-floor`` of clearance for every goal (a clearance-aware IK, no
 planner) and writes the kept variants as problem files (``<out>/armz_inspection_vNN.toml``,
@@ -73,7 +78,11 @@ def add_parser(subparsers: Any) -> argparse.ArgumentParser:
         default="paper",
         metavar="K[,K...]",
         help="kinds of variant, taken in turn: paper (A-E in the paper's order), far_ltr, "
-        "far_rtl (ending on the far wall, visited left to right / right to left)",
+        "far_rtl (ending on the far wall, visited left to right / right to left); rooms of "
+        "more kinds: side (the window in a side wall), roof (in the ceiling; no witness "
+        "found yet), heights (low or high, visited in reverse), two_windows (visited "
+        "shuffled), deep, deep_far (the far wall 8-10 m in), reverse, shuffled (the "
+        "paper's rooms in those orders)",
     )
     p.add_argument(
         "--first-index",

@@ -27,16 +27,22 @@ the far corner on the window's side) and right to left (E, D, C, A, B: it ends i
 corner of the other side, 5–7 m sideways of the window). "Left" is the side of A and B
 before mirroring.
 
+**Rooms of more kinds** (:mod:`plannerlab.problem.variant_rooms`, :data:`KINDS`): windows
+in a side wall or the ceiling, low or high, two windows, the far wall 8-10 m in; visits in
+reverse and shuffled orders. Their arms get the modules their reach needs (up to
+:data:`~plannerlab.problem.variant_rooms.MODULES_MAX`).
+
 Everything random comes from the ``numpy.random.Generator`` passed in: a fixed seed gives
-the same files (the kind draws nothing: the ``paper`` kind's files are those made before
-kinds existed).
+the same files (the kinds of :data:`ORDERS` draw nothing: the ``paper`` kind's files are
+those made before kinds existed, and those of every kind of :data:`ORDERS` are those made
+before the rooms of more kinds existed).
 """
 
 from __future__ import annotations
 
 import math
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
 
@@ -44,10 +50,16 @@ import numpy as np
 
 from plannerlab.collision.fcl_checker import CollisionChecker
 from plannerlab.errors import PlannerlabError
-from plannerlab.problem.goals import GoalRegion
+from plannerlab.problem import variant_rooms as rooms
 from plannerlab.problem.load import Problem, problem_from_dict
+from plannerlab.problem.variant_witness import (  # noqa: F401 (re-exported)
+    WitnessResult,
+    clearance_ik,
+    find_witness,
+    witness_states,
+)
 from plannerlab.record.files import write_text_atomic
-from plannerlab.robots.base import Array, wrap_to_pi
+from plannerlab.robots.base import Array
 
 #: margin ρ of the paper's corner points from the walls [m]
 RHO_M = 0.8
@@ -66,7 +78,10 @@ KIND_NOTES: dict[str, str] = {
     "paper": "A-E in the paper's order, ending at E by the near wall",
     "far_ltr": "left to right (A, B, C, E, D), ending at D in the far corner on the window's side",
     "far_rtl": "right to left (E, D, C, A, B), ending at B in the far corner away from the window",
+    **rooms.NOTES,
 }
+#: every kind: the paper's rooms in three orders, then the rooms of more kinds
+KINDS: tuple[str, ...] = (*ORDERS, *rooms.LAYOUTS)
 
 
 class VariantError(PlannerlabError):
@@ -105,6 +120,17 @@ class VariantSpec:
     room: Room
     extras: dict[str, Any] = field(default_factory=dict)
     kind: str = "paper"
+    #: (rooms of more kinds) windows other than the near wall's one of ``room``
+    windows: tuple[rooms.Window, ...] = ()
+    #: (rooms of more kinds) the order of the visits A-E
+    visits: tuple[str, ...] = ()
+
+    @property
+    def legs(self) -> tuple[str, ...]:
+        """The goals' names in leg order."""
+        if self.kind in ORDERS:
+            return ORDERS[self.kind]
+        return ("enter", *self.visits, "leave")
 
 
 # ---------------------------------------------------------------------- drawing
@@ -120,8 +146,10 @@ def draw_spec(index: int, rng: np.random.Generator, kind: str = "paper") -> Vari
     base's x (the arm leans into it from the rest pose), its centre z within ±0.6 m of the
     room's mid-height, at least 0.5 m from every edge of the wall.
     """
+    if kind not in KINDS:
+        raise VariantError(f"--kind: one of {', '.join(KINDS)}, got {kind!r}")
     if kind not in ORDERS:
-        raise VariantError(f"--kind: one of {', '.join(ORDERS)}, got {kind!r}")
+        return _draw_more(index, rng, kind)
     scale = float(rng.uniform(0.85, 1.3))
     shift = (
         float(rng.uniform(-1.0, 1.0)),
@@ -147,6 +175,52 @@ def draw_spec(index: int, rng: np.random.Generator, kind: str = "paper") -> Vari
     return VariantSpec(index, scale, shift, mirrored, n_modules, room, kind=kind)
 
 
+def _draw_more(index: int, rng: np.random.Generator, kind: str) -> VariantSpec:
+    """A room of more kinds (:mod:`plannerlab.problem.variant_rooms`): scaled, shifted and
+    mirrored as the paper kinds' are, its windows and the order of its visits drawn for
+    the kind; the arm as the paper kinds' or longer, as its reach needs (within 20 to
+    :data:`~plannerlab.problem.variant_rooms.MODULES_MAX`)."""
+    layout, order = rooms.LAYOUTS[kind]
+    scale = float(rng.uniform(0.85, 1.3))
+    shift = (
+        float(rng.uniform(-1.0, 1.0)),
+        float(rng.uniform(-0.5, 1.0)),
+        float(rng.uniform(-0.5, 0.5)),
+    )
+    mirrored = bool(rng.random() < 0.5)
+    n = int(round(24 * scale)) + int(rng.integers(-1, 3))
+    x0, x1, y0, y1, z0, z1 = rooms.draw_room(layout, scale, shift, rng)
+    nan = float("nan")
+    room = Room(x0, x1, y0, y1, z0, z1, nan, nan, nan, nan)
+    windows = rooms.draw_windows(layout, room, rng) or (_paper_window(room, rng),)
+    visits = rooms.draw_order(order, rng)
+    first = windows[0].centre(room)
+    if len(windows) == 1 and windows[0].wall == "near":
+        # one window in the near wall: the paper kinds' room, its walls named as theirs
+        (wx0, wz0), (wx1, wz1) = windows[0].lo, windows[0].hi
+        room, windows = replace(room, wx0=wx0, wx1=wx1, wz0=wz0, wz1=wz1), ()
+    spec = VariantSpec(
+        index, scale, shift, mirrored, 20, room, kind=kind, windows=windows, visits=visits
+    )
+    goals = {g["name"]: g["p_m"] for g in goal_tables(replace(spec, mirrored=False))}
+    need = rooms.modules_needed([0.0, 0.0, 0.35], first, [goals[k] for k in "ABCDE"])
+    n_modules = int(min(max(n, need, MODULES_RANGE[0]), rooms.MODULES_MAX))
+    return replace(spec, n_modules=n_modules)
+
+
+def _paper_window(room: Room, rng: np.random.Generator) -> rooms.Window:
+    """The near wall's window drawn as :func:`draw_spec` draws it."""
+    r = room
+    w = float(rng.uniform(2.7, 3.6))
+    h = min(float(rng.uniform(2.7, 3.6)), (r.z1 - r.z0) - 1.0)
+    lo, hi = max(r.x0 + 0.5 + w / 2, -2.5), min(r.x1 - 0.5 - w / 2, 2.5)
+    cx = float(rng.uniform(lo, hi)) if hi > lo else 0.5 * (r.x0 + r.x1)
+    zc = 0.5 * (r.z0 + r.z1)
+    dz = min(0.6, 0.5 * (r.z1 - r.z0) - h / 2 - 0.5)
+    cz = float(rng.uniform(zc - dz, zc + dz)) if dz > 0 else zc
+    return rooms.Window("near", (cx - w / 2, cz - h / 2), (cx + w / 2, cz + h / 2))
+
+
 # ---------------------------------------------------------------------- the problem file
 def _box(name: str, lo: Sequence[float], hi: Sequence[float]) -> dict[str, Any]:
     c = [0.5 * (a + b) for a, b in zip(lo, hi, strict=True)]
@@ -168,10 +242,35 @@ _MIRROR_NAMES = {
 }
 
 
+def _mirror_name(name: str) -> str:
+    """A box's name after mirroring: left and right swapped (``wall_left_2`` too)."""
+    if name in _MIRROR_NAMES:
+        return _MIRROR_NAMES[name]
+    for a, b in (("wall_left_", "wall_right_"), ("wall_right_", "wall_left_")):
+        if name.startswith(a):
+            return b + name[len(a) :]
+    return name
+
+
 def scene_boxes(spec: VariantSpec) -> list[dict[str, Any]]:
     """The room's boxes (``[[obstacles]]`` tables), as in the paper's file: ground,
     floor, ceiling, far, left and right walls, and the near wall as four boxes around the
-    window. Mirrored: x → −x, and "left"/"right" keep meaning −x/+x."""
+    window (rooms of more kinds: every wall cut round its windows,
+    :func:`~plannerlab.problem.variant_rooms.room_boxes`). Mirrored: x → −x, and
+    "left"/"right" keep meaning −x/+x."""
+    ground = {
+        "name": "ground",
+        "type": "box",
+        "center_m": [0.0, 0.0, -0.95],
+        "size_m": [60.0, 60.0, 1.0],
+    }
+    if spec.windows:
+        boxes = [ground, *rooms.room_boxes(spec.room, spec.windows, WALL_M)]
+        if spec.mirrored:
+            boxes = [ground] + [
+                {**_mirror_box(b), "name": _mirror_name(b["name"])} for b in boxes[1:]
+            ]
+        return boxes
     r, t = spec.room, WALL_M
     X0, X1 = r.x0 - t, r.x1 + t
     Y0, Y1 = r.y0 - t, r.y1 + t
@@ -209,27 +308,58 @@ def rest_tip(n_modules: int) -> tuple[list[float], list[float]]:
     return [float(v) for v in p], [float(v) for v in n]
 
 
+def _goal_frame(spec: VariantSpec) -> tuple[Array, Array]:
+    """The horizontal axes (across, inward) of the frame the goals A-E are placed in: the
+    world's x and y, or, for a window in a side wall (kind ``side``), turned about z so
+    that the window's wall is the near wall (its inward normal the frame's y)."""
+    wall = spec.windows[0].wall if spec.windows else "near"
+    if wall not in ("left", "right"):
+        return np.array([1.0, 0.0, 0.0]), np.array([0.0, 1.0, 0.0])
+    ey = np.array(spec.windows[0].inward(), dtype=float)
+    return np.cross(ey, [0.0, 0.0, 1.0]), ey
+
+
 def goal_tables(spec: VariantSpec) -> list[dict[str, Any]]:
     """The seven ``[[goals]]`` tables, placed relative to the walls as in the paper, in
-    the order of the spec's kind (:data:`ORDERS`)."""
+    the order of the spec's kind (:data:`ORDERS`; rooms of more kinds: ``enter`` inside
+    the first of their windows, and their visits' order)."""
     r = spec.room
     zc = 0.5 * (r.z0 + r.z1)
     s2 = math.sqrt(0.5)
+    if spec.windows:
+        w = spec.windows[0]
+        inward = w.inward()
+        p_enter = [c + 1.5 * d for c, d in zip(w.centre(r), inward, strict=True)]
+    else:
+        inward = [0.0, 1.0, 0.0]
+        p_enter = [0.5 * (r.wx0 + r.wx1), r.y0 + 1.5, 0.5 * (r.wz0 + r.wz1)]
     goals: list[dict[str, Any]] = [
         {
             "name": "enter",
             "note": "tip 1.5 m inside the window's centre, looking into the room",
-            "p_m": [0.5 * (r.wx0 + r.wx1), r.y0 + 1.5, 0.5 * (r.wz0 + r.wz1)],
-            "n": [0.0, 1.0, 0.0],
+            "p_m": p_enter,
+            "n": inward,
             "pos_tol_m": 0.3,
             "angle_tol_deg": 30.0,
         },
-        {"name": "A", "p_m": [r.x0 + RHO_M, r.y0 + RHO_M, zc], "n": [-1.0, 0.0, 0.0]},
-        {"name": "B", "p_m": [r.x0 + RHO_M, r.y1 - RHO_M, zc], "n": [-s2, s2, 0.0]},
-        {"name": "C", "p_m": [0.5 * (r.x0 + r.x1), r.y1 - RHO_M, zc], "n": [0.0, 1.0, 0.0]},
-        {"name": "D", "p_m": [r.x1 - RHO_M, r.y1 - RHO_M, zc], "n": [s2, s2, 0.0]},
-        {"name": "E", "p_m": [r.x1 - 1.1, r.y0 + 1.0, zc], "n": [1.0, 0.0, 0.0]},
     ]
+    # A-E in the frame whose near wall is the window's wall (the paper's own frame unless
+    # the window is in a side wall): u across, w inward, then back to the world
+    ex, ey = _goal_frame(spec)
+    u0, u1 = sorted(float(np.dot(ex[:2], c)) for c in ((r.x0, r.y0), (r.x1, r.y1)))
+    w0, w1 = sorted(float(np.dot(ey[:2], c)) for c in ((r.x0, r.y0), (r.x1, r.y1)))
+
+    def world(u: float, w: float, z: float) -> list[float]:
+        return [float(v) for v in u * ex + w * ey + np.array([0.0, 0.0, z])]
+
+    for name, (gu, gw), (nu, nw) in (
+        ("A", (u0 + RHO_M, w0 + RHO_M), (-1.0, 0.0)),
+        ("B", (u0 + RHO_M, w1 - RHO_M), (-s2, s2)),
+        ("C", (0.5 * (u0 + u1), w1 - RHO_M), (0.0, 1.0)),
+        ("D", (u1 - RHO_M, w1 - RHO_M), (s2, s2)),
+        ("E", (u1 - 1.1, w0 + 1.0), (1.0, 0.0)),
+    ):
+        goals.append({"name": name, "p_m": world(gu, gw, zc), "n": world(nu, nw, 0.0)})
     for g in goals[1:]:
         g["pos_tol_m"] = 0.1
         g["angle_tol_deg"] = 10.0
@@ -249,7 +379,16 @@ def goal_tables(spec: VariantSpec) -> list[dict[str, Any]]:
             g["p_m"] = [-g["p_m"][0], *g["p_m"][1:]]
             g["n"] = [-g["n"][0], *g["n"][1:]]
     by_name = {g["name"]: g for g in goals}
-    return [by_name[name] for name in ORDERS[spec.kind]]
+    return [by_name[name] for name in spec.legs]
+
+
+def _kind_words(spec: VariantSpec) -> str:
+    """The end of a variant's description: how it differs from the paper's kind."""
+    if spec.kind == "paper":
+        return ""
+    if spec.kind in ORDERS:
+        return f", visited {KIND_NOTES[spec.kind]}"
+    return f", {spec.kind}: {KIND_NOTES[spec.kind]} ({''.join(spec.visits)})"
 
 
 def problem_document(spec: VariantSpec, name: str) -> dict[str, Any]:
@@ -262,7 +401,7 @@ def problem_document(spec: VariantSpec, name: str) -> dict[str, Any]:
                 f"{', '.join(f'{v:+.2f}' for v in spec.shift_m)} m"
                 + (", mirrored" if spec.mirrored else "")
                 + f", {spec.n_modules} modules"
-                + ("" if spec.kind == "paper" else f", visited {KIND_NOTES[spec.kind]}")
+                + _kind_words(spec)
             ),
         },
         "robot": {
@@ -321,159 +460,6 @@ def to_toml(doc: dict[str, Any], header: str = "") -> str:
     return "\n".join(lines).lstrip("\n") + "\n"
 
 
-# ---------------------------------------------------------------------- witnesses
-@dataclass(frozen=True)
-class WitnessResult:
-    """One clearance-aware IK descent: the state reached and whether it is a witness."""
-
-    q: Array
-    success: bool
-    clearance_m: float
-    pos_err_m: float
-    angle_err_deg: float
-    iterations: int
-
-
-def _point_jacobians(frames: Array, link: Array, t: Array) -> tuple[Array, Array]:
-    """Points ``a + t (b − a)`` on Arm-Z links (m, 3) and their Jacobians (m, 3, dof).
-
-    Link i runs from face frame i to i + 1; joint k (1-based) turns about frame k's z
-    axis, and a point on link i moves with joints 1..i."""
-    o = frames[:, :3, 3]
-    p = o[link] + t[:, None] * (o[link + 1] - o[link])
-    z = frames[1:-1, :3, 2]
-    oj = frames[1:-1, :3, 3]
-    dof = z.shape[0]
-    J = np.cross(z[None, :, :], p[:, None, :] - oj[None, :, :])  # (m, dof, 3)
-    mask = np.arange(1, dof + 1)[None, :] <= link[:, None]
-    return p, np.transpose(J * mask[:, :, None], (0, 2, 1))
-
-
-def clearance_ik(
-    robot: Any,
-    checker: CollisionChecker,
-    goal: GoalRegion,
-    q_seed: Array,
-    min_clearance_m: float,
-    *,
-    target_fraction: float = 0.5,
-    max_iterations: int = 400,
-    max_step_rad: float = 0.08,
-    damping: float = 0.1,
-    push_weight: float = 3.0,
-    max_tip_units: float = 4.0,
-) -> WitnessResult:
-    """A damped-least-squares IK descent that keeps clearance (Arm-Z).
-
-    Each step solves one weighted least-squares problem: the tip's position and normal
-    errors scaled by the goal's tolerances (clipped to ``max_tip_units`` so far targets
-    are approached a little at a time) and, for every checked pair closer than
-    ``min_clearance_m`` + 2 cm, the pair's closest points pushed apart along the
-    checker's separating direction (``pair_distances``: link points' Jacobians, the
-    deficit in units of 2 cm, times ``push_weight``). It stops once the tip is within
-    ``target_fraction`` of both tolerances and every pair is at least
-    ``min_clearance_m`` apart.
-    """
-    q = wrap_to_pi(np.asarray(q_seed, dtype=float).copy(), robot.continuous)
-    pos_scale = 1.0 / goal.pos_tol_m
-    ang_scale = 1.0 / math.radians(goal.angle_tol_deg)
-    want = min_clearance_m + 0.02
-    d_min = pos_e = ang_e = math.inf
-    for it in range(max_iterations + 1):
-        F = robot.fk(q)
-        p, n = F[-1, :3, 3], F[-1, :3, 2]
-        pos_e, ang_e = (float(v) for v in goal.errors_from_tip(p, n))
-        pd = checker.pair_distances(q, want + 0.2)
-        d_min = float(pd.d_m.min()) if len(pd.d_m) else math.inf
-        inside = pos_e <= target_fraction * goal.pos_tol_m and ang_e <= (
-            target_fraction * goal.angle_tol_deg
-        )
-        if inside and d_min >= min_clearance_m:
-            return WitnessResult(q, True, d_min, pos_e, ang_e, it)
-        if it == max_iterations:
-            break
-        e = np.concatenate([(goal.p_world_m - p) * pos_scale, (goal.n_world - n) * ang_scale])
-        size = float(np.linalg.norm(e))
-        if size > max_tip_units:
-            e *= max_tip_units / size
-        z = F[1:-1, :3, 2]
-        oj = F[1:-1, :3, 3]
-        J_tip = np.vstack([np.cross(z, p - oj).T * pos_scale, np.cross(z, n).T * ang_scale])
-        rows, rhs = [J_tip], [e]
-        close = pd.d_m < want
-        if np.any(close):
-            link = pd.link[close]
-            _, Ja = _point_jacobians(F, link, pd.t_link[close])
-            nrm = pd.n_world[close]
-            G = np.einsum("mk,mkd->md", nrm, Ja)
-            other_link = pd.other_is_link[close]
-            if np.any(other_link):
-                _, Jb = _point_jacobians(
-                    F, pd.other[close][other_link], pd.t_other[close][other_link]
-                )
-                G[other_link] -= np.einsum("mk,mkd->md", nrm[other_link], Jb)
-            deficit = (want - pd.d_m[close]) / 0.02
-            rows.append(push_weight * G / 0.02)
-            rhs.append(push_weight * deficit)
-        A = np.vstack(rows)
-        b = np.concatenate(rhs)
-        dq = np.linalg.solve(A.T @ A + damping**2 * np.eye(robot.dof), A.T @ b)
-        biggest = float(np.max(np.abs(dq)))
-        if biggest > max_step_rad:
-            dq *= max_step_rad / biggest
-        q = wrap_to_pi(q + dq, robot.continuous)
-    return WitnessResult(q, False, d_min, pos_e, ang_e, max_iterations)
-
-
-def _approach(goal: GoalRegion, distance_m: float) -> GoalRegion:
-    """A loose goal ``distance_m`` back from ``goal`` along its normal (the tip then comes
-    in along the normal it must show)."""
-    return GoalRegion(
-        f"{goal.name}-approach",
-        goal.p_world_m - distance_m * goal.n_world,
-        goal.n_world,
-        0.5,
-        30.0,
-    )
-
-
-def find_witness(
-    robot: Any,
-    checker: CollisionChecker,
-    goal: GoalRegion,
-    seeds: Sequence[Array],
-    rng: np.random.Generator,
-    min_clearance_m: float,
-    attempts: int = 12,
-) -> WitnessResult | None:
-    """A witness state for ``goal``: collision-free, inside both tolerances, at least
-    ``min_clearance_m`` from the scene and between modules; or None.
-
-    Attempt k starts from seed ``k mod len(seeds)`` (plus Gaussian noise of 0.05 · 1.5^k
-    rad, at most 1 rad, from the second round of seeds on), descends by
-    :func:`clearance_ik` first to the approach point 2.5 m back along the goal's normal,
-    then to the goal. A seed already inside the goal with the clearance is taken as is.
-    """
-    for q0 in seeds:
-        pos_e, ang_e = (float(v) for v in goal.errors(robot, q0))
-        if pos_e <= goal.pos_tol_m and ang_e <= goal.angle_tol_deg:
-            if checker.clearance(q0) >= min_clearance_m:
-                return WitnessResult(
-                    np.array(q0, dtype=float), True, checker.clearance(q0), pos_e, ang_e, 0
-                )
-    for k in range(attempts):
-        q0 = np.array(seeds[k % len(seeds)], dtype=float)
-        if k >= len(seeds):
-            q0 = q0 + rng.normal(0.0, min(0.05 * 1.5**k, 1.0), robot.dof)
-        first = clearance_ik(robot, checker, _approach(goal, 2.5), q0, min_clearance_m)
-        result = clearance_ik(robot, checker, goal, first.q, min_clearance_m)
-        if result.success:
-            # the final word is the checker's: collision-free and the clearance kept
-            if checker.is_valid(result.q) and checker.clearance(result.q) >= min_clearance_m:
-                return result
-    return None
-
-
 @dataclass(frozen=True)
 class Variant:
     """A kept variant: what was drawn, the problem, its witnesses and its file text."""
@@ -486,29 +472,24 @@ class Variant:
     text: str
 
 
-def witness_states(
-    problem: Problem,
-    rng: np.random.Generator,
-    min_clearance_m: float,
-    checker: CollisionChecker | None = None,
-) -> tuple[list[Array], list[float]] | str:
-    """One witness per goal (in leg order) and its clearance [m], or the reason there is
-    none (a string naming the goal)."""
-    robot = problem.robot
-    checker = checker or CollisionChecker(robot, problem.scene)
-    if checker.clearance(problem.q_start) < min_clearance_m:
-        return f"the start state is closer than {min_clearance_m:g} m to the scene"
-    found: list[Array] = []
-    clear: list[float] = []
-    for goal in problem.goals:
-        previous = found[-1] if found else problem.q_start
-        seeds = [previous, *found[:-1][::-1], problem.q_start]
-        w = find_witness(robot, checker, goal, seeds, rng, min_clearance_m)
-        if w is None:
-            return f"no witness for goal {goal.name}"
-        found.append(w.q)
-        clear.append(float(checker.clearance(w.q)))
-    return found, clear
+def _windows_words(spec: VariantSpec) -> str:
+    """The header's words on the windows (the paper kinds': as their files say)."""
+    r = spec.room
+    if not spec.windows:
+        words = (
+            f"window in the\nnear wall x in [{r.wx0:.3f}, {r.wx1:.3f}], z in "
+            f"[{r.wz0:.3f}, {r.wz1:.3f}].\n"
+        )
+    else:
+        axes = {"near": "x, z", "far": "x, z", "left": "y, z", "right": "y, z", "ceiling": "x, y"}
+        words = "windows (before mirroring):\n" + "".join(
+            f"  in the {w.wall} wall, ({axes[w.wall]}) from ({w.lo[0]:.3f}, {w.lo[1]:.3f}) to "
+            f"({w.hi[0]:.3f}, {w.hi[1]:.3f});\n"
+            for w in spec.windows
+        )
+    if spec.kind in rooms.LAYOUTS:
+        words += f"Kind {spec.kind}: {KIND_NOTES[spec.kind]}; visits {', '.join(spec.visits)}.\n"
+    return words
 
 
 def _header(spec: VariantSpec, name: str, command: str, min_clearance_m: float) -> str:
@@ -522,9 +503,11 @@ def _header(spec: VariantSpec, name: str, command: str, min_clearance_m: float) 
         + ("mirrored x -> -x" if spec.mirrored else "not mirrored")
         + f", {spec.n_modules} modules.\n"
         f"Room interior (before mirroring) x in [{r.x0:.3f}, {r.x1:.3f}], y in [{r.y0:.3f}, "
-        f"{r.y1:.3f}], z in [{r.z0:.3f}, {r.z1:.3f}]; walls {WALL_M} m thick; window in the\n"
-        f"near wall x in [{r.wx0:.3f}, {r.wx1:.3f}], z in [{r.wz0:.3f}, {r.wz1:.3f}].\n"
-        f"Goals as in the paper: enter 1.5 m inside the window's centre; A, B, D at rho = "
+        f"{r.y1:.3f}], z in [{r.z0:.3f}, {r.z1:.3f}]; walls {WALL_M} m thick; "
+        + _windows_words(spec)
+        + "Goals as in the paper"
+        + ("" if spec.kind != "side" else " (the window's wall taken as the near wall)")
+        + f": enter 1.5 m inside the window's centre; A, B, D at rho = "
         f"{RHO_M} m from two walls;\nC mid far wall; E 1.1 m from the right wall, 1 m "
         "inside "
         f"the near wall; leave at the rest pose's tip.\n"
@@ -533,6 +516,20 @@ def _header(spec: VariantSpec, name: str, command: str, min_clearance_m: float) 
         f"collision-free with at least {min_clearance_m} m of clearance (collision checker's "
         f"signed distances)."
     )
+
+
+def _interior(spec: VariantSpec) -> tuple[Array, Array] | None:
+    """Rooms of more kinds: the room's inside less the module radius (world frame, after
+    mirroring), where the witness search leads the tip along straight segments
+    (:func:`~plannerlab.problem.variant_witness.find_witness`); None for the kinds of
+    :data:`ORDERS`, whose witnesses are searched as before they existed."""
+    if spec.kind in ORDERS:
+        return None
+    r, m = spec.room, rooms.MODULE_RADIUS_M
+    xs = sorted((-r.x0, -r.x1) if spec.mirrored else (r.x0, r.x1))
+    lo = np.array([xs[0] + m, r.y0 + m, r.z0 + m])
+    hi = np.array([xs[1] - m, r.y1 - m, r.z1 - m])
+    return lo, hi
 
 
 def make_variant(
@@ -548,7 +545,7 @@ def make_variant(
     name = f"armz_inspection_v{index:02d}"
     doc = problem_document(spec, name)
     problem = problem_from_dict(doc, f"<variant {name}>")
-    found = witness_states(problem, rng, min_clearance_m)
+    found = witness_states(problem, rng, min_clearance_m, interior=_interior(spec))
     if isinstance(found, str):
         return found
     states, clear = found
@@ -584,7 +581,7 @@ def generate(
     """``count`` kept variants, drawn in order from ``rng`` (a generator, or a seed for
     ``numpy.random.default_rng``; a dropped draw is reported through ``progress`` and
     replaced by the next draw), numbered from ``first_index``; the k-th kept one is of
-    kind ``kinds[k % len(kinds)]`` (:data:`ORDERS`).
+    kind ``kinds[k % len(kinds)]`` (:data:`KINDS`).
 
     Raises:
         VariantError: bad arguments, or fewer than ``count`` kept in ``max_draws`` draws
@@ -592,8 +589,8 @@ def generate(
     """
     if count < 1:
         raise VariantError(f"--count: a number of variants >= 1, got {count}")
-    if not kinds or any(k not in ORDERS for k in kinds):
-        raise VariantError(f"--kind: each one of {', '.join(ORDERS)}, got {list(kinds)}")
+    if not kinds or any(k not in KINDS for k in kinds):
+        raise VariantError(f"--kind: each one of {', '.join(KINDS)}, got {list(kinds)}")
     if first_index < 0:
         raise VariantError(f"--first-index: a number >= 0, got {first_index}")
     if not (0.0 <= min_clearance_m < 0.75):
@@ -617,12 +614,16 @@ def generate(
         draw += 1
         if isinstance(v, str):
             if progress:
-                progress(f"draw {draw}: variant {len(kept)} dropped: {v}")
+                progress(
+                    f"draw {draw}: variant {len(kept)} "
+                    f"({kinds[len(kept) % len(kinds)]}) dropped: {v}"
+                )
             continue
         kept.append(v)
         if progress:
             progress(
-                f"draw {draw}: kept {v.name} ({len(kept)}/{count}): {v.spec.n_modules} modules, "
+                f"draw {draw}: kept {v.name} ({len(kept)}/{count}, {v.spec.kind}): "
+                f"{v.spec.n_modules} modules, "
                 f"smallest witness clearance {min(v.clearances_m) * 100:.1f} cm"
             )
     return kept
