@@ -1,12 +1,14 @@
 """The escape study's tables and figures from its trial stores (issue 18, point 5).
 
-    python results/escapes/report.py [STORE_DIR]     (default: results/escapes)
+    python results/escapes/report.py [STORE_DIR] [--write]     (default: results/escapes)
 
 Reads ``STORE_DIR/<problem>/trials.jsonl`` (written by ``results/escapes/run.sh``), prints
 the Markdown tables that ``results/escapes.md`` holds between its ``<!-- headline -->`` and
-``<!-- /table -->`` marks (and rewrites them there, and the headline table in docs/results.md
-between ``<!-- escapes -->`` marks), and draws ``STORE_DIR/progress_traps.png`` and
-``STORE_DIR/progress_tasks.png``. Only trials that ran (not killed, no error) count
+``<!-- /table -->`` marks, and draws ``STORE_DIR/progress_traps.png`` and
+``STORE_DIR/progress_tasks.png``. Only with ``--write`` does it rewrite those marks in
+``results/escapes.md`` and the headline table in docs/results.md (between
+``<!-- escapes -->`` marks): a report of old stores must not overwrite the current
+documents by being run. Only trials that ran (not killed, no error) count
 as runs; a trial killed past its wall-clock limit counts as run and failed.
 
 Columns, per problem and planner:
@@ -271,7 +273,17 @@ def figures(data: dict[str, list[dict[str, Any]]], store_dir: Path) -> None:
 
 
 def main() -> None:
-    store_dir = Path(sys.argv[1]) if len(sys.argv) > 1 else ROOT / "results" / "escapes"
+    import argparse
+
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("store_dir", nargs="?", type=Path, default=ROOT / "results" / "escapes")
+    ap.add_argument(
+        "--write",
+        action="store_true",
+        help="rewrite the tables in results/escapes.md and docs/results.md (default: print)",
+    )
+    args = ap.parse_args()
+    store_dir = args.store_dir
     data = load(store_dir)
     rs = rows(data)
     text = (
@@ -282,6 +294,13 @@ def main() -> None:
         + "<!-- /table -->\n"
     )
     print(text)
+    if args.write:
+        write(rs, text)
+    figures(data, store_dir)
+
+
+def write(rs: list[dict[str, Any]], text: str) -> None:
+    """The tables into results/escapes.md and the headline into docs/results.md."""
     md = ROOT / "results" / "escapes.md"
     if md.exists():
         old = md.read_text()
@@ -293,7 +312,6 @@ def main() -> None:
     readme.write_text(
         re.sub(r"<!-- escapes -->.*?<!-- /escapes -->", lambda _: head, old, flags=re.S)
     )
-    figures(data, store_dir)
 
 
 if __name__ == "__main__":
