@@ -20,9 +20,9 @@ from plannerlab.errors import PlannerlabError
 from plannerlab.planners import make_planner
 from plannerlab.planners.base import Status
 from plannerlab.planners.context import PlanningContext
-from plannerlab.planners.trajopt.planner import _split, _Solve
 from plannerlab.planners.trajopt.geometry import PathGeometry
 from plannerlab.planners.trajopt.path import PathProblem
+from plannerlab.planners.trajopt.planner import _Solve, _split
 from plannerlab.planners.trajopt.solvers import PenaltySettings, Work, optimise
 from plannerlab.problem.catalog import load_problem
 from plannerlab.problem.goals import GoalRegion, JointGoal
