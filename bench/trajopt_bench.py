@@ -34,6 +34,7 @@ Run::
 
     PYTHONPATH=. .venv/bin/python bench/trajopt_bench.py /tmp/mbm [--execute] [--solvers]
         [--planners trajopt.line+rrtconnect,trajopt.rrtconnect] [--per-scenario 20]
+        [--offset 0]   # another sample: skip that many problems of each scenario
         [--time-limit 10] [--vamp-python ~/.cache/vamp-peer/venv/bin/python]
         [--rows rows.jsonl]   # each solve as it ends; a rerun resumes from them
 """
@@ -133,7 +134,7 @@ def load_problems(args: argparse.Namespace, per: int) -> list[Any]:
 
     files: list[Path] = []
     for s in SCENARIOS:
-        files += sorted(args.folder.glob(f"{s}_[0-9]*.toml"))[:per]
+        files += sorted(args.folder.glob(f"{s}_[0-9]*.toml"))[args.offset : args.offset + per]
     if not files:
         sys.exit(f"no imported MotionBenchMaker problem files in {args.folder}")
     return [parse_problem(f) for f in files]
@@ -172,7 +173,7 @@ def mbm(args: argparse.Namespace) -> list[str]:
     n_valid = len(problems) - len(invalid)
     out = [
         f"### (a) MotionBenchMaker Panda: {len(problems)} problems ({', '.join(SCENARIOS)}, "
-        f"first {args.per_scenario} each), {args.time_limit:g} s each",
+        f"{args.per_scenario} each from number {args.offset + 1}), {args.time_limit:g} s each",
         "",
         f"load average {load0[0]:.1f} / {load0[1]:.1f} (1 / 5 min) at the start, "
         f"{load1[0]:.1f} / {load1[1]:.1f} at the end, {os.cpu_count()} cores; "
@@ -340,6 +341,9 @@ def main() -> None:
     ap.add_argument("folder", type=Path, nargs="?", help="imported MotionBenchMaker problems")
     ap.add_argument("--planners", default="trajopt.line+rrtconnect,trajopt.rrtconnect")
     ap.add_argument("--per-scenario", type=int, default=20)
+    ap.add_argument(
+        "--offset", type=int, default=0, help="skip this many problems of each scenario first"
+    )
     ap.add_argument("--time-limit", type=float, default=10.0, help="per problem [s]")
     ap.add_argument("--execute", action="store_true", help="execute every path in PyBullet")
     ap.add_argument("--solvers", action="store_true", help="(c): the solvers side by side")

@@ -6,15 +6,18 @@ One leg:
 1. The geometry (:class:`~plannerlab.planners.trajopt.geometry.PathGeometry`) on the
    checker's compiled model, in the leg's time.
 2. For each seed of ``seeds`` in order (:mod:`~plannerlab.planners.trajopt.seeds`), and
-   for each of its paths: the path resampled at ``waypoint_m`` of motion, optimised
-   (:func:`~plannerlab.planners.trajopt.solvers.optimise`); then up to ``restarts``
-   times from the seed bent by a random bump, until one optimisation succeeds.
+   for each of its paths: the path resampled at ``coarse_factor · waypoint_m`` of motion
+   (the first pass, on few waypoints), optimised
+   (:func:`~plannerlab.planners.trajopt.solvers.optimise`); if that finds no feasible
+   path, the seed resampled at ``waypoint_m``; then up to ``restarts`` times from that
+   bent by a random bump, until one optimisation succeeds.
 3. **No tunnelling.** An optimised path that is feasible at its evaluated states is
    re-checked as every planner's path is: ``checker.check_path(path, joint_step / 4,
-   mode="grid")``, the problem's margin, every state of the grid. If an edge fails, that
-   edge and its neighbours are split in two (the states evaluated on them double) and the
-   path is optimised again from where it was, at most ``max_refines`` times. Only a path
-   that passes is returned as solved.
+   mode="grid")``, the problem's margin, every state of the grid. If it refuses an edge,
+   the grid states of every later edge are checked too, and each refused edge and its
+   neighbours are split in two (waypoints are added only there) and the path is
+   optimised again from where it was, at most ``max_refines`` times. Only a path that
+   passes is returned as solved.
 4. If no optimisation succeeds but a seed planner's path did (``rrtconnect``, ``leader``:
    re-checked by that planner), that path is returned, solved, with
    ``extra["optimised"] = False``.
@@ -259,12 +262,20 @@ class _Solve:
         if reach is None:  # no margin: the geometry's speeds along the seed
             P = seed.path
             reach = self.geometry.speeds(P[:: max(len(P) // 16, 1)])
+        # the first pass on coarse waypoints (the re-check adds waypoints where it
+        # refuses); if it finds no feasible path, the seed at waypoint_m, then restarts
         X0 = resample(seed.path, reach, s.waypoint_m, s.min_waypoints, s.max_waypoints)
+        first = [X0]
+        if s.coarse_factor > 1:
+            spacing = s.waypoint_m * s.coarse_factor
+            Xc = resample(seed.path, reach, spacing, s.min_waypoints, s.max_waypoints)
+            if len(Xc) < len(X0):
+                first.insert(0, Xc)
         why = ""
-        for attempt in range(s.restarts + 1):
+        for attempt in range(len(first) + s.restarts):
             X = (
-                X0
-                if attempt == 0
+                first[attempt]
+                if attempt < len(first)
                 else bumped(X0, self.rng, s.restart_sigma_rad, self.lower, self.upper)
             )
             self.extra["attempts"] += 1
@@ -272,7 +283,7 @@ class _Solve:
             out = self.optimise_path(X)
             if isinstance(out, PlanResult):
                 return out
-            why = f"{seed.name} seed, attempt {attempt}: {out}"
+            why = f"{seed.name} seed, attempt {attempt} ({len(X)} waypoints): {out}"
         return why
 
     def optimise_path(self, X: Array) -> PlanResult | str:
@@ -280,6 +291,7 @@ class _Solve:
         ended the leg), or why it failed."""
         s = self.s
         mu = s.penalty_start
+        self.extra.update(first_pass_waypoints=len(X), refined_edges=[])
         for refine in range(s.max_refines + 1):
             problem = PathProblem(
                 self.geometry,
@@ -315,14 +327,16 @@ class _Solve:
             checked = self.recheck(path)
             if isinstance(checked, PlanResult):
                 return checked
+            self.extra["refined_edges"].append(checked)
             X = _split(X, checked)
             self.extra["refines_tried"] = self.extra.get("refines_tried", 0) + 1
         return f"the re-check refused the path after {s.max_refines} refinements"
 
-    def recheck(self, path: Array) -> PlanResult | int:
+    def recheck(self, path: Array) -> PlanResult | list[int]:
         """The path re-checked at ``joint_step / 4`` on the grid within the budget and
-        the time limit (each + 1 %): solved, the budget's result, or the first edge
-        that fails."""
+        the time limit (each + 1 %): solved, the budget's result, or the edges that fail
+        (the first one ``check_path`` finds, then every later edge with an invalid grid
+        state: at most the grid's states in all, as a passing re-check)."""
         checker, tracker = self.checker, self.tracker
         self.extra["path_length_rad"] = path_length(path, self.cont)
         cost = int(checker.grid_states(path, self.step))
@@ -355,7 +369,18 @@ class _Solve:
                 path,
             )
         if not check.valid:
-            return int(check.first_invalid_edge or 0)
+            first = int(check.first_invalid_edge or 0)
+            c1 = checker.checks
+            edges = self._failing_edges_after(path, first, late)
+            self.extra["validation_checks"] += checker.checks - c1
+            if edges is None:
+                return self.result(
+                    Status.BUDGET_EXHAUSTED,
+                    f"{self.planner.name}: the time limit ran out while re-checking a "
+                    "refused path's later edges",
+                    path,
+                )
+            return [first, *edges]
         if not bool(self.goal.contains(self.robot, path[-1])):
             return self.result(
                 Status.APPROXIMATE,
@@ -364,11 +389,26 @@ class _Solve:
             )
         return self.result(Status.SOLVED, f"{self.planner.name}: optimised path", path)
 
+    def _failing_edges_after(self, path: Array, first: int, late: Any) -> list[int] | None:
+        """The edges after ``first`` with an invalid grid state (the re-check's grid),
+        None when the time limit ran out; every state looked at is a check."""
+        states, owners = self.checker.densify(path, self.step)
+        later = np.flatnonzero(owners > first)
+        bad: set[int] = set()
+        for i in range(0, len(later), RECHECK_CHUNK):
+            if late():
+                return None
+            idx = later[i : i + RECHECK_CHUNK]
+            valid = self.checker.valid_batch(states[idx])
+            bad.update(int(e) for e in owners[idx[~valid]])
+        return sorted(bad)
 
-def _split(X: Array, edge: int) -> Array:
-    """X with the edge ``edge`` and its neighbours split in two (midpoints inserted)."""
+
+def _split(X: Array, edges: list[int]) -> Array:
+    """X with the edges ``edges`` and their neighbours split in two (midpoints
+    inserted)."""
     K = len(X)
-    split = sorted({e for e in (edge - 1, edge, edge + 1) if 0 <= e < K - 1})
+    split = {e + d for e in edges for d in (-1, 0, 1) if 0 <= e + d < K - 1}
     rows: list[Array] = []
     for k in range(K):
         rows.append(X[k])

@@ -11,7 +11,9 @@ goal not reached) μ grows by ``penalty_growth`` and the solver goes on from the
 choice is argued in ``docs/planners.md``):
 
 ``gauss_newton``
-    Levenberg–Marquardt on the merit written as a sum of squares: the step solves
+    Levenberg–Marquardt on the merit written as a sum of squares (an inner solve ends
+    when M falls by less than ``rel_tol`` in a step, or by less than
+    ``feasible_rel_tol`` once the path is feasible): the step solves
     ``(H + λ diag H) Δ = −∇M`` with H the Gauss-Newton matrix (smoothness exact, one
     rank-one term per close pair and per goal residual), banded in waypoint-major
     order, by LAPACK's banded Cholesky (:func:`scipy.linalg.solveh_banded`); the step is
@@ -94,6 +96,8 @@ class PenaltySettings:
     feasible_fraction: float = 0.5
     #: an inner solve converged when M fell by less than this fraction in a step
     rel_tol: float = 1e-4
+    #: ... or by less than this fraction once the path is feasible (0: rel_tol only)
+    feasible_rel_tol: float = 0.0
     max_inner: int = 60
 
 
@@ -190,6 +194,9 @@ def _gauss_newton(
             X, x, ev = X_new, x_new, ev_new
             lam = max(lam / 3.0, 1e-9)
             if drop < s.rel_tol:
+                break
+            # early stop: feasible, and the smoothing has slowed down
+            if drop < s.feasible_rel_tol and feasible(problem, ev, s.feasible_fraction):
                 break
         else:
             lam *= 5.0
