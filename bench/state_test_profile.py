@@ -22,6 +22,9 @@ from __future__ import annotations
 import argparse
 import os
 import time
+from collections.abc import Callable
+from functools import partial
+from typing import Any
 
 import numpy as np
 from numba import njit
@@ -79,7 +82,7 @@ def _stages(P, Q, stage):
     return acc, confirmed
 
 
-def _cpu(fn) -> float:
+def _cpu(fn: Callable[[], Any]) -> float:
     t0 = time.process_time()
     fn()
     return time.process_time() - t0
@@ -93,8 +96,8 @@ def profile(name: str, n: int, repeats: int) -> None:
     P = checker.packed_model
     Q = np.random.default_rng(0).uniform(robot.lower, robot.upper, (n, robot.dof))
     labels = ["load", "+ kinematics", "+ scene pairs", "+ self pairs", "whole test"]
-    roads = [(lambda s=s: _stages(P, Q, s)) for s in range(5)]
-    roads.append(lambda: public.valid(Q))
+    roads: list[Callable[[], Any]] = [partial(_stages, P, Q, s) for s in range(5)]
+    roads.append(partial(public.valid, Q))
     labels.append("checker.valid(Q)")
     for fn in roads:
         fn()  # compile or load
