@@ -100,7 +100,8 @@ class CompiledModel(NamedTuple):
     obs_R: np.ndarray  # (n, 9) float64, row-major world <- obstacle
     obs_c: np.ndarray  # (n, 3)
     obs_h: np.ndarray  # (n, 3)
-    obs32: np.ndarray  # (n, 16) float32: centre (0:3), half sizes (3:6), rotation (6:15)
+    obs32: np.ndarray  # (n, 24) float32: centre (0:3), half sizes (3:6), rotation (6:15),
+    #   the world box around it: half extents (16:19), padded beyond float32's rounding
     caps32: np.ndarray  # (L, 8) float32: end a (0:3), end b (3:6), r_scene, r_self
     gates32: np.ndarray  # (m + 1, 8) float32: centre (0:3), r_scene, r_self
     cls32: np.ndarray  # (K, 8) float32: centre (0:3), r_scene, r_self
@@ -112,6 +113,27 @@ class CompiledModel(NamedTuple):
     link_rates: np.ndarray  # (dof, L) [m / rad or m / m], packed capsule order
     margin_m: float
     eps32_m: float
+
+
+def _world_box(kinds: np.ndarray, Rs: np.ndarray, hs: np.ndarray) -> np.ndarray:
+    """(n, 8): each obstacle's world axis-aligned box as half extents about its centre
+    (0:3; a box: ``Σ_b |R[a, b]| h_b``, a cylinder: the box around it, a sphere: its
+    radius), padded by 1e-5 relative and 1e-5 m (beyond float32's rounding of a gate's
+    offset from the centre: the state test's prefilter never drops a ball the exact test
+    would keep), then zeros."""
+    n = len(kinds)
+    out = np.zeros((n, 8))
+    for o in range(n):
+        R = np.abs(Rs[o].reshape(3, 3))
+        h = hs[o]
+        if kinds[o] == SPHERE:
+            e = np.full(3, h[0])
+        elif kinds[o] == CYLINDER:
+            e = R @ np.array([h[0], h[0], h[1]])
+        else:
+            e = R @ h[:3]
+        out[o, :3] = e * (1.0 + 1e-5) + 1e-5
+    return out
 
 
 def has_chain(robot: Any) -> bool:
@@ -381,7 +403,12 @@ def build_model(
         obs_R=_f(Rs),
         obs_c=_f(cs),
         obs_h=_f(hs),
-        obs32=_f(np.column_stack([cs, hs, Rs, np.zeros((n, 1))]).reshape(n, 16), np.float32),
+        obs32=_f(
+            np.column_stack([cs, hs, Rs, np.zeros((n, 1)), _world_box(kinds, Rs, hs)]).reshape(
+                n, 24
+            ),
+            np.float32,
+        ),
         caps32=_f(np.column_stack([ca, cb, rad, rads]).reshape(L, 8), np.float32),
         gates32=_f(np.column_stack([gate_c, gate_r, gate_rs, np.zeros((nb, 3))]), np.float32),
         cls32=_f(

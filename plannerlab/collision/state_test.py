@@ -52,6 +52,7 @@ from plannerlab.collision.geometry import BOX, SPHERE
 from plannerlab.collision.kinematics import chain_frames, chain_values, place
 from plannerlab.collision.simd import (
     LANES,
+    bits_mask,
     fma,
     kernel,
     load,
@@ -407,6 +408,18 @@ def _near(d2, r, live):
 
 
 @kernel
+def _in_box(O, o, x, y, z, r, live):
+    """Some live lane's ball (centre x, y, z, radius r) meets obstacle o's world box
+    (``O[o, 16:19]``: the box around the obstacle, padded beyond rounding): the cheap
+    prefilter of :func:`_point_d2`'s gate test (a ball clear of the box is clear of the
+    obstacle)."""
+    ix = vabs(x - splat(O[o, 0])) <= splat(O[o, 16]) + r
+    iy = vabs(y - splat(O[o, 1])) <= splat(O[o, 17]) + r
+    iz = vabs(z - splat(O[o, 2])) <= splat(O[o, 18]) + r
+    return (mask_bits(ix & iy & iz) & live) != 0
+
+
+@kernel
 def _gap2(A, a, B, b):
     """Squared distance between the points in slots A[a:] and B[b:] (three each)."""
     x = load(A, a) - load(B, b)
@@ -492,6 +505,8 @@ def _scene_pass(m, Z, mode, hu):
         rb = fma(grow, splat(Z.brate[b]), splat(gates[b, 3]) + eps)
         for o in range(kinds.shape[0]):
             kind = kinds[o]
+            if not _in_box(O, o, gx, gy, gz, rb, _ALL & ~hu[0]):
+                continue
             if not _near(_point_d2(kind, O, o, gx, gy, gz), rb, _ALL & ~hu[0]):
                 continue
             for c in range(m.body_cls[b], m.body_cls[b + 1]):
@@ -522,6 +537,39 @@ def _scene_pass(m, Z, mode, hu):
     return hu, False
 
 
+@njit(cache=True, nogil=True, inline="always")
+def _pairs_in(T, q0, q1, eps, grow, plain, hm):
+    """Capsule pairs ``q0:q1`` graded into the lane masks ``hm`` = (hit, unsure grown,
+    unsure plain), kept as vector masks (the tests of :func:`_grade_d2` and
+    :func:`_grade_bounds`); ``T`` = (X, cpairs, caps32, rate, cap_sphere); ``plain``:
+    every lane's growth is 0 (the grown radius is the plain one)."""
+    X, cpairs, caps, rate, sphere = T
+    mh, mg, m0 = hm
+    zero = splat(0.0)
+    for q in range(q0, q1):
+        i, j = cpairs[q, 0], cpairs[q, 1]
+        r0 = splat(caps[i, 7] + caps[j, 7])
+        h0 = r0 + eps
+        if plain:
+            hg = h0
+        else:
+            hg = fma(grow, splat(rate[i] + rate[j]), r0) + eps
+        if sphere[i] and sphere[j]:
+            lo = vmax(r0 - eps, zero)
+            d2 = _gap2(X, 6 * i * W, X, 6 * j * W)
+            mh = mh | (d2 < lo * lo)
+            mg = mg | (d2 <= hg * hg)
+            m0 = m0 | (d2 <= h0 * h0)
+            continue
+        if sphere[i]:  # the first a segment (a sphere: one of zero length)
+            i, j = j, i
+        lo_d, hi_d = _segments(_ends(X, i), _ends(X, j))
+        mh = mh | (hi_d < r0 - eps)
+        mg = mg | (lo_d <= hg)
+        m0 = m0 | (lo_d <= h0)
+    return mh, mg, m0
+
+
 @kernel
 def _self_pass(m, Z, mode, hu):
     """Every checked link pair, behind its body pair's and cluster pair's gates: the lane
@@ -530,14 +578,17 @@ def _self_pass(m, Z, mode, hu):
     F, G, K, X = Z.F, Z.G, Z.K, Z.X
     tables = (cls, caps, m.cl_caps, m.cl_body, m.cap_sphere, Z.placed)
     grow = load(Z.grow, 0)
+    plain = mask_bits(grow > splat(0.0)) == 0
     eps = splat(m.eps32_m)
-    sphere, rate = m.cap_sphere, Z.rate
+    none = bits_mask(0)
+    pair_tables = (X, m.cpairs, caps, Z.rate, m.cap_sphere)
     for p in range(m.bpairs.shape[0]):
         u, v = m.bpairs[p, 0], m.bpairs[p, 1]
         if u != v:
             r = fma(grow, splat(Z.brate[u] + Z.brate[v]), splat(gates[u, 4] + gates[v, 4]) + eps)
             if not _near(_gap2(G, 3 * u * W, G, 3 * v * W), r, _ALL & ~hu[0]):
                 continue
+        hm = (none, none, none)
         for cp in range(m.bpair_start[p], m.bpair_start[p + 1]):
             cu, cv = m.clpairs[cp, 0], m.clpairs[cp, 1]
             if cu != cv:
@@ -550,18 +601,14 @@ def _self_pass(m, Z, mode, hu):
                     continue
             _place_cluster(F, X, K, cu, tables, 2)
             _place_cluster(F, X, K, cv, tables, 2)
-            for q in range(m.clpair_start[cp], m.clpair_start[cp + 1]):
-                i, j = m.cpairs[q, 0], m.cpairs[q, 1]
-                r0 = splat(caps[i, 7] + caps[j, 7])
-                r = fma(grow, splat(rate[i] + rate[j]), r0)
-                if sphere[i] and sphere[j]:
-                    d2 = _gap2(X, 6 * i * W, X, 6 * j * W)
-                    hu = _grade_d2(d2, r0, r, eps, hu)
-                    continue
-                if sphere[i]:  # the first a segment (a sphere: one of zero length)
-                    i, j = j, i
-                lo, hi_d = _segments(_ends(X, i), _ends(X, j))
-                hu = _grade_bounds(lo, hi_d, r0, r, eps, hu)
+            hm = _pairs_in(
+                pair_tables, m.clpair_start[cp], m.clpair_start[cp + 1], eps, grow, plain, hm
+            )
+        hu = (
+            hu[0] | mask_bits(hm[0]),
+            hu[1] | mask_bits(hm[1]),
+            hu[2] | mask_bits(hm[2]),
+        )
         if _stop(hu[0], mode):
             return hu, True
     return hu, False

@@ -343,3 +343,69 @@ def test_float32s_bound_covers_what_the_kinematics_show():
                 worst = max(worst, float(np.abs(pos32 - pos64).max()))
         assert worst < m.eps32_m / 4, (kind, worst, m.eps32_m)
         assert m.eps32_m < 0.15 * float(np.min(robot.link_radii_m))  # far below a radius
+
+
+# ---------------------------------------------------------------------- the prefilter
+def _tilted_scene(robot, rng):
+    """Thin boxes and cylinders tilted about every axis (their world boxes far larger
+    than they are), and a sphere, each centred two thirds of the way from the base to the
+    tip of the robot at a random state (a 24-module Arm-Z reaches about 15 m)."""
+    from plannerlab.problem.scene import Box, Cylinder, Sphere
+
+    obstacles = []
+    for k in range(12):
+        p = robot.tip(rng.uniform(robot.lower, robot.upper))[0] / 1.5
+        T = pose_matrix(p, rng.uniform(-90, 90, 3))
+        if k == 11:
+            obstacles.append(Sphere("s", T, 1.5))
+        elif k % 2:
+            obstacles.append(Box(f"b{k}", T, (8.0, 0.2, 4.0)))
+        else:
+            obstacles.append(Cylinder(f"c{k}", T, 0.3, 8.0))
+    return Scene(tuple(obstacles))
+
+
+def test_each_obstacles_world_box_holds_it():
+    """The world box the state test's prefilter meets first (``obs32[:, 16:19]``) holds
+    every corner of a tilted box and every rim point of a tilted cylinder."""
+    rng = np.random.default_rng(5)
+    robot = ArmZ(n_modules=24)
+    scene = _tilted_scene(robot, rng)
+    m = CollisionChecker(robot, scene)._core.model
+    for o, ob in enumerate(scene.obstacles):
+        T = ob.T_world_obstacle
+        if ob.kind == "box":
+            pts = np.array(np.meshgrid(*[[-0.5, 0.5]] * 3)).reshape(3, -1).T * ob.size_m
+        elif ob.kind == "cylinder":
+            a = np.linspace(0.0, 2.0 * np.pi, 721)
+            ring = np.column_stack([np.cos(a), np.sin(a)]) * ob.radius_m
+            pts = np.vstack([np.column_stack([ring, np.full(len(a), z)]) for z in
+                             (-ob.length_m / 2.0, ob.length_m / 2.0)])  # fmt: skip
+        else:
+            pts = np.vstack([np.eye(3), -np.eye(3)]) * ob.radius_m
+        world = pts @ T[:3, :3].T + T[:3, 3]
+        half = m.obs32[o, 16:19].astype(float)
+        assert np.all(np.abs(world - m.obs_c[o]) <= half)
+        assert np.all(half < 1.5 * np.abs(world - m.obs_c[o]).max(axis=0) + 1e-4)  # not loose
+
+
+def test_the_prefilter_culls_no_real_hit_near_tilted_obstacles():
+    """Against tilted thin boxes and cylinders (where a gate ball meets the world box far
+    from the obstacle), the state test's verdicts are FCL's and float64's on random and
+    near-contact states: the world-box prefilter drops no hit."""
+    rng = np.random.default_rng(31)
+    robot = ArmZ(n_modules=24)
+    scene = _tilted_scene(robot, rng)
+    m = CollisionChecker(robot, scene, margin_m=0.01)._core
+    fcl = CollisionChecker(robot, scene, backend="fcl", margin_m=0.01)
+    Q = rng.uniform(robot.lower, robot.upper, (2000, robot.dof))
+    v = _model_valid(m, Q)
+    assert 0.05 < v.mean() < 0.95
+    assert np.array_equal(v, fcl.valid_batch(Q))
+    assert np.array_equal(v, _exact_valid(m, Q))
+    inside, outside = _near_contact(m, robot.lower, robot.upper, Q, 40, rng)
+    assert len(inside) == 40
+    assert fcl.valid_batch(inside).all() and not fcl.valid_batch(outside).any()
+    both = np.vstack([inside, outside])
+    assert np.array_equal(_model_valid(m, both), _exact_valid(m, both))
+    assert [m.is_valid(q) for q in both] == _exact_valid(m, both).tolist()

@@ -100,7 +100,7 @@ def test_edge_reach_is_what_the_states_one_by_one_say(stride: int):
         if not shim.state_valid(ck, a):
             continue
         b = a + rng.uniform(-1.0, 1.0, 10) * rng.choice([0.05, 0.5, 3.0])
-        status, j, n, checks = shim.edge_reach(ck, a, b, step, frac, stride, 10**9, d, q)
+        status, j, n, checks = shim.edge_reach(ck, a, b, step, frac, stride, 10**9, (d, q))
         looked = sorted({min(i * stride, n) for i in range(1, (n + stride - 1) // stride + 1)})
         free = {}
         for i in looked:
@@ -138,7 +138,7 @@ def test_edge_reach_stops_at_its_check_limit():
     b = a + 0.5
     d, q = np.empty(10), np.empty(10)
     for limit in (0, 1, 3):
-        status, _, _, checks = shim.edge_reach(ck, a, b, 0.0125, 0.2, 1, limit, d, q)
+        status, _, _, checks = shim.edge_reach(ck, a, b, 0.0125, 0.2, 1, limit, (d, q))
         assert status == shim.LIMIT and checks == limit
 
 

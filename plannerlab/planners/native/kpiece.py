@@ -488,7 +488,7 @@ def kpiece_run(ck, T, C, proj, goals, prm, counters, rng):
             counters[C_GOAL_TRIES] += 1 if to_goal else 0
             left = counters[C_HARD] - counters[C_CHECKS]
             status, j, n, checks = shim.edge_reach(
-                ck, T.Q[i], target, step, prm[P_MIN_FRACTION], stride, left, d, q
+                ck, T.Q[i], target, step, prm[P_MIN_FRACTION], stride, left, (d, q)
             )
             counters[C_CHECKS] += checks
             if status == shim.LIMIT:

@@ -76,10 +76,13 @@ def edge_valid(ck, q_a, q_b, joint_step, limit, d, q):
 
 
 @njit(cache=True, nogil=True)
-def _block(ck, q_a, d, lo, hi, n, stride, q, limit):
-    """Grid states ``min(i · stride, n)`` for i = lo + 1 … hi of the edge from q_a
-    (difference d, n states), coarse to fine: i = hi first, then the midpoints of ever
-    finer halvings. Returns (status, checks)."""
+def _block(ck, q_a, dq, span, n, stride, limit):
+    """Grid states ``min(i · stride, n)`` for i = lo + 1 … hi (``span`` = (lo, hi)) of the
+    edge from q_a (``dq`` = (d, q): its difference d, n states; q the scratch state),
+    coarse to fine: i = hi first, then the midpoints of ever finer halvings. Returns
+    (status, checks)."""
+    d, q = dq
+    lo, hi = span
     L = hi - lo
     if limit < 1:
         return LIMIT, 0
@@ -106,7 +109,7 @@ def _block(ck, q_a, d, lo, hi, n, stride, q, limit):
 
 
 @njit(cache=True, nogil=True)
-def edge_reach(ck, q_a, q_b, joint_step, min_fraction, stride, limit, d, q):
+def edge_reach(ck, q_a, q_b, joint_step, min_fraction, stride, limit, dq):
     """How far from q_a along edge q_a -> q_b its grid states are free, looking at every
     ``stride``-th state only (and the last), in blocks that double: the states up to the
     first beyond ``min_fraction`` of the edge, then as many again, twice as many, …, each
@@ -117,13 +120,14 @@ def edge_reach(ck, q_a, q_b, joint_step, min_fraction, stride, limit, d, q):
     Returns (status, j, n, checks): :data:`FREE` (every state looked at is free, j = n),
     :data:`BLOCKED` (those up to state j are free, j / n > ``min_fraction``, and one of
     the next block is blocked; j = -1: one of the first block is), or :data:`LIMIT`
-    (``limit`` checks were made first); n the grid's number of states; d holds the edge's
-    joint difference."""
+    (``limit`` checks were made first); n the grid's number of states; ``dq`` = (d, q) the
+    scratch: d then holds the edge's joint difference."""
+    d = dq[0]
     edge_delta(q_a, q_b, ck[0].continuous, d)
     n = edge_count(d, joint_step, ck[0].edge_weights)
     nc = (n + stride - 1) // stride  # the states looked at: min(i · stride, n), i = 1 … nc
     m = min(int(min_fraction * n) // stride + 1, nc)  # the first beyond the fraction
-    status, checks = _block(ck, q_a, d, 0, m, n, stride, q, limit)
+    status, checks = _block(ck, q_a, dq, (0, m), n, stride, limit)
     if status == LIMIT:
         return LIMIT, 0, n, checks
     if status == BLOCKED:
@@ -131,7 +135,7 @@ def edge_reach(ck, q_a, q_b, joint_step, min_fraction, stride, limit, d, q):
     lo = m
     while lo < nc:
         hi = min(2 * lo, nc)
-        status, k = _block(ck, q_a, d, lo, hi, n, stride, q, limit - checks)
+        status, k = _block(ck, q_a, dq, (lo, hi), n, stride, limit - checks)
         checks += k
         if status == LIMIT:
             return LIMIT, 0, n, checks

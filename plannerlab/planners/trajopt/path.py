@@ -211,11 +211,8 @@ class PathProblem:
         _accumulate(
             G_full,
             band,
-            self.state_k,
-            self.state_t,
-            g,
-            H,
-            weights,
+            (self.state_k, self.state_t),
+            (g, H, weights),
             self.last_free,
             bool(want_matrix),
         )
@@ -262,12 +259,15 @@ class PathProblem:
 
 
 @njit(cache=True, nogil=True)
-def _accumulate(G, band, state_k, state_t, g, H, w, last_free, want_matrix):
-    """Add the states' hinge terms (gradients g (m, dof), matrices H (m, dof, dof)), state
-    s's times ``w[s]``, into the waypoints' gradient G (K, dof) and the banded matrix of the free
+def _accumulate(G, band, states, terms, last_free, want_matrix):
+    """Add the states' hinge terms (``terms`` = (g, H, w): gradients g (m, dof), matrices H
+    (m, dof, dof)), state s's times ``w[s]``, state s at ``states`` = (state_k, state_t),
+    into the waypoints' gradient G (K, dof) and the banded matrix of the free
     waypoints 1 … ``last_free`` (lower form; waypoint k is free index k − 1): a state at
     ``(1 − t) X[k] + t X[k+1]`` gives (1 − t) of its gradient to k and t to k + 1, and
     (1 − t)², t² and t (1 − t) of its matrix to the blocks (k, k), (k+1, k+1), (k+1, k)."""
+    state_k, state_t = states
+    g, H, w = terms
     dof = G.shape[1]
     for s in range(state_k.shape[0]):
         k = state_k[s]

@@ -1,0 +1,114 @@
+"""The house rule of issue 32, checked on the source: no compiled kernel takes more than
+8 parameters (a kernel's inputs travel as named tuples of arrays, which numba loads from
+its cache; jitclass instances do not cache). The kernels still over it are listed, each
+with its count: the list can only shrink."""
+
+from __future__ import annotations
+
+import ast
+from pathlib import Path
+
+PACKAGE = Path(__file__).resolve().parents[2] / "plannerlab"
+
+#: the most parameters a compiled kernel may take
+MAX_KERNEL_PARAMETERS = 8
+
+#: kernels still over the rule ("module path:function" -> parameters), to be cut down
+STILL_OVER = {
+    "collision/armz.py:armz_advance_dt": 19,
+    "collision/armz.py:armz_path_advance": 24,
+    "collision/chain.py:chain_segments": 11,
+    "collision/chain_ik.py:_frames": 9,
+    "collision/chain_ik.py:descend_kernel": 23,
+    "collision/chain_valid.py:_capsules_hit": 13,
+    "collision/chain_valid.py:_place_body": 11,
+    "collision/chain_valid.py:_sphere_hit": 9,
+    "collision/geometry.py:capsule_obstacle": 10,
+    "collision/kernels.py:advance_dt": 16,
+    "collision/kernels.py:all_hits": 12,
+    "collision/kernels.py:chain_first_invalid": 21,
+    "collision/kernels.py:first_invalid": 12,
+    "collision/kernels.py:min_clearance_kernel": 13,
+    "collision/kernels.py:pair_distances_kernel": 13,
+    "collision/kernels.py:state_hits": 15,
+    "collision/kernels.py:valid_batch": 13,
+    "collision/lanes.py:_capsules_hit_lanes": 17,
+    "collision/lanes.py:_place_body_lanes": 11,
+    "collision/spheres.py:pair_gradient": 9,
+    "collision/spheres.py:pairs": 10,
+    "collision/spheres.py:point_gradient": 9,
+    "planners/clearance/compiled.py:_joint_direction": 9,
+    "planners/clearance/compiled.py:_tip_gauss_newton": 15,
+    "planners/clearance/compiled.py:_tip_steepest": 10,
+    "planners/native/kpiece.py:_target": 9,
+    "planners/native/kpiece.py:add_motion": 9,
+}
+
+
+def _is_kernel(node: ast.FunctionDef) -> bool:
+    """Compiled by numba: decorated by ``njit``/``jit`` (called or not, ``numba.`` or
+    not) or by the house's ``kernel`` (``collision.simd.kernel``)."""
+    for dec in node.decorator_list:
+        f = dec.func if isinstance(dec, ast.Call) else dec
+        name = f.attr if isinstance(f, ast.Attribute) else getattr(f, "id", "")
+        if name in ("njit", "jit", "kernel"):
+            return True
+    return False
+
+
+def _parameters(node: ast.FunctionDef) -> int:
+    a = node.args
+    return (
+        len(a.posonlyargs)
+        + len(a.args)
+        + len(a.kwonlyargs)
+        + (a.vararg is not None)
+        + (a.kwarg is not None)
+    )
+
+
+def kernels_over(source: str, limit: int = MAX_KERNEL_PARAMETERS) -> dict[str, int]:
+    """The kernels of one module's source taking more than ``limit`` parameters."""
+    out = {}
+    for node in ast.walk(ast.parse(source)):
+        if isinstance(node, ast.FunctionDef) and _is_kernel(node):
+            k = _parameters(node)
+            if k > limit:
+                out[node.name] = k
+    return out
+
+
+def _all_over() -> tuple[dict[str, int], int]:
+    over, n = {}, 0
+    for path in sorted(PACKAGE.rglob("*.py")):
+        text = path.read_text()
+        rel = path.relative_to(PACKAGE).as_posix()
+        n += sum(
+            isinstance(node, ast.FunctionDef) and _is_kernel(node)
+            for node in ast.walk(ast.parse(text))
+        )
+        for name, k in kernels_over(text).items():
+            over[f"{rel}:{name}"] = k
+    return over, n
+
+
+def test_the_counter_sees_kernels_over_the_limit():
+    src = (
+        "from numba import njit\nimport numba\nfrom plannerlab.collision.simd import kernel\n"
+        "@njit(cache=True)\ndef a(p1, p2, p3, p4, p5, p6, p7, p8, p9): pass\n"
+        "@numba.njit\ndef b(p1, p2, p3, p4, p5, p6, p7, p8, *rest): pass\n"
+        "@kernel\ndef c(p1, p2, p3, p4, p5, p6, p7, p8): pass\n"
+        "def d(p1, p2, p3, p4, p5, p6, p7, p8, p9): pass\n"
+    )
+    assert kernels_over(src) == {"a": 9, "b": 9}
+
+
+def test_no_new_kernel_takes_more_than_eight_parameters():
+    """Every kernel over the limit is listed with its count, and no listed one has grown;
+    one cut down to the limit must come off the list (the count only goes down)."""
+    over, n_kernels = _all_over()
+    assert n_kernels > 100  # the counter sees the package's kernels
+    assert sorted(set(over) - set(STILL_OVER)) == []
+    assert {k: v for k, v in over.items() if v > STILL_OVER[k]} == {}
+    assert sorted(set(STILL_OVER) - set(over)) == []  # cut down: take it off the list
+    assert len(over) <= 27
