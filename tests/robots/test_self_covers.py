@@ -130,3 +130,30 @@ def test_pairs_that_never_collide_are_found_on_the_meshes_not_the_covers(urdf: P
     # a pair that does meet is kept checked on the meshes too
     meeting = chain(urdf, 0)
     assert disabled_pairs(meeting, np.random.default_rng(0), n_states=100) == []
+
+
+@pytest.mark.parametrize("planner", ["native.rrtconnect", "ompl.rrtconnect"])
+def test_a_start_in_self_collision_is_refused_naming_the_urdf_links(
+    urdf: Path, planner: str
+) -> None:
+    """docs/problem-format.md: the error names the colliding pairs by the URDF's links,
+    not by the capsules of the covers (``slider#s3``)."""
+    import plannerlab as pl
+    from plannerlab.errors import ProblemError
+    from plannerlab.problem.load import problem_from_dict
+
+    doc = {
+        "problem": {"name": "two_boxes"},
+        "robot": {
+            "type": "urdf",
+            "urdf": str(urdf),
+            "tip_link": "slider",
+            "cover_max_primitives": 1,
+        },
+        "start": {"q": [0.0, -0.06]},
+        "goals": [{"name": "out", "q": [0.0, 0.05]}],
+    }
+    problem = problem_from_dict(doc, str(urdf.parent / "p.toml"))
+    with pytest.raises(ProblemError) as e:
+        pl.solve(problem, planner, 0, budget=pl.Budget(time_limit_s=5.0))
+    assert "base x slider" in str(e.value) and "#" not in str(e.value)
