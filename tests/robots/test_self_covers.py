@@ -103,9 +103,13 @@ def test_the_finer_cover_is_conservative_and_judges_self_collision_only(urdf: Pa
     cover's against the other link."""
     fine = chain(urdf, 128)
     n_first = sum(c.primitives for c in fine.mesh_covers)
-    assert fine.scene_only_links == frozenset(range(n_first))
-    assert fine.self_only_links == frozenset(range(n_first, len(fine.link_names)))
+    assert len(fine.scene_only_links) == n_first
+    assert not fine.scene_only_links & fine.self_only_links
+    assert len(fine.link_names) == n_first + len(fine.self_only_links)
     assert all("#s" in fine.link_names[i] for i in fine.self_only_links)
+    # each URDF link's capsules one run, its first cover first
+    assert fine.link_urdf_names == tuple(sorted(fine.link_urdf_names, key=["base", "slider"].index))
+    assert fine.link_names[0] == "base" and fine.link_names[1] == "base#s0"
     Q = np.random.default_rng(0).uniform(fine.lower, fine.upper, size=(200, 2))
     valid = CollisionChecker(fine, Scene()).valid_batch(Q)
     d = np.array([mesh_distance_m(fine, q) for q in Q])

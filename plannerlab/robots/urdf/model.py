@@ -54,7 +54,7 @@ default 4 mm, at most ``self_cover_max_primitives`` = 128 capsules; the same alg
 cached alike; it holds the mesh's convex hull, the solid PyBullet checks for a link's
 mesh, so that a state the finer cover passes is free in execution and for the referee)
 that judges self-collision only: its capsules (:attr:`UrdfChain.
-self_only_links`, named ``<link>#s<k>``, after every first-cover capsule) are never
+self_only_links`, named ``<link>#s<k>``, after the link's first-cover capsules) are never
 checked against the scene, and the first cover's capsules of that mesh (:attr:`UrdfChain.
 scene_only_links`) never against other links. The finer covers are not grown by the
 problem's clearance margin (which keeps the robot off the scene): links built to pass
@@ -290,7 +290,7 @@ def _capsules(
     the module docstring); the covers' reports and every collision mesh's file. With
     ``self_cover`` (excess aimed at [m], most primitives), each mesh also gets a finer
     cover for self-collision, kept where it is finer than the first (its capsules named
-    ``<link>#s<k>``, listed after every first-cover capsule)."""
+    ``<link>#s<k>``, listed after the link's first-cover capsules)."""
     from plannerlab.robots.urdf.meshes import MeshError, mesh_cover, resolve_mesh
 
     caps = _Capsules([], [], [], [], [], [])
@@ -298,6 +298,7 @@ def _capsules(
     fine_reports: list[MeshCover] = []
     mesh_files: dict[str, Path] = {}
     scene_only: list[int] = []
+    self_only: list[int] = []
     fine: list[tuple[str, int, Array, Array, float]] = []  # link, body, a, b, radius
     for lname, link in tree.links.items():
         b, T_link = placed[lname]
@@ -380,20 +381,19 @@ def _capsules(
             caps.a.append(end_a)
             caps.b.append(end_b)
             caps.radii.append(rad)
+        # the link's finer capsules right after its first ones: a URDF link's capsules
+        # stay one run (the simulator's measures group them so)
+        for k, (_, _, end_a, end_b, rad) in enumerate(fine):
+            self_only.append(len(caps.names))
+            caps.names.append(f"{lname}#s{k}")
+            caps.link.append(lname)
+            caps.body.append(b)
+            caps.a.append(end_a)
+            caps.b.append(end_b)
+            caps.radii.append(rad)
+        fine.clear()
     if not caps.names:
         raise UrdfError("urdf", f"collision elements; {path.name} has none")
-    self_only: list[int] = []
-    count: dict[str, int] = {}
-    for lname, b, end_a, end_b, rad in fine:
-        k = count.get(lname, 0)
-        count[lname] = k + 1
-        self_only.append(len(caps.names))
-        caps.names.append(f"{lname}#s{k}")
-        caps.link.append(lname)
-        caps.body.append(b)
-        caps.a.append(end_a)
-        caps.b.append(end_b)
-        caps.radii.append(rad)
     tiers = _Tiers(frozenset(scene_only), frozenset(self_only), tuple(fine_reports))
     return caps, reports, mesh_files, tiers
 
