@@ -21,7 +21,9 @@ float64):
 
 The pairs checked are the checker's: moving capsules against every obstacle (radii grown
 by the whole margin), and the robot's link pairs except ``excluded_pairs`` and pairs of
-two fixed links (radii grown by half the margin each: a pair keeps one margin).
+two fixed links (radii grown by half the margin each: a pair keeps one margin); a mesh
+robot's ``self_only_links`` never against the scene and grown by no margin, its
+``scene_only_links`` never against links.
 
 Calls from Python pass the model packed (:mod:`plannerlab.collision.packing`): five
 arrays, so a query's fixed cost is a few microseconds; compiled consumers (the native
@@ -123,21 +125,37 @@ class Core:
         r = np.asarray(robot.link_radii_m, dtype=float)
         #: capsule radii against the scene: inflated by the whole margin
         self.radii = np.ascontiguousarray(r + self.margin_m)
-        #: capsule radii against each other: by half of it (a pair keeps one margin)
-        self.radii_self = np.ascontiguousarray(r + self.margin_m / 2.0)
+        #: capsule radii against each other: by half of it (a pair keeps one margin); a
+        #: mesh robot's finer covers by none (their excess is the allowance: links built
+        #: to pass within a centimetre of each other, a UR10's wrists, stay apart)
+        half = np.full(len(r), self.margin_m / 2.0)
+        half[[i for i in getattr(robot, "self_only_links", ()) if 0 <= i < len(r)]] = 0.0
+        self.radii_self = np.ascontiguousarray(r + half)
         #: metric edge bound (zeros: radian steps only)
         self.edge_weights = np.ascontiguousarray(
             np.zeros(robot.dof) if edge_weights is None else edge_weights, dtype=float
         )
         L = len(self.radii)
         self.n_links = L
-        self.moving = np.array([i not in robot.fixed_links for i in range(L)])
+        # a mesh robot's finer covers judge self-collision only, its first covers the
+        # scene only (robots.urdf.model: "Self-collision at the meshes' accuracy")
+        self_only = set(getattr(robot, "self_only_links", ()))
+        scene_only = set(getattr(robot, "scene_only_links", ()))
+        self.moving = np.array(
+            [i not in robot.fixed_links and i not in self_only for i in range(L)]
+        )
         allowed = np.zeros((L, L), dtype=bool)
         excluded = set(robot.excluded_pairs)  # a property: computed once here
         fixed = set(robot.fixed_links)
         for i in range(L):
+            if i in scene_only:
+                continue
             for j in range(i + 1, L):
-                allowed[i, j] = (i, j) not in excluded and not (i in fixed and j in fixed)
+                allowed[i, j] = (
+                    (i, j) not in excluded
+                    and not (i in fixed and j in fixed)
+                    and j not in scene_only
+                )
         self.allowed = allowed
         n = len(scene.obstacles)
         self.kinds = np.zeros(n, dtype=np.int64)

@@ -137,7 +137,10 @@ class CollisionChecker:
         self.scene = scene
         self.checks = 0
         self._radii = np.asarray(robot.link_radii_m, dtype=float) + self.margin_m
-        self._radii_self = np.asarray(robot.link_radii_m, dtype=float) + self.margin_m / 2.0
+        # a mesh robot's finer covers (self-collision only) carry no margin (core.py)
+        half = np.full(len(robot.link_radii_m), self.margin_m / 2.0)
+        half[[i for i in getattr(robot, "self_only_links", ()) if 0 <= i < len(half)]] = 0.0
+        self._radii_self = np.asarray(robot.link_radii_m, dtype=float) + half
         L = len(self._radii)
         self._n_links = L
         self._link_names = tuple(robot.link_names)
@@ -166,14 +169,22 @@ class CollisionChecker:
             for o, m in zip(scene.obstacles, cover_of, strict=True)
         ]
         self._obs_lo, self._obs_hi = scene.aabbs()
-        moving = np.array([i not in robot.fixed_links for i in range(L)])
+        # a mesh robot's finer covers judge self-collision only, its first covers the
+        # scene only (robots.urdf.model: "Self-collision at the meshes' accuracy")
+        self_only = frozenset(getattr(robot, "self_only_links", ()))
+        scene_only = frozenset(getattr(robot, "scene_only_links", ()))
+        moving = np.array([i not in robot.fixed_links and i not in self_only for i in range(L)])
+        self._against_scene = moving
         self._scene_mask = moving[:, None] & np.ones((1, len(self._obstacles)), dtype=bool)
         excluded = robot.excluded_pairs
         pairs = [
             (i, j)
             for i in range(L)
+            if i not in scene_only
             for j in range(i + 1, L)
-            if (i, j) not in excluded and not (i in robot.fixed_links and j in robot.fixed_links)
+            if (i, j) not in excluded
+            and not (i in robot.fixed_links and j in robot.fixed_links)
+            and j not in scene_only
         ]
         self._self_pairs = np.array(pairs, dtype=int).reshape(-1, 2)
         self._request = fcl.CollisionRequest()
@@ -391,7 +402,7 @@ class CollisionChecker:
         self._place(seg)
         best = np.inf
         for li in range(self._n_links):
-            if li in self.robot.fixed_links:
+            if not self._against_scene[li]:
                 continue
             for obj in self._obstacles:
                 best = min(best, self._signed_distance(self._links[li], obj))

@@ -2,8 +2,12 @@
 does, and written to an SRDF the user can keep.
 
 :func:`disabled_pairs` samples the robot's joint space (a seeded generator) and checks
-its collision model (the capsules and mesh covers plannerlab plans with) link pair by
-link pair, at the URDF link level:
+link pair by link pair, at the URDF link level, on the links' **real geometry**
+(``geometry="hulls"``, the default: each link's collision meshes as their convex hulls,
+as PyBullet checks them, and so execution and the referee, and its primitives; python-fcl's
+exact test; ``"meshes"``: the meshes' own triangles, as MoveIt does) or on the capsules and
+covers plannerlab plans with (``geometry="covers"``: a pair that only the covers' excess
+brings together is then kept checked):
 
 * ``Adjacent``: links on one body or on neighbouring bodies (parent and child of a
   movable joint) -- plannerlab never checks them anyway;
@@ -22,6 +26,7 @@ are ignored here: the chain is rebuilt without them.
 from __future__ import annotations
 
 import xml.etree.ElementTree as ET
+from collections.abc import Callable
 from dataclasses import dataclass, replace
 from pathlib import Path
 
@@ -41,7 +46,11 @@ class DisabledPair:
 
 
 def disabled_pairs(
-    robot: UrdfChain, rng: np.random.Generator, n_states: int = 2000, never: bool = True
+    robot: UrdfChain,
+    rng: np.random.Generator,
+    n_states: int = 2000,
+    never: bool = True,
+    geometry: str = "hulls",
 ) -> list[DisabledPair]:
     """The link pairs of ``robot``'s URDF that need no self-collision check (module
     docstring), sorted by reason then names.
@@ -51,7 +60,11 @@ def disabled_pairs(
         rng: the generator drawing the random states.
         n_states: random states sampled (MoveIt's default density is 10 000).
         never: also list the pairs never in collision.
+        geometry: ``"hulls"``, ``"meshes"`` (the links' real geometry) or ``"covers"``
+            (module docstring).
     """
+    if geometry not in ("hulls", "meshes", "covers"):
+        raise ValueError(f"geometry: 'hulls', 'meshes' or 'covers', got {geometry!r}")
     from plannerlab.collision.fcl_checker import CollisionChecker
     from plannerlab.problem.scene import Scene
 
@@ -66,15 +79,18 @@ def disabled_pairs(
         for b in links[i + 1 :]:
             if body[a] == body[b] or frozenset((body[a], body[b])) in neighbours:
                 out[frozenset((a, b))] = "Adjacent"
-    checker = CollisionChecker(bare, Scene(), backend="core")  # type: ignore[arg-type]
+    if geometry != "covers":
+        colliding = _mesh_test(bare, out, geometry == "hulls")
+    else:
+        checker = CollisionChecker(bare, Scene(), backend="core")  # type: ignore[arg-type]
 
-    def colliding(q: np.ndarray) -> set[frozenset[str]]:
-        found = set()
-        for x, y in checker.colliding_pairs(q):
-            la, lb = urdf_of[x], urdf_of.get(y)
-            if lb is not None and la != lb:
-                found.add(frozenset((la, lb)))
-        return found
+        def colliding(q: np.ndarray) -> set[frozenset[str]]:
+            found = set()
+            for x, y in checker.colliding_pairs(q):
+                la, lb = urdf_of[x], urdf_of.get(y)
+                if lb is not None and la != lb:
+                    found.add(frozenset((la, lb)))
+            return found
 
     q0 = np.clip(np.zeros(bare.dof), bare.lower, bare.upper)
     for p in colliding(q0):
@@ -96,6 +112,46 @@ def disabled_pairs(
     order = {"Adjacent": 0, "Default": 1, "Always": 2, "Never": 3}
     pairs = [DisabledPair(*sorted(p), reason) for p, reason in out.items()]  # type: ignore[call-arg]
     return sorted(pairs, key=lambda d: (order[d.reason], d.link1, d.link2))
+
+
+def _mesh_test(
+    robot: UrdfChain, adjacent: dict[frozenset[str], str], hulls: bool
+) -> Callable[[np.ndarray], set[frozenset[str]]]:
+    """The URDF link pairs (not ``adjacent``) whose real geometry intersects at a state:
+    python-fcl's exact test of the links' triangle meshes (bounding-volume hierarchies),
+    each collision mesh as its convex hull with ``hulls``."""
+    import fcl
+
+    from plannerlab.robots.urdf.link_meshes import link_meshes
+
+    links = link_meshes(robot, hulls)
+    objs = []
+    for lm in links:
+        bvh = fcl.BVHModel()
+        bvh.beginModel(len(lm.vertices_m), len(lm.faces))
+        bvh.addSubModel(lm.vertices_m, np.asarray(lm.faces, dtype=np.int32))
+        bvh.endModel()
+        objs.append(fcl.CollisionObject(bvh, fcl.Transform()))
+    pairs = [
+        (i, j)
+        for i in range(len(links))
+        for j in range(i + 1, len(links))
+        if frozenset((links[i].link, links[j].link)) not in adjacent
+    ]
+    request = fcl.CollisionRequest()
+
+    def colliding(q: np.ndarray) -> set[frozenset[str]]:
+        B = robot._bodies(np.asarray(q, dtype=float))
+        for lm, o in zip(links, objs, strict=True):
+            T = B[lm.body]
+            o.setTransform(fcl.Transform(T[:3, :3].copy(), T[:3, 3].copy()))
+        return {
+            frozenset((links[i].link, links[j].link))
+            for i, j in pairs
+            if fcl.collide(objs[i], objs[j], request, fcl.CollisionResult()) > 0
+        }
+
+    return colliding
 
 
 def write_srdf(pairs: list[DisabledPair], path: Path, robot_name: str) -> None:

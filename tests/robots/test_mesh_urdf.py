@@ -36,8 +36,12 @@ def covers(tmp_path_factory: pytest.TempPathFactory) -> Path:
 
 
 def arm(tmp_path: Path, **kw: object) -> UrdfChain:
+    # the first covers only (the finer covers for self-collision: test_self_covers.py)
     args: dict[str, object] = dict(
-        mesh_paths=(PKG,), cover_excess_m=EXCESS_M, cover_cache_dir=tmp_path / "covers"
+        mesh_paths=(PKG,),
+        cover_excess_m=EXCESS_M,
+        cover_cache_dir=tmp_path / "covers",
+        self_cover_max_primitives=0,
     )
     args.update(kw)
     return UrdfChain(URDF, "tool", **args)  # type: ignore[arg-type]
@@ -111,15 +115,19 @@ def test_a_detailed_mesh_is_covered_within_the_budget_not_refused() -> None:
 
 
 def test_mesh_arm_loads_with_every_format_and_the_root_mesh(covers: Path) -> None:
-    r = arm(covers)
+    r = arm(covers, self_cover_max_primitives=128)
+    assert r.self_covers
     assert [c.link for c in r.mesh_covers] == ["base", "upper", "fore", "tool"]
     assert r.mesh_covers[3].file.endswith("pkgroot/mesh_arm_tools/meshes/tool.stl")
     assert all(c.primitives <= 32 and c.max_excess_m > 0 for c in r.mesh_covers)
     n_base = r.mesh_covers[0].primitives
-    # the root link's capsules are the fixed links
-    assert r.fixed_links == frozenset(range(n_base))
+    n_first = sum(c.primitives for c in r.mesh_covers)
+    # the root link's capsules are the fixed links (its first cover, then its finer one)
+    fine_base = {i for i in r.self_only_links if r.link_urdf_names[i] == "base"}
+    assert r.fixed_links == frozenset(range(n_base)) | fine_base
+    assert fine_base == set(range(n_base, n_base + len(fine_base)))
     assert sum(c.capsules for c in r.mesh_covers) > 0
-    assert len(r.link_names) == sum(c.primitives for c in r.mesh_covers)
+    assert len(r.link_names) == n_first + sum(c.primitives for c in r.self_covers)
     assert r.link_names[0] == "base#0" and set(r.link_urdf_names) == {
         "base",
         "upper",
@@ -167,7 +175,9 @@ def test_covers_shipped_beside_the_urdf_are_read_and_never_written(tmp_path: Pat
     shutil.copytree(DATA, robot_dir)
     shutil.copytree(tmp_path / "a" / "covers", robot_dir / "covers")
     shipped_files = sorted(p.name for p in (robot_dir / "covers").iterdir())
-    args = dict(mesh_paths=(robot_dir / "pkgroot",), cover_excess_m=EXCESS_M)
+    args = dict(
+        mesh_paths=(robot_dir / "pkgroot",), cover_excess_m=EXCESS_M, self_cover_max_primitives=0
+    )
     robot = UrdfChain(robot_dir / URDF.name, "tool", cover_cache_dir=tmp_path / "empty", **args)
     assert [c.cached for c in robot.mesh_covers] == [True] * 4
     assert np.array_equal(robot._cap_a, computed._cap_a)
@@ -218,6 +228,7 @@ def _problem(urdf: Path, **robot: object) -> dict[str, object]:
             "urdf": str(urdf),
             "tip_link": "tool",
             "cover_excess_m": EXCESS_M,
+            "self_cover_max_primitives": 0,  # the first covers only, as arm()
             **robot,
         },
         "start": {"q": [0.0, 0.0, 0.0]},
@@ -299,7 +310,8 @@ def test_a_mesh_larger_than_plannerlab_reads_is_refused_naming_it(
 # ---------------------------------------------------------------------- SRDF
 def test_disabled_pairs_are_computed_and_kept_in_an_srdf(covers: Path) -> None:
     r = arm(covers)
-    pairs = disabled_pairs(r, np.random.default_rng(0), n_states=200)
+    # judged on the covers (on the links' hulls: test_self_covers.py)
+    pairs = disabled_pairs(r, np.random.default_rng(0), n_states=200, geometry="covers")
     by = {(p.link1, p.link2): p.reason for p in pairs}
     # neighbours, and links sharing a body
     assert by[("base", "upper")] == "Adjacent"
@@ -312,7 +324,7 @@ def test_disabled_pairs_are_computed_and_kept_in_an_srdf(covers: Path) -> None:
     out = covers / "arm.srdf"
     write_srdf(pairs, out, "mesh_arm")
     assert sorted(read_srdf_disabled(out)) == sorted(by)
-    again = disabled_pairs(r, np.random.default_rng(0), n_states=200)
+    again = disabled_pairs(r, np.random.default_rng(0), n_states=200, geometry="covers")
     assert again == pairs
 
 

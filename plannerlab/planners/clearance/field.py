@@ -178,10 +178,17 @@ class ClearanceField:
         self._r = radii[self._link]
         fixed = np.zeros(L, dtype=bool)
         fixed[[i for i in robot.fixed_links if 0 <= i < L]] = True
-        self._scene_spheres = np.flatnonzero(~fixed[self._link])
+        # a mesh robot's finer covers judge self-collision only, its first covers the
+        # scene only (robots.urdf.model: "Self-collision at the meshes' accuracy")
+        self_only = np.zeros(L, dtype=bool)
+        self_only[[i for i in getattr(robot, "self_only_links", ()) if 0 <= i < L]] = True
+        scene_only = np.zeros(L, dtype=bool)
+        scene_only[[i for i in getattr(robot, "scene_only_links", ()) if 0 <= i < L]] = True
+        self._scene_spheres = np.flatnonzero(~(fixed | self_only)[self._link])
         # the link pairs checked against each other: not the same link, not excluded,
-        # not both fixed
+        # not both fixed, not a first cover that a finer one replaces
         allowed = ~np.eye(L, dtype=bool) & ~(fixed[:, None] & fixed[None, :])
+        allowed &= ~scene_only[:, None] & ~scene_only[None, :]
         for i, j in robot.excluded_pairs:
             allowed[i, j] = allowed[j, i] = False
         ia, ib = [], []

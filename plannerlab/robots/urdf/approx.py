@@ -179,13 +179,14 @@ def _proximity(mesh: Any, x: Array, what: str) -> Array:
     return out
 
 
-def _solid(V: Array, F: np.ndarray) -> _Solid:
+def _solid(V: Array, F: np.ndarray, hull: bool = False) -> _Solid:
     """The mesh if each of its bodies is watertight (the union of the bodies, with its
-    voxel depth), else its convex hull, else (flat) its surface."""
+    voxel depth), else its convex hull, else (flat) its surface; the convex hull (else the
+    surface) with ``hull``."""
     import trimesh
 
     mesh = trimesh.Trimesh(V, F, process=True)
-    if len(mesh.faces) <= MAX_DETAIL_FACES and mesh.is_watertight:
+    if not hull and len(mesh.faces) <= MAX_DETAIL_FACES and mesh.is_watertight:
         bodies = list(mesh.split(only_watertight=False))
         if bodies and all(b.is_watertight and b.is_volume for b in bodies):
             if len(bodies) > 1:  # overlapping shells: their union, by manifold3d
@@ -608,11 +609,14 @@ def _verify(V_in: Array, solid: _Solid, a: Array, b: Array, r: Array) -> int:
     return len(V_in) + VERIFY_SAMPLES
 
 
-def capsule_cover(V: Array, F: np.ndarray, target_m: float, budget: int) -> CapsuleCover:
+def capsule_cover(
+    V: Array, F: np.ndarray, target_m: float, budget: int, hull: bool = False
+) -> CapsuleCover:
     """Capsules covering the mesh (V, F), at most ``budget`` of them, reaching outside
     its solid by about ``target_m`` or more when the budget needs it (module docstring).
-    Always succeeds on a mesh with at least one triangle."""
-    solid = _solid(V, F)
+    With ``hull`` the solid is the mesh's convex hull (what PyBullet checks for a moving
+    link). Always succeeds on a mesh with at least one triangle."""
+    solid = _solid(V, F, hull)
     P, delta = _surface_points(solid, target_m)
     eps = max(target_m, 2.0 * delta)
     budget = max(1, int(budget))

@@ -187,6 +187,7 @@ def mesh_cover(
     where: str,
     cache_dir: Path | None,
     shipped_dirs: tuple[Path, ...] = (),
+    hull: bool = False,
 ) -> CapsuleCover:
     """The capsule cover of a mesh file (scaled), at most ``max_primitives`` capsules,
     aiming at :func:`cover_target_m` (coarser when the budget asks for it; see
@@ -194,6 +195,8 @@ def mesh_cover(
 
     Args:
         cache_dir: the cache folder (:func:`default_cache_dir`), or None: no cache.
+        hull: cover the mesh's convex hull (what PyBullet checks for a moving link),
+            not the mesh.
         shipped_dirs: read-only folders of covers shipped with a robot (the ``covers/``
             folder beside its URDF: the same file names as the cache's), looked in after
             the cache (only when caching is on); a cover computed here is written to the
@@ -214,6 +217,8 @@ def mesh_cover(
         h = hashlib.sha256()
         h.update(file_digest(Path(path)).encode())
         h.update(np.asarray([*s, excess_m, max_primitives, COVER_VERSION], dtype=float).tobytes())
+        if hull:  # (the first covers' keys are unchanged)
+            h.update(b"hull")
         key = Path(cache_dir) / f"{h.hexdigest()[:32]}.npz"
         for found in (key, *(Path(d) / key.name for d in shipped_dirs)):
             if not found.is_file():
@@ -234,7 +239,7 @@ def mesh_cover(
             except Exception:  # a damaged cache entry: compute again
                 pass
     V, F = load_mesh(Path(path), s, where)
-    cover = capsule_cover(V, F, cover_target_m(V, float(excess_m)), int(max_primitives))
+    cover = capsule_cover(V, F, cover_target_m(V, float(excess_m)), int(max_primitives), hull)
     if key is not None:
         _atomic_savez(
             key,

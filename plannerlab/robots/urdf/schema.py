@@ -55,6 +55,8 @@ def build(values: Mapping[str, Any]) -> UrdfChain:
             mesh_paths=mesh_paths,
             cover_excess_m=float(values["cover_excess_m"]),
             cover_max_primitives=int(values["cover_max_primitives"]),
+            self_cover_excess_m=float(values["self_cover_excess_m"]),
+            self_cover_max_primitives=int(values["self_cover_max_primitives"]),
             sim_urdf_path=Path(values["sim_urdf"]) if values["sim_urdf"] else None,
         )
     except UrdfError as exc:
@@ -122,6 +124,28 @@ TABLE = RobotTable(
             "",
             "the most capsules covering one collision mesh",
             minimum=1,
+            maximum=1024,
+            why_maximum="every capsule is one more to check",
+        ),
+        Key(
+            "self_cover_excess_m",
+            "number",
+            0.004,
+            "m",
+            "the distance a mesh link's second, finer cover (judging self-collision only) "
+            "aims to reach outside the mesh at most",
+            positive=True,
+            maximum=0.5,
+            why_maximum="a cover is an approximation of the link, not a blob around it",
+        ),
+        Key(
+            "self_cover_max_primitives",
+            "integer",
+            128,
+            "",
+            "the most capsules of a mesh's finer cover; 0: none (the first cover judges "
+            "self-collision too)",
+            minimum=0,
             maximum=1024,
             why_maximum="every capsule is one more to check",
         ),

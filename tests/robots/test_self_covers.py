@@ -1,0 +1,163 @@
+"""A mesh robot's self-collision judged on a second, finer cover (issue 35): two box
+meshes 3 cm apart whose one-capsule covers overlap, but whose finer covers do not."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+import trimesh
+
+from plannerlab.collision.fcl_checker import CollisionChecker
+from plannerlab.problem.scene import Scene
+from plannerlab.robots.urdf.model import UrdfChain
+from plannerlab.run.srdf import disabled_pairs
+
+#: the gap between the two boxes at q = 0 [m]
+GAP_M = 0.03
+
+URDF = """<?xml version="1.0"?>
+<robot name="two_boxes">
+  <link name="base">
+    <collision><origin xyz="0 0 0.05"/><geometry><mesh filename="box.stl"/></geometry></collision>
+  </link>
+  <link name="turn"/>
+  <link name="slider">
+    <collision><origin xyz="{x} 0 0.05"/><geometry><mesh filename="box.stl"/></geometry></collision>
+  </link>
+  <joint name="j1" type="revolute">
+    <parent link="base"/><child link="turn"/><axis xyz="0 0 1"/>
+    <limit lower="-0.5" upper="0.5" effort="10" velocity="1"/>
+  </joint>
+  <joint name="j2" type="prismatic">
+    <parent link="turn"/><child link="slider"/><axis xyz="1 0 0"/>
+    <limit lower="{low}" upper="0.1" effort="10" velocity="1"/>
+  </joint>
+</robot>
+"""
+
+
+@pytest.fixture(scope="module")
+def urdf(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """Two 10 cm cubes, the slider's GAP_M beyond the base's along x at q = 0."""
+    d = tmp_path_factory.mktemp("two_boxes")
+    trimesh.creation.box((0.1, 0.1, 0.1)).export(str(d / "box.stl"))
+    (d / "two_boxes.urdf").write_text(URDF.format(x=0.1 + GAP_M, low=-0.1), encoding="utf-8")
+    # the slider never nearer: the base lies in a disc of radius 7.1 cm about the turn axis,
+    # the slider beyond 8 cm of it: the meshes never meet
+    (d / "apart.urdf").write_text(URDF.format(x=0.1 + GAP_M, low=0.0), encoding="utf-8")
+    return d / "two_boxes.urdf"
+
+
+def chain(urdf: Path, fine: int) -> UrdfChain:
+    return UrdfChain(
+        urdf,
+        "slider",
+        cover_max_primitives=1,
+        self_cover_max_primitives=fine,
+        cover_cache_dir=urdf.parent / "covers",
+    )
+
+
+def mesh_distance_m(robot: UrdfChain, q: np.ndarray) -> float:
+    """The boxes' signed distance at q (negative: their penetration)."""
+    F = robot.fk(q)
+    names = robot.link_frame_names
+    boxes = []
+    for link, dz in (("base", 0.05), ("slider", 0.05)):
+        T = F[names.index(link)].copy()
+        off = np.array([0.1 + GAP_M if link == "slider" else 0.0, 0.0, dz])
+        T[:3, 3] = T[:3, :3] @ off + T[:3, 3]
+        boxes.append(trimesh.creation.box((0.1, 0.1, 0.1), transform=T))
+    m = trimesh.collision.CollisionManager()
+    m.add_object("a", boxes[0])
+    return float(m.min_distance_single(boxes[1]))
+
+
+def test_covers_that_overlap_where_the_meshes_do_not_are_judged_by_the_finer_cover(
+    urdf: Path,
+) -> None:
+    coarse = chain(urdf, 0)
+    fine = chain(urdf, 128)
+    q0 = np.zeros(2)
+    assert mesh_distance_m(fine, q0) == pytest.approx(GAP_M, abs=1e-6)
+    # one capsule a cube reaches beyond its faces by more than half the gap
+    assert coarse.mesh_covers[0].max_excess_m > GAP_M / 2
+    assert not CollisionChecker(coarse, Scene()).is_valid(q0)
+    # the finer cover: the gap is left free, and each cover is within a third of it
+    assert len(fine.self_covers) == 2
+    assert all(c.max_excess_m < GAP_M / 3 for c in fine.self_covers)
+    for backend in ("core", "fcl"):
+        assert CollisionChecker(fine, Scene(), backend=backend).is_valid(q0), backend
+    # boxes that intersect: invalid on either
+    q_in = np.array([0.0, -0.06])
+    assert mesh_distance_m(fine, q_in) < 0.0
+    for robot in (coarse, fine):
+        assert not CollisionChecker(robot, Scene()).is_valid(q_in)
+
+
+def test_the_finer_cover_is_conservative_and_judges_self_collision_only(urdf: Path) -> None:
+    """Every state the finer cover calls free has its meshes apart (seeded states across
+    the contact); its capsules are never checked against the scene, nor the first
+    cover's against the other link."""
+    fine = chain(urdf, 128)
+    n_first = sum(c.primitives for c in fine.mesh_covers)
+    assert len(fine.scene_only_links) == n_first
+    assert not fine.scene_only_links & fine.self_only_links
+    assert len(fine.link_names) == n_first + len(fine.self_only_links)
+    assert all("#s" in fine.link_names[i] for i in fine.self_only_links)
+    # each URDF link's capsules one run, its first cover first
+    assert fine.link_urdf_names == tuple(sorted(fine.link_urdf_names, key=["base", "slider"].index))
+    assert fine.link_names[0] == "base" and fine.link_names[1] == "base#s0"
+    Q = np.random.default_rng(0).uniform(fine.lower, fine.upper, size=(200, 2))
+    valid = CollisionChecker(fine, Scene()).valid_batch(Q)
+    d = np.array([mesh_distance_m(fine, q) for q in Q])
+    assert valid.any() and (~valid).any()
+    assert np.all(d[valid] > 0.0)
+    # the pairs checked: none between first-cover capsules of the two links
+    ck = CollisionChecker(fine, Scene(), backend="fcl")
+    pairs = {tuple(p) for p in ck._self_pairs.tolist()}
+    assert pairs and all(i in fine.self_only_links and j in fine.self_only_links for i, j in pairs)
+
+
+def test_pairs_that_never_collide_are_found_on_the_meshes_not_the_covers(urdf: Path) -> None:
+    """MoveIt's "Never": judged on the links' meshes, a pair that only the covers bring
+    together is disabled; judged on the one-capsule covers, it is not."""
+    apart = chain(urdf.parent / "apart.urdf", 0)
+    Q = np.random.default_rng(1).uniform(apart.lower, apart.upper, size=(50, 2))
+    assert min(mesh_distance_m(apart, q) for q in Q) > 0.0
+    on_meshes = disabled_pairs(apart, np.random.default_rng(0), n_states=100)
+    assert {(p.link1, p.link2): p.reason for p in on_meshes} == {("base", "slider"): "Never"}
+    on_covers = disabled_pairs(apart, np.random.default_rng(0), n_states=100, geometry="covers")
+    assert [(p.link1, p.link2, p.reason) for p in on_covers] == [("base", "slider", "Default")]
+    # a pair that does meet is kept checked on the meshes too
+    meeting = chain(urdf, 0)
+    assert disabled_pairs(meeting, np.random.default_rng(0), n_states=100) == []
+
+
+@pytest.mark.parametrize("planner", ["native.rrtconnect", "ompl.rrtconnect"])
+def test_a_start_in_self_collision_is_refused_naming_the_urdf_links(
+    urdf: Path, planner: str
+) -> None:
+    """docs/problem-format.md: the error names the colliding pairs by the URDF's links,
+    not by the capsules of the covers (``slider#s3``)."""
+    import plannerlab as pl
+    from plannerlab.errors import ProblemError
+    from plannerlab.problem.load import problem_from_dict
+
+    doc = {
+        "problem": {"name": "two_boxes"},
+        "robot": {
+            "type": "urdf",
+            "urdf": str(urdf),
+            "tip_link": "slider",
+            "cover_max_primitives": 1,
+        },
+        "start": {"q": [0.0, -0.06]},
+        "goals": [{"name": "out", "q": [0.0, 0.05]}],
+    }
+    problem = problem_from_dict(doc, str(urdf.parent / "p.toml"))
+    with pytest.raises(ProblemError) as e:
+        pl.solve(problem, planner, 0, budget=pl.Budget(time_limit_s=5.0))
+    assert "base x slider" in str(e.value) and "#" not in str(e.value)
