@@ -477,7 +477,9 @@ def report(
             out.append(f"- {k}: " + "; ".join(bad))
     both = [
         (a["plan_s"], b["plan_s"])
-        for a, b in zip(rows.get("native.rrtconnect", []), rows.get("ompl.rrtconnect", []))
+        for a, b in zip(
+            rows.get("native.rrtconnect", []), rows.get("ompl.rrtconnect", []), strict=False
+        )
         if a["ok"] and b["ok"]
     ]
     if both:

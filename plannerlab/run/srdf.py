@@ -26,12 +26,12 @@ are ignored here: the chain is rebuilt without them.
 from __future__ import annotations
 
 import xml.etree.ElementTree as ET
-from collections.abc import Callable
 from dataclasses import dataclass, replace
 from pathlib import Path
 
 import numpy as np
 
+from plannerlab.robots.urdf.link_meshes import colliding_link_pairs
 from plannerlab.robots.urdf.model import UrdfChain
 
 
@@ -80,7 +80,7 @@ def disabled_pairs(
             if body[a] == body[b] or frozenset((body[a], body[b])) in neighbours:
                 out[frozenset((a, b))] = "Adjacent"
     if geometry != "covers":
-        colliding = _mesh_test(bare, out, geometry == "hulls")
+        colliding = colliding_link_pairs(bare, out, geometry == "hulls")
     else:
         checker = CollisionChecker(bare, Scene(), backend="core")  # type: ignore[arg-type]
 
@@ -112,46 +112,6 @@ def disabled_pairs(
     order = {"Adjacent": 0, "Default": 1, "Always": 2, "Never": 3}
     pairs = [DisabledPair(*sorted(p), reason) for p, reason in out.items()]  # type: ignore[call-arg]
     return sorted(pairs, key=lambda d: (order[d.reason], d.link1, d.link2))
-
-
-def _mesh_test(
-    robot: UrdfChain, adjacent: dict[frozenset[str], str], hulls: bool
-) -> Callable[[np.ndarray], set[frozenset[str]]]:
-    """The URDF link pairs (not ``adjacent``) whose real geometry intersects at a state:
-    python-fcl's exact test of the links' triangle meshes (bounding-volume hierarchies),
-    each collision mesh as its convex hull with ``hulls``."""
-    import fcl
-
-    from plannerlab.robots.urdf.link_meshes import link_meshes
-
-    links = link_meshes(robot, hulls)
-    objs = []
-    for lm in links:
-        bvh = fcl.BVHModel()
-        bvh.beginModel(len(lm.vertices_m), len(lm.faces))
-        bvh.addSubModel(lm.vertices_m, np.asarray(lm.faces, dtype=np.int32))
-        bvh.endModel()
-        objs.append(fcl.CollisionObject(bvh, fcl.Transform()))
-    pairs = [
-        (i, j)
-        for i in range(len(links))
-        for j in range(i + 1, len(links))
-        if frozenset((links[i].link, links[j].link)) not in adjacent
-    ]
-    request = fcl.CollisionRequest()
-
-    def colliding(q: np.ndarray) -> set[frozenset[str]]:
-        B = robot._bodies(np.asarray(q, dtype=float))
-        for lm, o in zip(links, objs, strict=True):
-            T = B[lm.body]
-            o.setTransform(fcl.Transform(T[:3, :3].copy(), T[:3, 3].copy()))
-        return {
-            frozenset((links[i].link, links[j].link))
-            for i, j in pairs
-            if fcl.collide(objs[i], objs[j], request, fcl.CollisionResult()) > 0
-        }
-
-    return colliding
 
 
 def write_srdf(pairs: list[DisabledPair], path: Path, robot_name: str) -> None:

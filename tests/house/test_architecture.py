@@ -17,7 +17,11 @@ PACKAGE = Path(__file__).resolve().parents[2] / "plannerlab"
 
 #: engine -> the only place (a module path prefix, relative to the package) that may import it
 ENGINE_ROOMS = {
-    "fcl": ("collision/", "robots/urdf/approx.py"),  # covers: a point's distance to a mesh
+    "fcl": (
+        "collision/",
+        "robots/urdf/approx.py",  # covers: a point's distance to a mesh
+        "robots/urdf/link_meshes.py",  # the links' real meshes: which pairs ever collide
+    ),
     "ompl": ("planners/ompl/",),
     "pybullet": ("sim/",),
     "matplotlib": ("plot/",),

@@ -179,14 +179,14 @@ def _proximity(mesh: Any, x: Array, what: str) -> Array:
     return out
 
 
-def _solid(V: Array, F: np.ndarray, hull: bool = False) -> _Solid:
+def _solid(V: Array, F: np.ndarray, as_hull: bool = False) -> _Solid:
     """The mesh if each of its bodies is watertight (the union of the bodies, with its
     voxel depth), else its convex hull, else (flat) its surface; the convex hull (else the
-    surface) with ``hull``."""
+    surface) with ``as_hull``."""
     import trimesh
 
     mesh = trimesh.Trimesh(V, F, process=True)
-    if not hull and len(mesh.faces) <= MAX_DETAIL_FACES and mesh.is_watertight:
+    if not as_hull and len(mesh.faces) <= MAX_DETAIL_FACES and mesh.is_watertight:
         bodies = list(mesh.split(only_watertight=False))
         if bodies and all(b.is_watertight and b.is_volume for b in bodies):
             if len(bodies) > 1:  # overlapping shells: their union, by manifold3d

@@ -49,8 +49,8 @@ Self-collision at the meshes' accuracy
 A cover within the budget may reach 1-3 cm outside its mesh: fine against the scene (the
 margin is of that order), too fat between links that pass within millimetres of each
 other (a UR10's wrists: 2 % of random states free on its 32-capsule covers, 53 % on its
-meshes). So each mesh also gets a **second, finer cover** (``self_cover_excess_m``,
-default 4 mm, at most ``self_cover_max_primitives`` = 128 capsules; the same algorithm,
+meshes). So each mesh can also get a **second, finer cover** (``self_cover_excess_m``,
+default 4 mm, at most ``self_cover_max_primitives`` capsules, 128 asked; the same algorithm,
 cached alike; it holds the mesh's convex hull, the solid PyBullet checks for a link's
 mesh, so that a state the finer cover passes is free in execution and for the referee)
 that judges self-collision only: its capsules (:attr:`UrdfChain.
@@ -59,11 +59,22 @@ checked against the scene, and the first cover's capsules of that mesh (:attr:`U
 scene_only_links`) never against other links. The finer covers are not grown by the
 problem's clearance margin (which keeps the robot off the scene): links built to pass
 within a centimetre of each other (a UR10's wrist 1 and wrist 3, its forearm and wrist
-2, its base and upper arm) would otherwise collide in every state. Where the finer cover is no finer (a small
-mesh whose first cover is already within it) the first cover does both. Both covers
+2, its base and upper arm) would otherwise collide in every state. Where the finer
+cover is no finer (a small mesh whose first cover is already within it) the first
+cover does both. Both covers
 hold the mesh, so either verdict is conservative. The compiled state test reaches the
 finer capsules only through its gates (a ball per body, then per cluster of four
 capsules): a pair of links far apart costs one ball test, as before.
+
+**It is off by default** (``self_cover_max_primitives = 0``) for its cost: at 128 a mesh,
+a pair of overlapping bodies tests about a thousand cluster pairs, and the state test
+costs 23-57x more (UR10 2.0 -> 47 us, Kinova 1.5 -> 85 us a state; the bundled mesh
+Panda's end-to-end test 9 s -> 245 s; results/mesh_robots.md). A robot whose links pass
+within millimetres of each other (the UR10: 4 % of random states free on the first
+covers, 25.7 % with the finer ones, 53 % on its meshes) needs it; ask for it with
+``self_cover_max_primitives = 128`` in ``[robot]``. The gate that would make it cheap
+enough to be the default (a first-cover capsule pair opening only its finer capsules) is
+a kernel change not made yet.
 
 Only numpy (``yourdfpy`` for parsing, ``trimesh`` for meshes) is used here.
 """
@@ -72,7 +83,6 @@ from __future__ import annotations
 
 import logging
 import math
-import xml.etree.ElementTree as ET
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -82,164 +92,25 @@ from numpy.typing import NDArray
 
 from plannerlab.errors import PlannerlabError
 from plannerlab.robots.base import Array
-from plannerlab.robots.urdf.errors import UrdfError, hint
+from plannerlab.robots.urdf.errors import UrdfError
 from plannerlab.robots.urdf.meshes import CoverSettings, MeshCover
 from plannerlab.robots.urdf.pairs import excluded_pairs, read_srdf_disabled
+from plannerlab.robots.urdf.tree import (  # noqa: F401  (MOVABLE, axis_motion: re-exported)
+    MOVABLE,
+    _chain,
+    _joint_axis,
+    _joint_limits,
+    _load_urdf,
+    _origin,
+    _place_links,
+    _Tree,
+    axis_motion,
+)
 
-MOVABLE = ("revolute", "continuous", "prismatic")
 #: the folder beside a URDF that may ship its meshes' covers (cache files, read-only): a
 #: robot bundled with its covers loads at once on a new machine
 SHIPPED_COVERS = "covers"
 _LOG = logging.getLogger(__name__)
-
-
-def axis_motion(axis: Array, q: Array, prismatic: bool) -> Array:
-    """Joint motions (..., 4, 4) for values q (...,) about/along a unit axis (3,)."""
-    q = np.asarray(q, dtype=float)
-    T = np.broadcast_to(np.eye(4), q.shape + (4, 4)).copy()
-    if prismatic:
-        T[..., :3, 3] = q[..., None] * axis
-        return T
-    x, y, z = axis
-    K = np.array([[0.0, -z, y], [z, 0.0, -x], [-y, x, 0.0]])
-    s = np.sin(q)[..., None, None]
-    c = np.cos(q)[..., None, None]
-    T[..., :3, :3] = np.eye(3) + s * K + (1.0 - c) * (K @ K)
-    return T
-
-
-def _joint_axis(j: Any) -> Array:
-    """A URDF joint's unit axis (x when none is given)."""
-    a = np.array([1.0, 0.0, 0.0] if j.axis is None else j.axis, dtype=float)
-    n = float(np.linalg.norm(a))
-    if n < 1e-12:
-        raise UrdfError("urdf", f"a non-zero axis on joint {j.name}")
-    return a / n
-
-
-def _joint_limits(j: Any) -> tuple[float, float]:
-    """A URDF joint's limits (a continuous joint's: one turn)."""
-    if j.type == "continuous":
-        return (-math.pi, math.pi)
-    lim = j.limit
-    if lim is None or lim.lower is None or lim.upper is None:
-        raise UrdfError("urdf", f"lower and upper limits on joint {j.name} ({j.type})")
-    lo, hi = float(lim.lower), float(lim.upper)
-    if not (math.isfinite(lo) and math.isfinite(hi) and lo <= hi):
-        raise UrdfError("urdf", f"limits lower <= upper on joint {j.name}, got {lo}, {hi}")
-    return lo, hi
-
-
-def _origin(x: Any) -> Array:
-    return np.eye(4) if x.origin is None else np.asarray(x.origin, dtype=float)
-
-
-def _load_urdf(path: Path) -> Any:
-    """The parsed URDF (``yourdfpy``'s ``Robot``: links and joints, no meshes)."""
-    import yourdfpy
-
-    if not path.is_file():
-        raise UrdfError("urdf", f"an existing URDF file; {path} does not exist")
-    try:  # yourdfpy would recover from broken XML and read part of it
-        ET.parse(path)
-    except ET.ParseError as exc:
-        raise UrdfError("urdf", f"a well-formed URDF (XML); {path}: {exc}") from None
-    try:
-        model = yourdfpy.URDF.load(
-            str(path),
-            build_scene_graph=False,
-            build_collision_scene_graph=False,
-            load_meshes=False,
-            load_collision_meshes=False,
-        )
-    except Exception as exc:  # yourdfpy raises many kinds for a malformed file
-        raise UrdfError("urdf", f"a valid URDF; {path}: {exc}") from None
-    return model.robot
-
-
-@dataclass(frozen=True)
-class _Tree:
-    """A URDF's links by name, each link's joint to its parent, the root link, the
-    movable joints from the root to the tip link in order, and the movable joints off
-    that chain with the value each is frozen at."""
-
-    links: dict[str, Any]
-    joint_of_child: dict[str, Any]
-    root: str
-    movable: list[Any]
-    frozen: dict[str, float]
-
-
-def _chain(urdf: Any, tip_link: str, path: Path) -> _Tree:
-    """The chain from the URDF's root link to ``tip_link``, its joints checked."""
-    links = {link.name: link for link in urdf.links}
-    joint_of_child = {j.child: j for j in urdf.joints}
-    children = set(joint_of_child)
-    roots = [n for n in links if n not in children]
-    if len(roots) != 1:
-        raise UrdfError("urdf", f"a URDF tree with one root link; {path} has {roots}")
-    root = roots[0]
-    if tip_link not in links:
-        raise UrdfError(
-            "tip_link",
-            f"a link of {path.name}, got {tip_link!r}{hint(tip_link, list(links))}; "
-            f"its links: {', '.join(links)}",
-        )
-    # the chain: root -> tip
-    chain: list[Any] = []
-    name = tip_link
-    while name != root:
-        j = joint_of_child[name]
-        chain.append(j)
-        name = j.parent
-    chain.reverse()
-    for j in chain:
-        if j.type not in MOVABLE + ("fixed",):
-            raise UrdfError(
-                "urdf", f"revolute, continuous, prismatic or fixed joints; {j.name} is {j.type}"
-            )
-        if j.type in MOVABLE and j.mimic is not None:
-            raise UrdfError("urdf", f"no mimic joint on the chain; {j.name} mimics one")
-    movable = [j for j in chain if j.type in MOVABLE]
-    chain_names = {j.name for j in movable}
-    frozen: dict[str, float] = {}
-    for j in urdf.joints:
-        if j.type in MOVABLE and j.name not in chain_names:
-            lo, hi = _joint_limits(j)
-            frozen[j.name] = float(np.clip(0.0, lo, hi))
-        elif j.type not in MOVABLE + ("fixed",):
-            raise UrdfError(
-                "urdf", f"revolute, continuous, prismatic or fixed joints; {j.name} is {j.type}"
-            )
-    return _Tree(links, joint_of_child, root, movable, frozen)
-
-
-def _place_links(tree: _Tree) -> dict[str, tuple[int, Array]]:
-    """Every link's body and its pose on that body: (body, T_body_link) by link name."""
-    body_of_joint = {j.name: i + 1 for i, j in enumerate(tree.movable)}
-    placed: dict[str, tuple[int, Array]] = {tree.root: (0, np.eye(4))}
-
-    def place(link: str) -> tuple[int, Array]:
-        if link in placed:
-            return placed[link]
-        j = tree.joint_of_child[link]
-        origin = _origin(j)
-        if j.name in body_of_joint:
-            out = (body_of_joint[j.name], np.eye(4))
-        else:
-            b, T = place(j.parent)
-            T = T @ origin
-            if j.name in tree.frozen:
-                T = T @ axis_motion(
-                    _joint_axis(j), np.asarray(tree.frozen[j.name]), j.type == "prismatic"
-                )
-            out = (b, T)
-        placed[link] = out
-        return out
-
-    for link in tree.links:
-        place(link)
-    return placed
 
 
 @dataclass(frozen=True)
@@ -423,8 +294,9 @@ class UrdfChain:
         cover_max_primitives: the most capsules covering one mesh.
         self_cover_excess_m, self_cover_max_primitives: the second, finer cover of each
             mesh, judging self-collision only (the first one judges the scene): the
-            excess aimed at [m] and the most capsules; 0 primitives: no second cover
-            (the first judges both).
+            excess aimed at [m] and the most capsules; 0 primitives (the default): no
+            second cover (the first judges both); 128 is what the module docstring
+            measures.
         cover_cache: keep covers on disk; ``cover_cache_dir`` (None:
             ``~/.cache/plannerlab/covers``).
         sim_urdf_path: the robot's real geometry for the simulator: a URDF with the same
@@ -444,7 +316,7 @@ class UrdfChain:
     cover_excess_m: float = 0.01
     cover_max_primitives: int = 32
     self_cover_excess_m: float = 0.004
-    self_cover_max_primitives: int = 128
+    self_cover_max_primitives: int = 0
     cover_cache: bool = True
     cover_cache_dir: Path | None = None
     sim_urdf_path: Path | None = None
