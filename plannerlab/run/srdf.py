@@ -31,7 +31,7 @@ from pathlib import Path
 
 import numpy as np
 
-from plannerlab.robots.urdf.link_meshes import colliding_link_pairs
+from plannerlab.collision.fcl_checker import colliding_link_pairs
 from plannerlab.robots.urdf.model import UrdfChain
 
 

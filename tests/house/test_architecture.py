@@ -20,7 +20,6 @@ ENGINE_ROOMS = {
     "fcl": (
         "collision/",
         "robots/urdf/approx.py",  # covers: a point's distance to a mesh
-        "robots/urdf/link_meshes.py",  # the links' real meshes: which pairs ever collide
     ),
     "ompl": ("planners/ompl/",),
     "pybullet": ("sim/",),

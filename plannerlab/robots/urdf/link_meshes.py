@@ -5,7 +5,6 @@ rather than their covers (the self-collision pairs of :mod:`plannerlab.run.srdf`
 
 from __future__ import annotations
 
-from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
 
@@ -72,41 +71,3 @@ def link_meshes(robot: Any, hulls: bool = True) -> list[LinkMesh]:
 
 
 __all__ = ["LinkMesh", "link_meshes"]
-
-
-def colliding_link_pairs(
-    robot: Any, adjacent: dict[frozenset[str], str], hulls: bool
-) -> Callable[[np.ndarray], set[frozenset[str]]]:
-    """The URDF link pairs (not ``adjacent``) whose real geometry intersects at a state:
-    python-fcl's exact test of the links' triangle meshes (bounding-volume hierarchies),
-    each collision mesh as its convex hull with ``hulls``."""
-    import fcl
-
-    links = link_meshes(robot, hulls)
-    objs = []
-    for lm in links:
-        bvh = fcl.BVHModel()
-        bvh.beginModel(len(lm.vertices_m), len(lm.faces))
-        bvh.addSubModel(lm.vertices_m, np.asarray(lm.faces, dtype=np.int32))
-        bvh.endModel()
-        objs.append(fcl.CollisionObject(bvh, fcl.Transform()))
-    pairs = [
-        (i, j)
-        for i in range(len(links))
-        for j in range(i + 1, len(links))
-        if frozenset((links[i].link, links[j].link)) not in adjacent
-    ]
-    request = fcl.CollisionRequest()
-
-    def colliding(q: np.ndarray) -> set[frozenset[str]]:
-        B = robot._bodies(np.asarray(q, dtype=float))
-        for lm, o in zip(links, objs, strict=True):
-            T = B[lm.body]
-            o.setTransform(fcl.Transform(T[:3, :3].copy(), T[:3, 3].copy()))
-        return {
-            frozenset((links[i].link, links[j].link))
-            for i, j in pairs
-            if fcl.collide(objs[i], objs[j], request, fcl.CollisionResult()) > 0
-        }
-
-    return colliding
