@@ -57,7 +57,8 @@ case "$job" in
     # two test processes (pytest-xdist; PLANNERLAB_TEST_JOBS=0: in this process alone),
     # each taking the next test when it is free (worksteal: a few tests take a minute);
     # on a fresh clone they share numba's cache, so a kernel one compiles the other loads
-    exec "$VENV/bin/python" -m pytest -q -n "${PLANNERLAB_TEST_JOBS:-2}" --dist worksteal "$@" ;;
+    # (the 15 slowest tests are listed at the end: the suite aims at 10 minutes)
+    exec "$VENV/bin/python" -m pytest -q -n "${PLANNERLAB_TEST_JOBS:-2}" --dist worksteal --durations=15 "$@" ;;
   bench)
     for b in bench/*.py; do "$VENV/bin/python" "$b" "$@"; done ;;
   jupyter)
