@@ -438,7 +438,12 @@ def _slot3(A, i):
 
 
 # ------------------------------------------------------------------ the filter's passes
-@kernel
+# The passes (frames32, _scene_pass, _self_pass) are inlined into test_lanes by numba:
+# out of line, each call takes the model and the scratch (some eighty arrays, each
+# flattened into its fields) on the stack. Their callers are kernels (numba's reference
+# counting off): inlined into a function that counts references, every array of the
+# model would be counted in and out.
+@njit(cache=True, nogil=True, inline="always", _nrt=False)
 def frames32(m, Z):
     """Every body's frame in the eight lanes, and the body gates' centres."""
     if m.cpl_start.shape[0] > 0:
@@ -532,7 +537,7 @@ def _box_meets(O, o, B, live):
     return (mask_bits(m) & live) != 0
 
 
-@kernel
+@njit(cache=True, nogil=True, inline="always", _nrt=False)
 def _scene_pass(m, Z, mode, hu):
     """Every moving capsule against every obstacle, behind three gates: a box around a
     group of ``GROUP`` consecutive bodies of ``body_order`` (built per call from the
@@ -624,7 +629,7 @@ def _pairs_in(T, q0, q1, eps, grow, plain, hm):
     return mh, mg, m0
 
 
-@kernel
+@njit(cache=True, nogil=True, inline="always", _nrt=False)
 def _self_pass(m, Z, mode, hu):
     """Every checked link pair, behind its body pair's and cluster pair's gates: the lane
     masks ``hu`` updated, and whether the mode's stop came."""
