@@ -5,8 +5,9 @@ side (the *lanes* of :mod:`plannerlab.collision.simd`: one float32 vector per qu
 on the compiled model (:class:`~plannerlab.collision.model.CompiledModel`), in two stages:
 
 1. **A float32 filter in the lanes**: the kinematics of
-   :mod:`plannerlab.collision.kinematics`, then per body a gate (a ball around its
-   capsules) against each obstacle and each other body's gate, then the gates of the
+   :mod:`plannerlab.collision.kinematics`, then against each obstacle a box around
+   ``GROUP`` consecutive bodies (built per call), then per body a gate (a ball around
+   its capsules) against each obstacle and each other body's gate, then the gates of the
    body's clusters (a few neighbouring capsules each), then the capsules behind a gate
    that is not clear. Every radius is grown by the model's bound ``eps32_m`` of how far
    float32 can be off: a lane whose every pair is clear by more than that is **free**
