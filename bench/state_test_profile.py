@@ -48,7 +48,7 @@ from plannerlab.problem.catalog import load_problem
 PROBLEMS = ("problems/urdf/panda/bookshelf_small_0001.toml", "armz_inspection")
 
 
-@njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True, _nrt=False)
 def _stages(P, Q, stage):
     """Run the batch road up to ``stage`` (0 load, 1 kinematics, 2 scene, 3 self, 4 whole);
     returns a checksum (so nothing is optimised away) and the confirmed count."""

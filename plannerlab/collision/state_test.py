@@ -5,8 +5,9 @@ side (the *lanes* of :mod:`plannerlab.collision.simd`: one float32 vector per qu
 on the compiled model (:class:`~plannerlab.collision.model.CompiledModel`), in two stages:
 
 1. **A float32 filter in the lanes**: the kinematics of
-   :mod:`plannerlab.collision.kinematics`, then per body a gate (a ball around its
-   capsules) against each obstacle and each other body's gate, then the gates of the
+   :mod:`plannerlab.collision.kinematics`, then against each obstacle a box around
+   ``GROUP`` consecutive bodies (built per call), then per body a gate (a ball around
+   its capsules) against each obstacle and each other body's gate, then the gates of the
    body's clusters (a few neighbouring capsules each), then the capsules behind a gate
    that is not clear. Every radius is grown by the model's bound ``eps32_m`` of how far
    float32 can be off: a lane whose every pair is clear by more than that is **free**
@@ -73,6 +74,9 @@ EVERY_LANE = 0
 #: mode: stop once a lane of growth 0 has certainly hit
 ANY_HIT = 1
 _ALL = (1 << LANES) - 1
+#: bodies of ``body_order`` in a group of the scene pass's broadphase (a box around their
+#: gates, built per call, meets each obstacle's world box before the bodies do)
+GROUP = 4
 _F4 = np.float32
 
 
@@ -435,7 +439,12 @@ def _slot3(A, i):
 
 
 # ------------------------------------------------------------------ the filter's passes
-@kernel
+# The passes (frames32, _scene_pass, _self_pass) are inlined into test_lanes by numba:
+# out of line, each call takes the model and the scratch (some eighty arrays, each
+# flattened into its fields) on the stack. Their callers are kernels (numba's reference
+# counting off): inlined into a function that counts references, every array of the
+# model would be counted in and out.
+@njit(cache=True, nogil=True, inline="always", _nrt=False)
 def frames32(m, Z):
     """Every body's frame in the eight lanes, and the body gates' centres."""
     if m.cpl_start.shape[0] > 0:
@@ -488,50 +497,101 @@ def _stop(hit, mode):
 
 
 @kernel
+def _group_box(gates, G, brate, order, k0, k1, grow, eps):
+    """The lanes' world box around the body gates ``order[k0:k1]`` (G: their centres;
+    each gate grown as against the scene, ``brate`` its body's rate): (lo x, y, z, hi x,
+    y, z, any), its corners moved out by 2^-21 of their size and 1e-7 m beyond float32's
+    rounding of a gate's centre ± radius (``any``: some body in the group is gated)."""
+    big, small = splat(3.0e38), splat(-3.0e38)
+    lx, ly, lz, hx, hy, hz = big, big, big, small, small, small
+    some = False
+    for kb in range(k0, k1):
+        b = order[kb]
+        if gates[b, 3] < 0.0:
+            continue
+        some = True
+        gx, gy, gz = _slot3(G, b)
+        rb = fma(grow, splat(brate[b]), splat(gates[b, 3]) + eps)
+        lx, ly, lz = vmin(lx, gx - rb), vmin(ly, gy - rb), vmin(lz, gz - rb)
+        hx, hy, hz = vmax(hx, gx + rb), vmax(hy, gy + rb), vmax(hz, gz + rb)
+    rel, pad = splat(2.0**-21), splat(1e-7)
+    return (
+        lx - fma(vabs(lx), rel, pad),
+        ly - fma(vabs(ly), rel, pad),
+        lz - fma(vabs(lz), rel, pad),
+        hx + fma(vabs(hx), rel, pad),
+        hy + fma(vabs(hy), rel, pad),
+        hz + fma(vabs(hz), rel, pad),
+        some,
+    )
+
+
+@kernel
+def _box_meets(O, o, B, live):
+    """Some live lane's box B (lo x, y, z, hi x, y, z) meets obstacle o's world box
+    (``O[o, 16:19]`` about its centre, padded beyond rounding)."""
+    lx, ly, lz, hx, hy, hz = B[0], B[1], B[2], B[3], B[4], B[5]
+    cx, cy, cz = splat(O[o, 0]), splat(O[o, 1]), splat(O[o, 2])
+    wx, wy, wz = splat(O[o, 16]), splat(O[o, 17]), splat(O[o, 18])
+    m = (lx - cx <= wx) & (cx - hx <= wx) & (ly - cy <= wy) & (cy - hy <= wy)
+    m = m & (lz - cz <= wz) & (cz - hz <= wz)
+    return (mask_bits(m) & live) != 0
+
+
+@njit(cache=True, nogil=True, inline="always", _nrt=False)
 def _scene_pass(m, Z, mode, hu):
-    """Every moving capsule against every obstacle, behind its body's and its cluster's
-    gates: the lane masks ``hu`` (see :func:`_grade_d2`) updated, and whether the mode's
-    stop came."""
+    """Every moving capsule against every obstacle, behind three gates: a box around a
+    group of ``GROUP`` consecutive bodies of ``body_order`` (built per call from the
+    kinematics), its bodies' gates, and their clusters' gates. The lane masks ``hu``
+    (see :func:`_grade_d2`) updated, and whether the mode's stop came."""
     O, kinds, caps, cls, gates = m.obs32, m.obs_kind, m.caps32, m.cls32, m.gates32
     F, G, K, X = Z.F, Z.G, Z.K, Z.X
     tables = (cls, caps, m.cl_caps, m.cl_body, m.cap_sphere, Z.placed)
     grow = load(Z.grow, 0)
     eps = splat(m.eps32_m)
-    for kb in range(m.body_order.shape[0]):
-        b = m.body_order[kb]
-        if gates[b, 3] < 0.0:
+    nb = m.body_order.shape[0]
+    for k0 in range(0, nb, GROUP):
+        k1 = min(k0 + GROUP, nb)
+        B = _group_box(gates, G, Z.brate, m.body_order, k0, k1, grow, eps)
+        if not B[6]:
             continue
-        gx, gy, gz = _slot3(G, b)
-        rb = fma(grow, splat(Z.brate[b]), splat(gates[b, 3]) + eps)
         for o in range(kinds.shape[0]):
+            if not _box_meets(O, o, B, _ALL & ~hu[0]):
+                continue
             kind = kinds[o]
-            if not _in_box(O, o, gx, gy, gz, rb, _ALL & ~hu[0]):
-                continue
-            if not _near(_point_d2(kind, O, o, gx, gy, gz), rb, _ALL & ~hu[0]):
-                continue
-            for c in range(m.body_cls[b], m.body_cls[b + 1]):
-                if cls[c, 3] < 0.0:
+            for kb in range(k0, k1):
+                b = m.body_order[kb]
+                if gates[b, 3] < 0.0:
                     continue
-                _place_cluster(F, X, K, c, tables, 1)
-                kx, ky, kz = _slot3(K, c)
-                rc = fma(grow, splat(Z.crate[c]), splat(cls[c, 3]) + eps)
-                if not _near(_point_d2(kind, O, o, kx, ky, kz), rc, _ALL & ~hu[0]):
+                gx, gy, gz = _slot3(G, b)
+                rb = fma(grow, splat(Z.brate[b]), splat(gates[b, 3]) + eps)
+                if not _in_box(O, o, gx, gy, gz, rb, _ALL & ~hu[0]):
                     continue
-                _place_cluster(F, X, K, c, tables, 2)
-                for l in range(m.cl_caps[c], m.cl_caps[c + 1]):
-                    if not m.cap_moving[l]:
+                if not _near(_point_d2(kind, O, o, gx, gy, gz), rb, _ALL & ~hu[0]):
+                    continue
+                for c in range(m.body_cls[b], m.body_cls[b + 1]):
+                    if cls[c, 3] < 0.0:
                         continue
-                    r0 = splat(caps[l, 6])
-                    r = fma(grow, splat(Z.rate[l]), r0)
-                    if m.cap_sphere[l]:
-                        o6 = 6 * l * W
-                        d2 = _point_d2(
-                            kind, O, o, load(X, o6), load(X, o6 + W), load(X, o6 + 2 * W)
-                        )
-                        hu = _grade_d2(d2, r0, r, eps, hu)
-                    else:
-                        lo, hi_d = _segment_obstacle(kind, O, o, _ends(X, l))
-                        hu = _grade_bounds(lo, hi_d, r0, r, eps, hu)
+                    _place_cluster(F, X, K, c, tables, 1)
+                    kx, ky, kz = _slot3(K, c)
+                    rc = fma(grow, splat(Z.crate[c]), splat(cls[c, 3]) + eps)
+                    if not _near(_point_d2(kind, O, o, kx, ky, kz), rc, _ALL & ~hu[0]):
+                        continue
+                    _place_cluster(F, X, K, c, tables, 2)
+                    for l in range(m.cl_caps[c], m.cl_caps[c + 1]):
+                        if not m.cap_moving[l]:
+                            continue
+                        r0 = splat(caps[l, 6])
+                        r = fma(grow, splat(Z.rate[l]), r0)
+                        if m.cap_sphere[l]:
+                            o6 = 6 * l * W
+                            d2 = _point_d2(
+                                kind, O, o, load(X, o6), load(X, o6 + W), load(X, o6 + 2 * W)
+                            )
+                            hu = _grade_d2(d2, r0, r, eps, hu)
+                        else:
+                            lo, hi_d = _segment_obstacle(kind, O, o, _ends(X, l))
+                            hu = _grade_bounds(lo, hi_d, r0, r, eps, hu)
             if _stop(hu[0], mode):
                 return hu, True
     return hu, False
@@ -570,7 +630,7 @@ def _pairs_in(T, q0, q1, eps, grow, plain, hm):
     return mh, mg, m0
 
 
-@kernel
+@njit(cache=True, nogil=True, inline="always", _nrt=False)
 def _self_pass(m, Z, mode, hu):
     """Every checked link pair, behind its body pair's and cluster pair's gates: the lane
     masks ``hu`` updated, and whether the mode's stop came."""

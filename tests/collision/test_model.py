@@ -12,11 +12,24 @@ from dataclasses import dataclass
 import numpy as np
 import pytest
 from conftest import PROBLEMS
+from numba import njit
 
 from plannerlab.collision.core import Core
+from plannerlab.collision.exact import frames64
 from plannerlab.collision.fcl_checker import CollisionChecker, problem_checker
+from plannerlab.collision.kinematics import place
 from plannerlab.collision.model import ModelError
-from plannerlab.collision.state_test import exact_batch
+from plannerlab.collision.queries import open_packed
+from plannerlab.collision.simd import lane, splat
+from plannerlab.collision.state_test import (
+    GROUP,
+    W,
+    _group_box,
+    exact_batch,
+    frames32,
+    load_state,
+    set_plain,
+)
 from plannerlab.problem.catalog import load_problem
 from plannerlab.problem.load import parse_problem
 from plannerlab.problem.scene import Scene
@@ -409,3 +422,61 @@ def test_the_prefilter_culls_no_real_hit_near_tilted_obstacles():
     both = np.vstack([inside, outside])
     assert np.array_equal(_model_valid(m, both), _exact_valid(m, both))
     assert [m.is_valid(q) for q in both] == _exact_valid(m, both).tolist()
+
+
+@njit(cache=True)
+def _group_boxes_and_gates(P, Q):
+    """Per state (lanes of eight) and group of the scene pass's broadphase: its box in
+    float32 (lo, hi), and every body's gate centre in float64 (the exact kinematics)."""
+    m, Z = open_packed(P)
+    set_plain(Z)
+    nb = m.body_order.shape[0]
+    ng = (nb + GROUP - 1) // GROUP
+    boxes = np.zeros((Q.shape[0], ng, 6))
+    gates64 = np.zeros((Q.shape[0], nb, 3))
+    eps = splat(m.eps32_m)
+    for s0 in range(0, Q.shape[0], W):
+        for j in range(W):
+            load_state(Z, j, Q[s0 + j], m.continuous)
+        frames32(m, Z)
+        for g in range(ng):
+            k0, k1 = g * GROUP, min(g * GROUP + GROUP, nb)
+            B = _group_box(m.gates32, Z.G, Z.brate, m.body_order, k0, k1, splat(0.0), eps)
+            for j in range(W):
+                boxes[s0 + j, g, 0], boxes[s0 + j, g, 3] = lane(B[0], j), lane(B[3], j)
+                boxes[s0 + j, g, 1], boxes[s0 + j, g, 4] = lane(B[1], j), lane(B[4], j)
+                boxes[s0 + j, g, 2], boxes[s0 + j, g, 5] = lane(B[2], j), lane(B[5], j)
+        for j in range(W):
+            frames64(m, Z, Q[s0 + j])
+            for b in range(nb):
+                x, y, z = place(Z.e_F, b, m.gate_c, b, 0)
+                gates64[s0 + j, b, 0], gates64[s0 + j, b, 1], gates64[s0 + j, b, 2] = x, y, z
+    return boxes, gates64
+
+
+@pytest.mark.parametrize("kind", ["armz", "urdf"])
+def test_each_group_box_holds_its_bodies_gates_in_float64(kind):
+    """The scene pass's broadphase box around ``GROUP`` consecutive bodies (float32, built
+    per call) holds every one of its bodies' gate balls as float64 places them (so a
+    group clear of an obstacle's world box leaves no hit behind), and is no looser than
+    the balls' box by more than the float32 bound and its pad."""
+    problem = _problem(kind)
+    checker = problem_checker(problem)
+    m = checker.model
+    robot = problem.robot
+    Q = np.random.default_rng(41).uniform(robot.lower, robot.upper, (800, robot.dof))
+    boxes, gates64 = _group_boxes_and_gates(checker.packed_model, Q)
+    nb = len(m.body_order)
+    tested = 0
+    for g in range(boxes.shape[1]):
+        bodies = [b for b in m.body_order[g * GROUP : (g + 1) * GROUP] if m.gate_r_scene[b] >= 0]
+        if not bodies:
+            continue
+        r = m.gate_r_scene[bodies][None, :, None]
+        lo = (gates64[:, bodies] - r).min(axis=1)
+        hi = (gates64[:, bodies] + r).max(axis=1)
+        assert np.all(boxes[:, g, :3] <= lo) and np.all(boxes[:, g, 3:] >= hi)
+        slack = 2.0 * m.eps32_m + 1e-5 * max(1.0, float(np.abs(hi).max()))
+        assert np.all(lo - boxes[:, g, :3] <= slack) and np.all(boxes[:, g, 3:] - hi <= slack)
+        tested += len(bodies)
+    assert tested == int(np.sum(m.gate_r_scene >= 0)) and tested <= nb
