@@ -211,7 +211,10 @@ def test_leaving_a_two_opening_room_succeeds_on_a_check_budget(two_openings):
     """Seed 0, 1 000 000 checks (no clock): from B's witness in the two-opening room the
     body slides back out along its own curve until its tip sees the approach point by its
     own opening, the leader from there gets it into the goal region, and the path is valid
-    at a quarter of joint_step."""
+    at a quarter of joint_step. (Main's code at 6653204 solves it too, its slide ending
+    at 9.07 m where the tip sees the approach point by any opening: at the leader's
+    0.81 m clearance no point of this body inside the room sees it through the hole, so
+    the room shows the leader's other way out, not v49's early end of the slide.)"""
     problem, q_b = two_openings
     leave = problem.legs - 1
     budget = Budget(max_iterations=None, max_collision_checks=1_000_000, time_limit_s=None)
