@@ -116,6 +116,33 @@ def sees(
     return bool(scene_distance_m(scene, line).min() >= clearance_m)
 
 
+def sees_through(
+    scene: Scene,
+    p_m: Array,
+    via_m: Array,
+    target_m: Array,
+    clearance_m: float,
+    step_m: float = 0.1,
+) -> bool:
+    """Whether ``p_m`` sees ``target_m`` by the opening ``via_m`` lies in (a point that
+    sees ``target_m``): every straight line from ``p_m`` to a point of the segment
+    ``via_m`` – ``target_m`` (a fan, one line every ``step_m`` along it) keeps
+    ``clearance_m`` [m] from the scene. The fan sweeps the triangle between the line of
+    sight and the way by ``via_m``: free, the two are one way out; a room with a second
+    opening the line of sight takes (a window in the ceiling while the body fills the
+    near one) puts a wall inside the triangle. In a room with one (convex) opening and
+    ``via_m`` at it, it is :func:`sees`."""
+    p, v, t = (np.asarray(x, dtype=float) for x in (p_m, via_m, target_m))
+    if not sees(scene, p, t, clearance_m, step_m):
+        return False
+    n = max(2, int(np.ceil(np.linalg.norm(t - v) / step_m)) + 1)
+    ends = v + np.linspace(0.0, 1.0, n)[:, None] * (t - v)
+    m = max(2, int(np.ceil(np.max(np.linalg.norm(ends - p, axis=1)) / step_m)) + 1)
+    u = np.linspace(0.0, 1.0, m)[None, :, None]
+    lines = p + u * (ends[:, None, :] - p)
+    return bool(scene_distance_m(scene, lines.reshape(-1, 3)).min() >= clearance_m)
+
+
 @dataclass(frozen=True)
 class Slide:
     """How a slide ended.
@@ -256,12 +283,15 @@ def slide_out(
     max_step_rad: float,
     link_m: float,
     stop: Callable[[int], str | None] | None = None,
+    through_m: Array | None = None,
 ) -> Slide:
     """Slide the body of ``q0`` back out along its own curve until its tip sees
     ``target_m`` with ``clearance_m`` (see the module docstring). ``used``: iterations
     the leg has used already (the leg's budget, ``ctx.tracker``, bounds the slide);
     ``link_m``: the robot's typical link length (the tolerances are fractions of it);
-    ``stop(iterations)``: a reason to stop now, or None (default: the leg's budget)."""
+    ``stop(iterations)``: a reason to stop now, or None (default: the leg's budget);
+    ``through_m``: the slide ends only when the tip sees the target by the opening this
+    point lies in (:func:`sees_through`; None: by any)."""
     robot, tracker, scene = ctx.robot, ctx.tracker, ctx.scene
     q = wrap_to_pi(np.array(q0, dtype=float), robot.continuous)
     states = [q.copy()]
@@ -304,7 +334,11 @@ def slide_out(
         f, _, Jf, Js = _jacobians(robot, q)
         # the line of sight costs a tenth of a step: looked at every SIGHT_EVERY steps
         if (it % SIGHT_EVERY == 0 or sigma >= total) and sigma > 0.0:
-            if sees(scene, f[-1], target_m, clearance_m):
+            if (
+                sees(scene, f[-1], target_m, clearance_m)
+                if through_m is None
+                else sees_through(scene, f[-1], through_m, target_m, clearance_m)
+            ):
                 return Slide(
                     Status.SOLVED,
                     f"slid {sigma:.2f} m back along the body to face {pivot} in {it} steps",

@@ -199,6 +199,21 @@ def tip_path(
     return TipPath(points, arc, float(dist[free][chain].min()), n_free)
 
 
+def joined(first: TipPath, second: TipPath) -> TipPath:
+    """The leader's path ``first`` (ending at a waypoint) then ``second`` (from it): the
+    waypoint stays a corner (no shortcut across it; that is what it is for)."""
+    points = np.vstack([first.points_m, second.points_m[1:]])
+    seg = np.linalg.norm(np.diff(points, axis=0), axis=1)
+    points = points[np.concatenate([[True], seg > 1e-9])]
+    arc = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(points, axis=0), axis=1))])
+    return TipPath(
+        points,
+        arc,
+        min(first.min_distance_m, second.min_distance_m),
+        max(first.free_voxels, second.free_voxels),
+    )
+
+
 def _shortcut(points: Array, scene: Scene, clearance_m: float, step_m: float) -> Array:
     """The path with every point skipped whose neighbours see each other with the same
     clearance (greedy, from the start; the first and last two points kept)."""

@@ -93,6 +93,25 @@ def leaves_from_inside(fl: FollowLeader, ctx: PlanningContext, q: Array, leader:
     return deep_inside(ctx.scene, faces, target, fl.leader_clearance_m(ctx), reach / 3.0)
 
 
+def body_opening(fl: FollowLeader, ctx: PlanningContext, q: Array) -> Array | None:
+    """Where the body of ``q`` leaves the room, for leaving from inside: its pivot face
+    (:func:`~plannerlab.planners.clearance.slide.pivot_face`: the last face of the first
+    run from the base that sees the leg goal's approach point with the leader's
+    clearance) [m], (3,); None when no face or the tip sees it. The leader's grid knows
+    the scene, not the body: in a room with a second opening its shortest way out for
+    the tip may take the other one, while the body fills this one; routed by this point
+    (tip, pivot, approach point; backwards approach, pivot, tip) both trees keep to the
+    body's way out, and the retract ends when the tip sees the approach point by it
+    (:func:`~plannerlab.planners.clearance.slide.sees_through`)."""
+    from plannerlab.planners.clearance.slide import pivot_face
+
+    s, goal = fl.settings, ctx.goal
+    faces = np.asarray(ctx.robot.fk(q))[:, :3, 3]
+    target = goal.p_world_m - s.approach_m * goal.n_world
+    k = pivot_face(ctx.scene, faces, target, fl.leader_clearance_m(ctx))
+    return None if k < 0 else faces[k].copy()
+
+
 def track(
     fl: FollowLeader,
     ctx: PlanningContext,
@@ -101,6 +120,7 @@ def track(
     rng: np.random.Generator | None,
     used: int = 0,
     leader: TipPath | None = None,
+    via_m: Array | None = None,
 ) -> Track:
     """Follow-the-leader from ``q0`` into ``goal`` (any tip goal region): the leader's
     path from ``q0``'s tip (randomised with ``rng``, None: the deterministic grid), the
@@ -108,14 +128,15 @@ def track(
     point). The body states it passed through come back whatever the outcome: the
     reusable part of follow-the-leader (guide states of a sampling planner, the
     backward branches). ``used``: iterations the leg has used already; ``leader``:
-    the leader's path when the caller has it already."""
+    the leader's path when the caller has it already; ``via_m``: a waypoint of the
+    leader's path (:meth:`FollowLeader.leader_path`)."""
     tracker = ctx.tracker
 
     def stop() -> bool:
         return tracker.exhausted(used) is not None
 
     if leader is None:
-        leader = fl.leader_path(ctx.problem, ctx.leg, q0, rng, stop, goal=goal)
+        leader = fl.leader_path(ctx.problem, ctx.leg, q0, rng, stop, goal=goal, via_m=via_m)
     states = [np.array(q0, dtype=float)]
     if leader is None:
         why = tracker.exhausted(used) or "no path for the tip through free workspace"
@@ -130,7 +151,13 @@ def track(
     return Track(leader, st2, f"{reason}; {reason2}", states, it + it2)
 
 
-def retract(fl: FollowLeader, ctx: PlanningContext, q0: Array, used: int = 0) -> Track:
+def retract(
+    fl: FollowLeader,
+    ctx: PlanningContext,
+    q0: Array,
+    used: int = 0,
+    through_m: Array | None = None,
+) -> Track:
     """Leaving from deep inside: the body drawn back along its own curve until the tip
     sees the leg goal's approach point. What got the body in gets it out: the body lies
     on the curve its tip came in by; the leader's path forwards would lead the tip back
@@ -146,16 +173,21 @@ def retract(fl: FollowLeader, ctx: PlanningContext, q0: Array, used: int = 0) ->
     approach point (``fl.sees_approach``); a sub-goal the descent stalls before is passed
     over, two in a row end it. (The tip alone leaves the body to the descent, which
     coils it inside the room: the window must then take two passes of the body,
-    ``results/leave.md``.)"""
-    sl = _slide(fl, ctx, q0, used)
+    ``results/leave.md``.)
+
+    ``through_m`` (:func:`body_opening`): both end only when the tip sees the approach
+    point by the opening that point lies in (None: by any)."""
+    sl = _slide(fl, ctx, q0, used, through_m)
     if sl.status in (Status.SOLVED, Status.BUDGET_EXHAUSTED):
         return Track(None, sl.status, sl.reason, sl.states, sl.iterations)
-    tr = _retract_tip(fl, ctx, q0, used + sl.iterations)
+    tr = _retract_tip(fl, ctx, q0, used + sl.iterations, through_m)
     reason = f"{tr.reason} ({sl.reason})" if sl.iterations else tr.reason
     return Track(None, tr.status, reason, tr.states, tr.iterations + sl.iterations)
 
 
-def _slide(fl: FollowLeader, ctx: PlanningContext, q0: Array, used: int):
+def _slide(
+    fl: FollowLeader, ctx: PlanningContext, q0: Array, used: int, through_m: Array | None = None
+):
     """The slide of :func:`retract`, towards the leg goal's approach point with the
     leader's clearance, at the tracking descent's step and clearance floor."""
     from plannerlab.planners.clearance.settings import robot_size
@@ -173,10 +205,17 @@ def _slide(fl: FollowLeader, ctx: PlanningContext, q0: Array, used: int):
         clearance_floor_m=d.clearance_floor_m,
         max_step_rad=d.max_step_rad if d.max_step_rad > 0 else ctx.problem.joint_step / 2,
         link_m=robot_size(robot).pitch_m,
+        through_m=through_m,
     )
 
 
-def _retract_tip(fl: FollowLeader, ctx: PlanningContext, q0: Array, used: int = 0) -> Track:
+def _retract_tip(
+    fl: FollowLeader,
+    ctx: PlanningContext,
+    q0: Array,
+    used: int = 0,
+    through_m: Array | None = None,
+) -> Track:
     """The tip alone drawn back along the start's body, face by face (see :func:`retract`)."""
     s = fl.settings
     F = ctx.robot.fk(q0)
@@ -198,7 +237,7 @@ def _retract_tip(fl: FollowLeader, ctx: PlanningContext, q0: Array, used: int = 
         if st is Status.SOLVED:
             reached, stalls = reached + 1, 0
             status, reason = Status.SOLVED, f"retracted to face {k}"
-            if fl.sees_approach(ctx, states[-1]):
+            if fl.sees_approach(ctx, states[-1], through_m):
                 break
             continue
         stalls += 1

@@ -77,10 +77,10 @@ from plannerlab.planners.base import (
 from plannerlab.planners.clearance import SetupStopped
 from plannerlab.planners.clearance.descent import ClearanceDescent, ClearanceSettings, LegPath
 from plannerlab.planners.clearance.settings import DERIVED, resolve_distances
-from plannerlab.planners.clearance.slide import sees
+from plannerlab.planners.clearance.slide import sees, sees_through
 from plannerlab.planners.context import LegPlanner, PlanningContext
 from plannerlab.planners.follow_leader import moves as leader_moves
-from plannerlab.planners.follow_leader.grid import TipPath, tip_path
+from plannerlab.planners.follow_leader.grid import TipPath, joined, tip_path
 from plannerlab.planners.follow_leader.moves import Track
 from plannerlab.problem.goals import GoalRegion
 from plannerlab.robots.base import Array, joint_difference
@@ -251,12 +251,17 @@ class FollowLeader(LegPlanner):
         rng: np.random.Generator | None,
         stop: Callable[[], bool] | None = None,
         goal: GoalRegion | None = None,
+        via_m: Array | None = None,
     ) -> TipPath | None:
         """The leader's path from the tip of ``q`` into leg's goal, or into ``goal`` when
-        given (randomised with rng; None when there is none, or ``stop()`` said so)."""
+        given (randomised with rng; None when there is none, or ``stop()`` said so).
+        ``via_m``: a waypoint the path must pass (the body's own opening when leaving
+        from inside, :func:`~plannerlab.planners.follow_leader.moves.body_opening`): the
+        path from the tip to it, then from it into the goal (two searches, one grid shift
+        and centring weight)."""
         resolved = self.for_robot(problem.robot)
         if resolved is not self:
-            return resolved.leader_path(problem, leg, q, rng, stop, goal)
+            return resolved.leader_path(problem, leg, q, rng, stop, goal, via_m)
         s = self.settings
         robot = problem.robot
         goal = problem.goal(leg) if goal is None else goal
@@ -272,15 +277,59 @@ class FollowLeader(LegPlanner):
         if rng is not None:
             offset = rng.uniform(0.0, voxel, size=3)
             weight = s.centre_weight * float(rng.uniform(0.5, 1.5))
+        if via_m is not None:
+            via = np.asarray(via_m, dtype=float)
+            legs = ((p_tip, via, np.zeros(3), 0.0), (via, goal.p_world_m, goal.n_world, None))
+            parts = []
+            for a, b, n, appr in legs:
+                part = self._tip_path(
+                    problem, a, b, n, appr, base, reach, voxel, offset, weight, stop
+                )
+                if part is None:
+                    return None
+                parts.append(part)
+            return joined(parts[0], parts[1])
+        return self._tip_path(
+            problem,
+            p_tip,
+            goal.p_world_m,
+            goal.n_world,
+            None,
+            base,
+            reach,
+            voxel,
+            offset,
+            weight,
+            stop,
+        )
+
+    def _tip_path(
+        self,
+        problem,
+        p_from: Array,
+        p_goal: Array,
+        n_goal: Array,
+        approach_m: float | None,
+        base: Array,
+        reach: float,
+        voxel: float,
+        offset: Array | None,
+        weight: float,
+        stop: Callable[[], bool] | None,
+    ) -> TipPath | None:
+        """One :func:`tip_path` of :meth:`leader_path` (``approach_m`` None: the setting's),
+        its pad doubled up to the reach while none is found."""
+        s = self.settings
+        r_tip = float(np.asarray(problem.robot.link_radii_m)[-1])
         pad = s.pad_m
         while True:
             leader = tip_path(
                 problem.scene,
-                p_tip,
-                goal.p_world_m,
-                goal.n_world,
+                p_from,
+                p_goal,
+                n_goal,
                 clearance_m=r_tip + problem.safety_margin_m + s.extra_clearance_m,
-                approach_m=s.approach_m,
+                approach_m=s.approach_m if approach_m is None else approach_m,
                 voxel_m=voxel,
                 centre_m=s.centre_m,
                 centre_weight=weight,
@@ -373,11 +422,12 @@ class FollowLeader(LegPlanner):
         rng: np.random.Generator | None,
         used: int = 0,
         leader: TipPath | None = None,
+        via_m: Array | None = None,
     ) -> Track:
         """:func:`plannerlab.planners.follow_leader.moves.track` with this planner (its derived
         distances set for the leg's robot)."""
         fl = self.for_robot(ctx.robot)
-        return leader_moves.track(fl, ctx, q0, goal, rng, used, leader)
+        return leader_moves.track(fl, ctx, q0, goal, rng, used, leader, via_m)
 
     def detour_from(
         self, ctx: PlanningContext, q: Array, rng: np.random.Generator, used: int = 0
@@ -397,14 +447,17 @@ class FollowLeader(LegPlanner):
         r = fl._detour.plan(ctx.sub(sub, np.array(q)), rng)
         return Track(None, r.status, r.reason, list(r.path), r.iterations)
 
-    def sees_approach(self, ctx: PlanningContext, q: Array) -> bool:
+    def sees_approach(self, ctx: PlanningContext, q: Array, through_m: Array | None = None) -> bool:
         """Whether the straight line from the tip of ``q`` to the leg goal's approach
         point keeps the leader's clearance from the scene (the retract has got the tip
-        out)."""
+        out); with ``through_m``, by the opening that point lies in
+        (:func:`~plannerlab.planners.clearance.slide.sees_through`)."""
         s = self.for_robot(ctx.robot).settings
         goal, robot = ctx.goal, ctx.robot
         p_tip, _ = robot.tip(q)
         approach = goal.p_world_m - s.approach_m * goal.n_world
+        if through_m is not None:
+            return sees_through(ctx.scene, p_tip, through_m, approach, self.leader_clearance_m(ctx))
         return sees(ctx.scene, p_tip, approach, self.leader_clearance_m(ctx))
 
     def leader_clearance_m(self, ctx: PlanningContext) -> float:
@@ -417,10 +470,12 @@ class FollowLeader(LegPlanner):
             + s.extra_clearance_m
         )
 
-    def retract(self, ctx: PlanningContext, q0: Array, used: int = 0) -> Track:
+    def retract(
+        self, ctx: PlanningContext, q0: Array, used: int = 0, through_m: Array | None = None
+    ) -> Track:
         """:func:`plannerlab.planners.follow_leader.moves.retract` with this planner (its derived
         distances set for the leg's robot)."""
-        return leader_moves.retract(self.for_robot(ctx.robot), ctx, q0, used)
+        return leader_moves.retract(self.for_robot(ctx.robot), ctx, q0, used, through_m)
 
     def plan(self, ctx: PlanningContext, rng: np.random.Generator) -> PlanResult:
         """Plan the leader's path, follow it, finish with the leg's descent."""

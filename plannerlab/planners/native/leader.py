@@ -51,7 +51,7 @@ from plannerlab.errors import PlannerlabError
 from plannerlab.planners.base import PlanResult, Status, with_overrides
 from plannerlab.planners.clearance.descent import ClearanceSettings
 from plannerlab.planners.context import PlanningContext
-from plannerlab.planners.follow_leader.moves import Track, leaves_from_inside
+from plannerlab.planners.follow_leader.moves import Track, body_opening, leaves_from_inside
 from plannerlab.planners.follow_leader.planner import FollowLeader, FollowLeaderSettings
 from plannerlab.planners.native import kernels as K
 from plannerlab.planners.native.planner import NativePlanner, _check_settings
@@ -237,10 +237,25 @@ def build_guidance(
         if s.detour and not reached and tracker.exhausted(used) is None:
             grow_start(node, leader.detour_from(ctx, A.Q[node], rng, used), key)
 
+    # leaving from inside: where the start's body leaves the room (its pivot face); the
+    # leader's paths are routed by it and the retract ends when the tip sees the approach
+    # point by it (a room with more than one opening: the body's own way out)
+    opening: Array | None = None
+
+    def via(q: Array) -> Array | None:
+        """The opening as the leader's waypoint from ``q``, unless its tip sees the
+        approach point by it already."""
+        if opening is None or leader.sees_approach(ctx, q, opening):
+            return None
+        return opening
+
     def retract_branch() -> None:
-        end = grow_start(0, leader.retract(ctx, q0, used), "retract")
+        end = grow_start(0, leader.retract(ctx, q0, used, opening), "retract")
         if tracker.exhausted(used) is None:
-            end = grow_start(end, leader.track(ctx, A.Q[end], goal, rng, used), "after_retract")
+            q = A.Q[end]
+            end = grow_start(
+                end, leader.track(ctx, q, goal, rng, used, via_m=via(q)), "after_retract"
+            )
             detour(end, "detour_after_retract")
 
     if s.forward:
@@ -250,9 +265,16 @@ def build_guidance(
         if s.retract and leaves_from_inside(leader, ctx, q0, lead):
             # the leader's path runs back through the body: the retract branch first
             log["retract_first"] = True
+            opening = body_opening(leader, ctx, q0)
+            if opening is not None:
+                log["opening_m"] = [round(float(x), 3) for x in opening]
             retract_branch()
         if not reached and tracker.exhausted(used) is None:
-            end = grow_start(0, leader.track(ctx, q0, goal, rng, used, leader=lead), "forward")
+            if opening is not None:
+                tr = leader.track(ctx, q0, goal, rng, used, via_m=via(q0))
+            else:
+                tr = leader.track(ctx, q0, goal, rng, used, leader=lead)
+            end = grow_start(0, tr, "forward")
             detour(end, "detour_after_forward")
         if not reached and s.retract and "retract" not in log and tracker.exhausted(used) is None:
             # leaving from deep inside: the tip drawn back along its own body, then the
@@ -282,7 +304,7 @@ def build_guidance(
         for i in roots[: s.backward_goals]:
             if tracker.exhausted(used) is not None:
                 break
-            tb = leader.track(ctx, B.Q[i], tip_goal, rng, used)
+            tb = leader.track(ctx, B.Q[i], tip_goal, rng, used, via_m=opening)
             used += tb.iterations
             chain = _verified(ctx, tb.states, step, used)
             chains.append(chain)
