@@ -1,8 +1,12 @@
 """Spheres on a robot's links, placed by the robot's chain as the previous compiled model
 packed it (numba, cached): the compiled geometry of the clearance field
 (:mod:`plannerlab.planners.clearance`) and of ``trajopt.*``, which own none of their own.
-Still on :mod:`plannerlab.collision.model_old`'s chain, not yet on
-:mod:`plannerlab.collision.kinematics` (the state test's one kinematics).
+The chain comes from a checker's compiled robot–scene model
+(:func:`model_sphere_chain`: :class:`~plannerlab.collision.model.CompiledModel`, built
+once per problem, in the same folded frames) or from the robot's chain packed alone
+(:func:`sphere_chain` on :mod:`plannerlab.collision.model_old`); the kernels run
+chain_valid's kinematics, not yet :mod:`plannerlab.collision.kinematics` (the state
+test's one kinematics).
 
 A :class:`SphereChain` is the chain (:class:`~plannerlab.collision.model_old.
 ChainModel`: its base, fixed transforms with the joints' axes folded onto z, sliding
