@@ -136,6 +136,9 @@ class CollisionChecker:
         self.robot = robot
         self.scene = scene
         self.checks = 0
+        #: what consumers build once from this checker's robot, scene and model (a
+        #: planner's packed sphere field): see :meth:`derived`
+        self._derived: dict[str, Any] = {}
         self._radii = np.asarray(robot.link_radii_m, dtype=float) + self.margin_m
         # a mesh robot's finer covers (self-collision only) carry no margin (core.py)
         half = np.full(len(robot.link_radii_m), self.margin_m / 2.0)
@@ -489,6 +492,15 @@ class CollisionChecker:
                 "the compiled model needs the core backend (boxes, cylinders, spheres)"
             )
         return self._core.model
+
+    def derived(self, key: str, build: Callable[[], Any]) -> Any:
+        """What ``build()`` gives, built on the first call with ``key`` and kept by this
+        checker (one per problem and trial: its legs share it) for every later call: a
+        consumer's packing of this checker's robot, scene and model (``trajopt``'s sphere
+        field). ``build`` reads nothing but them; a build that raises keeps nothing."""
+        if key not in self._derived:
+            self._derived[key] = build()
+        return self._derived[key]
 
     @property
     def packed_model(self) -> tuple[np.ndarray, ...]:

@@ -1,8 +1,12 @@
 """Spheres on a robot's links, placed by the robot's chain as the previous compiled model
 packed it (numba, cached): the compiled geometry of the clearance field
 (:mod:`plannerlab.planners.clearance`) and of ``trajopt.*``, which own none of their own.
-Still on :mod:`plannerlab.collision.model_old`'s chain, not yet on
-:mod:`plannerlab.collision.kinematics` (the state test's one kinematics).
+The chain comes from a checker's compiled robot–scene model
+(:func:`model_sphere_chain`: :class:`~plannerlab.collision.model.CompiledModel`, built
+once per problem, in the same folded frames) or from the robot's chain packed alone
+(:func:`sphere_chain` on :mod:`plannerlab.collision.model_old`); the kernels run
+chain_valid's kinematics, not yet :mod:`plannerlab.collision.kinematics` (the state
+test's one kinematics).
 
 A :class:`SphereChain` is the chain (:class:`~plannerlab.collision.model_old.
 ChainModel`: its base, fixed transforms with the joints' axes folded onto z, sliding
@@ -122,6 +126,57 @@ def sphere_chain(model: Any, robot: Any) -> SphereChain:
             len(cpl_start) == 0
             and not np.any(prism)
             and np.array_equal(parent, np.arange(len(parent)))
+        ),
+    )
+
+
+def model_sphere_chain(model: Any, robot: Any) -> SphereChain:
+    """The :class:`SphereChain` of ``robot`` from the checker's compiled robot–scene model
+    (:class:`~plannerlab.collision.model.CompiledModel`, built once per problem): its
+    kinematics (the same folded frames as :func:`sphere_chain`'s), its capsules back in the
+    robot's link order and the robot's tip (``tip_data()``), in whole-array operations
+    (no chain packed again).
+
+    Raises:
+        ValueError: the model's capsules are not the robot's links one to one.
+    """
+    L = len(np.asarray(robot.link_radii_m))
+    perm = np.asarray(model.perm, dtype=np.int64)
+    if len(perm) != L:
+        raise ValueError(
+            f"robot {getattr(robot, 'kind', '?')!r}: its compiled model has {len(perm)} "
+            f"capsules for {L} links; the sphere field needs one capsule per link"
+        )
+    packed = np.empty(L, dtype=np.int64)  # link l is packed capsule packed[l]
+    packed[perm] = np.arange(L)
+    m = len(model.parent)
+    cpl_val = np.asarray(model.cpl_val, dtype=float)
+    # the kinematics read the coefficients three a row (``_body_frames``): padded
+    cpl_rows = np.zeros(((len(cpl_val) + 2) // 3, 3))
+    cpl_rows.reshape(-1)[: len(cpl_val)] = cpl_val
+    parent = np.asarray(model.parent, dtype=np.int64)
+    prism = np.asarray(model.slide, dtype=np.int64)
+    cpl_start = np.asarray(model.cpl_start, dtype=np.int64)
+    tip_body, p_bt, n_bt = robot.tip_data()
+    tip_body = int(tip_body)
+    A = np.asarray(model.fold[tip_body], dtype=float)
+    f = np.ascontiguousarray
+    return SphereChain(
+        T0=f(np.asarray(model.T0, dtype=float).reshape(3, 4)),
+        parent=f(parent),
+        prism=f(prism),
+        pre=f(np.asarray(model.pre, dtype=float).reshape(m, 3, 4)),
+        cpl_start=f(cpl_start),
+        cpl_idx=f(np.asarray(model.cpl_idx, dtype=np.int64)),
+        cpl_val=f(cpl_rows),
+        link_body=f(np.asarray(model.cap_body, dtype=np.int64)[packed]),
+        link_a=f(np.asarray(model.cap_a, dtype=float)[packed]),
+        link_b=f(np.asarray(model.cap_b, dtype=float)[packed]),
+        tip_body=tip_body,
+        tip_p=f(A.T @ np.asarray(p_bt, dtype=float)),
+        tip_n=f(A.T @ np.asarray(n_bt, dtype=float)),
+        serial=bool(
+            len(cpl_start) == 0 and not np.any(prism) and np.array_equal(parent, np.arange(m))
         ),
     )
 
@@ -419,22 +474,34 @@ def pair_spheres(
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """The fixed bookkeeping of :func:`pairs`: the spheres of every pair in its order,
     a (m,) and b (m,) (−1: an obstacle); each self pair's link pair, the link pairs' links
-    (k, 2) and each link's first and last sphere (L, 2; −1 for a link without spheres)."""
-    a = np.concatenate([np.tile(scene_idx, n_obstacles), self_a]).astype(np.int64)
-    b = np.concatenate([np.full(len(scene_idx) * n_obstacles, -1), self_b]).astype(np.int64)
+    (k, 2, in order) and each link's first and last sphere (L, 2; −1 for a link without
+    spheres). Whole-array operations only (a field is built in a leg's time)."""
+    scene_idx = np.asarray(scene_idx, dtype=np.int64)
+    self_a = np.asarray(self_a, dtype=np.int64)
+    self_b = np.asarray(self_b, dtype=np.int64)
+    a = np.concatenate([np.tile(scene_idx, n_obstacles), self_a])
+    b = np.concatenate([np.full(len(scene_idx) * n_obstacles, -1, dtype=np.int64), self_b])
     link = np.asarray(link, dtype=np.int64)
     n_links = int(link.max()) + 1 if len(link) else 0
     ends = np.full((n_links, 2), -1, dtype=np.int64)
-    for li in range(n_links):
-        on = np.flatnonzero(link == li)
-        if len(on):
-            ends[li] = on[0], on[-1]
-    pairs = np.stack([link[self_a], link[self_b]], axis=1) if len(self_a) else np.zeros((0, 2))
-    lp_links, lp_of_row = np.unique(pairs.astype(np.int64), axis=0, return_inverse=True)
+    if len(link):
+        idx = np.arange(len(link), dtype=np.int64)
+        first = np.full(n_links, len(link), dtype=np.int64)
+        np.minimum.at(first, link, idx)
+        np.maximum.at(ends[:, 1], link, idx)
+        ends[:, 0] = np.where(first < len(link), first, -1)
+    if len(self_a):
+        la, lb = link[self_a], link[self_b]
+        code = la * max(n_links, 1) + lb
+        codes, lp_of_row = np.unique(code, return_inverse=True)
+        lp_links = np.stack([codes // max(n_links, 1), codes % max(n_links, 1)], axis=1)
+    else:
+        lp_of_row = np.zeros(0, dtype=np.int64)
+        lp_links = np.zeros((0, 2), dtype=np.int64)
     return (
-        a,
-        b,
-        np.asarray(lp_of_row, dtype=np.int64).reshape(-1),
+        np.ascontiguousarray(a),
+        np.ascontiguousarray(b),
+        np.ascontiguousarray(lp_of_row, dtype=np.int64).reshape(-1),
         np.ascontiguousarray(lp_links, dtype=np.int64).reshape(-1, 2),
         ends,
     )

@@ -14,6 +14,8 @@ from plannerlab.collision.spheres import (
     frames,
     kin,
     link_ends,
+    model_sphere_chain,
+    pair_spheres,
     point_gradient,
     sphere_chain,
     tip_jacobians,
@@ -41,8 +43,21 @@ def robot(request):
     return load_problem(request.param).robot
 
 
-def test_link_axes_and_tip_are_the_robots(robot):
-    ch = sphere_chain(chain_model(robot), robot)
+def _checker_model(robot):
+    """The compiled model a checker of the robot (no obstacles) builds."""
+    from plannerlab.collision.fcl_checker import CollisionChecker
+    from plannerlab.problem.scene import Scene
+
+    return CollisionChecker(robot, Scene(()), "core").model
+
+
+@pytest.mark.parametrize("source", ["chain_alone", "checker_model"])
+def test_link_axes_and_tip_are_the_robots(robot, source):
+    """On the robot's chain packed alone and on a checker's compiled model alike."""
+    if source == "chain_alone":
+        ch = sphere_chain(chain_model(robot), robot)
+    else:
+        ch = model_sphere_chain(_checker_model(robot), robot)
     for q in _states(robot, 10, 0):
         Bf = frames(q, ch)
         a, b = link_ends(Bf, ch)
@@ -57,8 +72,8 @@ def test_link_axes_and_tip_are_the_robots(robot):
 
 def test_gradients_through_the_chain_are_the_derivatives(robot):
     """n · ∂p/∂q of a point on each link (its axis' midpoint) and the tip's Jacobians
-    against central differences of the robot's own kinematics."""
-    ch = sphere_chain(chain_model(robot), robot)
+    against central differences of the robot's own kinematics, on a checker's model."""
+    ch = model_sphere_chain(_checker_model(robot), robot)
     kn = kin(ch)
     rng = np.random.default_rng(1)
     h = 1e-6
@@ -112,3 +127,29 @@ def test_a_model_of_another_chain_is_refused_by_name():
     short, long = ArmZ(n_modules=6), ArmZ(n_modules=24)
     with pytest.raises(ValueError, match=r"'armz'.*capsules for 24 links"):
         sphere_chain(chain_model(short), long)
+
+
+def test_a_checker_model_of_another_chain_is_refused_by_name():
+    """As :func:`sphere_chain`: a checker's model of a six-module Arm-Z given with a
+    24-module one is refused, naming the robot and both counts."""
+    from plannerlab.robots.armz.model import ArmZ
+
+    short, long = ArmZ(n_modules=6), ArmZ(n_modules=24)
+    with pytest.raises(ValueError, match=r"'armz'.*6 capsules for 24 links"):
+        model_sphere_chain(_checker_model(short), long)
+
+
+def test_pair_bookkeeping_is_the_pairs_own():
+    """:func:`pair_spheres` on a small field, against the bookkeeping written out: scene
+    pairs obstacle by obstacle, then the self pairs; each self pair's link pair; the
+    links' first and last spheres (a link without spheres: −1)."""
+    link = np.array([0, 0, 1, 1, 1, 3])  # link 2 holds no sphere
+    scene_idx = np.array([2, 3, 4, 5])
+    self_a = np.array([0, 0, 1, 2, 4])
+    self_b = np.array([5, 2, 3, 5, 5])
+    a, b, lp_of_row, lp_links, ends = pair_spheres(scene_idx, 2, self_a, self_b, link)
+    np.testing.assert_array_equal(a, [2, 3, 4, 5, 2, 3, 4, 5, 0, 0, 1, 2, 4])
+    np.testing.assert_array_equal(b, [-1] * 8 + [5, 2, 3, 5, 5])
+    np.testing.assert_array_equal(lp_links, [[0, 1], [0, 3], [1, 3]])
+    np.testing.assert_array_equal(lp_of_row, [1, 0, 0, 2, 2])
+    np.testing.assert_array_equal(ends, [[0, 1], [2, 4], [-1, -1], [5, 5]])

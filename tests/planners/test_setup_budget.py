@@ -145,6 +145,34 @@ def test_the_clearance_field_of_a_thin_chain_is_capped_and_arm_zs_is_not(chain, 
     assert np.array_equal(np.bincount(field._link), [3] + [4] * 23)
 
 
+@pytest.mark.parametrize(
+    "name", ["problems/urdf/panda/bookshelf_small_0001.toml", "irb6_case1", "armz_pocket"]
+)
+def test_the_fields_spheres_and_pairs_are_the_rule_written_out(name):
+    """The field's spheres (evenly spaced on each link, both ends included) and its self
+    pairs (built in whole arrays) against the rule written out link by link: every pair
+    a < b of spheres on two different links that are checked against each other (not
+    both fixed, not an excluded pair), in order of a, then b."""
+    problem = load_problem(name)
+    robot = problem.robot
+    field = ClearanceField(robot, problem.scene, 0.1)
+    counts = np.bincount(field._link, minlength=len(robot.link_radii_m))
+    for i, k in enumerate(counts):
+        np.testing.assert_allclose(field._t[field._link == i], np.linspace(0.0, 1.0, k))
+    fixed = set(robot.fixed_links)
+    excluded = {frozenset(p) for p in robot.excluded_pairs}
+    want = [
+        (a, b)
+        for a in range(len(field._link))
+        for b in range(a + 1, len(field._link))
+        if field._link[a] != field._link[b]
+        and not (field._link[a] in fixed and field._link[b] in fixed)
+        and frozenset((int(field._link[a]), int(field._link[b]))) not in excluded
+    ]
+    assert len(want) > 0
+    assert list(zip(field._self_a.tolist(), field._self_b.tolist(), strict=True)) == want
+
+
 def test_a_field_whose_time_is_up_stops_and_the_planner_says_why(chain):
     with pytest.raises(SetupStopped, match="time is up"):
         ClearanceField(chain.robot, chain.scene, 0.01, stop=lambda: True)

@@ -20,7 +20,7 @@ from plannerlab.errors import PlannerlabError
 from plannerlab.planners import make_planner
 from plannerlab.planners.base import Status
 from plannerlab.planners.context import PlanningContext
-from plannerlab.planners.trajopt.geometry import PathGeometry
+from plannerlab.planners.trajopt.geometry import PathGeometry, problem_geometry
 from plannerlab.planners.trajopt.path import PathProblem
 from plannerlab.planners.trajopt.planner import _Solve, _split
 from plannerlab.planners.trajopt.solvers import PenaltySettings, Work, optimise
@@ -139,7 +139,7 @@ def test_hinge_gradient_and_tip_match_the_robot() -> None:
     normal, Jacobians) against the robot's own."""
     problem = thin_plate_problem()
     robot = problem.robot
-    geometry = PathGeometry(robot, problem.scene)
+    geometry = PathGeometry(robot, problem.scene, problem_checker(problem).model)
     X = _through_the_plate(problem, 7)
     c, g, H, dmin = geometry.hinge(X, 0.1, True)
     assert np.count_nonzero(c) >= 3 and dmin.min() < 0.0
@@ -159,6 +159,30 @@ def test_hinge_gradient_and_tip_match_the_robot() -> None:
     Jp_ref, Jn_ref = robot.tip_jacobian(q)
     assert np.allclose(p, p_ref, atol=1e-9) and np.allclose(n, n_ref, atol=1e-9)
     assert np.allclose(Jp, Jp_ref, atol=1e-7) and np.allclose(Jn, Jn_ref, atol=1e-7)
+
+
+def test_the_geometry_is_built_once_per_checker_on_its_model() -> None:
+    """``problem_geometry``: one field per checker (the legs of a trial share the trial's
+    checker), kept by it and built on its compiled model, where it gives the hinge of the
+    robot's chain packed alone; another checker builds its own; the planner's leg uses
+    the checker's."""
+    problem = thin_plate_problem()
+    checker = problem_checker(problem)
+    geometry = problem_geometry(checker)
+    assert problem_geometry(checker) is geometry
+    assert problem_geometry(problem_checker(problem)) is not geometry
+    X = _through_the_plate(problem, 7)
+    alone = PathGeometry(problem.robot, problem.scene)
+    on_model, on_chain = geometry.hinge(X, 0.1), alone.hinge(X, 0.1)
+    assert np.count_nonzero(on_chain[0]) >= 3
+    for a, b in zip(on_model, on_chain, strict=True):
+        np.testing.assert_allclose(a, b, rtol=1e-12, atol=1e-12)
+    other = problem_checker(problem)
+    ctx = PlanningContext.for_planner(
+        make_planner("trajopt.line"), problem, 0, problem.budget, checker=other
+    )
+    make_planner("trajopt.line").plan(ctx, np.random.default_rng(0))
+    assert "trajopt.PathGeometry" in other._derived  # built by the leg, kept
 
 
 def test_gauss_newton_matrix_of_smoothness_is_its_hessian() -> None:

@@ -173,8 +173,14 @@ class ClearanceField:
         seg = robot.link_segments(q_ref)
         lengths = np.linalg.norm(seg[:, 1] - seg[:, 0], axis=-1)
         counts = sphere_counts(lengths, radii, max_spheres)
-        self._link = np.concatenate([np.full(k, i) for i, k in enumerate(counts)])
-        self._t = np.concatenate([np.linspace(0.0, 1.0, k) for k in counts])
+        #: each link's length [m] at the reference state (the capsule's, rigid on its body)
+        self._lengths = np.asarray(lengths, dtype=float)
+        starts = np.concatenate([[0], np.cumsum(counts)]).astype(np.int64)
+        self._link = np.repeat(np.arange(L), counts)
+        # np.linspace(0, 1, k) per link, to the bit: i · (1 / (k − 1)), the last exactly 1
+        rank = np.arange(int(starts[-1])) - starts[self._link]
+        self._t = rank * (1.0 / (counts - 1).astype(float))[self._link]
+        self._t[starts[1:] - 1] = 1.0
         self._r = radii[self._link]
         fixed = np.zeros(L, dtype=bool)
         fixed[[i for i in robot.fixed_links if 0 <= i < L]] = True
@@ -191,24 +197,17 @@ class ClearanceField:
         allowed &= ~scene_only[:, None] & ~scene_only[None, :]
         for i, j in robot.excluded_pairs:
             allowed[i, j] = allowed[j, i] = False
-        ia, ib = [], []
+        self._self_a = np.zeros(0, dtype=int)
+        self._self_b = np.zeros(0, dtype=int)
         if include_self:
-            # the sphere pairs a < b in order (a first), link by link of a
-            starts = np.concatenate([[0], np.cumsum(counts)])
-            spheres = np.arange(len(self._t))
-            for i in range(L):
-                if stop is not None and stop():
-                    raise SetupStopped(
-                        f"the clearance field of {L} links stopped at link {i}: time is up"
-                    )
-                later = spheres[starts[i] :]  # spheres of link i and after
-                ok = allowed[i, self._link[later]] & (later >= starts[i + 1])
-                b = later[ok]
-                for a in range(int(starts[i]), int(starts[i + 1])):
-                    ia.append(np.full(len(b), a))
-                    ib.append(b)
-        self._self_a = np.concatenate(ia).astype(int) if ia else np.zeros(0, dtype=int)
-        self._self_b = np.concatenate(ib).astype(int) if ib else np.zeros(0, dtype=int)
+            if stop is not None and stop():
+                raise SetupStopped(f"the clearance field of {L} links stopped: time is up")
+            # the sphere pairs a < b of different, allowed links, in order (a first): one
+            # mask over the sphere pairs (at most MAX_SPHERES², 1 MB)
+            ok = allowed[self._link[:, None], self._link[None, :]]
+            ok &= self._link[:, None] < self._link[None, :]
+            a, b = np.nonzero(ok)
+            self._self_a, self._self_b = a.astype(int), b.astype(int)
         self._n_links = L
         self._analytic = getattr(robot, "kind", "") == "armz"
 

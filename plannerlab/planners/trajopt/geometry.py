@@ -42,7 +42,14 @@ from plannerlab.planners.clearance.compiled import CompiledField, SphereField
 from plannerlab.planners.clearance.field import ClearanceField
 from plannerlab.robots.base import Array
 
-__all__ = ["PathGeometry", "hinge_terms", "speed_terms", "tip_terms", "warm_up"]
+__all__ = [
+    "PathGeometry",
+    "hinge_terms",
+    "problem_geometry",
+    "speed_terms",
+    "tip_terms",
+    "warm_up",
+]
 
 
 @njit(cache=True, nogil=True)
@@ -106,10 +113,7 @@ def tip_terms(q, fld_t):
 def _single_spheres(field: ClearanceField) -> ClearanceField:
     """``field`` with the second sphere of every zero-length link left out (the pairs
     renumbered): a copy, the field itself when it has none."""
-    robot = field.robot
-    q_ref = np.clip(np.zeros(robot.dof), robot.lower, robot.upper)
-    seg = np.asarray(robot.link_segments(q_ref), dtype=float)
-    zero = np.linalg.norm(seg[:, 1] - seg[:, 0], axis=-1) <= 1e-12
+    zero = np.asarray(field._lengths) <= 1e-12
     link, t = np.asarray(field._link), np.asarray(field._t)
     keep = ~(zero[link] & (t > 0.0))
     if keep.all():
@@ -129,12 +133,15 @@ def _single_spheres(field: ClearanceField) -> ClearanceField:
 
 class PathGeometry:
     """The geometry of one robot in one scene for the optimiser: the sphere field on the
-    compiled model, packed once (see the module docstring).
+    compiled model, packed once (see the module docstring). Built in whole-array
+    operations (some 1 ms for a Panda); :func:`problem_geometry` keeps one per checker.
 
     Args:
         robot: the robot (a chain with a tip: ``chain_data()``, ``tip_data()``).
         scene: the obstacles (boxes, cylinders, spheres).
-        model: the checker's compiled robot–scene model (None: the robot's chain alone).
+        model: the checker's compiled robot–scene model (:class:`~plannerlab.collision.
+            model.CompiledModel`, whose kinematics the spheres ride on; None: the robot's
+            chain packed alone, the same numbers).
         stop: asked while the field's pairs are built (the leg's time limit).
 
     Raises:
@@ -173,6 +180,24 @@ class PathGeometry:
             np.ascontiguousarray(q, dtype=float), self._plain
         )
         return out
+
+
+def problem_geometry(checker: Any, stop: Any = None) -> PathGeometry:
+    """The :class:`PathGeometry` of a checker's robot and scene, built once per checker (on
+    its compiled model when it has one) and kept by it (``checker.derived``): every leg of
+    a trial shares the trial's checker, and so the field.
+
+    Raises:
+        as :class:`PathGeometry`.
+    """
+    try:
+        model = checker.model
+    except ValueError:  # no compiled core (an FCL-only scene): the chain packed alone
+        model = None
+    return checker.derived(  # type: ignore[no-any-return]
+        "trajopt.PathGeometry",
+        lambda: PathGeometry(checker.robot, checker.scene, model, stop),
+    )
 
 
 @njit(cache=True, nogil=True)

@@ -143,11 +143,11 @@ class _Solve:
             return self.result(Status.INVALID_START, self.ctx.start_problem, start)
         self.run.progress.note(float(self.goal.distance(self.robot, q0)))
         try:
-            from plannerlab.planners.trajopt.geometry import PathGeometry
+            from plannerlab.planners.trajopt.geometry import problem_geometry
 
-            # the sphere field rides on the robot's chain packed alone (the checker's own
-            # model is the state test's, in another layout)
-            self.geometry = PathGeometry(self.robot, self.ctx.scene, None, self.tracker.time_up)
+            # the sphere field on the checker's compiled model, built once per checker
+            # (the first leg of a trial builds it in its time; the others reuse it)
+            self.geometry = problem_geometry(self.checker, self.tracker.time_up)
         except ValueError as e:
             raise PlannerlabError(
                 f"{self.planner.name}: no compiled model of this problem: {e}"
