@@ -85,12 +85,12 @@ class Lanes(NamedTuple):
     V: np.ndarray  # (m * W,) the chain's joint values (a coupled chain)
     F: np.ndarray  # (nb * 12 * W,) body frames
     G: np.ndarray  # (nb * 3 * W,) body gate centres
-    K: np.ndarray  # (ncl * 3 * W,) cluster gate centres
+    K: np.ndarray  # ((ncl + G) * 3 * W,) cluster gate centres, then the groups'
     X: np.ndarray  # (L * 6 * W,) capsule ends a (xyz), b (xyz)
-    placed: np.ndarray  # (ncl,) int64: 0 nothing, 1 the cluster's centre, 2 its capsules
+    placed: np.ndarray  # (ncl + G,) int64: 0 nothing, 1 the centre, 2 its capsules
     grow: np.ndarray  # (W,) float32: each lane's growth
     rate: np.ndarray  # (L,) float32: each capsule's rate [m] (packed order)
-    crate: np.ndarray  # (ncl,) float32: each cluster's largest rate
+    crate: np.ndarray  # (ncl + G,) float32: each cluster's (then group's) largest rate
     brate: np.ndarray  # (nb,) float32: each body's largest rate
     Q64: np.ndarray  # (W, dof) float64: the states as given (the confirmation's)
     grow64: np.ndarray  # (W,) float64
@@ -118,7 +118,7 @@ def lanes(m):
     nj = m.parent.shape[0]
     nb = nj + 1
     L = max(m.cap_body.shape[0], 1)
-    ncl = max(m.cl_body.shape[0], 1)
+    ncl = max(m.cg_body.shape[0], 1)  # the clusters, then the groups
     n = m.obs_kind.shape[0]
     R = np.empty((n, 3, 3))
     for o in range(n):
@@ -212,6 +212,11 @@ def set_rates(m, Z, rate64):
             Z.crate[c] = max(Z.crate[c], r32)
             Z.brate[b] = max(Z.brate[b], r32)
             Z.brate64[b] = max(Z.brate64[b], r)
+    ncl = m.cl_body.shape[0]
+    for g in range(m.grp_cls.shape[0] - 1):
+        Z.crate[ncl + g] = 0.0
+        for c in range(m.grp_cls[g], m.grp_cls[g + 1]):
+            Z.crate[ncl + g] = max(Z.crate[ncl + g], Z.crate[c])
 
 
 # ------------------------------------------------------------------ geometry in the lanes
@@ -572,11 +577,11 @@ def _pairs_in(T, q0, q1, eps, grow, plain, hm):
 
 @kernel
 def _self_pass(m, Z, mode, hu):
-    """Every checked link pair, behind its body pair's and cluster pair's gates: the lane
-    masks ``hu`` updated, and whether the mode's stop came."""
-    caps, cls, gates = m.caps32, m.cls32, m.gates32
+    """Every checked link pair, behind its body pair's, group pair's and cluster pair's
+    gates: the lane masks ``hu`` updated, and whether the mode's stop came."""
+    caps, cls, gates = m.caps32, m.cg32, m.gates32  # cg32: the clusters, then the groups
     F, G, K, X = Z.F, Z.G, Z.K, Z.X
-    tables = (cls, caps, m.cl_caps, m.cl_body, m.cap_sphere, Z.placed)
+    tables = (cls, caps, m.cl_caps, m.cg_body, m.cap_sphere, Z.placed)
     grow = load(Z.grow, 0)
     plain = mask_bits(grow > splat(0.0)) == 0
     eps = splat(m.eps32_m)
@@ -589,21 +594,33 @@ def _self_pass(m, Z, mode, hu):
             if not _near(_gap2(G, 3 * u * W, G, 3 * v * W), r, _ALL & ~hu[0]):
                 continue
         hm = (none, none, none)
-        for cp in range(m.bpair_start[p], m.bpair_start[p + 1]):
-            cu, cv = m.clpairs[cp, 0], m.clpairs[cp, 1]
-            if cu != cv:
-                _place_cluster(F, X, K, cu, tables, 1)
-                _place_cluster(F, X, K, cv, tables, 1)
+        for gp in range(m.bpair_gstart[p], m.bpair_gstart[p + 1]):
+            gu, gv = m.gpairs[gp, 0], m.gpairs[gp, 1]
+            if m.gpairs[gp, 2]:  # a group's centre is placed like a cluster's (placed 1)
+                _place_cluster(F, X, K, gu, tables, 1)
+                _place_cluster(F, X, K, gv, tables, 1)
                 r = fma(
-                    grow, splat(Z.crate[cu] + Z.crate[cv]), splat(cls[cu, 4] + cls[cv, 4]) + eps
+                    grow, splat(Z.crate[gu] + Z.crate[gv]), splat(cls[gu, 4] + cls[gv, 4]) + eps
                 )
-                if not _near(_gap2(K, 3 * cu * W, K, 3 * cv * W), r, _ALL & ~hu[0]):
+                if not _near(_gap2(K, 3 * gu * W, K, 3 * gv * W), r, _ALL & ~hu[0]):
                     continue
-            _place_cluster(F, X, K, cu, tables, 2)
-            _place_cluster(F, X, K, cv, tables, 2)
-            hm = _pairs_in(
-                pair_tables, m.clpair_start[cp], m.clpair_start[cp + 1], eps, grow, plain, hm
-            )
+            for cp in range(m.gpair_start[gp], m.gpair_start[gp + 1]):
+                cu, cv = m.clpairs[cp, 0], m.clpairs[cp, 1]
+                if cu != cv:
+                    _place_cluster(F, X, K, cu, tables, 1)
+                    _place_cluster(F, X, K, cv, tables, 1)
+                    r = fma(
+                        grow,
+                        splat(Z.crate[cu] + Z.crate[cv]),
+                        splat(cls[cu, 4] + cls[cv, 4]) + eps,
+                    )
+                    if not _near(_gap2(K, 3 * cu * W, K, 3 * cv * W), r, _ALL & ~hu[0]):
+                        continue
+                _place_cluster(F, X, K, cu, tables, 2)
+                _place_cluster(F, X, K, cv, tables, 2)
+                hm = _pairs_in(
+                    pair_tables, m.clpair_start[cp], m.clpair_start[cp + 1], eps, grow, plain, hm
+                )
         hu = (
             hu[0] | mask_bits(hm[0]),
             hu[1] | mask_bits(hm[1]),
