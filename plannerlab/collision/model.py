@@ -21,7 +21,12 @@ obstacles. Its fields are named; no consumer indexes packed arrays by position.
 * **Gates**: a ball per body around its capsules (``gate_c`` in the body's frame,
   ``gate_r_scene``, ``-1`` for a body with no moving capsule, ``gate_r_self``), and the
   checked link pairs by body pair (``bpairs``, their capsule pairs ``cpairs`` from
-  ``bpair_start``).
+  ``bpair_start``). Within a body the capsules are ordered by role (scene, other links,
+  both: a gate holds capsules of one role), then, for a role of ``_GROUPED_FROM`` or more
+  capsules (a mesh's finer cover), by group of at most ``_GROUP`` neighbours, then by
+  cluster of at most ``_CLUSTER``: between links a body pair's gate opens its group
+  pairs' (``gpairs``, ``cg32``), each group pair's its cluster pairs', so two long links
+  side by side test a few group pairs, not every cluster pair.
 * **The scene** (``obs_*``): kind (``geometry.BOX``, ``CYLINDER``, ``SPHERE``), rotation
   (9,), centre, half sizes (a box), radius and half length (a cylinder), radius (a
   sphere).
