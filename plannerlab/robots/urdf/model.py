@@ -68,12 +68,16 @@ capsules of one role) a ball per group of at most 16 neighbouring capsules, then
 cluster of four (``collision/model.py``): a pair of links far apart costs one ball test,
 a pair of links near each other opens only the group pairs that meet.
 
-**It is on by default** (``self_cover_max_primitives = 128``). With the group level the
-finer covers cost 2.5x (UR10) and 4.3x (Kinova) the first covers' state test (without it
-12.7x and 66x; results/mesh_robots.md). ``self_cover_max_primitives = 0`` turns them off
-(the first covers then judge self-collision too: a UR10 is free in 4 % of random states
-on them, 25.7 % on the finer ones, 53 % on its meshes). The first load of a robot
-computes them (minutes for a large arm; cached after).
+**It is off by default** (``self_cover_max_primitives = 0``), though the state test no
+longer stands in the way: with the group level the finer covers cost 2.5x (UR10) and 4.3x
+(Kinova) the first covers' state test (without it 12.7x and 66x; results/mesh_robots.md).
+What still does: the bundled mesh Panda's end-to-end test (plan, execute, referee) took
+1144 s wall, 280 s of CPU with them on (load ~10), against 9 s without (round 2), and
+the simulator's clearance measure (``SimWorld.link_distances``) builds capsule x capsule
+arrays: 6.3 -> 20.7 ms a state. A robot whose links pass within millimetres of each other
+(the UR10: 4 % of random states free on the first covers, 25.7 % with the finer ones,
+53 % on its meshes) needs them; ask with ``self_cover_max_primitives = 128`` in
+``[robot]``. The first load of a robot computes them (minutes for a large arm; cached).
 
 Only numpy (``yourdfpy`` for parsing, ``trimesh`` for meshes) is used here.
 """
@@ -315,7 +319,7 @@ class UrdfChain:
     cover_excess_m: float = 0.01
     cover_max_primitives: int = 32
     self_cover_excess_m: float = 0.004
-    self_cover_max_primitives: int = 128
+    self_cover_max_primitives: int = 0
     cover_cache: bool = True
     cover_cache_dir: Path | None = None
     sim_urdf_path: Path | None = None
