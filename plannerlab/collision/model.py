@@ -285,7 +285,9 @@ def _balls(
     return c, r, rs
 
 
-def _pairs(allowed: Any, perm: np.ndarray, body: np.ndarray, cl_of: np.ndarray, grp_of: Any) -> tuple[Any, ...]:
+def _pairs(
+    allowed: Any, perm: np.ndarray, body: np.ndarray, cl_of: np.ndarray, grp_of: Any
+) -> tuple[Any, ...]:
     """The checked pairs in the packed order (i < j), grouped by body pair, group pair,
     then cluster pair: (bpairs, bpair_start, clpairs, clpair_start, cpairs, bpair_gstart,
     gpairs as group numbers, gpair_start) as arrays."""
@@ -472,11 +474,15 @@ def build_model(
         cg_body=_f(np.concatenate([cl_body, grp_body]), np.int64),
         cg32=_f(
             np.column_stack(
-                [np.concatenate([cl_c, grp_c]), np.concatenate([cl_r, grp_r]),
-                 np.concatenate([cl_rs, grp_rs]), np.zeros((ncl + ngr, 3))]
+                [
+                    np.concatenate([cl_c, grp_c]),
+                    np.concatenate([cl_r, grp_r]),
+                    np.concatenate([cl_rs, grp_rs]),
+                    np.zeros((ncl + ngr, 3)),
+                ]
             ).reshape(ncl + ngr, 8),
             np.float32,
-        ),  # fmt: skip
+        ),
         bpair_gstart=bpair_gstart,
         gpairs=_group_gates(gpairs, grp_cl, body_cl, grp_body, ncl),
         gpair_start=gpair_start,

@@ -9,10 +9,11 @@ on the compiled model (:class:`~plannerlab.collision.model.CompiledModel`), in t
    capsules) against each obstacle and each other body's gate, between links then the
    gates of the bodies' groups (a body of many capsules: a ball per at most sixteen
    neighbours), then the gates of the clusters (a few neighbouring capsules each), then
-   the capsules behind a gate that is not clear. Every radius is grown by the model's bound ``eps32_m`` of how far
-   float32 can be off: a lane whose every pair is clear by more than that is **free**
-   (certainly: in float64 too), a lane with a pair closer than its radius by more than
-   that has **hit** (certainly), and a lane in the thin band between is **unsure**.
+   the capsules behind a gate that is not clear. Every radius is grown by the model's
+   bound ``eps32_m`` of how far float32 can be off: a lane whose every pair is clear by
+   more than that is **free** (certainly: in float64 too), a lane with a pair closer than
+   its radius by more than that has **hit** (certainly), and a lane in the thin band
+   between is **unsure**.
 2. **A float64 confirmation** of the unsure lanes, state by state (:func:`exact_state`):
    the same kinematics in float64 and the exact tests of
    :mod:`plannerlab.collision.geometry` (FCL's verdicts to 1e-6 m). The verdicts are the
