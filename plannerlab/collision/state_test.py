@@ -6,14 +6,13 @@ on the compiled model (:class:`~plannerlab.collision.model.CompiledModel`), in t
 
 1. **A float32 filter in the lanes**: the kinematics of
    :mod:`plannerlab.collision.kinematics`, then per body a gate (a ball around its
-   capsules) against each obstacle and each other body's gate, between links then the
-   gates of the bodies' groups (a body of many capsules: a ball per at most sixteen
-   neighbours), then the gates of the clusters (a few neighbouring capsules each), then
-   the capsules behind a gate that is not clear. Every radius is grown by the model's
-   bound ``eps32_m`` of how far float32 can be off: a lane whose every pair is clear by
-   more than that is **free** (certainly: in float64 too), a lane with a pair closer than
-   its radius by more than that has **hit** (certainly), and a lane in the thin band
-   between is **unsure**.
+   capsules) against each obstacle and each other body's gate, then (between links) its
+   groups' gates (a body of many capsules) and its clusters' (a few neighbours each),
+   then the capsules behind a gate that is not clear. Every radius is grown by the
+   model's bound ``eps32_m`` of how far float32 can be off: a lane whose every pair is
+   clear by more than that is **free** (certainly: in float64 too), a lane with a pair
+   closer than its radius by more than that has **hit** (certainly), and a lane in the
+   thin band between is **unsure**.
 2. **A float64 confirmation** of the unsure lanes, state by state (:func:`exact_state`):
    the same kinematics in float64 and the exact tests of
    :mod:`plannerlab.collision.geometry` (FCL's verdicts to 1e-6 m). The verdicts are the
@@ -214,11 +213,8 @@ def set_rates(m, Z, rate64):
             Z.crate[c] = max(Z.crate[c], r32)
             Z.brate[b] = max(Z.brate[b], r32)
             Z.brate64[b] = max(Z.brate64[b], r)
-    ncl = m.cl_body.shape[0]
-    for g in range(m.grp_cls.shape[0] - 1):
-        Z.crate[ncl + g] = 0.0
-        for c in range(m.grp_cls[g], m.grp_cls[g + 1]):
-            Z.crate[ncl + g] = max(Z.crate[ncl + g], Z.crate[c])
+    for g in range(m.grp_cls.shape[0] - 1):  # the groups' after the clusters'
+        Z.crate[m.cl_body.shape[0] + g] = np.max(Z.crate[m.grp_cls[g] : m.grp_cls[g + 1]])
 
 
 # ------------------------------------------------------------------ geometry in the lanes
@@ -582,7 +578,7 @@ def _self_pass(m, Z, mode, hu):
     """Every checked link pair, behind its body pair's, group pair's and cluster pair's
     gates: the lane masks ``hu`` updated, and whether the mode's stop came."""
     caps, cls, gates = m.caps32, m.cg32, m.gates32  # cg32: the clusters, then the groups
-    F, G, K, X = Z.F, Z.G, Z.K, Z.X
+    F, G, K, X, cr = Z.F, Z.G, Z.K, Z.X, Z.crate
     tables = (cls, caps, m.cl_caps, m.cg_body, m.cap_sphere, Z.placed)
     grow = load(Z.grow, 0)
     plain = mask_bits(grow > splat(0.0)) == 0
@@ -601,9 +597,7 @@ def _self_pass(m, Z, mode, hu):
             if m.gpairs[gp, 2]:  # a group's centre is placed like a cluster's (placed 1)
                 _place_cluster(F, X, K, gu, tables, 1)
                 _place_cluster(F, X, K, gv, tables, 1)
-                r = fma(
-                    grow, splat(Z.crate[gu] + Z.crate[gv]), splat(cls[gu, 4] + cls[gv, 4]) + eps
-                )
+                r = fma(grow, splat(cr[gu] + cr[gv]), splat(cls[gu, 4] + cls[gv, 4]) + eps)
                 if not _near(_gap2(K, 3 * gu * W, K, 3 * gv * W), r, _ALL & ~hu[0]):
                     continue
             for cp in range(m.gpair_start[gp], m.gpair_start[gp + 1]):
@@ -611,11 +605,7 @@ def _self_pass(m, Z, mode, hu):
                 if cu != cv:
                     _place_cluster(F, X, K, cu, tables, 1)
                     _place_cluster(F, X, K, cv, tables, 1)
-                    r = fma(
-                        grow,
-                        splat(Z.crate[cu] + Z.crate[cv]),
-                        splat(cls[cu, 4] + cls[cv, 4]) + eps,
-                    )
+                    r = fma(grow, splat(cr[cu] + cr[cv]), splat(cls[cu, 4] + cls[cv, 4]) + eps)
                     if not _near(_gap2(K, 3 * cu * W, K, 3 * cv * W), r, _ALL & ~hu[0]):
                         continue
                 _place_cluster(F, X, K, cu, tables, 2)
