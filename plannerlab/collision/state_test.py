@@ -4,15 +4,14 @@ Every planner spends its time here. :func:`test_lanes` tests up to eight states 
 side (the *lanes* of :mod:`plannerlab.collision.simd`: one float32 vector per quantity)
 on the compiled model (:class:`~plannerlab.collision.model.CompiledModel`), in two stages:
 
-1. **A float32 filter in the lanes**: the kinematics of
-   :mod:`plannerlab.collision.kinematics`, then per body a gate (a ball around its
-   capsules) against each obstacle and each other body's gate, then (between links) its
-   groups' gates (a body of many capsules) and its clusters' (a few neighbours each),
-   then the capsules behind a gate that is not clear. Every radius is grown by the
-   model's bound ``eps32_m`` of how far float32 can be off: a lane whose every pair is
-   clear by more than that is **free** (certainly: in float64 too), a lane with a pair
-   closer than its radius by more than that has **hit** (certainly), and a lane in the
-   thin band between is **unsure**.
+1. **A float32 filter in the lanes**: the kinematics of :mod:`plannerlab.collision.kinematics`,
+   then per body a gate (a ball around its capsules) against each obstacle and each other body's
+   gate, then (between links) its groups' gates (a body of many capsules) and its clusters' (a
+   few neighbours each), then the capsules behind a gate that is not clear. Every radius is
+   grown by the model's bound ``eps32_m`` of how far float32 can be off: a lane whose every pair
+   is clear by more than that is **free** (certainly: in float64 too), a lane with a pair closer
+   than its radius by more than that has **hit** (certainly), and a lane in the thin band
+   between is **unsure**.
 2. **A float64 confirmation** of the unsure lanes, state by state (:func:`exact_state`):
    the same kinematics in float64 and the exact tests of
    :mod:`plannerlab.collision.geometry` (FCL's verdicts to 1e-6 m). The verdicts are the
@@ -214,7 +213,9 @@ def set_rates(m, Z, rate64):
             Z.brate[b] = max(Z.brate[b], r32)
             Z.brate64[b] = max(Z.brate64[b], r)
     for g in range(m.grp_cls.shape[0] - 1):  # the groups' after the clusters'
-        Z.crate[m.cl_body.shape[0] + g] = np.max(Z.crate[m.grp_cls[g] : m.grp_cls[g + 1]])
+        k, Z.crate[m.cl_body.shape[0] + g] = m.cl_body.shape[0] + g, 0.0
+        for c in range(m.grp_cls[g], m.grp_cls[g + 1]):
+            Z.crate[k] = max(Z.crate[k], Z.crate[c])
 
 
 # ------------------------------------------------------------------ geometry in the lanes
@@ -575,8 +576,7 @@ def _pairs_in(T, q0, q1, eps, grow, plain, hm):
 
 @kernel
 def _self_pass(m, Z, mode, hu):
-    """Every checked link pair, behind its body pair's, group pair's and cluster pair's
-    gates: the lane masks ``hu`` updated, and whether the mode's stop came."""
+    """Every checked link pair behind its body, group and cluster pairs' gates (hu, stop)."""
     caps, cls, gates = m.caps32, m.cg32, m.gates32  # cg32: the clusters, then the groups
     F, G, K, X, cr = Z.F, Z.G, Z.K, Z.X, Z.crate
     tables = (cls, caps, m.cl_caps, m.cg_body, m.cap_sphere, Z.placed)
