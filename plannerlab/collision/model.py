@@ -21,7 +21,12 @@ obstacles. Its fields are named; no consumer indexes packed arrays by position.
 * **Gates**: a ball per body around its capsules (``gate_c`` in the body's frame,
   ``gate_r_scene``, ``-1`` for a body with no moving capsule, ``gate_r_self``), and the
   checked link pairs by body pair (``bpairs``, their capsule pairs ``cpairs`` from
-  ``bpair_start``).
+  ``bpair_start``). Within a body the capsules are ordered by role (scene, other links,
+  both: a gate holds capsules of one role), then, for a role of ``_GROUPED_FROM`` or more
+  capsules (a mesh's finer cover), by group of at most ``_GROUP`` neighbours, then by
+  cluster of at most ``_CLUSTER``: between links a body pair's gate opens its group
+  pairs' (``gpairs``, ``cg32``), each group pair's its cluster pairs', so two long links
+  side by side test a few group pairs, not every cluster pair.
 * **The scene** (``obs_*``): kind (``geometry.BOX``, ``CYLINDER``, ``SPHERE``), rotation
   (9,), centre, half sizes (a box), radius and half length (a cylinder), radius (a
   sphere).
@@ -95,6 +100,14 @@ class CompiledModel(NamedTuple):
     clpairs: np.ndarray  # (CP, 2) int64 cluster pairs holding a checked capsule pair
     clpair_start: np.ndarray  # (CP + 1,) int64 into cpairs
     cpairs: np.ndarray  # (Q, 2) int64 packed capsule pairs (i < j)
+    # a group level between body and cluster pairs (the self pass only): a body of many
+    # capsules is cut into groups of neighbouring clusters, each with its ball
+    grp_cls: np.ndarray  # (G + 1,) int64: clusters of group g (consecutive)
+    cg_body: np.ndarray  # (K + G,) int64: the clusters' bodies, then the groups'
+    cg32: np.ndarray  # (K + G, 8) float32: cls32's rows, then the groups' (row K + g)
+    bpair_gstart: np.ndarray  # (P + 1,) int64 into gpairs
+    gpairs: np.ndarray  # (GP, 3) int64: rows of cg32 (K + g), gate tested (1) or not (0)
+    gpair_start: np.ndarray  # (GP + 1,) int64 into clpairs
     # the scene
     obs_kind: np.ndarray  # (n,) int64
     obs_R: np.ndarray  # (n, 9) float64, row-major world <- obstacle
@@ -162,6 +175,10 @@ def _ball(points: np.ndarray, reach: np.ndarray) -> tuple[np.ndarray, float]:
 
 #: capsules per cluster at most (a cluster's ball gates its capsules)
 _CLUSTER = 4
+#: capsules per group at most, and the fewest of a role's capsules in a body that are cut
+#: into groups (fewer: one group, whose gate the self pass skips when it is the body's)
+_GROUP = 16
+_GROUPED_FROM = 33
 
 
 def _clusters(points: np.ndarray, idx: np.ndarray, size: int) -> list[np.ndarray]:
@@ -223,17 +240,28 @@ def _folded(parent: Any, pre: Any, axes: Any) -> tuple[list[np.ndarray], np.ndar
     return A, pre_f
 
 
-def _packed_order(cap_body: np.ndarray, mid: np.ndarray, nb: int) -> tuple[Any, ...]:
-    """The capsules by body, and within a body by cluster of at most ``_CLUSTER``
-    neighbours: (perm, cluster starts, each body's first cluster)."""
+def _packed_order(
+    cap_body: np.ndarray, mid: np.ndarray, nb: int, role: np.ndarray
+) -> tuple[Any, ...]:
+    """The capsules by body, within a body by role (``role``: which tests see the capsule:
+    the scene, other links or both; a gate holds capsules of one role), by group of at
+    most ``_GROUP`` neighbours (a role of ``_GROUPED_FROM`` capsules or more; else one
+    group) and by cluster of at most ``_CLUSTER``: (perm, cluster starts, each body's
+    first cluster, each group's first cluster)."""
     perm_l: list[int] = []
-    cl_start, body_cl = [0], [0]
+    cl_start, body_cl, grp_cl = [0], [0], [0]
     for b in range(nb):
-        for members in _clusters(mid, np.flatnonzero(cap_body == b), _CLUSTER):
-            perm_l.extend(int(x) for x in members)
-            cl_start.append(len(perm_l))
+        mine = np.flatnonzero(cap_body == b)
+        for r in np.unique(role[mine]):
+            idx = mine[role[mine] == r]
+            groups = _clusters(mid, idx, _GROUP) if len(idx) >= _GROUPED_FROM else [idx]
+            for g in groups:
+                for members in _clusters(mid, g, _CLUSTER):
+                    perm_l.extend(int(x) for x in members)
+                    cl_start.append(len(perm_l))
+                grp_cl.append(len(cl_start) - 1)
         body_cl.append(len(cl_start) - 1)
-    return np.array(perm_l, dtype=np.int64), cl_start, body_cl
+    return np.array(perm_l, dtype=np.int64), cl_start, body_cl, grp_cl
 
 
 def _balls(
@@ -257,31 +285,46 @@ def _balls(
     return c, r, rs
 
 
-def _pairs(allowed: Any, perm: np.ndarray, body: np.ndarray, cl_of: np.ndarray) -> tuple[Any, ...]:
-    """The checked pairs in the packed order (i < j), grouped by body pair, then cluster
-    pair: (bpairs, bpair_start, clpairs, clpair_start, cpairs) as arrays."""
+def _pairs(
+    allowed: Any, perm: np.ndarray, body: np.ndarray, cl_of: np.ndarray, grp_of: Any
+) -> tuple[Any, ...]:
+    """The checked pairs in the packed order (i < j), grouped by body pair, group pair,
+    then cluster pair: (bpairs, bpair_start, clpairs, clpair_start, cpairs, bpair_gstart,
+    gpairs as group numbers, gpair_start) as arrays."""
     a = np.asarray(allowed, dtype=bool)
     sym = a | a.T
     al = np.triu(sym[np.ix_(perm, perm)], 1)
     ii, jj = np.nonzero(al)
+    gr = np.asarray(grp_of)[cl_of]
     keys = sorted(
-        (min(body[i], body[j]), max(body[i], body[j]), cl_of[i], cl_of[j], i, j)
+        (min(body[i], body[j]), max(body[i], body[j]), gr[i], gr[j], cl_of[i], cl_of[j], i, j)
         for i, j in zip(ii.tolist(), jj.tolist(), strict=True)
     )
     bpairs: list[tuple[int, int]] = []
     bpair_start: list[int] = []
+    bpair_gstart: list[int] = []
+    gpairs: list[tuple[int, int]] = []
+    gpair_start: list[int] = []
     clpairs: list[tuple[int, int]] = []
     clpair_start: list[int] = []
     cpairs: list[tuple[int, int]] = []
-    for u, v, cu, cv, i, j in keys:
-        if not bpairs or bpairs[-1] != (u, v):
+    for u, v, gu, gv, cu, cv, i, j in keys:
+        new_b = not bpairs or bpairs[-1] != (u, v)
+        if new_b:
             bpairs.append((int(u), int(v)))
             bpair_start.append(len(clpairs))
-        if not clpairs or clpairs[-1] != (cu, cv) or bpair_start[-1] == len(clpairs):
+            bpair_gstart.append(len(gpairs))
+        g = (int(gu), int(gv))
+        if new_b or gpairs[-1] != g:
+            gpairs.append(g)
+            gpair_start.append(len(clpairs))
+        if not clpairs or clpairs[-1] != (cu, cv) or gpair_start[-1] == len(clpairs):
             clpairs.append((int(cu), int(cv)))
             clpair_start.append(len(cpairs))
         cpairs.append((int(i), int(j)))
     bpair_start.append(len(clpairs))
+    bpair_gstart.append(len(gpairs))
+    gpair_start.append(len(clpairs))
     clpair_start.append(len(cpairs))
 
     def rows(x: list[tuple[int, int]]) -> np.ndarray:
@@ -293,7 +336,26 @@ def _pairs(allowed: Any, perm: np.ndarray, body: np.ndarray, cl_of: np.ndarray) 
         rows(clpairs),
         _f(clpair_start, np.int64),
         rows(cpairs),
+        _f(bpair_gstart, np.int64),
+        rows(gpairs),
+        _f(gpair_start, np.int64),
     )
+
+
+def _group_gates(
+    gpairs: np.ndarray, grp_cl: list[int], body_cl: list[int], grp_body: np.ndarray, ncl: int
+) -> np.ndarray:
+    """(GP, 3): each group pair as rows of ``cg32`` (``ncl + g``) and whether its gate is
+    worth testing: not when it is one group twice, nor when each group is its whole body
+    (the body pair's gate was the same ball)."""
+    out = np.zeros((len(gpairs), 3), dtype=np.int64)
+    for k, (gu, gv) in enumerate(gpairs.tolist()):
+        whole = [
+            grp_cl[g] == body_cl[grp_body[g]] and grp_cl[g + 1] == body_cl[grp_body[g] + 1]
+            for g in (gu, gv)
+        ]
+        out[k] = (ncl + gu, ncl + gv, int(gu != gv and not all(whole)))
+    return _f(out, np.int64)
 
 
 def build_model(
@@ -334,7 +396,11 @@ def build_model(
     cap_body = np.asarray(cap_body, dtype=np.int64)
     cap_a = np.asarray(cap_a, dtype=float).reshape(-1, 3)
     cap_b = np.asarray(cap_b, dtype=float).reshape(-1, 3)
-    perm, cl_start, body_cl = _packed_order(cap_body, (cap_a + cap_b) / 2.0, nb)
+    moving = np.asarray(geo.moving, dtype=bool)
+    checked = np.asarray(geo.allowed, dtype=bool)
+    checked = (checked | checked.T).any(axis=1)
+    role = moving.astype(np.int64) + 2 * checked.astype(np.int64)
+    perm, cl_start, body_cl, grp_cl = _packed_order(cap_body, (cap_a + cap_b) / 2.0, nb, role)
     body = cap_body[perm]
     L = len(perm)
     ca = np.array([A[int(b)].T @ p for b, p in zip(body, cap_a[perm], strict=True)]).reshape(-1, 3)
@@ -348,9 +414,14 @@ def build_model(
     gate_c, gate_r, gate_rs = _balls((ca, cb), (rad, rads, mov), body_ranges)
     cl_ranges = [(cl_start[k], cl_start[k + 1]) for k in range(ncl)]
     cl_c, cl_r, cl_rs = _balls((ca, cb), (rad, rads, mov), cl_ranges)
-    bpairs, bpair_start, clpairs, clpair_start, cpairs = _pairs(
-        geo.allowed, perm, body, np.repeat(np.arange(ncl), np.diff(cl_start))
-    )
+    ngr = len(grp_cl) - 1
+    grp_of = np.repeat(np.arange(ngr), np.diff(grp_cl))
+    grp_body = body[np.array(cl_start, dtype=np.int64)[grp_cl[:-1]]] if ngr else np.zeros(0, int)
+    grp_ranges = [(cl_start[grp_cl[g]], cl_start[grp_cl[g + 1]]) for g in range(ngr)]
+    grp_c, grp_r, grp_rs = _balls((ca, cb), (rad, rads, mov), grp_ranges)
+    cl_body = body[np.array(cl_start[:-1], dtype=np.int64)] if ncl else np.zeros(0, int)
+    pairs = _pairs(geo.allowed, perm, body, np.repeat(np.arange(ncl), np.diff(cl_start)), grp_of)
+    bpairs, bpair_start, clpairs, clpair_start, cpairs, bpair_gstart, gpairs, gpair_start = pairs
     order = np.arange(nb)[::-1] if body_order is None else np.asarray(body_order)
     kinds = np.asarray(geo.kinds, dtype=np.int64)
     n = len(kinds)
@@ -389,7 +460,7 @@ def build_model(
         gate_r_self=_f(gate_rs),
         body_cls=_f(body_cl, np.int64),
         cl_caps=_f(cl_start, np.int64),
-        cl_body=_f(body[np.array(cl_start[:-1], dtype=np.int64)] if ncl else [], np.int64),
+        cl_body=_f(cl_body, np.int64),
         cl_c=_f(cl_c),
         cl_r_scene=_f(cl_r),
         cl_r_self=_f(cl_rs),
@@ -399,6 +470,22 @@ def build_model(
         clpairs=clpairs,
         clpair_start=clpair_start,
         cpairs=cpairs,
+        grp_cls=_f(grp_cl, np.int64),
+        cg_body=_f(np.concatenate([cl_body, grp_body]), np.int64),
+        cg32=_f(
+            np.column_stack(
+                [
+                    np.concatenate([cl_c, grp_c]),
+                    np.concatenate([cl_r, grp_r]),
+                    np.concatenate([cl_rs, grp_rs]),
+                    np.zeros((ncl + ngr, 3)),
+                ]
+            ).reshape(ncl + ngr, 8),
+            np.float32,
+        ),
+        bpair_gstart=bpair_gstart,
+        gpairs=_group_gates(gpairs, grp_cl, body_cl, grp_body, ncl),
+        gpair_start=gpair_start,
         obs_kind=_f(kinds, np.int64),
         obs_R=_f(Rs),
         obs_c=_f(cs),

@@ -121,6 +121,59 @@ def test_the_finer_cover_is_conservative_and_judges_self_collision_only(urdf: Pa
     assert pairs and all(i in fine.self_only_links and j in fine.self_only_links for i, j in pairs)
 
 
+def test_the_group_gates_over_the_finer_capsules_hold_them_and_change_no_verdict(
+    urdf: Path,
+) -> None:
+    """The state test's group level (``collision/model.py``: a body's many finer capsules
+    cut into groups of neighbouring clusters, a group pair's ball opening its cluster
+    pairs): each group's ball holds its capsules, every checked capsule pair lies under
+    its group pair, and the filter's verdicts are float64's, on random states, across the
+    contact and on certified (grown) edges."""
+    from plannerlab.collision.state_test import exact_batch
+
+    fine = chain(urdf, 128)
+    core = CollisionChecker(fine, Scene(), backend="core")._core
+    m = core.model
+    ncl = len(m.cl_body)
+    assert len(m.grp_cls) - 1 > 2 and m.gpairs[:, 2].sum() > 4  # groups, gates tested
+    for g in range(len(m.grp_cls) - 1):  # each group's ball (self radius) holds its capsules
+        c0, c1 = m.grp_cls[g], m.grp_cls[g + 1]
+        l0, l1 = m.cl_caps[c0], m.cl_caps[c1]
+        centre, r = m.cg32[ncl + g, :3].astype(float), float(m.cg32[ncl + g, 4])
+        reach = np.linalg.norm(np.vstack([m.cap_a[l0:l1], m.cap_b[l0:l1]]) - centre, axis=1)
+        assert np.all(reach + np.tile(m.r_self[l0:l1], 2) <= r + 1e-6)
+    for gp in range(len(m.gpairs)):  # each cluster pair under its groups
+        gu, gv = m.gpairs[gp, :2] - ncl
+        for cp in range(m.gpair_start[gp], m.gpair_start[gp + 1]):
+            cu, cv = m.clpairs[cp]
+            assert m.grp_cls[gu] <= cu < m.grp_cls[gu + 1]
+            assert m.grp_cls[gv] <= cv < m.grp_cls[gv + 1]
+    rng = np.random.default_rng(3)
+    Q = rng.uniform(fine.lower, fine.upper, size=(400, 2))
+    v = core.valid(Q)
+    assert 0.05 < v.mean() < 0.95
+    assert np.array_equal(v, exact_batch(m, Q, np.empty(len(Q), dtype=np.bool_)))
+    # across the contact: each valid state moved towards an invalid one by bisection
+    A, B = Q[v][:40], Q[~v][:40]
+    t_lo, t_hi = np.zeros(len(A)), np.ones(len(A))
+    for _ in range(40):
+        t = 0.5 * (t_lo + t_hi)
+        ok = core.valid(A + t[:, None] * (B - A))
+        t_lo, t_hi = np.where(ok, t, t_lo), np.where(ok, t_hi, t)
+    near = np.vstack([A + t_lo[:, None] * (B - A), A + t_hi[:, None] * (B - A)])
+    ref = exact_batch(m, near, np.empty(len(near), dtype=np.bool_))
+    assert np.array_equal(core.valid(near), ref) and ref[: len(A)].all() and not ref[len(A) :].any()
+    # certified edges (grown lanes, the groups' rates) give the grid's verdict
+    step = 0.002
+    seen = set()
+    for a, b in zip(Q[:-1:4], Q[1::4], strict=True):
+        n, bad = core.edge_first_invalid(a, b, step)
+        status, _, n2 = core.edge_certified(a, b, step)
+        assert n2 == n and status == (0 if bad < 0 else 1)
+        seen.add(status)
+    assert seen == {0, 1}
+
+
 def test_pairs_that_never_collide_are_found_on_the_meshes_not_the_covers(urdf: Path) -> None:
     """MoveIt's "Never": judged on the links' meshes, a pair that only the covers bring
     together is disabled; judged on the one-capsule covers, it is not."""

@@ -63,18 +63,21 @@ within a centimetre of each other (a UR10's wrist 1 and wrist 3, its forearm and
 cover is no finer (a small mesh whose first cover is already within it) the first
 cover does both. Both covers
 hold the mesh, so either verdict is conservative. The compiled state test reaches the
-finer capsules only through its gates (a ball per body, then per cluster of four
-capsules): a pair of links far apart costs one ball test, as before.
+finer capsules only through its gates: a ball per body, then (a body of 33 or more
+capsules of one role) a ball per group of at most 16 neighbouring capsules, then per
+cluster of four (``collision/model.py``): a pair of links far apart costs one ball test,
+a pair of links near each other opens only the group pairs that meet.
 
-**It is off by default** (``self_cover_max_primitives = 0``) for its cost: at 128 a mesh,
-a pair of overlapping bodies tests about a thousand cluster pairs, and the state test
-costs 23-57x more (UR10 2.0 -> 47 us, Kinova 1.5 -> 85 us a state; the bundled mesh
-Panda's end-to-end test 9 s -> 245 s; results/mesh_robots.md). A robot whose links pass
-within millimetres of each other (the UR10: 4 % of random states free on the first
-covers, 25.7 % with the finer ones, 53 % on its meshes) needs it; ask for it with
-``self_cover_max_primitives = 128`` in ``[robot]``. The gate that would make it cheap
-enough to be the default (a first-cover capsule pair opening only its finer capsules) is
-a kernel change not made yet.
+**It is off by default** (``self_cover_max_primitives = 0``), though the state test no
+longer stands in the way: with the group level the finer covers cost 2.5x (UR10) and 4.3x
+(Kinova) the first covers' state test (without it 12.7x and 66x; results/mesh_robots.md).
+What still does: the bundled mesh Panda's end-to-end test (plan, execute, referee) took
+1144 s wall, 280 s of CPU with them on (load ~10), against 9 s without (round 2), and
+the simulator's clearance measure (``SimWorld.link_distances``) builds capsule x capsule
+arrays: 6.3 -> 20.7 ms a state. A robot whose links pass within millimetres of each other
+(the UR10: 4 % of random states free on the first covers, 25.7 % with the finer ones,
+53 % on its meshes) needs them; ask with ``self_cover_max_primitives = 128`` in
+``[robot]``. The first load of a robot computes them (minutes for a large arm; cached).
 
 Only numpy (``yourdfpy`` for parsing, ``trimesh`` for meshes) is used here.
 """

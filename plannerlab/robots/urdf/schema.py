@@ -145,7 +145,7 @@ TABLE = RobotTable(
             "",
             "the most capsules of a mesh's finer cover; 0: none (the first cover judges "
             "self-collision too); 128 for links that pass within millimetres of each other "
-            "(a UR10's wrists; the state test then costs 20-60x more)",
+            "(a UR10's wrists; the state test then costs 2.5-4.3x more)",
             minimum=0,
             maximum=1024,
             why_maximum="every capsule is one more to check",
