@@ -41,6 +41,9 @@ LANES = 8
 #: increments and decrements of each array's count (measured ~2 000 cycles a call for the
 #: model). (``_nrt`` is numba's own keyword, outside its typed signature.)
 kernel: Any = cast(Any, njit)(cache=True, nogil=True, _nrt=False)
+#: the same, inlined into its caller by numba (the state test's passes: out of line each
+#: call handed over the model and the scratch, some 80 arrays, on the stack)
+inline_kernel: Any = cast(Any, njit)(cache=True, nogil=True, inline="always", _nrt=False)
 _F32 = ir.FloatType()
 _VEC = ir.VectorType(_F32, LANES)
 _MASK = ir.VectorType(ir.IntType(1), LANES)

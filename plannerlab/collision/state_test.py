@@ -60,6 +60,7 @@ from plannerlab.collision.simd import (
     LANES,
     bits_mask,
     fma,
+    inline_kernel,
     kernel,
     load,
     mask_bits,
@@ -223,7 +224,7 @@ def set_rates(m, Z, rate64):
             Z.crate[k] = max(Z.crate[k], Z.crate[c])
 
 
-@njit(cache=True, nogil=True, inline="always", _nrt=False)
+@inline_kernel
 def frames32(m, Z):
     """Every body's frame in the eight lanes, and the body gates' centres."""
     if m.cpl_start.shape[0] > 0:
@@ -275,7 +276,7 @@ def _stop(hit, mode):
     return hit == _ALL
 
 
-@njit(cache=True, nogil=True, inline="always", _nrt=False)
+@inline_kernel
 def _scene_pass(m, Z, mode, hu):
     """Every moving capsule against every obstacle, behind three gates: a box around a
     group of ``GROUP`` consecutive bodies of ``body_order`` (built per call from the
@@ -367,7 +368,7 @@ def _pairs_in(T, q0, q1, eps, grow, plain, hm):
     return mh, mg, m0
 
 
-@njit(cache=True, nogil=True, inline="always", _nrt=False)
+@inline_kernel
 def _self_pass(m, Z, mode, hu):
     """Every checked link pair behind its body, group and cluster pairs' gates (hu, stop)."""
     caps, cls, gates = m.caps32, m.cg32, m.gates32  # cg32: the clusters, then the groups

@@ -172,7 +172,7 @@ class ClearanceField:
         q_ref = np.clip(np.zeros(robot.dof), robot.lower, robot.upper)
         seg = robot.link_segments(q_ref)
         lengths = np.linalg.norm(seg[:, 1] - seg[:, 0], axis=-1)
-        counts = sphere_counts(lengths, radii, max_spheres)
+        counts = np.asarray(sphere_counts(lengths, radii, max_spheres), dtype=np.int64)
         #: each link's length [m] at the reference state (the capsule's, rigid on its body)
         self._lengths = np.asarray(lengths, dtype=float)
         starts = np.concatenate([[0], np.cumsum(counts)]).astype(np.int64)

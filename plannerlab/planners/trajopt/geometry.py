@@ -194,7 +194,7 @@ def problem_geometry(checker: Any, stop: Any = None) -> PathGeometry:
         model = checker.model
     except ValueError:  # no compiled core (an FCL-only scene): the chain packed alone
         model = None
-    return checker.derived(  # type: ignore[no-any-return]
+    return checker.derived(
         "trajopt.PathGeometry",
         lambda: PathGeometry(checker.robot, checker.scene, model, stop),
     )
