@@ -95,6 +95,7 @@ import logging
 import math
 from collections.abc import Callable
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
@@ -404,9 +405,33 @@ def retime(
         g, room = gravity_and_room(q)
         return (np.asarray(inverse_dynamics(q, qd, qdd), dtype=float) - g) / room
 
+    class _TorqueConstraint(constraint.JointTorqueConstraint):
+        """toppra's torque constraint, its parameters computed with three inverse
+        dynamics calls a grid point instead of four: ``inv_dyn(q, 0, 0)`` is exactly 0
+        here (the torque measured from gravity's), so toppra's ``c`` is left out; a, b
+        come out bit-identical (x - 0.0 == x)."""
+
+        def compute_constraint_params(self, path: Any, gridpoints: Array) -> Any:
+            from toppra.constraint import canlinear_colloc_to_interpolate
+
+            assert self.discretization_type == constraint.DiscretizationType.Interpolation
+            n_dof = path.dof
+            p = path.eval(gridpoints)
+            ps = path.evald(gridpoints)
+            pss = path.evaldd(gridpoints)
+            a = np.array([inv_dyn(p_, zeros, ps_) for p_, ps_ in zip(p, ps, strict=True)])
+            b = np.array([inv_dyn(p_, ps_, pss_) for p_, ps_, pss_ in zip(p, ps, pss, strict=True)])
+            c = np.zeros_like(a)
+            eye = np.eye(n_dof)
+            F = np.concatenate([eye, -eye])
+            g = np.concatenate([self.tau_lim[:, 1], -self.tau_lim[:, 0]])
+            return canlinear_colloc_to_interpolate(
+                a, b, c, F, g, None, None, gridpoints, identical=True
+            )
+
     constraints = [
         constraint.JointVelocityConstraint(np.stack([-v, v], axis=1)),
-        constraint.JointTorqueConstraint(
+        _TorqueConstraint(
             inv_dyn,
             np.tile([-float(torque_fraction), float(torque_fraction)], (dof, 1)),
             np.zeros(dof),

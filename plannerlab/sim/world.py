@@ -273,6 +273,8 @@ class SimWorld:
             if sorted(movable) == sorted(self._joints)
             else None
         )
+        self._dyn_order_array = np.asarray(self._dyn_order or [], dtype=np.intp)
+        self._dyn_identity = self._dyn_order == list(range(len(self._joints)))
 
         # Self-collision filters: the pairs the FCL checker never checks.
         self._excluded_pairs = robot.excluded_pairs
@@ -467,8 +469,8 @@ class SimWorld:
             self.body,
             self._joints,
             pybullet.POSITION_CONTROL,
-            targetPositions=[float(v) for v in q_urdf],
-            targetVelocities=[float(v) for v in qd_urdf],
+            targetPositions=np.asarray(q_urdf, dtype=float).tolist(),
+            targetVelocities=np.asarray(qd_urdf, dtype=float).tolist(),
             forces=self.max_force.tolist(),
             **gains,
         )
@@ -485,15 +487,15 @@ class SimWorld:
                 f"the {self.robot.kind} URDF has movable joints outside robot.joint_names; "
                 "no inverse dynamics"
             )
-        n = len(self._dyn_order)
-        args = []
-        for v in (q_urdf, qd_urdf, qdd_urdf):
-            full = [0.0] * n
-            for i, k in enumerate(self._dyn_order):
-                full[k] = float(v[i])
-            args.append(full)
-        tau = self.client.calculateInverseDynamics(self.body, *args)
-        return np.array([tau[k] for k in self._dyn_order], dtype=float)
+        # toppra asks this ~10^4 times a leg: plain lists when the orders agree
+        order = self._dyn_order_array
+        if self._dyn_identity:
+            args = [np.asarray(v, dtype=float).tolist() for v in (q_urdf, qd_urdf, qdd_urdf)]
+            return np.array(self.client.calculateInverseDynamics(self.body, *args))
+        full = np.zeros((3, len(order)))
+        full[:, order] = np.stack((q_urdf, qd_urdf, qdd_urdf))
+        tau = np.asarray(self.client.calculateInverseDynamics(self.body, *full.tolist()))
+        return tau[order]
 
     def step(self, steps: int = 1) -> None:
         """Advance the physics ``steps`` time steps of ``dt_s``."""
