@@ -8,8 +8,18 @@ command, ``--jobs 2``.
     python results/escapes/study.py run --seeds 0-1 --out /tmp/slice    # a slice
     python results/escapes/study.py estimate /tmp/slice --seeds 20       # its full size
 
-``run`` makes every trial (problem × planner × seed; a deterministic planner, whose
-seeds are one run, on the first seed only) and runs them all in one queue, ``--jobs`` at a
+**Which planners.** "Every family at its best settings" is measured, not chosen
+(``--members best``, the default; :mod:`plannerlab.comparison.screen`): a **screen** runs
+every member of every family (:data:`FAMILIES`) once, on the first seed, on every
+problem; then each family's best member there (the most problems planned and executed
+cleanly, ties by the fewest checks) runs on every seed. The screen's trials are the
+study's first seed. Why: the 22 members on 20 seeds cost about 6 CPU-hours (3 h on 2
+cores; measured with ``estimate`` on a slice of seed 0 at ``25183da``, 77 % of it the
+executions' physics), the screen and the seven best about 2 CPU-hours. ``--members all``
+runs every member on every seed.
+
+``run`` makes the trials (problem × planner × seed; a deterministic planner, whose seeds
+are one run, on the first seed only) and runs them in one queue, ``--jobs`` at a
 time, each in its own process (:func:`plannerlab.comparison.runner.run_comparison`),
 appending each record to ``OUT/trials.jsonl`` as it finishes: an interrupted study
 resumes where it stopped. The longest problems go first so the queue ends on short
@@ -130,14 +140,16 @@ def commit() -> tuple[str, bool]:
         return "unknown", True
 
 
-def trials(args: argparse.Namespace) -> list[Any]:
-    """Every trial of the study, longest problems first."""
-    from plannerlab.comparison.spec import ComparisonSpec
-    from plannerlab.comparison.trial import parse_seeds
+def problems_of(args: argparse.Namespace) -> list[str]:
+    return args.problems.split(",") if args.problems else list(TASKS + TRAPS)
 
-    seeds = parse_seeds(args.seeds)
-    names = args.planners.split(",") if args.planners else planners()
-    problems = args.problems.split(",") if args.problems else list(TASKS + TRAPS)
+
+def trials(args: argparse.Namespace, names: list[str], seeds: list[int]) -> list[Any]:
+    """The trials of ``names`` on ``seeds`` (a deterministic planner on the first only),
+    longest problems first."""
+    from plannerlab.comparison.spec import ComparisonSpec
+
+    problems = problems_of(args)
     budget = {
         "max_collision_checks": args.checks,
         "time_limit_s": args.guard,
@@ -176,24 +188,21 @@ def cmd_run(args: argparse.Namespace) -> int:
             file=sys.stderr,
         )
         return 2
-    grid = trials(args)
-    limits = {t.key: limit for t, limit in grid}
+    from plannerlab.comparison.trial import parse_seeds
+
+    seeds = parse_seeds(args.seeds)
+    names = args.planners.split(",") if args.planners else planners()
+    store = TrialStore(out / "trials.jsonl")
+    # --members best: the screen (every member on the first seed), then each family's
+    # best member on every seed (plannerlab.comparison.screen); all: every member
+    grid = trials(args, names, seeds if args.members == "all" else seeds[:1])
     meta.update(
-        commit=head,
-        dirty=dirty,
-        command=" ".join(["python", "results/escapes/study.py", *sys.argv[1:]]),
-        budget={"max_collision_checks": args.checks, "time_limit_s": args.guard},
-        planners=sorted({t.planner for t, _ in grid}),
-        problems=sorted({t.problem for t, _ in grid}),
-        seeds=args.seeds,
-        jobs=args.jobs,
-        trials=len(grid),
-        started=meta.get("started") or datetime.now(UTC).isoformat(timespec="seconds"),
-        load_at_start=meta.get("load_at_start") or list(os.getloadavg()),
+        members=args.members,
+        screen_seed=seeds[0] if args.members == "best" else None,
+        planners=names,
     )
-    meta_path.write_text(json.dumps(meta, indent=1) + "\n")
-    done = [0]
     t0 = time.monotonic()
+    done = [0]
 
     def on_done(rec: Any, skipped: bool) -> None:
         done[0] += 1
@@ -210,21 +219,59 @@ def cmd_run(args: argparse.Namespace) -> int:
         raise KeyboardInterrupt  # the runner stops its trials; the store keeps the rest
 
     signal.signal(signal.SIGTERM, stop)
-    run = run_comparison(
-        [t for t, _ in grid],
-        TrialStore(out / "trials.jsonl"),
-        jobs=args.jobs,
-        on_done=on_done,
-        trial_timeout_s=lambda t: limits[t.key],
-    )
+    ran = skipped = 0
+    for stage in range(2 if args.members == "best" else 1):
+        if stage == 1:
+            from plannerlab.comparison.screen import best_members
+
+            fams = {f: [m for m in ms if m in names] for f, ms in families().items()}
+            best = best_members(store.load().values(), fams, seeds[0], problems_of(args))
+            meta["best"] = best
+            print(
+                "the screen's best: " + ", ".join(f"{f}: {m}" for f, m in best.items()),
+                file=sys.stderr,
+                flush=True,
+            )
+            grid = trials(args, sorted(set(best.values()), key=names.index), seeds)
+        done[0] = 0
+        _write_meta(meta_path, meta, head, dirty, grid, args)
+        limits = {t.key: limit for t, limit in grid}
+        run = run_comparison(
+            [t for t, _ in grid],
+            store,
+            jobs=args.jobs,
+            on_done=on_done,
+            trial_timeout_s=lambda t, limits=limits: limits[t.key],
+        )
+        ran += run.ran
+        skipped += run.skipped
     meta.update(
         finished=datetime.now(UTC).isoformat(timespec="seconds"),
         load_at_end=list(os.getloadavg()),
         wall_s=round((meta.get("wall_s") or 0.0) + time.monotonic() - t0, 1),
+        trials=len(store.load()),
     )
     meta_path.write_text(json.dumps(meta, indent=1) + "\n")
-    print(f"{run.ran} trials run now, {run.skipped} already in {out / 'trials.jsonl'}")
+    print(f"{ran} trials run now, {skipped} already in {out / 'trials.jsonl'}")
     return 0
+
+
+def _write_meta(
+    meta_path: Path, meta: dict[str, Any], head: str, dirty: bool, grid: list[Any], args: Any
+) -> None:
+    """The store's ``study.json``: commit, command, budgets, problems, seeds, the load."""
+    meta.update(
+        commit=head,
+        dirty=dirty,
+        command=" ".join(["python", "results/escapes/study.py", *sys.argv[1:]]),
+        budget={"max_collision_checks": args.checks, "time_limit_s": args.guard},
+        problems=sorted({t.problem for t, _ in grid}),
+        seeds=args.seeds,
+        jobs=args.jobs,
+        started=meta.get("started") or datetime.now(UTC).isoformat(timespec="seconds"),
+        load_at_start=meta.get("load_at_start") or list(os.getloadavg()),
+    )
+    meta_path.write_text(json.dumps(meta, indent=1) + "\n")
 
 
 def load(out: Path) -> list[Any]:
@@ -270,22 +317,31 @@ def _short(planner: str) -> str:
     return planner.replace("gradient.", "").replace("native.", "").replace("ompl.", "")
 
 
-def glance(table: dict[tuple[str, str], dict[str, Any]], problems: list[str]) -> list[list[Any]]:
-    """Per family and problem: its best member (most executed cleanly, then fewest
-    median checks) and that member's cell."""
+def glance(
+    table: dict[tuple[str, str], dict[str, Any]],
+    problems: list[str],
+    best: dict[str, str] | None = None,
+) -> list[list[Any]]:
+    """Per family and problem: its best member and that member's cell. With ``best``
+    (the screen's choice: the member the study ran on every seed) that member; without
+    (``--members all``) the member with the most executed cleanly, then fewest median
+    checks, per problem."""
     rows = []
     for family, members in families().items():
+        if best is not None:
+            members = (best[family],) if family in best else ()
         row = []
         for p in problems:
             have = [(m, table[(p, m)]) for m in members if (p, m) in table]
             if not have:
                 row.append(None)
                 continue
-            best = max(
-                have,
-                key=lambda mc: (mc[1]["clean"] / mc[1]["seeds"], -(mc[1]["checks"] or 1e18)),
+            row.append(
+                max(
+                    have,
+                    key=lambda mc: (mc[1]["clean"] / mc[1]["seeds"], -(mc[1]["checks"] or 1e18)),
+                )
             )
-            row.append(best)
         rows.append([family, row])
     return rows
 
@@ -300,7 +356,7 @@ def cmd_report(args: argparse.Namespace) -> int:
     table = cells(recs)
     problems = [p for p in TASKS + TRAPS if any(k[0] == p for k in table)]
     names = [p for p in planners() if any(k[1] == p for k in table)]
-    rows = glance(table, problems)
+    rows = glance(table, problems, meta.get("best"))
     fam_cells = [
         [
             Cell(0, 0)
@@ -408,8 +464,17 @@ def _markdown(meta, rows, table, problems, names) -> str:
         f"{meta.get('jobs')} at a time, {meta.get('wall_s', 0) / 3600:.2f} h; load average at "
         f"the start {load0:.1f}, at the end {load1:.1f}.",
         "",
-        "**At a glance**: each family's best member per problem, executed cleanly / seeds "
-        "(`escapes/study/escapes_by_family.png`).",
+        (
+            "**At a glance**: each family's best member on the screen (every member once, "
+            f"on seed {meta.get('screen_seed')}: the most problems executed cleanly, then "
+            "the fewest checks), run on every seed; executed cleanly / seeds "
+            "(`escapes/study/escapes_by_family.png`). The screen chose "
+            + ", ".join(f"`{m}` ({f})" for f, m in meta["best"].items())
+            + "."
+            if meta.get("best")
+            else "**At a glance**: each family's best member per problem, executed cleanly / "
+            "seeds (`escapes/study/escapes_by_family.png`)."
+        ),
         "",
         "| family | " + " | ".join(short) + " |",
         "|---|" + "---|" * len(problems),
@@ -426,7 +491,8 @@ def _markdown(meta, rows, table, problems, names) -> str:
     lines += [
         "",
         "**Every planner**: executed cleanly / seeds; median collision checks of the solved "
-        "trials (summed over the legs) (`escapes/study/escapes_by_planner.png`).",
+        "trials (summed over the legs) (`escapes/study/escapes_by_planner.png`)"
+        + ("; a member the screen did not choose ran once (x/1)." if meta.get("best") else "."),
         "",
         "| planner | " + " | ".join(short) + " |",
         "|---|" + "---|" * len(problems),
@@ -500,6 +566,13 @@ def main(argv: list[str] | None = None) -> int:
     r.add_argument("--planners", default="", help="a subset, comma-separated")
     r.add_argument("--problems", default="", help="a subset, comma-separated")
     r.add_argument("--mixed", action="store_true", help="add to a store of another commit")
+    r.add_argument(
+        "--members",
+        choices=("best", "all"),
+        default="best",
+        help="best: every member on the first seed (the screen), then each family's best "
+        "on every seed; all: every member on every seed",
+    )
     r.set_defaults(func=cmd_run)
     p = sub.add_parser("report", help="tables and figures from the store")
     p.add_argument("--out", default=str(OUT))
