@@ -175,6 +175,18 @@ def _rrtconnect(overrides: Mapping[str, Any]) -> Planner:
 _ESCAPE_RRTCONNECT: Mapping[str, Any] = MappingProxyType({"escape_planner": _rrtconnect})
 
 
+def _leader(overrides: Mapping[str, Any]) -> Planner:
+    """Follow-the-leader (``gradient.follow_leader``): the clearance detours' route
+    escape, handed to their factory as ``route_planner``."""
+    return _follow_leader("gradient.follow_leader", overrides)
+
+
+#: options of the clearance descents: RRT-Connect's escape, the detours' route escape
+_CLEARANCE_ESCAPES: Mapping[str, Any] = MappingProxyType(
+    {"escape_planner": _rrtconnect, "route_planner": _leader}
+)
+
+
 def _entries() -> dict[str, PlannerEntry]:
     entries = [
         PlannerEntry(
@@ -226,7 +238,8 @@ def _entries() -> dict[str, PlannerEntry]:
         (
             "gradient.clearance+detour",
             "gradient.clearance; at a stall, sub-goals near the stall (the goal's approach "
-            "point, then the tip drawn back along its own body), the descent resumes",
+            "point, then the tip drawn back along its own body), the descent resumes; when "
+            "none leads in, the tip's route through free workspace (follow-the-leader)",
             False,
         ),
         (
@@ -248,7 +261,7 @@ def _entries() -> dict[str, PlannerEntry]:
                 _clearance,
                 summary,
                 uses_rng=uses_rng,
-                options=_ESCAPE_RRTCONNECT,
+                options=_CLEARANCE_ESCAPES,
             )
         )
     for name, summary, uses_rng in (

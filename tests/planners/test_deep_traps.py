@@ -76,3 +76,28 @@ def test_gradient_rrtconnect_starts_its_escape_at_the_stall_not_the_start():
     # the escape starts where the descent ended: as far from the start as the descent went
     assert 1.0 < first["start_from_leg_start_rad"] <= first["descent_before_stall_rad"] + 1e-9
     assert first["descent_before_stall_rad"] >= 2.0
+
+
+@pytest.mark.parametrize("name", ["armz_deep_a", "armz_deep_b"])
+def test_detour_enters_a_deep_trap_by_the_tips_route_when_no_retract_does(name):
+    """Entering the room straight from rest, every retract's descent falls back in front
+    of the roof; the detour's last resort, the tip's route through the window (followed
+    as follow-the-leader does), gets in. Without it the same leg stalls."""
+    problem = load_problem(name)
+    budget = problem.budget.replace(
+        max_collision_checks=60_000, time_limit_s=None, max_iterations=100_000_000
+    )
+    r = make_planner("gradient.clearance+detour").solve(
+        problem, 0, budget, np.random.default_rng(0)
+    )
+    assert r.status is Status.SOLVED, r.reason
+    first = r.extra["escapes"][0]
+    assert first["how"].startswith("no retract led in") and "the tip's route" in first["how"]
+    assert first["start_from_stall_rad"] == 0.0  # the route starts at the stall
+    assert problem.goal(0).contains(problem.robot, r.path[-1])
+    checker = CollisionChecker(problem.robot, problem.scene, margin_m=problem.safety_margin_m)
+    assert checker.check_path(r.path, problem.joint_step).valid
+    off = make_planner("gradient.clearance+detour", {"route_escape": False}).solve(
+        problem, 0, budget, np.random.default_rng(0)
+    )
+    assert off.status is Status.LOCAL_MINIMUM

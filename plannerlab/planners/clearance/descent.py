@@ -61,6 +61,7 @@ the descent, its escapes and :class:`LegPath`, the clearance family's result.
 
 from __future__ import annotations
 
+import dataclasses
 from collections.abc import Callable, Mapping
 from typing import Any
 
@@ -94,10 +95,13 @@ class ClearanceDescent(DescentStep, LegPlanner):
         name: str,
         settings: ClearanceSettings,
         escape_planner: Callable[[Mapping[str, Any]], Planner] | None = None,
+        route_planner: Callable[[Mapping[str, Any]], Planner] | None = None,
     ) -> None:
         self.name = name
         self.settings = settings
         self.escape_planner = escape_planner
+        #: makes follow-the-leader (overrides -> planner) for the detours' route escape
+        self.route_planner = route_planner
         #: (problem, its model): the field of the last problem solved (see :meth:`model`)
         self._model_cache: tuple[Any, Model] | None = None
         #: (robot, this descent with its distances derived for it) (see :meth:`for_robot`)
@@ -113,7 +117,9 @@ class ClearanceDescent(DescentStep, LegPlanner):
         cached = self._resolved
         if cached is not None and cached[0] is robot:
             return cached[1]
-        descent = ClearanceDescent(self.name, self.settings.for_robot(robot), self.escape_planner)
+        descent = ClearanceDescent(
+            self.name, self.settings.for_robot(robot), self.escape_planner, self.route_planner
+        )
         self._resolved = (robot, descent)
         return descent
 
@@ -500,6 +506,39 @@ class ClearanceDescent(DescentStep, LegPlanner):
                 return esc, iterations, f"{how} (draw {draw})"
         return [np.array(q_stall)], iterations, how
 
+    def _route(
+        self, ctx: PlanningContext, q_stall: Array, used: int, rng: np.random.Generator
+    ) -> tuple[list[Array], int, str]:
+        """The detours' last resort: follow-the-leader from the stall (the tip's route
+        through free workspace into the goal, tracked by this descent's settings), a
+        sub-solve in the leg's context (its checks are the leg's). Why: a stall whose
+        goal lies behind a wall the tip faces (a room entered from outside, straight
+        from rest) is left by no retract of the body: each retract's descent falls back
+        into the same basin (``armz_deep_a``, ``armz_deep_b``: every retract tried, none
+        got in); the way in is the tip's route through the opening."""
+        if self.route_planner is None or not self.settings.route_escape:
+            return [np.array(q_stall)], 0, "no route escape"
+        tracker = ctx.tracker
+        sub = tracker.remaining(limit_iterations=False)
+        if sub is None:
+            return [np.array(q_stall)], 0, f"route: {tracker.exhausted() or 'no budget'}"
+        b = tracker.budget
+        if b.max_iterations is not None:
+            sub = sub.replace(max_iterations=max(b.max_iterations - used, 1))
+        s = self.settings
+        # this descent's settings, but its escapes (follow-the-leader sets its own)
+        own = ("escape", "max_escapes", "escape_checks", "route_escape")
+        descent = {
+            f"descent.{f.name}": getattr(s, f.name)
+            for f in dataclasses.fields(s)
+            if f.name not in own and getattr(s, f.name) is not None
+        }
+        leader = self.route_planner(descent)
+        r = plan_in(leader, ctx.sub(sub, q_stall), rng)
+        if r.solved:
+            return list(r.path), r.iterations, f"the tip's route ({r.reason})"
+        return [np.array(q_stall)], r.iterations, f"the tip's route: {r.status.value}"
+
     def _rrtconnect(
         self, ctx: PlanningContext, q_stall: Array, rng: np.random.Generator
     ) -> tuple[list[Array], int, str]:
@@ -611,6 +650,11 @@ class ClearanceDescent(DescentStep, LegPlanner):
                 esc, it, how = self._rrtconnect(ctx, q_stall, rng)
             if slid is None:
                 leg_path.iterations += it
+            if len(esc) <= 1 and s.escape in ("detour", "random_detour"):
+                # no retract led into the goal: the tip's route, from the stall
+                esc, it, how_route = self._route(ctx, q_stall, leg_path.iterations, rng)
+                leg_path.iterations += it
+                how = f"no retract led in ({how}); {how_route}"
             left_stall = len(esc) > 1
             leg_path.escapes += int(left_stall)
             escapes_log.append(
@@ -671,11 +715,15 @@ def make(
     overrides: dict,
     *,
     escape_planner: Callable[[Mapping[str, Any]], Planner] | None = None,
+    route_planner: Callable[[Mapping[str, Any]], Planner] | None = None,
 ) -> ClearanceDescent:
     """Registry factory for the ``gradient.clearance`` family. ``escape_planner(overrides)``
     makes the RRT-Connect planner of the ``rrtconnect`` escape (the registry passes OMPL's,
-    so this module needs neither the registry nor ``ompl``)."""
+    so this module needs neither the registry nor ``ompl``); ``route_planner(overrides)``
+    makes follow-the-leader for the detours' route escape (``route_escape``)."""
     if name not in VARIANTS:
         raise PlannerlabError(f"{name} is not a clearance descent ({', '.join(VARIANTS)})")
     base = ClearanceSettings(**VARIANTS[name])  # type: ignore[arg-type]
-    return ClearanceDescent(name, with_overrides(base, overrides, name), escape_planner)
+    return ClearanceDescent(
+        name, with_overrides(base, overrides, name), escape_planner, route_planner
+    )

@@ -167,6 +167,11 @@ class ClearanceSettings:
         max_escapes: stalls escaped at most (``random_detour``: also the most draws from
             one stall) [1].
         escape_checks: collision checks the ``rrtconnect`` escape may use at most [1].
+        route_escape: the detours' last resort, when the body's own retracts lead
+            nowhere: the tip's route through free workspace from the stall into the goal
+            (follow-the-leader's leader path), followed as follow-the-leader does (a
+            sub-solve in the leg's context; only when the registry hands the planner
+            one, as it does ``gradient.clearance+detour`` and ``+random_detour``).
         approach_m: the tip first descends to the goal's approach point, this far back
             along the goal's normal, then in along it (0: no approach point; a goal state
             has none) [m]; derived, 2.5 on Arm-Z.
@@ -210,6 +215,7 @@ class ClearanceSettings:
     escape: str = "none"
     max_escapes: int = 3
     escape_checks: int = 50000
+    route_escape: bool = True
     approach_m: float = DERIVED
     retract_step: int = 2
     subgoal_pos_tol_m: float = DERIVED
