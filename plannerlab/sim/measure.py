@@ -214,7 +214,9 @@ class ClosestPoints(Protocol):
 
     def set_state(self, q_rad: Array) -> None: ...
 
-    def link_distances(self, max_distance_m: float) -> tuple[Array, list[str], Array]: ...
+    def link_distances(
+        self, max_distance_m: float, starts: Array | None = None
+    ) -> tuple[Array, list[str], Array]: ...
 
 
 def _link_groups(robot: Robot) -> tuple[np.ndarray, list[str]] | None:
@@ -281,15 +283,8 @@ def sampled_clearance(
         # capped there: PyBullet computes only the pairs within reach (a mesh robot's
         # meshes against a triangle-mesh obstacle within 1 m cost 0.1 s a query)
         reach = min(max_distance_m, best[0] + 2.0 * resolution_m + 0.5 * abs(best[0]))
-        scene, obstacle, pair = probe.link_distances(reach)
-        if groups is not None:
-            at = np.minimum.reduceat(np.asarray(scene), starts)
-            ends = [*starts[1:], len(scene)]
-            obstacle = [
-                obstacle[int(a + np.argmin(scene[a:b]))] for a, b in zip(starts, ends, strict=True)
-            ]
-            scene = at
-            pair = np.minimum.reduceat(np.minimum.reduceat(pair, starts, axis=0), starts, axis=1)
+        # a mesh robot's distances come per URDF link (its run of capsules)
+        scene, obstacle, pair = probe.link_distances(reach, starts if groups is not None else None)
         samples += 1
         l_scene = int(np.argmin(scene))
         l_a, l_b = np.unravel_index(int(np.argmin(pair)), pair.shape)

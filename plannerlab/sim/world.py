@@ -556,42 +556,66 @@ class SimWorld:
             [[0.0]] * len(self._joints),
         )
 
-    def link_distances(self, max_distance_m: float) -> tuple[Array, list[str], Array]:
+    def link_distances(
+        self, max_distance_m: float, starts: Array | None = None
+    ) -> tuple[Array, list[str], Array]:
         """Closest distances of the robot's current state, from PyBullet's closest points
         (``getClosestPoints``) up to ``max_distance_m``: every robot link not in
         ``robot.fixed_links`` against every obstacle, and every pair of robot links not
         in ``robot.excluded_pairs`` (the pairs the collision checker checks).
 
+        Args:
+            max_distance_m: pairs farther than this are not read [m].
+            starts: (G,) increasing robot link indices, 0 first: report per group of
+                consecutive links (the links from ``starts[g]`` up to the next start)
+                instead of per link. A mesh robot's URDF link is covered by a run of
+                capsules that PyBullet measures as one link, its meshes: per URDF link
+                the arrays are G, not L capsules long (a finer cover has hundreds, and
+                (L, L) arrays cost more than the query).
+
         Returns:
-            ``scene_m`` (L,): per robot link, the distance to the nearest obstacle [m]
-            (negative: penetration; ``max_distance_m`` when none is that close, inf for a
-            fixed link); ``obstacle``: that obstacle's name per link ("" when none);
-            ``self_m`` (L, L): symmetric, the distance between two links [m]
-            (``max_distance_m`` when farther, inf for a link with itself and for an
-            excluded pair).
+            ``scene_m`` (L,) or (G,): per robot link (group), the distance to the nearest
+            obstacle [m] (negative: penetration; ``max_distance_m`` when none is that
+            close, inf for a fixed link); ``obstacle``: that obstacle's name ("" when
+            none); ``self_m`` (L, L) or (G, G): symmetric, the distance between two links
+            [m] (``max_distance_m`` when farther, inf for a link with itself and for an
+            excluded pair; a group pair: its first links').
         """
         c = self.client
         robot = self.robot
         L = len(robot.link_names)
         dmax = float(max_distance_m)
-        scene = np.full(L, dmax)
-        scene[list(robot.fixed_links)] = np.inf
-        names = [""] * L
+        fixed = np.zeros(L, dtype=bool)
+        fixed[list(robot.fixed_links)] = True
+        if starts is None:
+            group = np.arange(L)
+            first = group
+        else:
+            first = np.asarray(starts, dtype=np.intp)
+            group = np.searchsorted(first, np.arange(L), side="right") - 1
+        G = len(first)
+        scene = np.where(fixed[first], np.inf, dmax)
+        names = [""] * G
         for uid, name in self.obstacle_names.items():
             for pt in c.getClosestPoints(self.body, uid, dmax):
                 i = self._robot_link.get(pt[3])
-                d = float(pt[8])
-                if i is not None and i not in robot.fixed_links and d < scene[i]:
-                    scene[i] = d
-                    names[i] = name
-        pair = np.where(self._unchecked_pairs, np.inf, dmax)
+                if i is None or fixed[i]:
+                    continue
+                g, d = int(group[i]), float(pt[8])
+                if d < scene[g]:
+                    scene[g] = d
+                    names[g] = name
+        unchecked = (
+            self._unchecked_pairs if starts is None else self._unchecked_pairs[np.ix_(first, first)]
+        )
+        pair = np.where(unchecked, np.inf, dmax)
         for pt in c.getClosestPoints(self.body, self.body, dmax):
             i, k = self._robot_link.get(pt[3]), self._robot_link.get(pt[4])
             if i is None or k is None or self._unchecked_pairs[i, k]:
                 continue
-            d = float(pt[8])
-            if d < pair[i, k]:
-                pair[i, k] = pair[k, i] = d
+            g, h, d = int(group[i]), int(group[k]), float(pt[8])
+            if d < pair[g, h]:
+                pair[g, h] = pair[h, g] = d
         return scene, names, pair
 
     def contacts(self, min_depth_m: float = 0.0) -> list[Contact]:

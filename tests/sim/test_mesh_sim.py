@@ -167,3 +167,24 @@ def test_a_sim_urdf_without_the_chain_s_links_is_refused(tmp_path: Path) -> None
 
     with pytest.raises(ProblemError, match=r"robot.sim_urdf.*lacks.*fore"):
         spheres_problem(str(other))
+
+
+def test_a_mesh_robots_distances_per_urdf_link_are_its_capsules_reduced(cache: Path) -> None:
+    """``link_distances(reach, starts)`` reports per URDF link (its run of capsules) what
+    the per-capsule arrays give reduced over each run: the arrays are G, not L, long."""
+    p = arm_problem(cache, [WALL, BALL], [0.0, 0.0, 0.0])
+    urdf = list(p.robot.link_urdf_names)
+    starts = np.array([0] + [i for i in range(1, len(urdf)) if urdf[i] != urdf[i - 1]])
+    assert len(starts) < len(urdf)  # some URDF link has several capsules
+    rng = np.random.default_rng(3)
+    with SimWorld(p.robot, p.scene) as w:
+        for q in rng.uniform(-1.5, 1.5, size=(6, p.robot.dof)):
+            w.set_state(q)
+            scene, names, pair = w.link_distances(0.5)
+            g_scene, g_names, g_pair = w.link_distances(0.5, starts)
+            assert g_scene.shape == (len(starts),) and g_pair.shape == (len(starts),) * 2
+            assert np.array_equal(g_scene, np.minimum.reduceat(scene, starts))
+            want = np.minimum.reduceat(np.minimum.reduceat(pair, starts, axis=0), starts, axis=1)
+            assert np.array_equal(g_pair, want)
+            assert g_names == [names[i] for i in starts]
+            assert (g_scene < 0.5).any()  # something is measured, not only the cap
