@@ -56,12 +56,12 @@ one run repeated).
 The settings are in :mod:`~plannerlab.planners.clearance.settings`, the step in numpy in
 :mod:`~plannerlab.planners.clearance.step` (a base of :class:`ClearanceDescent`), the field
 and step on either engine in :mod:`~plannerlab.planners.clearance.models`; this module holds
-the descent, its escapes and :class:`LegPath`, the clearance family's result.
+the descent and its escapes (the sub-solves of other planners in
+:mod:`~plannerlab.planners.clearance.escapes`).
 """
 
 from __future__ import annotations
 
-import dataclasses
 from collections.abc import Callable, Mapping
 from typing import Any
 
@@ -75,13 +75,14 @@ from plannerlab.planners.base import (
     Status,
     with_overrides,
 )
+from plannerlab.planners.clearance.escapes import route, rrtconnect
 from plannerlab.planners.clearance.field import ClearanceField, SetupStopped
 from plannerlab.planners.clearance.legpath import LegPath
 from plannerlab.planners.clearance.models import CompiledStep, Model, NumpyModel
 from plannerlab.planners.clearance.settings import ClearanceSettings, robot_size
 from plannerlab.planners.clearance.slide import Slide, deep_inside, sight_clearance_m, slide_out
 from plannerlab.planners.clearance.step import DescentStep
-from plannerlab.planners.context import LegPlanner, PlanningContext, plan_in
+from plannerlab.planners.context import LegPlanner, PlanningContext
 from plannerlab.problem.goals import GoalRegion, JointGoal
 from plannerlab.robots.base import Array, joint_difference, wrap_to_pi
 from plannerlab.robots.paths import path_length
@@ -506,65 +507,6 @@ class ClearanceDescent(DescentStep, LegPlanner):
                 return esc, iterations, f"{how} (draw {draw})"
         return [np.array(q_stall)], iterations, how
 
-    def _route(
-        self, ctx: PlanningContext, q_stall: Array, used: int, rng: np.random.Generator
-    ) -> tuple[list[Array], int, str]:
-        """The detours' last resort: follow-the-leader from the stall (the tip's route
-        through free workspace into the goal, tracked by this descent's settings), a
-        sub-solve in the leg's context (its checks are the leg's). Why: a stall whose
-        goal lies behind a wall the tip faces (a room entered from outside, straight
-        from rest) is left by no retract of the body: each retract's descent falls back
-        into the same basin (``armz_deep_a``, ``armz_deep_b``: every retract tried, none
-        got in); the way in is the tip's route through the opening."""
-        if self.route_planner is None or not self.settings.route_escape:
-            return [np.array(q_stall)], 0, "no route escape"
-        tracker = ctx.tracker
-        sub = tracker.remaining(limit_iterations=False)
-        if sub is None:
-            return [np.array(q_stall)], 0, f"route: {tracker.exhausted() or 'no budget'}"
-        b = tracker.budget
-        if b.max_iterations is not None:
-            sub = sub.replace(max_iterations=max(b.max_iterations - used, 1))
-        s = self.settings
-        # this descent's settings, but its escapes (follow-the-leader sets its own)
-        own = ("escape", "max_escapes", "escape_checks", "route_escape")
-        descent = {
-            f"descent.{f.name}": getattr(s, f.name)
-            for f in dataclasses.fields(s)
-            if f.name not in own and getattr(s, f.name) is not None
-        }
-        leader = self.route_planner(descent)
-        r = plan_in(leader, ctx.sub(sub, q_stall), rng)
-        if r.solved:
-            return list(r.path), r.iterations, f"the tip's route ({r.reason})"
-        return [np.array(q_stall)], r.iterations, f"the tip's route: {r.status.value}"
-
-    def _rrtconnect(
-        self, ctx: PlanningContext, q_stall: Array, rng: np.random.Generator
-    ) -> tuple[list[Array], int, str]:
-        """RRT-Connect from the stall to a goal state found near it by this descent, with
-        its settings (:meth:`near_goal_state`, the sub-solve's goal finder) or, when the
-        descent from the stall ends in no collision-free goal state, to
-        ``escape_goal_samples`` goal states drawn by IK (OMPL's ``near_or_ik`` goal
-        selection), with the checks and time left, at most ``escape_checks`` checks: a
-        sub-solve in the leg's context (its checks are the leg's); its iterations count
-        in the leg's afterwards (the caller adds them)."""
-        if self.escape_planner is None:
-            raise PlannerlabError(
-                f"{self.name}: no escape planner given (make it by name, make_planner)"
-            )
-        tracker = ctx.tracker
-        sub = tracker.remaining(self.settings.escape_checks, limit_iterations=False)
-        if sub is None:
-            return [np.array(q_stall)], 0, f"not started: {tracker.exhausted() or 'no budget'}"
-        rrt = self.escape_planner(
-            {"goal_selection": "near_or_ik", "goal_samples": self.settings.escape_goal_samples}
-        )
-        r = plan_in(rrt, ctx.sub(sub, q_stall, near_goal=self.near_goal_state), rng)
-        if r.solved:
-            return list(r.path), r.iterations, "rrtconnect"
-        return [np.array(q_stall)], r.iterations, f"rrtconnect: {r.status.value}"
-
     # ------------------------------------------------------------------ solve
     def warm_up(self, problem, leg: int, q_start: Array) -> None:
         """For the compiled backend on an Arm-Z, load (or compile) its kernels before the
@@ -647,12 +589,12 @@ class ClearanceDescent(DescentStep, LegPlanner):
             elif s.escape == "random_detour":
                 esc, it, how = self._random_detours(ctx, q_stall, used, rng)
             else:
-                esc, it, how = self._rrtconnect(ctx, q_stall, rng)
+                esc, it, how = rrtconnect(self, ctx, q_stall, rng)
             if slid is None:
                 leg_path.iterations += it
             if len(esc) <= 1 and s.escape in ("detour", "random_detour"):
                 # no retract led into the goal: the tip's route, from the stall
-                esc, it, how_route = self._route(ctx, q_stall, leg_path.iterations, rng)
+                esc, it, how_route = route(self, ctx, q_stall, leg_path.iterations, rng)
                 leg_path.iterations += it
                 how = f"no retract led in ({how}); {how_route}"
             left_stall = len(esc) > 1
