@@ -9,8 +9,10 @@ exact test; ``"meshes"``: the meshes' own triangles, as MoveIt does) or on the c
 covers plannerlab plans with (``geometry="covers"``: a pair that only the covers' excess
 brings together is then kept checked):
 
-* ``Adjacent``: links on one body or on neighbouring bodies (parent and child of a
-  movable joint) -- plannerlab never checks them anyway;
+* ``Adjacent``: links on one body or on adjacent bodies (parent and child of a movable
+  joint, or joined through bodies without collision geometry, as MoveIt counts them:
+  :func:`~plannerlab.robots.urdf.pairs.adjacent_bodies`) -- plannerlab never checks
+  them anyway;
 * ``Default``: in collision at the default state (every joint at 0, clipped into its
   limits);
 * ``Always``: in collision in every sampled state;
@@ -33,6 +35,7 @@ import numpy as np
 
 from plannerlab.collision.fcl_checker import colliding_link_pairs
 from plannerlab.robots.urdf.model import UrdfChain
+from plannerlab.robots.urdf.pairs import adjacent_bodies
 
 
 @dataclass(frozen=True)
@@ -72,7 +75,7 @@ def disabled_pairs(
     urdf_of = dict(zip(bare.link_names, bare.link_urdf_names, strict=True))
     body = {bare.link_urdf_names[i]: int(bare._cap_body[i]) for i in range(len(bare.link_names))}
     parent = [int(p) for p in bare._parent_body]
-    neighbours = {frozenset((parent[i], i + 1)) for i in range(len(parent))}
+    neighbours = adjacent_bodies(parent, body.values())
     links = sorted(set(bare.link_urdf_names))
     out: dict[frozenset[str], str] = {}
     for i, a in enumerate(links):

@@ -22,7 +22,11 @@ URDF = """<?xml version="1.0"?>
   <link name="base">
     <collision><origin xyz="0 0 0.05"/><geometry><mesh filename="box.stl"/></geometry></collision>
   </link>
-  <link name="turn"/>
+  <link name="turn">
+    <!-- a small knob on the joint: with no geometry, base and slider would be adjacent
+         (MoveIt's rule) and never checked against each other -->
+    <collision><origin xyz="0 0 0.3"/><geometry><box size="0.01 0.01 0.01"/></geometry></collision>
+  </link>
   <link name="slider">
     <collision><origin xyz="{x} 0 0.05"/><geometry><mesh filename="box.stl"/></geometry></collision>
   </link>
@@ -105,10 +109,12 @@ def test_the_finer_cover_is_conservative_and_judges_self_collision_only(urdf: Pa
     n_first = sum(c.primitives for c in fine.mesh_covers)
     assert len(fine.scene_only_links) == n_first
     assert not fine.scene_only_links & fine.self_only_links
-    assert len(fine.link_names) == n_first + len(fine.self_only_links)
+    # the first covers, the joint's knob (a box: a capsule of both roles), the finer covers
+    assert len(fine.link_names) == n_first + 1 + len(fine.self_only_links)
     assert all("#s" in fine.link_names[i] for i in fine.self_only_links)
     # each URDF link's capsules one run, its first cover first
-    assert fine.link_urdf_names == tuple(sorted(fine.link_urdf_names, key=["base", "slider"].index))
+    order = ["base", "turn", "slider"]
+    assert fine.link_urdf_names == tuple(sorted(fine.link_urdf_names, key=order.index))
     assert fine.link_names[0] == "base" and fine.link_names[1] == "base#s0"
     Q = np.random.default_rng(0).uniform(fine.lower, fine.upper, size=(200, 2))
     valid = CollisionChecker(fine, Scene()).valid_batch(Q)
@@ -181,12 +187,15 @@ def test_pairs_that_never_collide_are_found_on_the_meshes_not_the_covers(urdf: P
     Q = np.random.default_rng(1).uniform(apart.lower, apart.upper, size=(50, 2))
     assert min(mesh_distance_m(apart, q) for q in Q) > 0.0
     on_meshes = disabled_pairs(apart, np.random.default_rng(0), n_states=100)
-    assert {(p.link1, p.link2): p.reason for p in on_meshes} == {("base", "slider"): "Never"}
+    knob = [("base", "turn", "Adjacent"), ("slider", "turn", "Adjacent")]  # the joint's knob
+    assert [(p.link1, p.link2, p.reason) for p in on_meshes] == [*knob, ("base", "slider", "Never")]
     on_covers = disabled_pairs(apart, np.random.default_rng(0), n_states=100, geometry="covers")
-    assert [(p.link1, p.link2, p.reason) for p in on_covers] == [("base", "slider", "Default")]
+    got = [(p.link1, p.link2, p.reason) for p in on_covers]
+    assert got == [*knob, ("base", "slider", "Default")]
     # a pair that does meet is kept checked on the meshes too
     meeting = chain(urdf, 0)
-    assert disabled_pairs(meeting, np.random.default_rng(0), n_states=100) == []
+    got = disabled_pairs(meeting, np.random.default_rng(0), n_states=100)
+    assert [(p.link1, p.link2, p.reason) for p in got] == knob
 
 
 @pytest.mark.parametrize("planner", ["native.rrtconnect", "ompl.rrtconnect"])

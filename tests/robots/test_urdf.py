@@ -322,3 +322,47 @@ def test_import_mbm_on_the_command_line_writes_a_problem_that_loads(tmp_path, ca
     problem = parse_problem(tmp_path / "out" / "table_test.toml")
     assert problem.name == "table_test" and len(problem.scene.obstacles) == 2
     assert problem.safety_margin_m == 0.0 and problem.joint_step == pytest.approx(0.02)
+
+
+def _bare_middle(tmp_path, bare: bool):
+    """base -(turn)- housing -(tilt)- arm: the housing bare or with a small box; the arm's
+    cylinder starts inside the base's box, as a joint housing's neighbours are built."""
+    box = '<geometry><box size="0.02 0.02 0.02"/></geometry>'
+    housing = "" if bare else f"<collision>{box}</collision>"
+    limit = 'effort="1" velocity="1"'
+    urdf = tmp_path / f"bare_{bare}.urdf"
+    urdf.write_text(
+        f"""<robot name="bare">
+  <link name="base"><collision><geometry><box size="0.3 0.3 0.3"/></geometry></collision></link>
+  <link name="housing">{housing}</link>
+  <link name="arm"><collision><origin xyz="0 0 0.3"/>
+    <geometry><cylinder radius="0.05" length="0.8"/></geometry></collision></link>
+  <joint name="turn" type="revolute"><parent link="base"/><child link="housing"/>
+    <origin xyz="0 0 0.1"/><axis xyz="0 0 1"/><limit lower="-3" upper="3" {limit}/></joint>
+  <joint name="tilt" type="revolute"><parent link="housing"/><child link="arm"/>
+    <axis xyz="0 1 0"/><limit lower="-1" upper="1" {limit}/></joint>
+</robot>
+""",
+        encoding="utf-8",
+    )
+    return UrdfChain(urdf, "arm")
+
+
+def test_links_joined_through_a_bare_body_are_adjacent_as_moveit_counts_them(tmp_path):
+    """The arm hangs from the base through a housing with no collision geometry: MoveIt
+    calls base and arm adjacent ("adjacent with no geometry links between them"); checked,
+    they would collide in every state. A housing with geometry keeps them checked."""
+    from plannerlab.collision.fcl_checker import CollisionChecker
+    from plannerlab.problem.scene import Scene
+
+    robot = _bare_middle(tmp_path, bare=True)
+    names = list(robot.link_urdf_names)
+    base, arm = names.index("base"), names.index("arm")
+    assert (min(base, arm), max(base, arm)) in robot.excluded_pairs
+    checker = CollisionChecker(robot, Scene())
+    assert checker.is_valid(np.array([0.3, 0.2]))
+    solid = _bare_middle(tmp_path, bare=False)
+    names = list(solid.link_urdf_names)
+    base, arm = names.index("base"), names.index("arm")
+    assert (min(base, arm), max(base, arm)) not in solid.excluded_pairs
+    assert not CollisionChecker(solid, Scene()).is_valid(np.array([0.3, 0.2]))

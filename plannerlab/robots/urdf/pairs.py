@@ -4,6 +4,7 @@ the problem's allowed pairs, capsules on one body or on neighbouring bodies."""
 from __future__ import annotations
 
 import xml.etree.ElementTree as ET
+from collections.abc import Iterable, Sequence
 from pathlib import Path
 from typing import Any
 
@@ -19,6 +20,35 @@ def read_srdf_disabled(path: Path) -> list[tuple[str, str]]:
     return [(str(e.get("link1")), str(e.get("link2"))) for e in root.iter("disable_collisions")]
 
 
+def adjacent_bodies(
+    parent_body: Sequence[int], with_geometry: Iterable[int]
+) -> set[frozenset[int]]:
+    """Body pairs that are adjacent as MoveIt's set-up assistant counts them: parent and
+    child of a movable joint (body ``i + 1`` hangs from ``parent_body[i]``), or joined
+    through bodies without collision geometry (its "adjacent with no geometry links
+    between them"). A body with no geometry of its own (a Unitree Z1's ``link01``: a
+    bare joint housing) would otherwise leave its two neighbours, built to overlap at
+    the joint, checked against each other, and in collision in every state.
+    """
+    n = len(parent_body) + 1
+    links: dict[int, set[int]] = {b: set() for b in range(n)}
+    for i, p in enumerate(parent_body):
+        links[int(p)].add(i + 1)
+        links[i + 1].add(int(p))
+    solid = set(int(b) for b in with_geometry)
+    out: set[frozenset[int]] = set()
+    for b in range(n):
+        seen, stack = {b}, [b]
+        while stack:  # b's neighbours, and on through the bare ones
+            for c in links[stack.pop()]:
+                if c not in seen:
+                    seen.add(c)
+                    out.add(frozenset((b, c)))
+                    if c not in solid:
+                        stack.append(c)
+    return out
+
+
 def excluded_pairs(
     caps: Any,
     parent_body: list[int],
@@ -28,7 +58,7 @@ def excluded_pairs(
     path: Path,
 ) -> set[tuple[int, int]]:
     """Capsule pairs never checked (``caps``: the chain's capsules, their URDF links and
-    bodies): on one body, on neighbouring bodies, or of links the
+    bodies): on one body, on adjacent bodies (:func:`adjacent_bodies`), or of links the
     SRDF or the problem's allowed-collision pairs name."""
     disabled: set[frozenset[str]] = set()
     if srdf_path is not None:
@@ -42,7 +72,7 @@ def excluded_pairs(
                     f"pairs of links of {path.name}; {n!r} is not one{hint(n, list(links))}",
                 )
         disabled.add(frozenset((l1, l2)))
-    neighbours = {frozenset((parent_body[i], i + 1)) for i in range(len(parent_body))}
+    neighbours = adjacent_bodies(parent_body, caps.body)
     excluded = set()
     L = len(caps.names)
     for i in range(L):
@@ -57,4 +87,4 @@ def excluded_pairs(
     return excluded
 
 
-__all__ = ["excluded_pairs", "read_srdf_disabled"]
+__all__ = ["adjacent_bodies", "excluded_pairs", "read_srdf_disabled"]
