@@ -172,7 +172,6 @@ def trials(args: argparse.Namespace, names: list[str], seeds: list[int]) -> list
 
 
 def cmd_run(args: argparse.Namespace) -> int:
-    from plannerlab.comparison.runner import run_comparison
     from plannerlab.comparison.store import TrialStore
 
     out = Path(args.out)
@@ -202,13 +201,13 @@ def cmd_run(args: argparse.Namespace) -> int:
         planners=names,
     )
     t0 = time.monotonic()
-    done = [0]
+    count = {"done": 0, "of": len(grid)}
 
     def on_done(rec: Any, skipped: bool) -> None:
-        done[0] += 1
+        count["done"] += 1
         if not skipped:
             print(
-                f"[{done[0]}/{len(grid)}] {rec.problem} {rec.planner} s{rec.seed}: "
+                f"[{count['done']}/{count['of']}] {rec.problem} {rec.planner} s{rec.seed}: "
                 f"{rec.status} in {rec.wall_s or 0.0:.1f} s "
                 f"({time.monotonic() - t0:.0f} s, load {os.getloadavg()[0]:.1f})",
                 file=sys.stderr,
@@ -219,6 +218,32 @@ def cmd_run(args: argparse.Namespace) -> int:
         raise KeyboardInterrupt  # the runner stops its trials; the store keeps the rest
 
     signal.signal(signal.SIGTERM, stop)
+    ran = skipped = 0
+    try:
+        ran, skipped = _stages(
+            args, store, meta, (meta_path, head, dirty), (names, seeds, grid), (on_done, count)
+        )
+    finally:  # an interrupted run keeps its wall time (the store keeps its trials)
+        meta.update(
+            load_at_end=list(os.getloadavg()),
+            wall_s=round((meta.get("wall_s") or 0.0) + time.monotonic() - t0, 1),
+            trials=len(store.load()),
+        )
+        meta_path.write_text(json.dumps(meta, indent=1) + "\n")
+    meta["finished"] = datetime.now(UTC).isoformat(timespec="seconds")
+    meta_path.write_text(json.dumps(meta, indent=1) + "\n")
+    print(f"{ran} trials run now, {skipped} already in {out / 'trials.jsonl'}")
+    return 0
+
+
+def _stages(args, store, meta, where, what, report):
+    """The screen and the best members' seeds (``--members best``), or every member on
+    every seed (``all``): (trials run, trials already in the store)."""
+    from plannerlab.comparison.runner import run_comparison
+
+    meta_path, head, dirty = where
+    names, seeds, grid = what
+    on_done, count = report
     ran = skipped = 0
     for stage in range(2 if args.members == "best" else 1):
         if stage == 1:
@@ -233,7 +258,7 @@ def cmd_run(args: argparse.Namespace) -> int:
                 flush=True,
             )
             grid = trials(args, sorted(set(best.values()), key=names.index), seeds)
-        done[0] = 0
+        count.update(done=0, of=len(grid))
         _write_meta(meta_path, meta, head, dirty, grid, args)
         limits = {t.key: limit for t, limit in grid}
         run = run_comparison(
@@ -245,15 +270,7 @@ def cmd_run(args: argparse.Namespace) -> int:
         )
         ran += run.ran
         skipped += run.skipped
-    meta.update(
-        finished=datetime.now(UTC).isoformat(timespec="seconds"),
-        load_at_end=list(os.getloadavg()),
-        wall_s=round((meta.get("wall_s") or 0.0) + time.monotonic() - t0, 1),
-        trials=len(store.load()),
-    )
-    meta_path.write_text(json.dumps(meta, indent=1) + "\n")
-    print(f"{ran} trials run now, {skipped} already in {out / 'trials.jsonl'}")
-    return 0
+    return ran, skipped
 
 
 def _write_meta(
@@ -445,6 +462,7 @@ def _fmt(x: float | None) -> str:
 
 
 def _markdown(meta, rows, table, problems, names) -> str:
+    n_trials = sum(c["seeds"] for c in table.values())
     short = [p.removeprefix("armz_") for p in problems]
     budget = meta["budget"]
     load0 = meta.get("load_at_start", [0.0])[0]
@@ -460,7 +478,7 @@ def _markdown(meta, rows, table, problems, names) -> str:
         f"At `{meta['commit']}`{' (with changes)' if meta.get('dirty') else ''}; per leg "
         f"{budget['max_collision_checks']:,} collision checks, {budget['time_limit_s']:g} s "
         f"of planning as a guard, iterations lifted; seeds {meta['seeds']} (a deterministic "
-        f"planner: one run); every solved plan executed in PyBullet; {meta['trials']} trials, "
+        f"planner: one run); every solved plan executed in PyBullet; {n_trials} trials, "
         f"{meta.get('jobs')} at a time, {meta.get('wall_s', 0) / 3600:.2f} h; load average at "
         f"the start {load0:.1f}, at the end {load1:.1f}.",
         "",
