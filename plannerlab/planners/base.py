@@ -534,5 +534,34 @@ def with_overrides(settings: Any, overrides: Mapping[str, Any], planner: str) ->
                 raise PlannerlabError(
                     f"setting {key} of {planner}: expected {type(current).__name__}, got {value!r}"
                 ) from None
-        changes[key] = value
+        changes[key] = _typed(value, current, key, planner)
     return dataclasses.replace(settings, **changes)
+
+
+def _typed(value: Any, current: Any, key: str, planner: str) -> Any:
+    """``value`` as the type of the setting's default ``current``, or a clear error: a
+    flag takes only true/false, a count only a whole number, a length or time only a
+    number, a name only a string (a TOML file's ``route_escape = "maybe"`` or
+    ``max_checks = 2.5`` must not pass silently). A default of ``None`` is a number."""
+    if isinstance(current, bool):
+        ok = isinstance(value, bool)
+        expected = "true or false"
+    elif isinstance(current, int):
+        if isinstance(value, float) and value.is_integer():
+            value = int(value)
+        ok = isinstance(value, int) and not isinstance(value, bool)
+        expected = "a whole number"
+    elif isinstance(current, float) or current is None:
+        if value is None and current is None:
+            return None
+        ok = isinstance(value, (int, float)) and not isinstance(value, bool)
+        value = float(value) if ok else value
+        expected = "a number"
+    elif isinstance(current, str):
+        ok = isinstance(value, str)
+        expected = "a string"
+    else:
+        return value
+    if not ok:
+        raise PlannerlabError(f"setting {key} of {planner}: expected {expected}, got {value!r}")
+    return value

@@ -9,7 +9,14 @@ from conftest import toy_problem
 
 from plannerlab.collision.fcl_checker import CollisionChecker
 from plannerlab.errors import PlannerlabError
-from plannerlab.planners.base import BudgetTracker, LegRun, PlanResult, Status, StepClock
+from plannerlab.planners.base import (
+    BudgetTracker,
+    LegRun,
+    PlanResult,
+    Status,
+    StepClock,
+    with_overrides,
+)
 from plannerlab.planners.gradient import GradientSettings
 from plannerlab.problem.load import Budget
 from plannerlab.robots.paths import path_length
@@ -172,3 +179,38 @@ def test_a_childs_checks_are_its_parents_through_the_shared_checker_and_its_char
     # (the parent counts them already)
     parent.charge(_sub_result(iterations=6, checks=child.checks_used, fk_calls=9), checks=False)
     assert (parent.checks_used, parent.iterations, parent.fk_calls) == (10, 6, 9)
+
+
+@pytest.mark.parametrize(
+    ("key", "value", "expected"),
+    [
+        ("route_escape", "maybe", "expected bool"),  # a string not a flag (CLI coercion)
+        ("route_escape", 3, "expected true or false"),  # a TOML number where a flag is
+        ("max_escapes", 2.5, "expected a whole number"),
+        ("max_escapes", True, "expected a whole number"),
+        ("max_step_rad", [0.1], "expected a number"),
+        ("escape", 1, "expected a string"),
+    ],
+)
+def test_a_setting_of_the_wrong_type_is_refused_by_name(key, value, expected):
+    """Overrides from a TOML file keep their types: a value of the wrong type is refused
+    with the setting's name and what it takes, never passed on (`route_escape = 3` used to
+    reach the planner as a truthy number)."""
+    from plannerlab.planners.clearance.settings import ClearanceSettings
+
+    with pytest.raises(PlannerlabError, match=f"setting {key} of gradient.clearance: {expected}"):
+        with_overrides(ClearanceSettings(), {key: value}, "gradient.clearance")
+
+
+def test_settings_of_the_right_type_pass_and_whole_floats_count():
+    from plannerlab.planners.clearance.settings import ClearanceSettings
+
+    s = with_overrides(
+        ClearanceSettings(),
+        {"route_escape": False, "max_escapes": 3.0, "max_step_rad": 1, "escape": "detour"},
+        "gradient.clearance",
+    )
+    assert s.route_escape is False and s.max_escapes == 3 and isinstance(s.max_escapes, int)
+    assert s.max_step_rad == 1.0 and isinstance(s.max_step_rad, float) and s.escape == "detour"
+    cli = with_overrides(ClearanceSettings(), {"route_escape": "no"}, "gradient.clearance")
+    assert cli.route_escape is False  # the CLI's strings are still read as flags
