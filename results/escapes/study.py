@@ -463,6 +463,8 @@ def _fmt(x: float | None) -> str:
 
 def _markdown(meta, rows, table, problems, names) -> str:
     n_trials = sum(c["seeds"] for c in table.values())
+    cpu_h = sum(c["cpu_s"] for c in table.values()) / 3600
+    jobs = int(meta.get("jobs") or 1)
     short = [p.removeprefix("armz_") for p in problems]
     budget = meta["budget"]
     load0 = meta.get("load_at_start", [0.0])[0]
@@ -479,8 +481,9 @@ def _markdown(meta, rows, table, problems, names) -> str:
         f"{budget['max_collision_checks']:,} collision checks, {budget['time_limit_s']:g} s "
         f"of planning as a guard, iterations lifted; seeds {meta['seeds']} (a deterministic "
         f"planner: one run); every solved plan executed in PyBullet; {n_trials} trials, "
-        f"{meta.get('jobs')} at a time, {meta.get('wall_s', 0) / 3600:.2f} h; load average at "
-        f"the start {load0:.1f}, at the end {load1:.1f}.",
+        f"{jobs} at a time, {meta.get('wall_s', 0) / 3600:.2f} h of wall time as recorded; "
+        f"the trials' own CPU time {cpu_h:.2f} h, {cpu_h / jobs:.2f} h on {jobs} cores; load "
+        f"average at the start {load0:.1f}, at the end {load1:.1f}.",
         "",
         (
             "**At a glance**: each family's best member on the screen (every member once, "
