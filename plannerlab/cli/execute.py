@@ -13,7 +13,7 @@ from rich.text import Text
 
 from plannerlab import extras as px
 from plannerlab.cli.common import require_display
-from plannerlab.cli.solve import add_plan_arguments, leg_table, solve_and_save
+from plannerlab.cli.solve import add_plan_arguments, into_folder, leg_table, solve_and_save
 from plannerlab.cli.tables import Kind, natural_width, table
 from plannerlab.errors import PlanFileError, PlannerlabError
 from plannerlab.record.cells import fmt
@@ -137,7 +137,9 @@ def cmd_execute(args: argparse.Namespace, console: Console) -> int:
         if not args.planner:
             raise PlannerlabError("execute PROBLEM needs --planner NAME (or give a PLAN.json)")
         plan, plan_file = solve_and_save(args, console)
-    out = Path(args.out) if args.out else execution_path(plan_file)
+    out = execution_path(plan_file)
+    if args.out:
+        out = into_folder(Path(args.out), out.name)
     problem = plan.load_problem()
     if args.problem.endswith(".json"):
         px.check_plan(plan, problem, args.problem)

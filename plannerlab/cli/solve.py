@@ -57,6 +57,12 @@ def leg_table(plan: Any, title: str) -> Table:
     return t
 
 
+def into_folder(out: Path, name: str) -> Path:
+    """``--out``: a file to write, or an existing folder to write ``name`` into (checked
+    before any work, so a plan is never computed and then lost at saving)."""
+    return out / name if out.is_dir() else out
+
+
 def _default_plan_path(problem: str, planner: str, seed: int) -> Path:
     return RESULTS_DIR / "plans" / f"{problem}__{planner}__seed{seed}.json"
 
@@ -74,7 +80,8 @@ def solve_and_save(args: argparse.Namespace, console: Console, out: Path | None 
     overrides = parse_overrides(args.set)
     legs = px.legs_from_spec(problem, args.legs)
     n_legs = len(legs) if legs is not None else problem.legs
-    out = out or _default_plan_path(problem.name, args.planner, args.seed)
+    default = _default_plan_path(problem.name, args.planner, args.seed)
+    out = into_folder(out, default.name) if out else default
     out.parent.mkdir(parents=True, exist_ok=True)  # a path that cannot exist fails now
     status = console.status(f"{args.planner} on {problem.name}: leg 1/{n_legs}")
 

@@ -112,6 +112,28 @@ def test_solve_execute_plot_round_trip(capsys, tmp_path):
     code, out, _ = run(capsys, "execute", str(plan_path), "--out", str(tmp_path / "x.json"))
     assert code == 0 and json.loads((tmp_path / "x.json").read_text())["executions"]
 
+    # --out an existing folder: the file of its default name goes into it (it used to
+    # fail only at saving, "Is a directory", the plan computed and lost)
+    folder = tmp_path / "plans"
+    folder.mkdir()
+    code, out, _ = run(
+        capsys,
+        "solve",
+        "armz_pocket",
+        "--planner",
+        "gradient.analytic",
+        "--seed",
+        "3",
+        "--out",
+        str(folder),
+        "--json",
+    )
+    assert code == 0 and json.loads(out)["legs"][0]["status"] == "local_minimum"
+    saved = folder / "armz_pocket__gradient.analytic__seed3.json"
+    assert json.loads(saved.read_text())["legs"][0]["path"] == leg["path"]
+    code, out, _ = run(capsys, "execute", str(plan_path), "--out", str(folder))
+    assert code == 0 and json.loads((folder / "plan.exec.json").read_text())["executions"]
+
     code, out, _ = run(capsys, "plot", str(plan_path), "--out", str(tmp_path / "fig"), "--json")
     files = json.loads(out)
     assert code == 0 and any(f.endswith("stall.png") for f in files)
