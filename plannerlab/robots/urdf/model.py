@@ -319,7 +319,7 @@ class UrdfChain:
     cover_excess_m: float = 0.01
     cover_max_primitives: int = 32
     self_cover_excess_m: float = 0.004
-    self_cover_max_primitives: int = 128
+    self_cover_max_primitives: int = 0
     cover_cache: bool = True
     cover_cache_dir: Path | None = None
     sim_urdf_path: Path | None = None

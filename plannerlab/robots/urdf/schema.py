@@ -141,7 +141,7 @@ TABLE = RobotTable(
         Key(
             "self_cover_max_primitives",
             "integer",
-            128,
+            0,
             "",
             "the most capsules of a mesh's finer cover; 0: none (the first cover judges "
             "self-collision too); 128 for links that pass within millimetres of each other "
