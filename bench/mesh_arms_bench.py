@@ -2,7 +2,8 @@
 refereed on their real meshes (issue 35's targets).
 
 The arms: UR10, Kinova (Jaco 2, ``kinova.urdf``), SO-101, Panda and Z1 from
-``example-robot-data`` 6.0.0 and the xArm6 from ``pybullet_data``, each with plannerlab's
+``example-robot-data`` 6.0.0 and the xArm6 and the KUKA iiwa (``kuka_iiwa/model.urdf``)
+from ``pybullet_data``, each with plannerlab's
 defaults (:func:`plannerlab.run.robot_info.default_tip_link`, the covers' defaults).
 
 The problems are made by one method for every arm, sized to its reach ``R`` (the
@@ -58,6 +59,7 @@ ARMS = {
     "so101": ("erd", "so_arm_description/urdf/so101.urdf"),
     "panda": ("erd", "panda_description/urdf/panda.urdf"),
     "z1": ("erd", "z1_description/urdf/z1.urdf"),
+    "iiwa": ("pybullet", "kuka_iiwa/model.urdf"),
 }
 
 
