@@ -115,7 +115,8 @@ class Options(NamedTuple):
     """A search's settings: guide states (k, dof; k = 0: none), ``f`` = (guide_bias,
     guide_sigma_rad, range_rad, joint_step), the dynamic domain ``dd`` = (radius,
     min_radius, alpha) (radius 0: none), ``i`` = (max_iterations, need_free, every: the
-    coarse check's stride, 1 for every edge in full at once)."""
+    coarse check's stride, 1 for every edge in full at once; balance: 1 to grow the
+    smaller tree while it has at most half the other's nodes)."""
 
     guides: np.ndarray
     f: np.ndarray
@@ -408,7 +409,10 @@ def rrtc_run(S, A, B, sizes, O, counters, limits):
     Each iteration draws a sample (:func:`sample`: uniform, or a guide state perturbed,
     with probability ``guide_bias``), extends the tree whose turn it is one step of at
     most ``range_rad`` towards it, and, if that edge is free, connects the other tree to
-    the new node step by step (OMPL's RRT-Connect); the trees then swap roles.
+    the new node step by step (OMPL's RRT-Connect); the trees then swap roles, unless
+    ``O.i[3]`` (balance, VAMP's default) and one tree has at most half the other's nodes:
+    then the smaller one grows (a goal tree in a pocket gets the iterations, not the start
+    tree sprawling outside).
 
     Limits: ``O.i[0]`` iterations (total), ``limits`` = (soft, hard) total checks: the
     soft one ends this call (:data:`CHUNK`) between two edges (a connection stops where
@@ -436,6 +440,8 @@ def rrtc_run(S, A, B, sizes, O, counters, limits):
         counters[0] += 1
         sample(S.rng, m.lower, m.upper, m.continuous, O.guides, O.f[0], O.f[1], q_rand)
         t = counters[2]
+        if O.i[3] != 0 and 2 * sizes[1 - t] <= sizes[t]:
+            t = 1 - t  # balanced: the tree of at most half the other's nodes grows
         counters[2] = 1 - t
         Tt, To = (A, B) if t == 0 else (B, A)
         code, c, _ = _grow(S, Tt, sizes[t], t == 1, -1, q_rand, O, hard - counters[1])

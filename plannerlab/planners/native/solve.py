@@ -269,7 +269,15 @@ class NativeSolve:
             self.guides,
             np.array([s.guide_bias, s.guide_sigma_rad, range_rad, self.step]),
             dd,
-            np.array([max_it, need_free, int(getattr(s, "lazy_every", 1))], dtype=np.int64),
+            np.array(
+                [
+                    max_it,
+                    need_free,
+                    int(getattr(s, "lazy_every", 1)),
+                    int(getattr(s, "balance", False)),
+                ],
+                dtype=np.int64,
+            ),
         )
 
     def _time_reserve_reached(self, recheck_checks: int) -> bool:
