@@ -33,7 +33,6 @@ import math
 import numpy as np
 from numba import njit
 
-_EPS = 1e-300
 _GOLD = 0.5 * (math.sqrt(5.0) - 1.0)  # 0.618...
 _T_TOL = 1e-13
 

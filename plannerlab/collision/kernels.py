@@ -7,18 +7,12 @@ some kinematics made.
   built once, boxes refit per state), traversed against each obstacle and against itself
   (:func:`state_hits`); node pairs that are apart or hold no checked pair are pruned.
 * **Narrow phase.** Exact capsule tests (:mod:`plannerlab.collision.geometry`).
-* **Batches and edges.** :func:`valid_batch`, :func:`first_invalid`, a URDF chain's states
-  with its kinematics fused in (:func:`chain_first_invalid`), an edge's states
-  (:func:`edge_states`, bit for bit ``interpolate_edge``'s).
-* **Conservative advancement.** One step from a valid state (:func:`advance_dt`) with the
-  configuration-free rates of :func:`edge_rates` (see :mod:`plannerlab.collision.core`).
 * **Distances.** Every checked pair below a margin (:func:`pair_distances_kernel`), the
   smallest over a batch (:func:`min_clearance_kernel`), every colliding pair
   (:func:`all_hits`).
 
-Arm-Z's kinematics and the checks with them fused in are in
-:mod:`plannerlab.collision.armz`; :class:`~plannerlab.collision.core.Core` is the Python
-front of both.
+:class:`~plannerlab.collision.core.Core` is their Python front (on the segments of the one
+kinematics, :mod:`plannerlab.collision.kinematics`).
 """
 
 from __future__ import annotations
@@ -28,7 +22,6 @@ import math
 import numpy as np
 from numba import njit
 
-from plannerlab.collision.chain import chain_segments
 from plannerlab.collision.geometry import capsule_obstacle, capsule_obstacle_hit, seg_seg
 
 
@@ -244,129 +237,6 @@ def scratch(L):
 
 
 @njit(cache=True, nogil=True)
-def valid_batch(segs, radii, radii_self, moving, allowed, tree, kinds, Rs, cs, hs, olo, ohi, out):
-    """Validity of every state: segs (k, L, 2, 3) → out (k,) bool."""
-    k, L = segs.shape[0], segs.shape[1]
-    buf = scratch(L)
-    pairs = np.empty((1, 3), dtype=np.int64)
-    for s in range(k):
-        m = state_hits(
-            segs[s],
-            radii,
-            radii_self,
-            moving,
-            allowed,
-            tree,
-            kinds,
-            Rs,
-            cs,
-            hs,
-            olo,
-            ohi,
-            buf,
-            True,
-            pairs,
-        )
-        out[s] = m == 0
-    return out
-
-
-@njit(cache=True, nogil=True)
-def first_invalid(segs, radii, radii_self, moving, allowed, tree, kinds, Rs, cs, hs, olo, ohi):
-    """Index of the first invalid state of segs (k, L, 2, 3), or -1."""
-    k, L = segs.shape[0], segs.shape[1]
-    buf = scratch(L)
-    pairs = np.empty((1, 3), dtype=np.int64)
-    for s in range(k):
-        if state_hits(
-            segs[s],
-            radii,
-            radii_self,
-            moving,
-            allowed,
-            tree,
-            kinds,
-            Rs,
-            cs,
-            hs,
-            olo,
-            ohi,
-            buf,
-            True,
-            pairs,
-        ):
-            return s
-    return -1
-
-
-@njit(cache=True, nogil=True)
-def chain_first_invalid(
-    Q,
-    T0,
-    parent,
-    pre,
-    axes,
-    prismatic,
-    cap_body,
-    cap_a,
-    cap_b,
-    coupling,
-    radii,
-    radii_self,
-    moving,
-    allowed,
-    tree,
-    kinds,
-    Rs,
-    cs,
-    hs,
-    olo,
-    ohi,
-):
-    """:func:`first_invalid` of a URDF chain's states Q (k, dof), kinematics included
-    (:func:`~plannerlab.collision.chain.chain_segments`): one compiled call per query."""
-    segs = np.empty((Q.shape[0], cap_body.shape[0], 2, 3))
-    chain_segments(Q, T0, parent, pre, axes, prismatic, cap_body, cap_a, cap_b, coupling, segs)
-    return first_invalid(
-        segs, radii, radii_self, moving, allowed, tree, kinds, Rs, cs, hs, olo, ohi
-    )
-
-
-@njit(cache=True, nogil=True)
-def edge_states(q_a, q_b, joint_step, continuous, limit, cap, weights):
-    """The states of ``interpolate_edge(q_a, q_b, joint_step)[1:]``, bit for bit, at most
-    ``limit`` of them: (n, Q (min(n, limit), dof)), n the edge's full count; an edge of
-    more than ``cap`` states gives (cap + 1, no states).
-
-    ``weights`` (dof,) adds a metric bound: at least ``ceil(sum_i weights_i |d_i|)``
-    steps (weights = reach_i / step_m: no point moves more than step_m per step); zeros
-    leave the count of ``interpolate_edge``."""
-    dof = q_a.shape[0]
-    d = np.empty(dof)
-    span = 0.0
-    metric = 0.0
-    for i in range(dof):
-        x = q_b[i] - q_a[i]
-        if continuous[i]:
-            x = (x + np.pi) % (2.0 * np.pi) - np.pi
-        d[i] = x
-        span = max(span, abs(x))
-        metric += weights[i] * abs(x)
-    n_f = max(1.0, math.ceil(span / joint_step - 1e-12), math.ceil(metric - 1e-12))
-    if n_f > cap:  # refused: the caller raises
-        return cap + 1, np.empty((0, dof))
-    n = int(n_f)
-    m = min(n, limit)
-    Q = np.empty((m, dof))
-    inv = 1.0 / n
-    for j in range(1, m + 1):
-        t = 1.0 if j == n else j * inv
-        for i in range(dof):
-            Q[j - 1, i] = q_a[i] + t * d[i]
-    return n, Q
-
-
-@njit(cache=True, nogil=True)
 def box_gap(lo, hi, i, olo, ohi, j):
     """A lower bound of the distance between the shapes in boxes i and j: the boxes' gap."""
     g2 = 0.0
@@ -374,97 +244,6 @@ def box_gap(lo, hi, i, olo, ohi, j):
         x = max(olo[j, c] - hi[i, c], lo[i, c] - ohi[j, c], 0.0)
         g2 += x * x
     return math.sqrt(g2)
-
-
-@njit(cache=True, nogil=True)
-def advance_dt(
-    seg,
-    radii,
-    radii_self,
-    moving,
-    allowed,
-    kinds,
-    Rs,
-    cs,
-    hs,
-    olo,
-    ohi,
-    v_link,
-    v_pair,
-    margin,
-    dt_max,
-    buf,
-):
-    """Conservative advancement from one valid state: the largest ``dt <= dt_max`` with
-    ``v_p · dt <= d_p + margin`` for every checked pair ``p``.
-
-    ``d_p``: the pair's distance with the capsules inflated (by the margin against the
-    scene, by half of it each against each other; clamped at 0), ``v_p``: an upper bound
-    of how fast the pair's distance changes per unit of the edge parameter (``v_link``
-    (L,) for a link against the scene, ``v_pair`` (L, L) for a link pair). Pairs whose
-    boxes are so far apart that they cannot limit the step are not measured.
-    """
-    lo, hi, w, lo2, hi2, _ = buf
-    L = seg.shape[0]
-    n_obs = kinds.shape[0]
-    link_boxes(seg, radii, lo, hi)
-    nv = np.empty(3)
-    best = dt_max
-    for li in range(L):
-        v = v_link[li]
-        if not moving[li] or v <= 0.0:
-            continue
-        for oi in range(n_obs):
-            if box_gap(lo, hi, li, olo, ohi, oi) + margin >= best * v:
-                continue
-            dist, _ = capsule_obstacle(
-                kinds[oi],
-                Rs[oi],
-                cs[oi],
-                hs[oi],
-                seg[li, 0],
-                seg[li, 1],
-                radii[li],
-                False,
-                nv,
-                w,
-            )
-            dt = (max(dist, 0.0) + margin) / v
-            if dt < best:
-                best = dt
-    link_boxes(seg, radii_self, lo2[:L], hi2[:L])
-    for i in range(L):
-        for j in range(i + 1, L):
-            v = v_pair[i, j]
-            if v <= 0.0 or not allowed[i, j]:
-                continue
-            if box_gap(lo2, hi2, i, lo2, hi2, j) + margin >= best * v:
-                continue
-            d2, _, _ = seg_seg(seg[i, 0], seg[i, 1], seg[j, 0], seg[j, 1])
-            dist = math.sqrt(d2) - radii_self[i] - radii_self[j]
-            dt = (max(dist, 0.0) + margin) / v
-            if dt < best:
-                best = dt
-    return best
-
-
-@njit(cache=True, nogil=True)
-def edge_rates(d, W, Pr, v_link, v_pair):
-    """Per unit of the edge parameter, bounds of how fast each link (against the scene)
-    and each link pair moves along an edge of joint change ``d``: ``|d| @ W``, ``|d| @ Pr``."""
-    dof, L = W.shape
-    for li in range(L):
-        v_link[li] = 0.0
-        for j in range(L):
-            v_pair[li, j] = 0.0
-    for k in range(dof):
-        a = abs(d[k])
-        if a == 0.0:
-            continue
-        for li in range(L):
-            v_link[li] += a * W[k, li]
-            for j in range(li + 1, L):
-                v_pair[li, j] += a * Pr[k, li, j]
 
 
 @njit(cache=True, nogil=True)
