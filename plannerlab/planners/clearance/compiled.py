@@ -500,7 +500,7 @@ class CompiledField:
     :class:`ClearanceField` (so both backends see the same field), the scene and the
     robot's chain from the compiled robot–scene model (``model``: a checker's
     :class:`~plannerlab.collision.model.CompiledModel`, or None: the robot's chain
-    packed alone, :func:`~plannerlab.collision.model_old.chain_model`), packed once.
+    folded alone, :func:`~plannerlab.collision.model.folded_chain`), packed once.
 
     Raises:
         ModelError: the robot gives no serial chain.
@@ -509,19 +509,13 @@ class CompiledField:
     """
 
     def __init__(self, field: ClearanceField, far_m: float, model: Any = None) -> None:
-        from plannerlab.collision.model_old import chain_model
-
         robot = field.robot
         if not callable(getattr(robot, "tip_data", None)):
             raise ValueError(
                 f"the compiled descent needs the robot's tip (tip_data()); "
                 f"robot {getattr(robot, 'kind', '?')!r} gives none"
             )
-        chain = (
-            sphere_chain(chain_model(robot), robot)
-            if model is None
-            else model_sphere_chain(model, robot)
-        )
+        chain = sphere_chain(robot) if model is None else model_sphere_chain(model, robot)
         link = np.array(field._link, dtype=np.int64)
         scene_idx = np.array(field._scene_spheres, dtype=np.int64)
         self_a = np.array(field._self_a, dtype=np.int64)
