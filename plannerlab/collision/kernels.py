@@ -18,11 +18,29 @@ kinematics, :mod:`plannerlab.collision.kinematics`).
 from __future__ import annotations
 
 import math
+from typing import NamedTuple
 
 import numpy as np
 from numba import njit
 
 from plannerlab.collision.geometry import capsule_obstacle, capsule_obstacle_hit, seg_seg
+
+
+class PairGeometry(NamedTuple):
+    """What the distance kernels need besides the capsule axes (one argument: numba loads
+    kernels taking a named tuple of arrays from its cache)."""
+
+    radii: np.ndarray  # (L,) against the scene, margin included
+    radii_self: np.ndarray  # (L,) against each other
+    moving: np.ndarray  # (L,) bool
+    allowed: np.ndarray  # (L, L) bool: the checked link pairs
+    tree: tuple  # :func:`chain_tree` of ``allowed``
+    kinds: np.ndarray  # (n,) obstacle kinds
+    Rs: np.ndarray  # (n, 3, 3)
+    cs: np.ndarray  # (n, 3)
+    hs: np.ndarray  # (n, 3)
+    olo: np.ndarray  # (n, 3) the obstacles' world boxes
+    ohi: np.ndarray
 
 
 @njit(cache=True, nogil=True)
@@ -117,23 +135,7 @@ def _node_boxes(tree, lo, hi, nlo, nhi):
 
 
 @njit(cache=True, nogil=True)
-def state_hits(
-    seg,
-    radii,
-    radii_self,
-    moving,
-    allowed,
-    tree,
-    kinds,
-    Rs,
-    cs,
-    hs,
-    olo,
-    ohi,
-    buf,
-    first_only,
-    out_pairs,
-):
+def state_hits(seg, geo, buf, first_only, out_pairs):
     """Colliding pairs of one state; returns how many were written to out_pairs (m, 3).
 
     Row = (link, other, other_is_link). With ``first_only`` stops at the first. ``buf``:
@@ -141,6 +143,7 @@ def state_hits(
     consecutive links, traversed against each obstacle and against itself, pruning node
     pairs whose boxes are apart or that hold no checked pair; cost ~ L log L.
     """
+    radii, radii_self, moving, allowed, tree, kinds, Rs, cs, hs, olo, ohi = geo
     lo, hi, w, nlo, nhi, stack = buf
     start, end, left, right, prefix = tree
     n_obs = kinds.shape[0]
@@ -247,39 +250,24 @@ def box_gap(lo, hi, i, olo, ohi, j):
 
 
 @njit(cache=True, nogil=True)
-def all_hits(seg, radii, radii_self, moving, allowed, tree, kinds, Rs, cs, hs, olo, ohi):
-    """Every colliding pair of one state (L, 2, 3): (m, 3) rows (link, other, other_is_link)."""
+def all_hits(seg, geo):
+    """Every colliding pair of one state (L, 2, 3): (m, 3) rows (link, other, other_is_link);
+    ``geo`` the pairs' geometry (:class:`PairGeometry`)."""
     L = seg.shape[0]
-    out = np.empty((L * kinds.shape[0] + L * L, 3), dtype=np.int64)
-    m = state_hits(
-        seg,
-        radii,
-        radii_self,
-        moving,
-        allowed,
-        tree,
-        kinds,
-        Rs,
-        cs,
-        hs,
-        olo,
-        ohi,
-        scratch(L),
-        False,
-        out,
-    )
+    out = np.empty((L * geo.kinds.shape[0] + L * L, 3), dtype=np.int64)
+    m = state_hits(seg, geo, scratch(L), False, out)
     return out[:m].copy()
 
 
 @njit(cache=True, nogil=True)
-def pair_distances_kernel(
-    seg, radii, radii_self, moving, allowed, tree, kinds, Rs, cs, hs, olo, ohi, margin
-):
-    """Every checked pair of one state whose signed distance is below ``margin`` [m].
+def pair_distances_kernel(seg, geo, margin):
+    """Every checked pair of one state whose signed distance is below ``margin`` [m]
+    (``geo``: :class:`PairGeometry`).
 
     Returns (idx (m, 3) int: link, other, other_is_link; d (m,); t_link (m,);
     t_other (m,); n (m, 3)).
     """
+    radii, radii_self, moving, allowed, tree, kinds, Rs, cs, hs, olo, ohi = geo
     L = seg.shape[0]
     n_obs = kinds.shape[0]
     lo = np.empty((L, 3))
@@ -302,7 +290,7 @@ def pair_distances_kernel(
             if not _overlap(lo, hi, li, olo, ohi, oi, pad):
                 continue
             dist, t = capsule_obstacle(
-                kinds[oi], Rs[oi], cs[oi], hs[oi], seg[li, 0], seg[li, 1], radii[li], True, nv, w
+                (kinds, Rs, cs, hs), oi, seg[li, 0], seg[li, 1], radii[li], True, nv, w
             )
             if dist < margin:
                 idx[m, 0] = li
@@ -354,9 +342,7 @@ def pair_distances_kernel(
 
 
 @njit(cache=True, nogil=True)
-def min_clearance_kernel(
-    segs, radii, radii_self, moving, allowed, tree, kinds, Rs, cs, hs, olo, ohi, include_self
-):
+def min_clearance_kernel(segs, geo, include_self):
     """Smallest signed distance [m] over every checked pair of every state (k, L, 2, 3)
     (link pairs only with ``include_self``; inf when none): the minimum of
     :func:`pair_distances_kernel`'s distances over the states, the same distance functions
@@ -364,7 +350,9 @@ def min_clearance_kernel(
     capsule's, grown by its radius, and the obstacle's or the other capsule's) are apart
     by a gap ``g > 0`` is at least ``g`` apart, so once ``g`` is no smaller than the
     smallest distance found so far the pair cannot lower it and is not measured (boxes
-    that touch bound nothing: a penetration may hide inside)."""
+    that touch bound nothing: a penetration may hide inside). ``geo``:
+    :class:`PairGeometry`."""
+    radii, radii_self, moving, allowed, tree, kinds, Rs, cs, hs, olo, ohi = geo
     L = segs.shape[1]
     n_obs = kinds.shape[0]
     lo = np.empty((L, 3))
@@ -385,10 +373,8 @@ def min_clearance_kernel(
                 if g > 0.0 and g >= best:
                     continue
                 dist, _ = capsule_obstacle(
-                    kinds[oi],
-                    Rs[oi],
-                    cs[oi],
-                    hs[oi],
+                    (kinds, Rs, cs, hs),
+                    oi,
                     seg[li, 0],
                     seg[li, 1],
                     radii[li],

@@ -217,9 +217,10 @@ def _to_state(cpl, i, x, sign, out):
 
 
 @njit(cache=True, nogil=True, inline="always")
-def point_gradient(Bf, kn, body, p, n0, n1, n2, sign, out):
+def point_gradient(Bf, kn, body, p, nv, sign, out):
     """Add ``sign · n · ∂p/∂q`` into ``out`` (dof,) for the point p (3,) on ``body``
-    (``kn``: the chain's :func:`kin`)."""
+    (``kn``: the chain's :func:`kin`; ``nv`` = (n0, n1, n2), three floats)."""
+    n0, n1, n2 = nv
     parent, slide, cpl, _, serial = kn
     if serial:  # joints 0 … body − 1, each turning about its body's z
         for i in range(body):
@@ -298,7 +299,7 @@ def tip_jacobians(Bf, ch, p, n, dof):
 
 # ---------------------------------------------------------------------- pairs
 @njit(cache=True, nogil=True)
-def pairs(P, r, scene_idx, self_a, self_b, scene, far_m, lp_of_row, lp_links, ends):
+def pairs(P, r, scene_idx, self_ab, scene, far_m, cull):
     """Every sphere pair, in ``ClearanceField._pairs``' order: distance d (m,), direction
     n (m, 3). ``scene``: the obstacles (kinds, Rs, cs, pars, bound). A pair at least
     ``far_m`` apart gets d = ``far_m`` and no direction (the descent asks nothing of it:
@@ -307,7 +308,10 @@ def pairs(P, r, scene_idx, self_a, self_b, scene, far_m, lp_of_row, lp_links, en
     ``bound``) when they are that far. The self pairs of two links whose sphere chains are
     that far apart (their midpoints farther than both half-lengths, radii and ``far_m``)
     are skipped together (``lp_of_row``: each self pair's link pair, ``lp_links`` (k, 2)
-    its links, ``ends`` (L, 2) each link's first and last sphere; :func:`pair_spheres`)."""
+    its links, ``ends`` (L, 2) each link's first and last sphere; :func:`pair_spheres`):
+    ``self_ab`` = (self_a, self_b), ``cull`` = (lp_of_row, lp_links, ends)."""
+    self_a, self_b = self_ab
+    lp_of_row, lp_links, ends = cull
     kinds, Rs, cs, pars, bound = scene
     n_scene = scene_idx.shape[0]
     n_obs = kinds.shape[0]
@@ -470,14 +474,15 @@ def pair_spheres(
 
 
 @njit(cache=True, nogil=True, inline="always")
-def pair_gradient(Bf, kn, P, link, nrm, a, b, row, out):
+def pair_gradient(Bf, kn, P, link, nrm, pair, out):
     """∇d (dof,) of one pair into ``out``: n · ∂p_a/∂q (− n · ∂p_b/∂q for a self pair;
     b = −1: an obstacle) with p_s sphere s's centre (:func:`point_gradient`; ``kn``:
-    :func:`kin` of the chain)."""
+    :func:`kin` of the chain; ``pair`` = (a, b, row))."""
+    a, b, row = pair
     link_body = kn[3]
     n0, n1, n2 = nrm[row, 0], nrm[row, 1], nrm[row, 2]
     for j in range(out.shape[0]):
         out[j] = 0.0
-    point_gradient(Bf, kn, link_body[link[a]], P[a], n0, n1, n2, 1.0, out)
+    point_gradient(Bf, kn, link_body[link[a]], P[a], (n0, n1, n2), 1.0, out)
     if b >= 0:
-        point_gradient(Bf, kn, link_body[link[b]], P[b], n0, n1, n2, -1.0, out)
+        point_gradient(Bf, kn, link_body[link[b]], P[b], (n0, n1, n2), -1.0, out)

@@ -90,7 +90,7 @@ def test_gradients_through_the_chain_are_the_derivatives(robot):
         )  # (dof, L, 3)
         for l in range(len(mid)):
             out = np.zeros(robot.dof)
-            point_gradient(Bf, kn, kn[3][l], mid[l], *n[l], 1.0, out)
+            point_gradient(Bf, kn, kn[3][l], mid[l], (n[l][0], n[l][1], n[l][2]), 1.0, out)
             np.testing.assert_allclose(out, d_mid[:, l] @ n[l], atol=1e-6)
         p, nt = tip_pose(Bf, ch)
         Jp, Jn = tip_jacobians(Bf, ch, p, nt, robot.dof)
