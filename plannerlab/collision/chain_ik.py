@@ -5,10 +5,13 @@ position error scaled by ``pos_tol_m`` and the tip normal error scaled by the an
 tolerance in radians; each step scaled so that no joint moves more than ``max_step_rad``;
 bounded joints clipped, continuous ones wrapped into [-π, π); stop once both errors are
 below ``target_fraction`` of the tolerances) in one numba call per descent, on the chain
-of ``robot.chain_data()`` (:mod:`plannerlab.collision.chain`: parents, fixed transforms,
-axes, sliding joints, an optional coupling) and its tip (``robot.tip_data()``: the body,
-the tip point and normal in its frame). The Jacobian is the chain's own: joint ``i`` turns
-(or slides) about its world axis ``w_i`` through its body's origin ``o_i``, so
+of ``robot.chain_data()`` folded as the compiled model folds it
+(:func:`~plannerlab.collision.model.folded_chain`: every joint's axis turned onto its
+frame's z axis) and its tip (``robot.tip_data()``: the body, the tip point and normal in
+its frame), on the one forward kinematics
+(:func:`~plannerlab.collision.kinematics.chain_frames`). The Jacobian is the chain's own:
+joint ``i`` turns (or slides) about its world axis ``w_i`` (its body's folded z) through
+its body's origin ``o_i``, so
 ``dp/dv_i = w_i × (p − o_i)`` (``w_i``) and ``dn/dv_i = w_i × n`` (0), and through the
 coupling ``dv/dq``.
 
@@ -23,67 +26,67 @@ collision check).
 from __future__ import annotations
 
 import math
-from typing import Any
+from typing import Any, NamedTuple
 
 import numpy as np
 from numba import njit
 
-from plannerlab.collision.chain import chain_parts
+from plannerlab.collision.kinematics import chain_frames, chain_values
+from plannerlab.collision.model import folded_chain
 from plannerlab.robots.registry import compiled_ik
 
 
+class IkChain(NamedTuple):
+    """A robot's chain folded (:func:`~plannerlab.collision.model.folded_chain`: the
+    compiled model's kinematic fields) and its tip, for :func:`descend_kernel`."""
+
+    T0: np.ndarray  # (12,)
+    parent: np.ndarray  # (n,)
+    pre: np.ndarray  # (n, 12) the axes folded onto z
+    slide: np.ndarray  # (n,) bool
+    cpl_start: np.ndarray  # the coupling, sparse (empty: v = q)
+    cpl_idx: np.ndarray
+    cpl_val: np.ndarray
+    path: np.ndarray  # the chain joints that move the tip body, root first
+    tip_body: int
+    tip_p: np.ndarray  # (3,) the tip point and normal in the tip body's folded frame
+    tip_n: np.ndarray
+
+
+class IkGoal(NamedTuple):
+    """The goal region: tip point p_d and normal n_d, tolerances [m] and [rad]."""
+
+    p_d: np.ndarray
+    n_d: np.ndarray
+    pos_tol: float
+    ang_tol: float
+
+
+class IkBounds(NamedTuple):
+    lower: np.ndarray
+    upper: np.ndarray
+    continuous: np.ndarray
+
+
+class IkSteps(NamedTuple):
+    """The descent's settings (:func:`plannerlab.problem.ik.solve_ik`'s)."""
+
+    max_iterations: int
+    damping: float
+    max_step: float
+    target_fraction: float
+
+
 @njit(cache=True, nogil=True)
-def _frames(q, T0, parent, pre, axes, prismatic, coupling, B, v):
-    """Body frames B (n + 1, 4, 4) of state q; v (n,) the chain's joint values."""
-    n = parent.shape[0]
-    for i in range(n):
-        if coupling.shape[0] > 0:
-            x = 0.0
-            for j in range(q.shape[0]):
-                x += coupling[i, j] * q[j]
-            v[i] = x
-        else:
-            v[i] = q[i]
-    for a in range(4):
-        for b in range(4):
-            B[0, a, b] = T0[a, b]
-    M = np.empty((4, 4))
-    P = np.empty((4, 4))
-    for i in range(n):
-        x, y, z = axes[i, 0], axes[i, 1], axes[i, 2]
-        for a in range(4):
-            for b in range(4):
-                M[a, b] = 1.0 if a == b else 0.0
-        if prismatic[i]:
-            M[0, 3] = v[i] * x
-            M[1, 3] = v[i] * y
-            M[2, 3] = v[i] * z
-        else:
-            c = math.cos(v[i])
-            s = math.sin(v[i])
-            t = 1.0 - c
-            M[0, 0] = c + t * x * x
-            M[0, 1] = t * x * y - s * z
-            M[0, 2] = t * x * z + s * y
-            M[1, 0] = t * x * y + s * z
-            M[1, 1] = c + t * y * y
-            M[1, 2] = t * y * z - s * x
-            M[2, 0] = t * x * z - s * y
-            M[2, 1] = t * y * z + s * x
-            M[2, 2] = c + t * z * z
-        F = B[parent[i]]
-        for a in range(4):
-            for b in range(4):
-                acc = 0.0
-                for k in range(4):
-                    acc += F[a, k] * pre[i, k, b]
-                P[a, b] = acc
-        for a in range(4):
-            for b in range(4):
-                acc = 0.0
-                for k in range(4):
-                    acc += P[a, k] * M[k, b]
-                B[i + 1, a, b] = acc
+def _frames(q, ch, F, v):
+    """Body frames F (flat, (n + 1) x 12: 3 x 4 rows) of state q by the one kinematics
+    (:func:`~plannerlab.collision.kinematics.chain_frames`); v (n,) the coupling's
+    joint values."""
+    if ch.cpl_start.shape[0] == 0:
+        chain_frames(F, q, ch.T0, ch.pre, ch.parent, ch.slide)
+    else:
+        chain_values(q, (ch.cpl_start, ch.cpl_idx, ch.cpl_val), v)
+        chain_frames(F, v, ch.T0, ch.pre, ch.parent, ch.slide)
 
 
 @njit(cache=True, nogil=True)
@@ -132,36 +135,24 @@ def _solve6(A, e, x):
 
 
 @njit(cache=True, nogil=True)
-def descend_kernel(
-    q0,
-    T0,
-    parent,
-    pre,
-    axes,
-    prismatic,
-    coupling,
-    path,
-    tip_body,
-    p_bt,
-    n_bt,
-    p_d,
-    n_d,
-    pos_tol,
-    ang_tol,
-    lower,
-    upper,
-    continuous,
-    max_iterations,
-    damping,
-    max_step,
-    target_fraction,
-    q,
-):
+def descend_kernel(q0, ch, goal, bounds, steps_of, q):
     """One descent from q0 (dof,) into q (dof,): returns (steps, pos_err_m, ang_err_rad)
-    at q. ``path``: the chain joints that move the tip body; ``ang_tol`` [rad]."""
+    at q, on the chain ``ch`` (:class:`IkChain`) towards ``goal`` (:class:`IkGoal`) within
+    ``bounds`` (:class:`IkBounds`) by the settings ``steps_of`` (:class:`IkSteps`)."""
+    p_d, n_d, pos_tol, ang_tol = goal
+    lower, upper, continuous = bounds
+    max_iterations, damping, max_step, target_fraction = steps_of
+    path, slide, cpl_start, cpl_idx, cpl_val = (
+        ch.path,
+        ch.slide,
+        ch.cpl_start,
+        ch.cpl_idx,
+        ch.cpl_val,
+    )
     dof = q0.shape[0]
-    n = parent.shape[0]
-    B = np.empty((n + 1, 4, 4))
+    n = ch.parent.shape[0]
+    F = np.empty(12 * (n + 1))
+    B = F.reshape((n + 1, 3, 4))
     v = np.empty(n)
     p = np.empty(3)
     nv = np.empty(3)
@@ -184,8 +175,8 @@ def descend_kernel(
     lam2 = damping * damping
     steps = 0
     for it in range(max_iterations + 1):
-        _frames(q, T0, parent, pre, axes, prismatic, coupling, B, v)
-        _tip(B, tip_body, p_bt, n_bt, p, nv)
+        _frames(q, ch, F, v)
+        _tip(B, ch.tip_body, ch.tip_p, ch.tip_n, p, nv)
         pe, ae = _errors(p, nv, p_d, n_d)
         if (pe <= target_fraction * pos_tol and ae <= target_fraction * ang_tol) or (
             it == max_iterations
@@ -201,27 +192,25 @@ def descend_kernel(
                 Jv[a, i] = 0.0
         for k in range(path.shape[0]):
             i = path[k]
-            F = B[i + 1]
-            wx = F[0, 0] * axes[i, 0] + F[0, 1] * axes[i, 1] + F[0, 2] * axes[i, 2]
-            wy = F[1, 0] * axes[i, 0] + F[1, 1] * axes[i, 1] + F[1, 2] * axes[i, 2]
-            wz = F[2, 0] * axes[i, 0] + F[2, 1] * axes[i, 1] + F[2, 2] * axes[i, 2]
-            if prismatic[i]:
+            Fi = B[i + 1]  # the joint's axis: its body's folded z
+            wx, wy, wz = Fi[0, 2], Fi[1, 2], Fi[2, 2]
+            if slide[i]:
                 Jv[0, i], Jv[1, i], Jv[2, i] = wx * ps, wy * ps, wz * ps
             else:
-                rx, ry, rz = p[0] - F[0, 3], p[1] - F[1, 3], p[2] - F[2, 3]
+                rx, ry, rz = p[0] - Fi[0, 3], p[1] - Fi[1, 3], p[2] - Fi[2, 3]
                 Jv[0, i] = (wy * rz - wz * ry) * ps
                 Jv[1, i] = (wz * rx - wx * rz) * ps
                 Jv[2, i] = (wx * ry - wy * rx) * ps
                 Jv[3, i] = (wy * nv[2] - wz * nv[1]) * an
                 Jv[4, i] = (wz * nv[0] - wx * nv[2]) * an
                 Jv[5, i] = (wx * nv[1] - wy * nv[0]) * an
-        if coupling.shape[0] > 0:
+        if cpl_start.shape[0] > 0:  # J = Jv · dv/dq, the coupling sparse
             for a in range(6):
                 for j in range(dof):
-                    acc = 0.0
-                    for i in range(n):
-                        acc += Jv[a, i] * coupling[i, j]
-                    J[a, j] = acc
+                    J[a, j] = 0.0
+                for i in range(n):
+                    for k in range(cpl_start[i], cpl_start[i + 1]):
+                        J[a, cpl_idx[k]] += Jv[a, i] * cpl_val[k]
         else:
             for a in range(6):
                 for j in range(dof):
@@ -254,30 +243,30 @@ def descend_kernel(
     return steps, 0.0, 0.0  # not reached
 
 
-def ik_arrays(robot: Any) -> tuple[Any, ...]:
-    """The chain and tip of a robot as :func:`descend_kernel`'s arrays after ``q0`` and
-    before the goal: (T0, parent, pre, axes, prismatic, coupling, path, tip_body, p_bt,
-    n_bt)."""
-    parent, pre, axes, prismatic, _, _, _, coupling = chain_parts(robot)
+def ik_arrays(robot: Any) -> IkChain:
+    """The chain and tip of a robot as :func:`descend_kernel` takes them (folded as the
+    compiled model folds it)."""
+    ch = folded_chain(robot)
     tip_body, p_bt, n_bt = robot.tip_data()
     path = []
     b = int(tip_body)
-    parent = np.asarray(parent, dtype=np.int64)
     while b > 0:
         path.append(b - 1)
-        b = int(parent[b - 1])
+        b = int(ch.parent[b - 1])
+    A = np.asarray(ch.fold[int(tip_body)], dtype=float)
     f = np.ascontiguousarray
-    return (
-        f(robot.T_world_base, dtype=np.float64),
-        f(parent),
-        f(pre, dtype=np.float64),
-        f(axes, dtype=np.float64),
-        f(prismatic, dtype=np.bool_),
-        np.zeros((0, 0)) if coupling is None else f(coupling, dtype=np.float64),
-        np.array(path[::-1], dtype=np.int64),
-        int(tip_body),
-        f(p_bt, dtype=np.float64),
-        f(n_bt, dtype=np.float64),
+    return IkChain(
+        T0=ch.T0,
+        parent=ch.parent,
+        pre=ch.pre,
+        slide=ch.slide,
+        cpl_start=ch.cpl_start,
+        cpl_idx=ch.cpl_idx,
+        cpl_val=ch.cpl_val,
+        path=np.array(path[::-1], dtype=np.int64),
+        tip_body=int(tip_body),
+        tip_p=f(A.T @ np.asarray(p_bt, dtype=np.float64)),
+        tip_n=f(A.T @ np.asarray(n_bt, dtype=np.float64)),
     )
 
 
@@ -292,7 +281,7 @@ class ChainDescent:
         self.dof = int(robot.dof)
         self._arrays = ik_arrays(robot)
         f = np.ascontiguousarray
-        self._bounds = (
+        self._bounds = IkBounds(
             f(robot.lower, dtype=np.float64),
             f(robot.upper, dtype=np.float64),
             f(robot.continuous, dtype=np.bool_),
@@ -302,13 +291,10 @@ class ChainDescent:
             q = np.clip(np.zeros(self.dof), robot.lower, robot.upper)
             kernel(
                 q,
-                *self._arrays,
-                *((np.zeros(3), np.ones(3) / 3**0.5, 1.0, 1.0)),
-                *self._bounds,
-                0,
-                0.05,
-                0.25,
-                0.3,
+                self._arrays,
+                IkGoal(np.zeros(3), np.ones(3) / 3**0.5, 1.0, 1.0),
+                self._bounds,
+                IkSteps(0, 0.05, 0.25, 0.3),
                 np.empty(self.dof),
             )
 
@@ -325,16 +311,17 @@ class ChainDescent:
         kernel: Any = descend_kernel  # a numba dispatcher
         steps, _, _ = kernel(
             np.ascontiguousarray(q_seed, dtype=np.float64).reshape(self.dof),
-            *self._arrays,
-            np.ascontiguousarray(goal.p_world_m, dtype=np.float64),
-            np.ascontiguousarray(goal.n_world, dtype=np.float64),
-            float(goal.pos_tol_m),
-            math.radians(float(goal.angle_tol_deg)),
-            *self._bounds,
-            int(max_iterations),
-            float(damping),
-            float(max_step_rad),
-            float(target_fraction),
+            self._arrays,
+            IkGoal(
+                np.ascontiguousarray(goal.p_world_m, dtype=np.float64),
+                np.ascontiguousarray(goal.n_world, dtype=np.float64),
+                float(goal.pos_tol_m),
+                math.radians(float(goal.angle_tol_deg)),
+            ),
+            self._bounds,
+            IkSteps(
+                int(max_iterations), float(damping), float(max_step_rad), float(target_fraction)
+            ),
             q,
         )
         return q, int(steps)
@@ -352,4 +339,14 @@ def descent_for_robot(robot: Any) -> ChainDescent | None:
     return descent_for(robot) if compiled_ik(str(getattr(robot, "kind", ""))) else None
 
 
-__all__ = ["ChainDescent", "descend_kernel", "descent_for", "descent_for_robot", "ik_arrays"]
+__all__ = [
+    "ChainDescent",
+    "IkBounds",
+    "IkChain",
+    "IkGoal",
+    "IkSteps",
+    "descend_kernel",
+    "descent_for",
+    "descent_for_robot",
+    "ik_arrays",
+]

@@ -40,6 +40,7 @@ import numpy as np
 from plannerlab.collision import queries
 from plannerlab.collision.geometry import BOX, CYLINDER, SPHERE
 from plannerlab.collision.kernels import (
+    PairGeometry,
     all_hits,
     chain_tree,
     min_clearance_kernel,
@@ -179,7 +180,7 @@ class Core:
         olo = np.ascontiguousarray(lo, dtype=float).reshape(n, 3)
         ohi = np.ascontiguousarray(hi, dtype=float).reshape(n, 3)
         # the exact distance kernels' arguments (kernels.py: capsule axes and these)
-        self._geo = (
+        self._geo = PairGeometry(
             self.radii,
             self.radii_self,
             self.moving,
@@ -347,14 +348,14 @@ class Core:
     # ------------------------------------------------------------------ distances
     def hits(self, q: Array) -> np.ndarray:
         """Every colliding pair at q: (m, 3) rows (link, other, other_is_link)."""
-        h = all_hits(self.segments(q)[0], *self._geo)
+        h = all_hits(self.segments(q)[0], self._geo)
         # the checker's order: scene pairs by (link, obstacle), then link pairs by (i, j)
         return h[np.lexsort((h[:, 1], h[:, 0], h[:, 2]))]
 
     def pair_distances(self, q: Array, margin_m: float) -> PairDistances:
         """Every checked pair at q (dof,) whose signed distance is below ``margin_m``."""
         seg = self.segments(q)[0]
-        idx, d, tl, to, n = pair_distances_kernel(seg, *self._geo, float(margin_m))
+        idx, d, tl, to, n = pair_distances_kernel(seg, self._geo, float(margin_m))
         return PairDistances(
             link=idx[:, 0].copy(),
             other=idx[:, 1].copy(),
@@ -368,7 +369,7 @@ class Core:
     def min_clearance(self, Q: Array, include_self: bool = True) -> float:
         """:meth:`clearance`'s smallest over the states Q (k, dof), in one compiled call
         (inf when there is no state or no pair)."""
-        return float(min_clearance_kernel(self.segments(Q), *self._geo, bool(include_self)))
+        return float(min_clearance_kernel(self.segments(Q), self._geo, bool(include_self)))
 
     def clearance(self, q: Array, include_self: bool = True) -> float:
         """Smallest signed distance [m] over every checked pair (inf when none)."""

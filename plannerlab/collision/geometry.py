@@ -33,7 +33,6 @@ import math
 import numpy as np
 from numba import njit
 
-_EPS = 1e-300
 _GOLD = 0.5 * (math.sqrt(5.0) - 1.0)  # 0.618...
 _T_TOL = 1e-13
 
@@ -254,14 +253,16 @@ def seg_sd_min(kind, p0, p1, h, stop_below):
 
 
 @njit(cache=True, nogil=True)
-def capsule_obstacle(kind, R, c, h, a, b, r, want_normal, n_out, w):
-    """Signed distance [m] of capsule (a→b, r) to one obstacle, and t on the capsule axis.
+def capsule_obstacle(obstacles, o, a, b, r, want_normal, n_out, w):
+    """Signed distance [m] of capsule (a→b, r) to obstacle ``o`` of ``obstacles`` (kinds,
+    Rs, cs, hs), and t on the capsule axis.
 
-    ``kind``: 0 box (h = half sizes), 1 cylinder (h = radius, half length), 2 sphere
+    Its ``kind``: 0 box (h = half sizes), 1 cylinder (h = radius, half length), 2 sphere
     (h[0] = radius). With ``want_normal`` the unit direction (world) that increases the
     distance when the capsule's closest point moves along it is written to ``n_out``.
     ``w``: scratch space (≥ 32 floats).
     """
+    kind, R, c, h = obstacles[0][o], obstacles[1][o], obstacles[2][o], obstacles[3][o]
     if kind == 2:
         d2, t = seg_point(a, b, c)
         dist = math.sqrt(d2)

@@ -7,29 +7,40 @@ some kinematics made.
   built once, boxes refit per state), traversed against each obstacle and against itself
   (:func:`state_hits`); node pairs that are apart or hold no checked pair are pruned.
 * **Narrow phase.** Exact capsule tests (:mod:`plannerlab.collision.geometry`).
-* **Batches and edges.** :func:`valid_batch`, :func:`first_invalid`, a URDF chain's states
-  with its kinematics fused in (:func:`chain_first_invalid`), an edge's states
-  (:func:`edge_states`, bit for bit ``interpolate_edge``'s).
-* **Conservative advancement.** One step from a valid state (:func:`advance_dt`) with the
-  configuration-free rates of :func:`edge_rates` (see :mod:`plannerlab.collision.core`).
 * **Distances.** Every checked pair below a margin (:func:`pair_distances_kernel`), the
   smallest over a batch (:func:`min_clearance_kernel`), every colliding pair
   (:func:`all_hits`).
 
-Arm-Z's kinematics and the checks with them fused in are in
-:mod:`plannerlab.collision.armz`; :class:`~plannerlab.collision.core.Core` is the Python
-front of both.
+:class:`~plannerlab.collision.core.Core` is their Python front (on the segments of the one
+kinematics, :mod:`plannerlab.collision.kinematics`).
 """
 
 from __future__ import annotations
 
 import math
+from typing import NamedTuple
 
 import numpy as np
 from numba import njit
 
-from plannerlab.collision.chain import chain_segments
 from plannerlab.collision.geometry import capsule_obstacle, capsule_obstacle_hit, seg_seg
+
+
+class PairGeometry(NamedTuple):
+    """What the distance kernels need besides the capsule axes (one argument: numba loads
+    kernels taking a named tuple of arrays from its cache)."""
+
+    radii: np.ndarray  # (L,) against the scene, margin included
+    radii_self: np.ndarray  # (L,) against each other
+    moving: np.ndarray  # (L,) bool
+    allowed: np.ndarray  # (L, L) bool: the checked link pairs
+    tree: tuple  # :func:`chain_tree` of ``allowed``
+    kinds: np.ndarray  # (n,) obstacle kinds
+    Rs: np.ndarray  # (n, 3, 3)
+    cs: np.ndarray  # (n, 3)
+    hs: np.ndarray  # (n, 3)
+    olo: np.ndarray  # (n, 3) the obstacles' world boxes
+    ohi: np.ndarray
 
 
 @njit(cache=True, nogil=True)
@@ -124,23 +135,7 @@ def _node_boxes(tree, lo, hi, nlo, nhi):
 
 
 @njit(cache=True, nogil=True)
-def state_hits(
-    seg,
-    radii,
-    radii_self,
-    moving,
-    allowed,
-    tree,
-    kinds,
-    Rs,
-    cs,
-    hs,
-    olo,
-    ohi,
-    buf,
-    first_only,
-    out_pairs,
-):
+def state_hits(seg, geo, buf, first_only, out_pairs):
     """Colliding pairs of one state; returns how many were written to out_pairs (m, 3).
 
     Row = (link, other, other_is_link). With ``first_only`` stops at the first. ``buf``:
@@ -148,6 +143,7 @@ def state_hits(
     consecutive links, traversed against each obstacle and against itself, pruning node
     pairs whose boxes are apart or that hold no checked pair; cost ~ L log L.
     """
+    radii, radii_self, moving, allowed, tree, kinds, Rs, cs, hs, olo, ohi = geo
     lo, hi, w, nlo, nhi, stack = buf
     start, end, left, right, prefix = tree
     n_obs = kinds.shape[0]
@@ -244,129 +240,6 @@ def scratch(L):
 
 
 @njit(cache=True, nogil=True)
-def valid_batch(segs, radii, radii_self, moving, allowed, tree, kinds, Rs, cs, hs, olo, ohi, out):
-    """Validity of every state: segs (k, L, 2, 3) → out (k,) bool."""
-    k, L = segs.shape[0], segs.shape[1]
-    buf = scratch(L)
-    pairs = np.empty((1, 3), dtype=np.int64)
-    for s in range(k):
-        m = state_hits(
-            segs[s],
-            radii,
-            radii_self,
-            moving,
-            allowed,
-            tree,
-            kinds,
-            Rs,
-            cs,
-            hs,
-            olo,
-            ohi,
-            buf,
-            True,
-            pairs,
-        )
-        out[s] = m == 0
-    return out
-
-
-@njit(cache=True, nogil=True)
-def first_invalid(segs, radii, radii_self, moving, allowed, tree, kinds, Rs, cs, hs, olo, ohi):
-    """Index of the first invalid state of segs (k, L, 2, 3), or -1."""
-    k, L = segs.shape[0], segs.shape[1]
-    buf = scratch(L)
-    pairs = np.empty((1, 3), dtype=np.int64)
-    for s in range(k):
-        if state_hits(
-            segs[s],
-            radii,
-            radii_self,
-            moving,
-            allowed,
-            tree,
-            kinds,
-            Rs,
-            cs,
-            hs,
-            olo,
-            ohi,
-            buf,
-            True,
-            pairs,
-        ):
-            return s
-    return -1
-
-
-@njit(cache=True, nogil=True)
-def chain_first_invalid(
-    Q,
-    T0,
-    parent,
-    pre,
-    axes,
-    prismatic,
-    cap_body,
-    cap_a,
-    cap_b,
-    coupling,
-    radii,
-    radii_self,
-    moving,
-    allowed,
-    tree,
-    kinds,
-    Rs,
-    cs,
-    hs,
-    olo,
-    ohi,
-):
-    """:func:`first_invalid` of a URDF chain's states Q (k, dof), kinematics included
-    (:func:`~plannerlab.collision.chain.chain_segments`): one compiled call per query."""
-    segs = np.empty((Q.shape[0], cap_body.shape[0], 2, 3))
-    chain_segments(Q, T0, parent, pre, axes, prismatic, cap_body, cap_a, cap_b, coupling, segs)
-    return first_invalid(
-        segs, radii, radii_self, moving, allowed, tree, kinds, Rs, cs, hs, olo, ohi
-    )
-
-
-@njit(cache=True, nogil=True)
-def edge_states(q_a, q_b, joint_step, continuous, limit, cap, weights):
-    """The states of ``interpolate_edge(q_a, q_b, joint_step)[1:]``, bit for bit, at most
-    ``limit`` of them: (n, Q (min(n, limit), dof)), n the edge's full count; an edge of
-    more than ``cap`` states gives (cap + 1, no states).
-
-    ``weights`` (dof,) adds a metric bound: at least ``ceil(sum_i weights_i |d_i|)``
-    steps (weights = reach_i / step_m: no point moves more than step_m per step); zeros
-    leave the count of ``interpolate_edge``."""
-    dof = q_a.shape[0]
-    d = np.empty(dof)
-    span = 0.0
-    metric = 0.0
-    for i in range(dof):
-        x = q_b[i] - q_a[i]
-        if continuous[i]:
-            x = (x + np.pi) % (2.0 * np.pi) - np.pi
-        d[i] = x
-        span = max(span, abs(x))
-        metric += weights[i] * abs(x)
-    n_f = max(1.0, math.ceil(span / joint_step - 1e-12), math.ceil(metric - 1e-12))
-    if n_f > cap:  # refused: the caller raises
-        return cap + 1, np.empty((0, dof))
-    n = int(n_f)
-    m = min(n, limit)
-    Q = np.empty((m, dof))
-    inv = 1.0 / n
-    for j in range(1, m + 1):
-        t = 1.0 if j == n else j * inv
-        for i in range(dof):
-            Q[j - 1, i] = q_a[i] + t * d[i]
-    return n, Q
-
-
-@njit(cache=True, nogil=True)
 def box_gap(lo, hi, i, olo, ohi, j):
     """A lower bound of the distance between the shapes in boxes i and j: the boxes' gap."""
     g2 = 0.0
@@ -377,130 +250,24 @@ def box_gap(lo, hi, i, olo, ohi, j):
 
 
 @njit(cache=True, nogil=True)
-def advance_dt(
-    seg,
-    radii,
-    radii_self,
-    moving,
-    allowed,
-    kinds,
-    Rs,
-    cs,
-    hs,
-    olo,
-    ohi,
-    v_link,
-    v_pair,
-    margin,
-    dt_max,
-    buf,
-):
-    """Conservative advancement from one valid state: the largest ``dt <= dt_max`` with
-    ``v_p · dt <= d_p + margin`` for every checked pair ``p``.
-
-    ``d_p``: the pair's distance with the capsules inflated (by the margin against the
-    scene, by half of it each against each other; clamped at 0), ``v_p``: an upper bound
-    of how fast the pair's distance changes per unit of the edge parameter (``v_link``
-    (L,) for a link against the scene, ``v_pair`` (L, L) for a link pair). Pairs whose
-    boxes are so far apart that they cannot limit the step are not measured.
-    """
-    lo, hi, w, lo2, hi2, _ = buf
+def all_hits(seg, geo):
+    """Every colliding pair of one state (L, 2, 3): (m, 3) rows (link, other, other_is_link);
+    ``geo`` the pairs' geometry (:class:`PairGeometry`)."""
     L = seg.shape[0]
-    n_obs = kinds.shape[0]
-    link_boxes(seg, radii, lo, hi)
-    nv = np.empty(3)
-    best = dt_max
-    for li in range(L):
-        v = v_link[li]
-        if not moving[li] or v <= 0.0:
-            continue
-        for oi in range(n_obs):
-            if box_gap(lo, hi, li, olo, ohi, oi) + margin >= best * v:
-                continue
-            dist, _ = capsule_obstacle(
-                kinds[oi],
-                Rs[oi],
-                cs[oi],
-                hs[oi],
-                seg[li, 0],
-                seg[li, 1],
-                radii[li],
-                False,
-                nv,
-                w,
-            )
-            dt = (max(dist, 0.0) + margin) / v
-            if dt < best:
-                best = dt
-    link_boxes(seg, radii_self, lo2[:L], hi2[:L])
-    for i in range(L):
-        for j in range(i + 1, L):
-            v = v_pair[i, j]
-            if v <= 0.0 or not allowed[i, j]:
-                continue
-            if box_gap(lo2, hi2, i, lo2, hi2, j) + margin >= best * v:
-                continue
-            d2, _, _ = seg_seg(seg[i, 0], seg[i, 1], seg[j, 0], seg[j, 1])
-            dist = math.sqrt(d2) - radii_self[i] - radii_self[j]
-            dt = (max(dist, 0.0) + margin) / v
-            if dt < best:
-                best = dt
-    return best
-
-
-@njit(cache=True, nogil=True)
-def edge_rates(d, W, Pr, v_link, v_pair):
-    """Per unit of the edge parameter, bounds of how fast each link (against the scene)
-    and each link pair moves along an edge of joint change ``d``: ``|d| @ W``, ``|d| @ Pr``."""
-    dof, L = W.shape
-    for li in range(L):
-        v_link[li] = 0.0
-        for j in range(L):
-            v_pair[li, j] = 0.0
-    for k in range(dof):
-        a = abs(d[k])
-        if a == 0.0:
-            continue
-        for li in range(L):
-            v_link[li] += a * W[k, li]
-            for j in range(li + 1, L):
-                v_pair[li, j] += a * Pr[k, li, j]
-
-
-@njit(cache=True, nogil=True)
-def all_hits(seg, radii, radii_self, moving, allowed, tree, kinds, Rs, cs, hs, olo, ohi):
-    """Every colliding pair of one state (L, 2, 3): (m, 3) rows (link, other, other_is_link)."""
-    L = seg.shape[0]
-    out = np.empty((L * kinds.shape[0] + L * L, 3), dtype=np.int64)
-    m = state_hits(
-        seg,
-        radii,
-        radii_self,
-        moving,
-        allowed,
-        tree,
-        kinds,
-        Rs,
-        cs,
-        hs,
-        olo,
-        ohi,
-        scratch(L),
-        False,
-        out,
-    )
+    out = np.empty((L * geo.kinds.shape[0] + L * L, 3), dtype=np.int64)
+    m = state_hits(seg, geo, scratch(L), False, out)
     return out[:m].copy()
 
 
 @njit(cache=True, nogil=True)
-def pair_distances_kernel(
-    seg, radii, radii_self, moving, allowed, tree, kinds, Rs, cs, hs, olo, ohi, margin
-):
-    """Every checked pair of one state whose signed distance is below ``margin`` [m].
+def pair_distances_kernel(seg, geo, margin):
+    """Every checked pair of one state whose signed distance is below ``margin`` [m]
+    (``geo``: :class:`PairGeometry`).
 
     Returns (idx (m, 3) int: link, other, other_is_link; d (m,); t_link (m,);
     t_other (m,); n (m, 3)).
     """
+    radii, radii_self, moving, allowed, tree, kinds, Rs, cs, hs, olo, ohi = geo
     L = seg.shape[0]
     n_obs = kinds.shape[0]
     lo = np.empty((L, 3))
@@ -523,7 +290,7 @@ def pair_distances_kernel(
             if not _overlap(lo, hi, li, olo, ohi, oi, pad):
                 continue
             dist, t = capsule_obstacle(
-                kinds[oi], Rs[oi], cs[oi], hs[oi], seg[li, 0], seg[li, 1], radii[li], True, nv, w
+                (kinds, Rs, cs, hs), oi, seg[li, 0], seg[li, 1], radii[li], True, nv, w
             )
             if dist < margin:
                 idx[m, 0] = li
@@ -575,9 +342,7 @@ def pair_distances_kernel(
 
 
 @njit(cache=True, nogil=True)
-def min_clearance_kernel(
-    segs, radii, radii_self, moving, allowed, tree, kinds, Rs, cs, hs, olo, ohi, include_self
-):
+def min_clearance_kernel(segs, geo, include_self):
     """Smallest signed distance [m] over every checked pair of every state (k, L, 2, 3)
     (link pairs only with ``include_self``; inf when none): the minimum of
     :func:`pair_distances_kernel`'s distances over the states, the same distance functions
@@ -585,7 +350,9 @@ def min_clearance_kernel(
     capsule's, grown by its radius, and the obstacle's or the other capsule's) are apart
     by a gap ``g > 0`` is at least ``g`` apart, so once ``g`` is no smaller than the
     smallest distance found so far the pair cannot lower it and is not measured (boxes
-    that touch bound nothing: a penetration may hide inside)."""
+    that touch bound nothing: a penetration may hide inside). ``geo``:
+    :class:`PairGeometry`."""
+    radii, radii_self, moving, allowed, tree, kinds, Rs, cs, hs, olo, ohi = geo
     L = segs.shape[1]
     n_obs = kinds.shape[0]
     lo = np.empty((L, 3))
@@ -606,10 +373,8 @@ def min_clearance_kernel(
                 if g > 0.0 and g >= best:
                     continue
                 dist, _ = capsule_obstacle(
-                    kinds[oi],
-                    Rs[oi],
-                    cs[oi],
-                    hs[oi],
+                    (kinds, Rs, cs, hs),
+                    oi,
                     seg[li, 0],
                     seg[li, 1],
                     radii[li],

@@ -358,6 +358,60 @@ def _group_gates(
     return _f(out, np.int64)
 
 
+class Chain(NamedTuple):
+    """A robot's chain folded alone (no scene, no margin): the kinematic fields of
+    :class:`CompiledModel` by the same names, and the capsules in the robot's order with
+    their ends in their bodies' folded frames. What the one kinematics
+    (:mod:`plannerlab.collision.kinematics`) runs on where no checker's model is at hand
+    (the sphere field of a robot alone, the IK)."""
+
+    parent: np.ndarray  # (m,) int64
+    slide: np.ndarray  # (m,) bool
+    T0: np.ndarray  # (12,) float64
+    pre: np.ndarray  # (m, 12) float64
+    fold: np.ndarray  # (m + 1, 3, 3): body b's folded frame is the robot's times fold[b]
+    cpl_start: np.ndarray  # the coupling, sparse (empty: v = q)
+    cpl_idx: np.ndarray
+    cpl_val: np.ndarray
+    cap_body: np.ndarray  # (L,) int64, the robot's order
+    cap_a: np.ndarray  # (L, 3) folded
+    cap_b: np.ndarray  # (L, 3) folded
+
+
+def folded_chain(robot: Any) -> Chain:
+    """The robot's chain (``chain_data()``) folded as :func:`build_model` folds it: every
+    joint's axis turned onto its frame's z axis.
+
+    Raises:
+        ModelError: the robot gives no serial chain.
+    """
+    if not has_chain(robot):
+        raise ModelError(
+            f"robot type {getattr(robot, 'kind', type(robot).__name__)!r} gives no serial "
+            "chain (chain_data()): its kinematics cannot be compiled"
+        )
+    parent, pre, axes, prismatic, cap_body, cap_a, cap_b, coupling = chain_parts(robot)
+    m = len(parent)
+    cpl_start, cpl_idx, cpl_val = _coupling(coupling, m)
+    A, pre_f = _folded(parent, pre, axes)
+    body = np.asarray(cap_body, dtype=np.int64)
+    ca = np.asarray(cap_a, dtype=float).reshape(-1, 3)
+    cb = np.asarray(cap_b, dtype=float).reshape(-1, 3)
+    return Chain(
+        parent=_f(parent, np.int64),
+        slide=_f(prismatic, np.bool_),
+        T0=_f(np.asarray(robot.T_world_base, dtype=float)[:3].reshape(12)),
+        pre=_f(pre_f.reshape(m, 12)),
+        fold=_f(np.array(A).reshape(m + 1, 3, 3)),
+        cpl_start=_f(cpl_start, np.int64),
+        cpl_idx=_f(cpl_idx, np.int64),
+        cpl_val=_f(cpl_val),
+        cap_body=_f(body, np.int64),
+        cap_a=_f(np.array([A[int(b)].T @ p for b, p in zip(body, ca, strict=True)]).reshape(-1, 3)),
+        cap_b=_f(np.array([A[int(b)].T @ p for b, p in zip(body, cb, strict=True)]).reshape(-1, 3)),
+    )
+
+
 def build_model(
     robot: Any,
     geo: ChainGeometry,
@@ -561,9 +615,11 @@ __all__ = [
     "BOX",
     "CYLINDER",
     "SPHERE",
+    "Chain",
     "ChainGeometry",
     "CompiledModel",
     "ModelError",
     "build_model",
+    "folded_chain",
     "has_chain",
 ]

@@ -1,21 +1,18 @@
-"""Spheres on a robot's links, placed by the robot's chain as the previous compiled model
-packed it (numba, cached): the compiled geometry of the clearance field
-(:mod:`plannerlab.planners.clearance`) and of ``trajopt.*``, which own none of their own.
-The chain comes from a checker's compiled robot–scene model
-(:func:`model_sphere_chain`: :class:`~plannerlab.collision.model.CompiledModel`, built
-once per problem, in the same folded frames) or from the robot's chain packed alone
-(:func:`sphere_chain` on :mod:`plannerlab.collision.model_old`); the kernels run
-chain_valid's kinematics, not yet :mod:`plannerlab.collision.kinematics` (the state
-test's one kinematics).
+"""Spheres on a robot's links, placed by the one forward kinematics
+(:func:`plannerlab.collision.kinematics.chain_frames` in float64, numba, cached): the
+compiled geometry of the clearance field (:mod:`plannerlab.planners.clearance`) and of
+``trajopt.*``, which own none of their own. The chain comes from a checker's compiled
+robot–scene model (:func:`model_sphere_chain`: :class:`~plannerlab.collision.model.
+CompiledModel`, built once per problem) or from the robot's chain folded alone
+(:func:`sphere_chain`: :func:`~plannerlab.collision.model.folded_chain`), in the same
+folded frames and under the same field names.
 
-A :class:`SphereChain` is the chain (:class:`~plannerlab.collision.model_old.
-ChainModel`: its base, fixed transforms with the joints' axes folded onto z, sliding
-joints and coupling, as :func:`~plannerlab.collision.chain_pack._pack` packs them) with
-each link's capsule axis in its body's folded frame, in the robot's link order, and the
-tip (body, point, normal: ``robot.tip_data()``). The kernels below:
+A :class:`SphereChain` is the chain (its base, fixed transforms with the joints' axes
+folded onto z, sliding joints and coupling, the model's fields) with each link's capsule
+axis in its body's folded frame, in the robot's link order, and the tip (body, point,
+normal: ``robot.tip_data()``). The kernels below:
 
-* :func:`frames`: the body frames (nb, 3, 4) of one state, chain_valid's own
-  ``_body_frames`` (the kinematics of every compiled check);
+* :func:`frames`: the body frames (nb, 3, 4) of one state, by ``chain_frames``;
 * :func:`link_ends`, :func:`centres`: the links' axes and the sphere centres
   ``a + t (b − a)`` on them; :func:`tip_pose`: the tip's point and normal;
 * :func:`point_gradient`: ``n · ∂p/∂q`` of a point p on a body (sign times, added into a
@@ -36,9 +33,8 @@ from typing import Any, NamedTuple
 import numpy as np
 from numba import njit
 
-from plannerlab.collision.chain import chain_parts
-from plannerlab.collision.chain_pack import _align
-from plannerlab.collision.chain_valid import _body_frames, _unpack
+from plannerlab.collision.kinematics import chain_frames, chain_values
+from plannerlab.collision.model import folded_chain
 
 #: obstacle kinds of :func:`pairs`
 BOX, CYLINDER, SPHERE = 0, 1, 2
@@ -47,13 +43,13 @@ BOX, CYLINDER, SPHERE = 0, 1, 2
 class SphereChain(NamedTuple):
     """A robot's chain for the sphere kernels (see the module docstring)."""
 
-    T0: np.ndarray  # (3, 4) the base in the world
+    T0: np.ndarray  # (12,) the base in the world, 3 x 4 rows
     parent: np.ndarray  # (n,) the body each chain joint hangs from
-    prism: np.ndarray  # (n,) int: the joint slides
-    pre: np.ndarray  # (n, 3, 4) parent body -> joint frame, the axis folded onto z
+    slide: np.ndarray  # (n,) bool: the joint slides
+    pre: np.ndarray  # (n, 12) parent body -> joint frame, the axis folded onto z
     cpl_start: np.ndarray  # the coupling, sparse (empty: v = q)
     cpl_idx: np.ndarray
-    cpl_val: np.ndarray  # (k, 3) its coefficients, three a row
+    cpl_val: np.ndarray  # (k,) its coefficients
     link_body: np.ndarray  # (L,) each link's body
     link_a: np.ndarray  # (L, 3) its axis' ends in the body's folded frame
     link_b: np.ndarray
@@ -65,77 +61,63 @@ class SphereChain(NamedTuple):
     serial: bool
 
 
-@njit(cache=True, nogil=True)
-def _chain_views(m):
-    """The model's kinematic arrays: (T0, parent, prism, pre, cpl, cap_a, cap_b) (the
-    capsules in the model's packed order)."""
-    ints, floats, cpl = _unpack(m.P, m.M, m.idat)
-    return (
-        floats[0].copy(),
-        ints[0].copy(),
-        ints[1].copy(),
-        floats[1].copy(),
-        cpl,
-        (
-            floats[2].copy(),
-            floats[3].copy(),
-        ),
-    )
-
-
-def sphere_chain(model: Any, robot: Any) -> SphereChain:
-    """The :class:`SphereChain` of ``robot`` from its compiled ``model``
-    (:class:`~plannerlab.collision.model_old.ChainModel`, as
-    :func:`~plannerlab.collision.model_old.chain_model` packs it): the model's kinematics, its
-    capsules back in the robot's link order, and the robot's tip (``tip_data()``).
-
-    Raises:
-        ValueError: the model's capsules are not the robot's links one to one.
-    """
-    T0, parent, prism, pre, (cpl_start, cpl_idx, cpl_val), (ca, cb) = _chain_views(model)
-    chain = chain_parts(robot)
-    axes, cap_body = np.asarray(chain[2], dtype=float), np.asarray(chain[4], dtype=np.int64)
-    L = len(np.asarray(robot.link_radii_m))
-    perm = np.asarray(model.perm, dtype=np.int64)
-    if len(perm) != L or len(cap_body) != L:
-        raise ValueError(
-            f"robot {getattr(robot, 'kind', '?')!r}: its chain has {len(cap_body)} capsules "
-            f"for {L} links; the sphere field needs one capsule per link"
-        )
-    packed = np.empty(L, dtype=np.int64)  # link l is packed capsule packed[l]
-    packed[perm] = np.arange(L)
+def _sphere_chain(ch: Any, link: tuple[Any, Any, Any], robot: Any) -> SphereChain:
+    """The :class:`SphereChain` of the folded chain ``ch`` (the model's kinematic fields:
+    :class:`~plannerlab.collision.model.CompiledModel` or
+    :class:`~plannerlab.collision.model.Chain`), the links' bodies and axes (robot order,
+    folded frames) and the robot's tip."""
     tip_body, p_bt, n_bt = robot.tip_data()
     tip_body = int(tip_body)
-    A = np.eye(3) if tip_body == 0 else _align(axes[tip_body - 1])
+    A = np.asarray(ch.fold[tip_body], dtype=float)
+    parent = np.asarray(ch.parent, dtype=np.int64)
+    slide = np.asarray(ch.slide, dtype=np.bool_)
+    cpl_start = np.asarray(ch.cpl_start, dtype=np.int64)
+    m = len(parent)
     f = np.ascontiguousarray
     return SphereChain(
-        T0=f(T0),
+        T0=f(np.asarray(ch.T0, dtype=float).reshape(12)),
         parent=f(parent),
-        prism=f(prism),
-        pre=f(pre),
+        slide=f(slide),
+        pre=f(np.asarray(ch.pre, dtype=float).reshape(m, 12)),
         cpl_start=f(cpl_start),
-        cpl_idx=f(cpl_idx),
-        cpl_val=f(cpl_val),
-        link_body=f(cap_body),
-        link_a=f(ca[packed]),
-        link_b=f(cb[packed]),
+        cpl_idx=f(np.asarray(ch.cpl_idx, dtype=np.int64)),
+        cpl_val=f(np.asarray(ch.cpl_val, dtype=float)),
+        link_body=f(np.asarray(link[0], dtype=np.int64)),
+        link_a=f(np.asarray(link[1], dtype=float)),
+        link_b=f(np.asarray(link[2], dtype=float)),
         tip_body=tip_body,
         tip_p=f(A.T @ np.asarray(p_bt, dtype=float)),
         tip_n=f(A.T @ np.asarray(n_bt, dtype=float)),
         serial=bool(
-            len(cpl_start) == 0
-            and not np.any(prism)
-            and np.array_equal(parent, np.arange(len(parent)))
+            len(cpl_start) == 0 and not np.any(slide) and np.array_equal(parent, np.arange(m))
         ),
     )
+
+
+def sphere_chain(robot: Any) -> SphereChain:
+    """The :class:`SphereChain` of ``robot`` from its chain folded alone
+    (:func:`~plannerlab.collision.model.folded_chain`: no scene, no checker), its capsules
+    in the robot's link order, and the robot's tip (``tip_data()``).
+
+    Raises:
+        ModelError: the robot gives no serial chain.
+        ValueError: the chain's capsules are not the robot's links one to one.
+    """
+    ch = folded_chain(robot)
+    L = len(np.asarray(robot.link_radii_m))
+    if len(ch.cap_body) != L:
+        raise ValueError(
+            f"robot {getattr(robot, 'kind', '?')!r}: its chain has {len(ch.cap_body)} capsules "
+            f"for {L} links; the sphere field needs one capsule per link"
+        )
+    return _sphere_chain(ch, (ch.cap_body, ch.cap_a, ch.cap_b), robot)
 
 
 def model_sphere_chain(model: Any, robot: Any) -> SphereChain:
     """The :class:`SphereChain` of ``robot`` from the checker's compiled robot–scene model
     (:class:`~plannerlab.collision.model.CompiledModel`, built once per problem): its
-    kinematics (the same folded frames as :func:`sphere_chain`'s), its capsules back in the
-    robot's link order and the robot's tip (``tip_data()``), in whole-array operations
-    (no chain packed again).
+    kinematics, its capsules back in the robot's link order and the robot's tip
+    (``tip_data()``), in whole-array operations (no chain folded again).
 
     Raises:
         ValueError: the model's capsules are not the robot's links one to one.
@@ -149,49 +131,29 @@ def model_sphere_chain(model: Any, robot: Any) -> SphereChain:
         )
     packed = np.empty(L, dtype=np.int64)  # link l is packed capsule packed[l]
     packed[perm] = np.arange(L)
-    m = len(model.parent)
-    cpl_val = np.asarray(model.cpl_val, dtype=float)
-    # the kinematics read the coefficients three a row (``_body_frames``): padded
-    cpl_rows = np.zeros(((len(cpl_val) + 2) // 3, 3))
-    cpl_rows.reshape(-1)[: len(cpl_val)] = cpl_val
-    parent = np.asarray(model.parent, dtype=np.int64)
-    prism = np.asarray(model.slide, dtype=np.int64)
-    cpl_start = np.asarray(model.cpl_start, dtype=np.int64)
-    tip_body, p_bt, n_bt = robot.tip_data()
-    tip_body = int(tip_body)
-    A = np.asarray(model.fold[tip_body], dtype=float)
-    f = np.ascontiguousarray
-    return SphereChain(
-        T0=f(np.asarray(model.T0, dtype=float).reshape(3, 4)),
-        parent=f(parent),
-        prism=f(prism),
-        pre=f(np.asarray(model.pre, dtype=float).reshape(m, 3, 4)),
-        cpl_start=f(cpl_start),
-        cpl_idx=f(np.asarray(model.cpl_idx, dtype=np.int64)),
-        cpl_val=f(cpl_rows),
-        link_body=f(np.asarray(model.cap_body, dtype=np.int64)[packed]),
-        link_a=f(np.asarray(model.cap_a, dtype=float)[packed]),
-        link_b=f(np.asarray(model.cap_b, dtype=float)[packed]),
-        tip_body=tip_body,
-        tip_p=f(A.T @ np.asarray(p_bt, dtype=float)),
-        tip_n=f(A.T @ np.asarray(n_bt, dtype=float)),
-        serial=bool(
-            len(cpl_start) == 0 and not np.any(prism) and np.array_equal(parent, np.arange(m))
-        ),
+    link = (
+        np.asarray(model.cap_body, dtype=np.int64)[packed],
+        np.asarray(model.cap_a, dtype=float)[packed],
+        np.asarray(model.cap_b, dtype=float)[packed],
     )
+    return _sphere_chain(model, link, robot)
 
 
 # ---------------------------------------------------------------------- kinematics
 @njit(cache=True, nogil=True, inline="always")
 def frames(q, ch):
-    """The body frames (nb, 3, 4) of state q (dof,): chain_valid's ``_body_frames``."""
+    """The body frames (nb, 3, 4) of state q (dof,): the one kinematics
+    (:func:`~plannerlab.collision.kinematics.chain_frames`, float64), through the
+    coupling's joint values when there is one."""
     n = ch.parent.shape[0]
-    Bf = np.empty((n + 1, 3, 4))
-    v = np.empty(n)
-    _body_frames(
-        q, ch.T0, ch.parent, ch.prism, ch.pre, Bf, (ch.cpl_start, ch.cpl_idx, ch.cpl_val), v
-    )
-    return Bf
+    F = np.empty(12 * (n + 1))
+    if ch.cpl_start.shape[0] == 0:
+        chain_frames(F, q, ch.T0, ch.pre, ch.parent, ch.slide)
+    else:
+        v = np.empty(n)
+        chain_values(q, (ch.cpl_start, ch.cpl_idx, ch.cpl_val), v)
+        chain_frames(F, v, ch.T0, ch.pre, ch.parent, ch.slide)
+    return F.reshape((n + 1, 3, 4))
 
 
 @njit(cache=True, nogil=True, inline="always")
@@ -251,14 +213,15 @@ def _to_state(cpl, i, x, sign, out):
         out[i] += sign * x
         return
     for k in range(cpl_start[i], cpl_start[i + 1]):
-        out[cpl_idx[k]] += sign * (cpl_val[k // 3, k % 3] * x)
+        out[cpl_idx[k]] += sign * (cpl_val[k] * x)
 
 
 @njit(cache=True, nogil=True, inline="always")
-def point_gradient(Bf, kn, body, p, n0, n1, n2, sign, out):
+def point_gradient(Bf, kn, body, p, nv, sign, out):
     """Add ``sign · n · ∂p/∂q`` into ``out`` (dof,) for the point p (3,) on ``body``
-    (``kn``: the chain's :func:`kin`)."""
-    parent, prism, cpl, _, serial = kn
+    (``kn``: the chain's :func:`kin`; ``nv`` = (n0, n1, n2), three floats)."""
+    n0, n1, n2 = nv
+    parent, slide, cpl, _, serial = kn
     if serial:  # joints 0 … body − 1, each turning about its body's z
         for i in range(body):
             b = i + 1
@@ -273,7 +236,7 @@ def point_gradient(Bf, kn, body, p, n0, n1, n2, sign, out):
     while b > 0:
         i = b - 1  # the joint that moves body b
         zx, zy, zz = Bf[b, 0, 2], Bf[b, 1, 2], Bf[b, 2, 2]
-        if prism[i] != 0:
+        if slide[i]:
             g = n0 * zx + n1 * zy + n2 * zz
         else:
             dx = p[0] - Bf[b, 0, 3]
@@ -287,8 +250,8 @@ def point_gradient(Bf, kn, body, p, n0, n1, n2, sign, out):
 @njit(cache=True, nogil=True, inline="always")
 def kin(ch):
     """The arrays :func:`point_gradient` and :func:`pair_gradient` walk the chain with:
-    (parent, prism, coupling, each link's body, serial), taken out of the chain once."""
-    return ch.parent, ch.prism, (ch.cpl_start, ch.cpl_idx, ch.cpl_val), ch.link_body, ch.serial
+    (parent, slide, coupling, each link's body, serial), taken out of the chain once."""
+    return ch.parent, ch.slide, (ch.cpl_start, ch.cpl_idx, ch.cpl_val), ch.link_body, ch.serial
 
 
 @njit(cache=True, nogil=True, inline="always")
@@ -297,14 +260,14 @@ def tip_jacobians(Bf, ch, p, n, dof):
     ``z_i × n`` for a turning joint i, ``z_i`` and 0 for a sliding one)."""
     Jp = np.zeros((3, dof))
     Jn = np.zeros((3, dof))
-    parent, prism, cpl, _, _ = kin(ch)
+    parent, slide, cpl, _, _ = kin(ch)
     cpl_start, cpl_idx, cpl_val = cpl
     coupled = cpl_start.shape[0] > 0
     b = ch.tip_body
     while b > 0:
         i = b - 1
         zx, zy, zz = Bf[b, 0, 2], Bf[b, 1, 2], Bf[b, 2, 2]
-        if prism[i] != 0:
+        if slide[i]:
             p0, p1, p2 = zx, zy, zz
             m0, m1, m2 = 0.0, 0.0, 0.0
         else:
@@ -322,7 +285,7 @@ def tip_jacobians(Bf, ch, p, n, dof):
             Jn[0, i], Jn[1, i], Jn[2, i] = m0, m1, m2
         else:
             for k in range(cpl_start[i], cpl_start[i + 1]):
-                c = cpl_val[k // 3, k % 3]
+                c = cpl_val[k]
                 j = cpl_idx[k]
                 Jp[0, j] += c * p0
                 Jp[1, j] += c * p1
@@ -336,7 +299,7 @@ def tip_jacobians(Bf, ch, p, n, dof):
 
 # ---------------------------------------------------------------------- pairs
 @njit(cache=True, nogil=True)
-def pairs(P, r, scene_idx, self_a, self_b, scene, far_m, lp_of_row, lp_links, ends):
+def pairs(P, r, scene_idx, self_ab, scene, far_m, cull):
     """Every sphere pair, in ``ClearanceField._pairs``' order: distance d (m,), direction
     n (m, 3). ``scene``: the obstacles (kinds, Rs, cs, pars, bound). A pair at least
     ``far_m`` apart gets d = ``far_m`` and no direction (the descent asks nothing of it:
@@ -345,7 +308,10 @@ def pairs(P, r, scene_idx, self_a, self_b, scene, far_m, lp_of_row, lp_links, en
     ``bound``) when they are that far. The self pairs of two links whose sphere chains are
     that far apart (their midpoints farther than both half-lengths, radii and ``far_m``)
     are skipped together (``lp_of_row``: each self pair's link pair, ``lp_links`` (k, 2)
-    its links, ``ends`` (L, 2) each link's first and last sphere; :func:`pair_spheres`)."""
+    its links, ``ends`` (L, 2) each link's first and last sphere; :func:`pair_spheres`):
+    ``self_ab`` = (self_a, self_b), ``cull`` = (lp_of_row, lp_links, ends)."""
+    self_a, self_b = self_ab
+    lp_of_row, lp_links, ends = cull
     kinds, Rs, cs, pars, bound = scene
     n_scene = scene_idx.shape[0]
     n_obs = kinds.shape[0]
@@ -508,14 +474,15 @@ def pair_spheres(
 
 
 @njit(cache=True, nogil=True, inline="always")
-def pair_gradient(Bf, kn, P, link, nrm, a, b, row, out):
+def pair_gradient(Bf, kn, P, link, nrm, pair, out):
     """∇d (dof,) of one pair into ``out``: n · ∂p_a/∂q (− n · ∂p_b/∂q for a self pair;
     b = −1: an obstacle) with p_s sphere s's centre (:func:`point_gradient`; ``kn``:
-    :func:`kin` of the chain)."""
+    :func:`kin` of the chain; ``pair`` = (a, b, row))."""
+    a, b, row = pair
     link_body = kn[3]
     n0, n1, n2 = nrm[row, 0], nrm[row, 1], nrm[row, 2]
     for j in range(out.shape[0]):
         out[j] = 0.0
-    point_gradient(Bf, kn, link_body[link[a]], P[a], n0, n1, n2, 1.0, out)
+    point_gradient(Bf, kn, link_body[link[a]], P[a], (n0, n1, n2), 1.0, out)
     if b >= 0:
-        point_gradient(Bf, kn, link_body[link[b]], P[b], n0, n1, n2, -1.0, out)
+        point_gradient(Bf, kn, link_body[link[b]], P[b], (n0, n1, n2), -1.0, out)

@@ -1,7 +1,7 @@
-"""The fused validity check of a URDF chain (collision/chain.py: ``ChainValidity``) gives
-the compiled core's verdicts (core.py's generic kernels) and FCL's, on the spherized Panda
-in imported MotionBenchMaker-form scenes and on a small chain of capsules that turns about
-x, y and an oblique axis and slides."""
+"""The compiled core on a URDF chain (its one kinematics, :mod:`plannerlab.collision.
+kinematics`, and its state test) gives the robot's own capsules and FCL's verdicts, on the
+spherized Panda in imported MotionBenchMaker-form scenes and on a small chain of capsules
+that turns about x, y and an oblique axis and slides."""
 
 from __future__ import annotations
 
@@ -11,7 +11,6 @@ import numpy as np
 import pytest
 from conftest import ROOT
 
-from plannerlab.collision.chain_check import ChainValidity
 from plannerlab.collision.core import Core
 from plannerlab.collision.fcl_checker import CollisionChecker
 from plannerlab.problem.load import Problem, parse_problem
@@ -41,53 +40,17 @@ def _imported(tmp_path: Path, which: str) -> Problem:
 
 
 @pytest.mark.parametrize("which", ["shelf", "table"])
-@pytest.mark.parametrize("margin_m", [0.0, 0.01])
-def test_the_fused_check_gives_the_cores_verdicts_on_panda_states(tmp_path, which, margin_m):
+def test_the_core_agrees_with_fcl_on_panda_states(tmp_path, which):
     problem = _imported(tmp_path, which)
     robot = problem.robot
-    core = Core(robot, problem.scene, margin_m=margin_m)
-    fused = ChainValidity.of(core)
-    Q = np.random.default_rng(7).uniform(robot.lower, robot.upper, (6000, robot.dof))
-    v_core = core.valid(Q)
-    assert 0.2 < v_core.mean() < 0.97  # both kinds of state are there
-    assert np.array_equal(fused.valid(Q), v_core)
-    assert [fused.is_valid(q) for q in Q[:400]] == v_core[:400].tolist()
-    bad = int(np.flatnonzero(~v_core)[0])
-    assert fused.first_invalid(Q) == core.first_invalid(Q) == bad
-    assert fused.first_invalid(Q[v_core][:50]) == -1
-    # its own kinematics (every joint axis turned onto z) give the robot's capsules
-    assert np.abs(fused.segments(Q[:200]) - robot.link_segments(Q[:200])).max() < 1e-12
-
-
-def test_the_fused_check_agrees_with_fcl_on_panda_states(tmp_path):
-    problem = _imported(tmp_path, "shelf")
-    fcl = CollisionChecker(problem.robot, problem.scene, backend="fcl", margin_m=0.01)
-    fused = ChainValidity.of(Core(problem.robot, problem.scene, margin_m=0.01))
-    Q = np.random.default_rng(8).uniform(problem.robot.lower, problem.robot.upper, (3000, 7))
+    fcl = CollisionChecker(robot, problem.scene, backend="fcl", margin_m=0.01)
+    core = Core(robot, problem.scene, margin_m=0.01)
+    Q = np.random.default_rng(8).uniform(robot.lower, robot.upper, (3000, robot.dof))
     v_fcl = fcl.valid_batch(Q)
-    assert 0.2 < v_fcl.mean() < 0.97
-    assert np.array_equal(fused.valid(Q), v_fcl)
-
-
-def test_states_a_hair_from_contact_get_the_cores_verdicts(tmp_path):
-    """Bisected to 1e-10 rad between a valid and an invalid state, pairs of states a hair
-    either side of first contact: the bounding balls never hide a contact."""
-    problem = _imported(tmp_path, "table")
-    robot = problem.robot
-    core = Core(robot, problem.scene, margin_m=0.0)
-    fused = ChainValidity.of(core)
-    Q = np.random.default_rng(9).uniform(robot.lower, robot.upper, (400, robot.dof))
-    v = core.valid(Q)
-    good, bad = Q[v][:60], Q[~v][:60]
-    lo, hi = good.copy(), bad.copy()  # lo valid, hi invalid, along the segment
-    for _ in range(40):
-        mid = (lo + hi) / 2.0
-        ok = core.valid(mid)
-        lo[ok], hi[~ok] = mid[ok], mid[~ok]
-    assert np.abs(hi - lo).max() < 1e-10
-    edge = np.concatenate([lo, hi])
-    assert core.valid(lo).all() and not core.valid(hi).any()
-    assert np.array_equal(fused.valid(edge), core.valid(edge))
+    assert 0.2 < v_fcl.mean() < 0.97  # both kinds of state are there
+    assert np.array_equal(core.valid(Q), v_fcl)
+    # the one kinematics (every joint axis turned onto z) gives the robot's capsules
+    assert np.abs(core.segments(Q[:200]) - robot.link_segments(Q[:200])).max() < 1e-9
 
 
 _OBLIQUE_URDF = """<robot name="oblique">
@@ -119,7 +82,8 @@ _OBLIQUE_URDF = """<robot name="oblique">
 
 def test_a_chain_of_capsules_turning_about_any_axis_and_sliding(tmp_path):
     """Capsules (not spheres: segment tests), axes x, y, oblique, a prismatic joint; a box,
-    a cylinder and a sphere in the scene; with and without margin."""
+    a cylinder and a sphere in the scene; with and without margin: the core's kinematics
+    give the robot's capsules and its verdicts are FCL's."""
     urdf = tmp_path / "oblique.urdf"
     urdf.write_text(_OBLIQUE_URDF, encoding="utf-8")
     robot = UrdfChain(urdf, "d")
@@ -130,23 +94,11 @@ def test_a_chain_of_capsules_turning_about_any_axis_and_sliding(tmp_path):
             Sphere("ball", pose_matrix([0.0, -0.6, 0.9], [0.0, 0.0, 0.0]), 0.15),
         )
     )
-    Q = np.random.default_rng(10).uniform(robot.lower, robot.upper, (5000, robot.dof))
+    Q = np.random.default_rng(10).uniform(robot.lower, robot.upper, (1500, robot.dof))
     for margin_m in (0.0, 0.02):
         core = Core(robot, scene, margin_m=margin_m)
-        fused = ChainValidity.of(core)
+        fcl = CollisionChecker(robot, scene, backend="fcl", margin_m=margin_m)
         v_core = core.valid(Q)
         assert 0.2 < v_core.mean() < 0.95
-        assert np.array_equal(fused.valid(Q), v_core)
-        assert np.abs(fused.segments(Q[:200]) - robot.link_segments(Q[:200])).max() < 1e-12
-    fcl = CollisionChecker(robot, scene, backend="fcl", margin_m=0.02)
-    assert np.array_equal(fused.valid(Q[:1500]), fcl.valid_batch(Q[:1500]))
-
-
-def test_a_state_of_the_wrong_size_is_refused(tmp_path):
-    fused = ChainValidity.of(Core(_imported(tmp_path, "shelf").robot, Scene()))
-    with pytest.raises(ValueError, match="7 joints"):
-        fused.valid(np.zeros((3, 6)))
-    with pytest.raises(ValueError, match="7 joints"):
-        fused.is_valid(np.zeros(8))
-    with pytest.raises(ValueError, match="one state"):
-        fused.is_valid(np.zeros((2, 7)))
+        assert np.array_equal(v_core, fcl.valid_batch(Q))
+        assert np.abs(core.segments(Q[:200]) - robot.link_segments(Q[:200])).max() < 1e-9

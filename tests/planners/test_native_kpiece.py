@@ -172,7 +172,7 @@ def _search(name: str, seed: int, checks: int) -> tuple[Any, ...]:
     prm[KP.P_STRIDE] = s.lazy_every
     goals = np.zeros((0, dof))
     x = np.empty(k, dtype=np.int64)
-    KP.add_motion(T, C, proj, counters, p.q_start, -1, K.CHECKED, 1.0, x)
+    KP.add_motion(T, C, proj, counters, p.q_start, (-1, K.CHECKED, 1.0), x)
     code = KP.kpiece_run(shim.bundle(checker), T, C, proj, goals, prm, counters, K.seed_state(rng))
     assert code == K.HARD
     return p, model, T, C, proj, counters

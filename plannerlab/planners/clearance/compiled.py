@@ -106,13 +106,10 @@ def _pairs_of(P, fld, far_m):
         P,
         fld.r,
         fld.scene_idx,
-        fld.self_a,
-        fld.self_b,
+        (fld.self_a, fld.self_b),
         fld.scene,
         far_m,
-        fld.lp_of_row,
-        fld.lp_links,
-        fld.ends,
+        (fld.lp_of_row, fld.lp_links, fld.ends),
     )
 
 
@@ -163,39 +160,21 @@ def evaluate(q, fld, far_m, goal, rule, want_direction, d_ref, floor_m):
         return F, f, dist, ang_err_deg, cost, grad, d, direction, spacious, metric, joint_err
     close_pairs = (Bf, fld, P, nrm, n_close, close, margin)
     if goal.joint:
-        direction, metric = _joint_direction(
-            dq,
-            joint_err,
-            close_pairs,
-            grad,
-            weight,
-            rule.gauss_newton,
-            rule.damping,
-            rule.goal_depth,
-            goal.tol_rad,
-        )
+        direction, metric = _joint_direction(dq, joint_err, close_pairs, grad, rule, goal.tol_rad)
         return F, f, dist, ang_err_deg, cost, grad, d, direction, spacious, metric, joint_err
 
     Jp, Jn = tip_jacobians(Bf, ch, p, n, dof)
     if not rule.gauss_newton:
-        direction = _tip_steepest(diff, dist, cn, goal.n, Jp, Jn, grad, r1, r2, weight)
+        direction = _tip_steepest(diff, dist, cn, goal.n, (Jp, Jn), grad, rule)
         return F, f, dist, ang_err_deg, cost, grad, d, direction, spacious, metric, joint_err
     direction, A = _tip_gauss_newton(
-        p,
-        n,
-        goal.p,
-        goal.n,
-        dist,
-        cn,
+        (p, n, dist, cn),
+        (goal.p, goal.n, goal.pos_tol, goal.angle_tol_deg),
         Jp,
         Jn,
-        goal.pos_tol,
-        goal.angle_tol_deg,
-        rule.goal_depth,
+        rule,
         close_pairs,
         grad,
-        weight,
-        rule.damping,
     )
     return F, f, dist, ang_err_deg, cost, grad, d, direction, spacious, A, joint_err
 
@@ -258,7 +237,7 @@ def _clearance_cost(Bf, fld, P, nrm, d, dof):
             close[k] = i
             k += 1
             wgt = -2.0 * (margin - d[i]) / margin
-            pair_gradient(Bf, kn, P, link, nrm, A_idx[i], B_idx[i], i, gi)
+            pair_gradient(Bf, kn, P, link, nrm, (A_idx[i], B_idx[i], i), gi)
             for j in range(dof):
                 grad[j] += wgt * gi[j]
     return cost, grad, n_close, close
@@ -275,8 +254,11 @@ def _spacious(d, d_ref, floor_m):
 
 
 @njit(cache=True, nogil=True, inline="always")
-def _tip_steepest(diff, dist, cn, n_goal, Jp, Jn, grad, r1, r2, weight):
-    """Steepest descent on F = r1 |p − p_goal| + r2 (1 − n · n_goal)² + w · cost (dof,)."""
+def _tip_steepest(diff, dist, cn, n_goal, J, grad, rule):
+    """Steepest descent on F = r1 |p − p_goal| + r2 (1 − n · n_goal)² + w · cost (dof,);
+    J = (Jp, Jn) the tip's Jacobians, ``rule`` the :class:`StepRule` (scalars only)."""
+    Jp, Jn = J
+    r1, r2, weight = rule.r1, rule.r2, rule.weight
     dof = Jp.shape[1]
     direction = np.zeros(dof)
     for j in range(dof):
@@ -289,27 +271,16 @@ def _tip_steepest(diff, dist, cn, n_goal, Jp, Jn, grad, r1, r2, weight):
 
 
 @njit(cache=True, nogil=True, inline="always")
-def _tip_gauss_newton(
-    p,
-    n,
-    p_goal,
-    n_goal,
-    dist,
-    cn,
-    Jp,
-    Jn,
-    pos_tol,
-    angle_tol_deg,
-    goal_depth,
-    pairs,
-    grad,
-    weight,
-    damping,
-):
+def _tip_gauss_newton(tip, target, Jp, Jn, rule, pairs, grad):
     """Damped Gauss-Newton on the tip residuals (p_goal − p) / pos_tol and
     (n_goal − n) / angle_tol (each zero once deeper than ``goal_depth`` tolerances in the
     goal) plus one residual per close pair (``pairs``, see :func:`_with_close_pairs`):
-    the step (dof,) and the matrix of its quadratic model (dof, dof)."""
+    the step (dof,) and the matrix of its quadratic model (dof, dof). ``tip`` = (p, n,
+    dist, cn), ``target`` = (p_goal, n_goal, pos_tol, angle_tol_deg), ``rule`` the
+    :class:`StepRule` (scalars only)."""
+    p, n, dist, cn = tip
+    p_goal, n_goal, pos_tol, angle_tol_deg = target
+    goal_depth, weight, damping = rule.goal_depth, rule.weight, rule.damping
     dof = Jp.shape[1]
     pos_scale = 1.0 / pos_tol
     ang_scale = 1.0 / math.radians(angle_tol_deg)
@@ -346,7 +317,7 @@ def _with_close_pairs(A, b, pairs, grad, weight):
         dd = np.empty((n_close, dof))
         for c in range(n_close):
             i = close[c]
-            pair_gradient(Bf, kn, P, link, nrm, A_idx[i], B_idx[i], i, gi)
+            pair_gradient(Bf, kn, P, link, nrm, (A_idx[i], B_idx[i], i), gi)
             dd[c] = gi
         k2 = weight / margin
         A = A + k2 * (dd.T @ dd)
@@ -365,14 +336,18 @@ def _damped_solve(A, b, damping):
 
 
 @njit(cache=True, nogil=True, inline="always")
-def _joint_direction(
-    dq, joint_err, pairs, grad, weight, gauss_newton, damping, goal_depth, tol_rad
-):
+def _joint_direction(dq, joint_err, pairs, grad, rule, tol_rad):
     """The step towards a goal state (``ClearanceDescent._joint_direction``): steepest
     descent on F = |dq / tol|² + w · cost, or damped Gauss-Newton on the joint residual
     −dq / tol (Jacobian I / tol) plus one residual per close pair (``pairs``, see
     :func:`_with_close_pairs`); dq = q − q_goal. Returns the step and the matrix of its
-    quadratic model (the hold's metric)."""
+    quadratic model (the hold's metric). ``rule``: the :class:`StepRule` (scalars only)."""
+    weight, gauss_newton, damping, goal_depth = (
+        rule.weight,
+        rule.gauss_newton,
+        rule.damping,
+        rule.goal_depth,
+    )
     dof = dq.shape[0]
     direction = np.zeros(dof)
     if not gauss_newton:
@@ -413,7 +388,7 @@ def hold_clearance(q, direction, fld, floor_m, metric):
     k = 0
     for i in range(d.shape[0]):
         if d[i] < floor_m:
-            pair_gradient(Bf, kn, P, link, nrm, A_idx[i], B_idx[i], i, gi)
+            pair_gradient(Bf, kn, P, link, nrm, (A_idx[i], B_idx[i], i), gi)
             G[k] = gi
             k += 1
     dnorm = math.sqrt(np.sum(direction * direction))
@@ -500,7 +475,7 @@ class CompiledField:
     :class:`ClearanceField` (so both backends see the same field), the scene and the
     robot's chain from the compiled robot–scene model (``model``: a checker's
     :class:`~plannerlab.collision.model.CompiledModel`, or None: the robot's chain
-    packed alone, :func:`~plannerlab.collision.model_old.chain_model`), packed once.
+    folded alone, :func:`~plannerlab.collision.model.folded_chain`), packed once.
 
     Raises:
         ModelError: the robot gives no serial chain.
@@ -509,19 +484,13 @@ class CompiledField:
     """
 
     def __init__(self, field: ClearanceField, far_m: float, model: Any = None) -> None:
-        from plannerlab.collision.model_old import chain_model
-
         robot = field.robot
         if not callable(getattr(robot, "tip_data", None)):
             raise ValueError(
                 f"the compiled descent needs the robot's tip (tip_data()); "
                 f"robot {getattr(robot, 'kind', '?')!r} gives none"
             )
-        chain = (
-            sphere_chain(chain_model(robot), robot)
-            if model is None
-            else model_sphere_chain(model, robot)
-        )
+        chain = sphere_chain(robot) if model is None else model_sphere_chain(model, robot)
         link = np.array(field._link, dtype=np.int64)
         scene_idx = np.array(field._scene_spheres, dtype=np.int64)
         self_a = np.array(field._self_a, dtype=np.int64)

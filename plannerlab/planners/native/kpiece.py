@@ -356,9 +356,11 @@ def _reaches(q, goals, continuous, tol):
 
 
 @njit(cache=True, nogil=True)
-def add_motion(T, C, proj, counters, q, parent, flag, dist, x):
+def add_motion(T, C, proj, counters, q, edge, x):
     """Motion q (from ``parent``, edge ``flag``) into the tree and its cell (a new cell
-    scored by ``dist``, its goal distance); returns its index."""
+    scored by ``dist``, its goal distance); ``edge`` = (parent, flag, dist); returns its
+    index."""
+    parent, flag, dist = edge
     r = counters[C_MOTIONS]
     counters[C_MOTIONS] = r + 1
     T.Q[r] = q
@@ -403,9 +405,11 @@ def _select(C, counters, rng, border):
 
 
 @njit(cache=True, nogil=True)
-def _target(T, m, goals, prm, lower, upper, continuous, rng, out):
+def _target(T, m, goals, prm, bounds, rng, out):
     """Where to move from motion m: a goal state (probability ``goal_bias``) or a state
-    uniform within ``range_rad`` of m's per joint (wrapped, or clipped to the bounds)."""
+    uniform within ``range_rad`` of m's per joint (wrapped, or clipped to the bounds:
+    ``bounds`` = (lower, upper, continuous))."""
+    lower, upper, continuous = bounds
     if goals.shape[0] > 0 and uniform(rng) < prm[P_GOAL_BIAS]:
         out[:] = goals[randint(rng, goals.shape[0])]
         return True
@@ -484,7 +488,7 @@ def kpiece_run(ck, T, C, proj, goals, prm, counters, rng):
             i = T.prev[i]
         kept = False
         if T.flag[i] != DEAD:
-            to_goal = _target(T, i, goals, prm, m.lower, m.upper, m.continuous, rng, target)
+            to_goal = _target(T, i, goals, prm, (m.lower, m.upper, m.continuous), rng, target)
             counters[C_GOAL_TRIES] += 1 if to_goal else 0
             left = counters[C_HARD] - counters[C_CHECKS]
             status, j, n, checks = shim.edge_reach(
@@ -502,7 +506,7 @@ def kpiece_run(ck, T, C, proj, goals, prm, counters, rng):
                     shim.grid_state(T.Q[i], d, j, n, q_new)
                 dist = goal_distance(q_new, goals, m.continuous)
                 flag = CHECKED if (j == n and stride == 1) else COARSE
-                r = add_motion(T, C, proj, counters, q_new, i, flag, dist, x)
+                r = add_motion(T, C, proj, counters, q_new, (i, flag, dist), x)
                 if _reaches(q_new, goals, m.continuous, prm[P_GOAL_TOL]):
                     code = _certify(ck, T, counters, r, step, d, q)
                     if code == 2:

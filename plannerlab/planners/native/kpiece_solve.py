@@ -108,7 +108,7 @@ def kpiece(solve: NativeSolve) -> PlanResult:
     counters[KP.C_MAX_ITER] = UNLIMITED if b.max_iterations is None else b.max_iterations
     x = np.empty(k, dtype=np.int64)
     dist = KP.goal_distance(q0, G, model.continuous)
-    KP.add_motion(T, C, proj, counters, q0, -1, K.CHECKED, dist, x)
+    KP.add_motion(T, C, proj, counters, q0, (-1, K.CHECKED, dist), x)
     box: list[Any] = [T, C]
     solve._charged = 0
 

@@ -65,7 +65,7 @@ def _warm_kpiece(checker: Any) -> None:
     counters[KP.C_DISC_ITER] = 1
     q = np.zeros(dof)
     goals = np.zeros((1, dof))
-    KP.add_motion(T, C, proj, counters, q, -1, 1, 0.0, np.empty(2, dtype=np.int64))
+    KP.add_motion(T, C, proj, counters, q, (-1, 1, 0.0), np.empty(2, dtype=np.int64))
     rng = np.array([1, 2, 3, 4], dtype=np.uint64)
     prm = np.zeros(KP.N_PARAMS)
     prm[KP.P_STRIDE] = 1

@@ -73,13 +73,10 @@ def hinge_terms(Q, fld_t, d_safe, want_matrix):
             P,
             fld.r,
             fld.scene_idx,
-            fld.self_a,
-            fld.self_b,
+            (fld.self_a, fld.self_b),
             fld.scene,
             d_safe,
-            fld.lp_of_row,
-            fld.lp_links,
-            fld.ends,
+            (fld.lp_of_row, fld.lp_links, fld.ends),
         )
         for i in range(d.shape[0]):
             di = d[i]
@@ -87,7 +84,7 @@ def hinge_terms(Q, fld_t, d_safe, want_matrix):
                 dmin[s] = di
             if di < d_safe:
                 h = d_safe - di
-                pair_gradient(Bf, kn, P, fld.link, nrm, fld.A[i], fld.B[i], i, g)
+                pair_gradient(Bf, kn, P, fld.link, nrm, (fld.A[i], fld.B[i], i), g)
                 cost[s] += h * h
                 for j in range(dof):
                     grad[s, j] -= 2.0 * h * g[j]
@@ -222,7 +219,7 @@ def speed_terms(Q, fld_t):
                 e0 = 1.0 if axis == 0 else 0.0
                 e1 = 1.0 if axis == 1 else 0.0
                 e2 = 1.0 if axis == 2 else 0.0
-                point_gradient(Bf, kn, body, P[sp], e0, e1, e2, 1.0, g)
+                point_gradient(Bf, kn, body, P[sp], (e0, e1, e2), 1.0, g)
                 for j in range(dof):
                     # |∂p/∂q_j| >= each component; the norm over the three is below √3
                     # times the largest: the bound is the norm, summed per axis below
