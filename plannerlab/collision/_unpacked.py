@@ -122,4 +122,6 @@ def unpack_lanes(f64, f32, i64, b1, head):
         _v1(f64, head, 480),
         _v2(i64, head, 486),
         _v2(i64, head, 492),
+        _v1(f32, head, 498),
+        _v1(i64, head, 504),
     )
