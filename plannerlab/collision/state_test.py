@@ -60,6 +60,7 @@ from plannerlab.collision.lane_geometry import (
     _self_boxes,
     _slot3,
 )
+from plannerlab.collision.model import SELF_GROUP
 from plannerlab.collision.simd import (
     LANES,
     bits_mask,
@@ -81,9 +82,8 @@ EVERY_LANE = 0
 ANY_HIT = 1
 _ALL = (1 << LANES) - 1
 #: bodies of ``body_order`` in a group of the scene pass's broadphase (a box around their
-#: gates, built per call, meets each obstacle's world box before the bodies do); in the
-#: self pass, consecutive bodies (0-3, 4-7, ...) whose box meets another group's before
-#: their body pairs are tested
+#: gates, built per call, meets each obstacle's world box before the bodies do; the self
+#: pass's groups are the model's ``SELF_GROUP`` consecutive bodies)
 GROUP = 4
 _F4 = np.float32
 
@@ -121,8 +121,7 @@ class Lanes(NamedTuple):
     edge_rate: np.ndarray  # (L,) the capsules' motion per grid step [m]
     edge_stack: np.ndarray  # (S, 2) int64 stretches still to prove
     edge_marks: np.ndarray  # (3, W) int64 the stretches of one call
-    SB: np.ndarray  # (ng * 6 * W,) the self pass's box around each group of GROUP bodies
-    snear: np.ndarray  # (ng * ng,) int64: lanes where groups g <= h's boxes meet (g ng + h)
+    SB: np.ndarray  # (ng * 6 * W,) the self pass's box around each group of SELF_GROUP bodies
 
 
 @njit(cache=True, nogil=True)
@@ -134,7 +133,7 @@ def lanes(m):
     L = max(m.cap_body.shape[0], 1)
     ncl = max(m.cg_body.shape[0], 1)  # the clusters, then the groups
     n = m.obs_kind.shape[0]
-    ng = (nb + GROUP - 1) // GROUP
+    ng = (nb + SELF_GROUP - 1) // SELF_GROUP
     R = np.empty((n, 3, 3))
     for o in range(n):
         for a in range(3):
@@ -171,7 +170,6 @@ def lanes(m):
         np.zeros((4096, 2), dtype=np.int64),
         np.zeros((3, W), dtype=np.int64),
         np.zeros(ng * 6 * W, dtype=f4),
-        np.zeros(ng * ng, dtype=np.int64),
     )
 
 
@@ -394,9 +392,10 @@ def _pairs_in(T, q0, q1, cv, eps, grow, plain, hm):
 
 @inline_kernel
 def _self_pass(m, Z, mode, hu):
-    """Every checked link pair behind the boxes around groups of ``GROUP`` consecutive
-    bodies (built per call: two groups apart in every lane skip their body pairs), then
-    its body, group and cluster pairs' gates (hu, stop)."""
+    """Every checked link pair behind the boxes around groups of ``SELF_GROUP``
+    consecutive bodies (built per call: two groups apart in every live lane skip their
+    body pairs, taken group pair by group pair), then its body, group and cluster pairs'
+    gates (hu, stop)."""
     caps, cls, gates = m.caps32, m.cg32, m.gates32  # cg32: the clusters, then the groups
     F, G, K, X, cr = Z.F, Z.G, Z.K, Z.X, Z.crate
     tables = (cls, caps, m.cl_caps, m.cg_body, m.cap_sphere, Z.placed)
@@ -405,48 +404,52 @@ def _self_pass(m, Z, mode, hu):
     eps = splat(m.eps32_m)
     none = bits_mask(0)
     pair_tables = (X, m.cpairs, caps, Z.rate, m.cap_sphere, K, cls, cr)
-    near = Z.snear  # the broadphase: lanes where two groups of bodies may meet
-    ng = _self_boxes(gates, G, Z.brate, Z.SB, GROUP, grow, eps)
-    for g in range(ng):
-        for h in range(g, ng):
-            near[g * ng + h] = _boxes_meet(Z.SB, g, h)
-    for p in range(m.bpairs.shape[0]):
-        u, v = m.bpairs[p, 0], m.bpairs[p, 1]
-        if u != v:
-            live = near[(u // GROUP) * ng + v // GROUP] & ~hu[0]
-            if live == 0:
-                continue
-            r = fma(grow, splat(Z.brate[u] + Z.brate[v]), splat(gates[u, 4] + gates[v, 4]) + eps)
-            if not _near(_gap2(G, 3 * u * W, G, 3 * v * W), r, live):
-                continue
-        hm = (none, none, none)
-        for gp in range(m.bpair_gstart[p], m.bpair_gstart[p + 1]):
-            gu, gv = m.gpairs[gp, 0], m.gpairs[gp, 1]
-            if m.gpairs[gp, 2]:  # a group's centre is placed like a cluster's (placed 1)
-                _place_cluster(F, X, K, gu, tables, 1)
-                _place_cluster(F, X, K, gv, tables, 1)
-                r = fma(grow, splat(cr[gu] + cr[gv]), splat(cls[gu, 4] + cls[gv, 4]) + eps)
-                if not _near(_gap2(K, 3 * gu * W, K, 3 * gv * W), r, _ALL & ~hu[0]):
+    # the broadphase: a box per group of SELF_GROUP consecutive bodies; the body pairs
+    # of two groups whose boxes meet in no live lane are skipped (one branch a group pair)
+    ng = _self_boxes(gates, G, Z.brate, Z.SB, SELF_GROUP, grow, eps)
+    for gh in range(ng * ng):
+        g, h = gh // ng, gh % ng
+        b0, b1 = m.gbpair_start[gh], m.gbpair_start[gh + 1]
+        if b0 == b1:
+            continue
+        meet = _boxes_meet(Z.SB, g, h) & ~hu[0]
+        if meet == 0:
+            continue
+        for kp in range(b0, b1):
+            p = m.bpair_gorder[kp]
+            u, v = m.bpairs[p, 0], m.bpairs[p, 1]
+            if u != v:
+                r = fma(grow, splat(Z.brate[u] + Z.brate[v]), splat(gates[u, 4] + gates[v, 4]))
+                if not _near(_gap2(G, 3 * u * W, G, 3 * v * W), r + eps, meet & ~hu[0]):
                     continue
-            for cp in range(m.gpair_start[gp], m.gpair_start[gp + 1]):
-                cu, cv = m.clpairs[cp, 0], m.clpairs[cp, 1]
-                if cu != cv:
-                    _place_cluster(F, X, K, cu, tables, 1)
-                    _place_cluster(F, X, K, cv, tables, 1)
-                    r = fma(grow, splat(cr[cu] + cr[cv]), splat(cls[cu, 4] + cls[cv, 4]) + eps)
-                    if not _near(_gap2(K, 3 * cu * W, K, 3 * cv * W), r, _ALL & ~hu[0]):
+            hm = (none, none, none)
+            for gp in range(m.bpair_gstart[p], m.bpair_gstart[p + 1]):
+                gu, gv = m.gpairs[gp, 0], m.gpairs[gp, 1]
+                if m.gpairs[gp, 2]:  # a group's centre is placed like a cluster's (placed 1)
+                    _place_cluster(F, X, K, gu, tables, 1)
+                    _place_cluster(F, X, K, gv, tables, 1)
+                    r = fma(grow, splat(cr[gu] + cr[gv]), splat(cls[gu, 4] + cls[gv, 4]) + eps)
+                    if not _near(_gap2(K, 3 * gu * W, K, 3 * gv * W), r, meet & ~hu[0]):
                         continue
-                _place_cluster(F, X, K, cu, tables, 2)
-                _place_cluster(F, X, K, cv, tables, 2)
-                q0, q1 = m.clpair_start[cp], m.clpair_start[cp + 1]
-                hm = _pairs_in(pair_tables, q0, q1, cv, eps, grow, plain, hm)
-        hu = (
-            hu[0] | mask_bits(hm[0]),
-            hu[1] | mask_bits(hm[1]),
-            hu[2] | mask_bits(hm[2]),
-        )
-        if _stop(hu[0], mode):
-            return hu, True
+                for cp in range(m.gpair_start[gp], m.gpair_start[gp + 1]):
+                    cu, cv = m.clpairs[cp, 0], m.clpairs[cp, 1]
+                    if cu != cv:
+                        _place_cluster(F, X, K, cu, tables, 1)
+                        _place_cluster(F, X, K, cv, tables, 1)
+                        r = fma(grow, splat(cr[cu] + cr[cv]), splat(cls[cu, 4] + cls[cv, 4]) + eps)
+                        if not _near(_gap2(K, 3 * cu * W, K, 3 * cv * W), r, meet & ~hu[0]):
+                            continue
+                    _place_cluster(F, X, K, cu, tables, 2)
+                    _place_cluster(F, X, K, cv, tables, 2)
+                    q0, q1 = m.clpair_start[cp], m.clpair_start[cp + 1]
+                    hm = _pairs_in(pair_tables, q0, q1, cv, eps, grow, plain, hm)
+            hu = (
+                hu[0] | mask_bits(hm[0]),
+                hu[1] | mask_bits(hm[1]),
+                hu[2] | mask_bits(hm[2]),
+            )
+            if _stop(hu[0], mode):
+                return hu, True
     return hu, False
 
 

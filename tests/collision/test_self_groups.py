@@ -1,6 +1,6 @@
-"""The self pass's broadphase (issue 32): a box around each group of ``GROUP`` consecutive
-bodies, built per call in float32 lanes (``lane_geometry._self_boxes``), lets a body pair
-through in a lane only where the boxes of its two groups meet. The gate must be
+"""The self pass's broadphase (issue 32): a box around each group of ``SELF_GROUP``
+consecutive bodies, built per call in float32 lanes (``lane_geometry._self_boxes``), lets
+a body pair through in a lane only where the boxes of its two groups meet. The gate must be
 conservative: each box holds its bodies' gate balls (their radii between links) as the
 float64 kinematics place them, every body pair whose balls meet (or nearly: near contact)
 is let through, and the verdicts stay float64's and FCL's on self-colliding and
@@ -18,9 +18,10 @@ from plannerlab.collision.exact import frames64
 from plannerlab.collision.fcl_checker import CollisionChecker, problem_checker
 from plannerlab.collision.kinematics import place
 from plannerlab.collision.lane_geometry import _boxes_meet, _self_boxes
+from plannerlab.collision.model import SELF_GROUP as GROUP
 from plannerlab.collision.queries import open_packed
 from plannerlab.collision.simd import splat
-from plannerlab.collision.state_test import GROUP, W, frames32, load_state, set_plain
+from plannerlab.collision.state_test import W, frames32, load_state, set_plain
 from plannerlab.problem.load import parse_problem
 from plannerlab.problem.scene import Scene
 from plannerlab.robots.armz.model import ArmZ
