@@ -26,6 +26,7 @@ from plannerlab.collision.simd import (
     mask_bits,
     select,
     splat,
+    store,
     vabs,
     vmax,
     vmin,
@@ -304,3 +305,47 @@ def _box_meets(O, o, B, live):
     m = (lx - cx <= wx) & (cx - hx <= wx) & (ly - cy <= wy) & (cy - hy <= wy)
     m = m & (lz - cz <= wz) & (cz - hz <= wz)
     return (mask_bits(m) & live) != 0
+
+
+@kernel
+def _self_boxes(gates, G, brate, SB, group, grow, eps):
+    """The self pass's broadphase (per call): into ``SB`` the lanes' world box around each
+    group of ``group`` consecutive bodies (``g · group`` to ``g · group + group − 1``; the
+    groups ``SB`` has room for): their gates' centres G ∓ their radii between links
+    ``gates[b, 4]`` grown by ``grow · brate[b]`` and by eps (each ball alone carries the
+    whole eps of a body pair's gate), corners moved out by 2^-21 relative and 1e-7 m
+    beyond float32's rounding. A group without a gated body gets an empty box (it meets
+    nothing). Returns the number of groups."""
+    nb = gates.shape[0]
+    ng = SB.shape[0] // (6 * W)
+    rel, pad = splat(2.0**-21), splat(1e-7)
+    for g in range(ng):
+        big, small = splat(3.0e38), splat(-3.0e38)
+        lx, ly, lz, hx, hy, hz = big, big, big, small, small, small
+        for b in range(g * group, min(g * group + group, nb)):
+            if gates[b, 4] < 0.0:
+                continue
+            gx, gy, gz = _slot3(G, b)
+            rb = fma(grow, splat(brate[b]), splat(gates[b, 4]) + eps)
+            lx, ly, lz = vmin(lx, gx - rb), vmin(ly, gy - rb), vmin(lz, gz - rb)
+            hx, hy, hz = vmax(hx, gx + rb), vmax(hy, gy + rb), vmax(hz, gz + rb)
+        o = 6 * g * W
+        store(SB, o, lx - fma(vabs(lx), rel, pad))
+        store(SB, o + W, ly - fma(vabs(ly), rel, pad))
+        store(SB, o + 2 * W, lz - fma(vabs(lz), rel, pad))
+        store(SB, o + 3 * W, hx + fma(vabs(hx), rel, pad))
+        store(SB, o + 4 * W, hy + fma(vabs(hy), rel, pad))
+        store(SB, o + 5 * W, hz + fma(vabs(hz), rel, pad))
+    return ng
+
+
+@kernel
+def _boxes_meet(SB, g, h):
+    """Lanes (bits) where the boxes of groups g and h in ``SB`` (see :func:`_self_boxes`)
+    meet."""
+    a, b = 6 * g * W, 6 * h * W
+    m = (load(SB, a) <= load(SB, b + 3 * W)) & (load(SB, b) <= load(SB, a + 3 * W))
+    m = m & (load(SB, a + W) <= load(SB, b + 4 * W)) & (load(SB, b + W) <= load(SB, a + 4 * W))
+    m = m & (load(SB, a + 2 * W) <= load(SB, b + 5 * W))
+    m = m & (load(SB, b + 2 * W) <= load(SB, a + 5 * W))
+    return mask_bits(m)

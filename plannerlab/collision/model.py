@@ -108,6 +108,10 @@ class CompiledModel(NamedTuple):
     bpair_gstart: np.ndarray  # (P + 1,) int64 into gpairs
     gpairs: np.ndarray  # (GP, 3) int64: rows of cg32 (K + g), gate tested (1) or not (0)
     gpair_start: np.ndarray  # (GP + 1,) int64 into clpairs
+    # the self pass's broadphase: body pairs by the pair of groups of SELF_GROUP
+    # consecutive bodies they join (g <= h, ng = ceil((m + 1) / SELF_GROUP) groups)
+    bpair_gorder: np.ndarray  # (P,) int64: rows of bpairs, by group pair
+    gbpair_start: np.ndarray  # (ng * ng + 1,) int64 into bpair_gorder, group pair g ng + h
     # the scene
     obs_kind: np.ndarray  # (n,) int64
     obs_R: np.ndarray  # (n, 9) float64, row-major world <- obstacle
@@ -171,6 +175,21 @@ def _ball(points: np.ndarray, reach: np.ndarray) -> tuple[np.ndarray, float]:
         return np.zeros(3), -1.0
     c = (points.min(axis=0) + points.max(axis=0)) / 2.0
     return c, float(np.max(np.linalg.norm(points - c, axis=1) + reach)) + _BOUND_PAD_M
+
+
+#: consecutive bodies per group of the self pass's broadphase (a box around their gates,
+#: built per call, meets another group's before their body pairs are tested)
+SELF_GROUP = 4
+
+
+def _pairs_by_group(bpairs: np.ndarray, nb: int) -> tuple[np.ndarray, np.ndarray]:
+    """The body pairs (u <= v) ordered by the pair of groups of ``SELF_GROUP`` consecutive
+    bodies they join, and where each group pair (g <= h, key ``g ng + h``) starts."""
+    ng = (nb + SELF_GROUP - 1) // SELF_GROUP
+    key = (bpairs[:, 0] // SELF_GROUP) * ng + bpairs[:, 1] // SELF_GROUP
+    order = np.argsort(key, kind="stable")
+    start = np.searchsorted(key[order], np.arange(ng * ng + 1))
+    return _f(order, np.int64), _f(start, np.int64)
 
 
 #: capsules per cluster at most (a cluster's ball gates its capsules)
@@ -476,6 +495,7 @@ def build_model(
     cl_body = body[np.array(cl_start[:-1], dtype=np.int64)] if ncl else np.zeros(0, int)
     pairs = _pairs(geo.allowed, perm, body, np.repeat(np.arange(ncl), np.diff(cl_start)), grp_of)
     bpairs, bpair_start, clpairs, clpair_start, cpairs, bpair_gstart, gpairs, gpair_start = pairs
+    bpair_gorder, gbpair_start = _pairs_by_group(bpairs, nb)
     order = np.arange(nb)[::-1] if body_order is None else np.asarray(body_order)
     kinds = np.asarray(geo.kinds, dtype=np.int64)
     n = len(kinds)
@@ -540,6 +560,8 @@ def build_model(
         bpair_gstart=bpair_gstart,
         gpairs=_group_gates(gpairs, grp_cl, body_cl, grp_body, ncl),
         gpair_start=gpair_start,
+        bpair_gorder=bpair_gorder,
+        gbpair_start=gbpair_start,
         obs_kind=_f(kinds, np.int64),
         obs_R=_f(Rs),
         obs_c=_f(cs),
@@ -619,6 +641,7 @@ __all__ = [
     "ChainGeometry",
     "CompiledModel",
     "ModelError",
+    "SELF_GROUP",
     "build_model",
     "folded_chain",
     "has_chain",

@@ -7,9 +7,11 @@ on the compiled model (:class:`~plannerlab.collision.model.CompiledModel`), in t
 1. **A float32 filter in the lanes**: the kinematics of
    :mod:`plannerlab.collision.kinematics`, then against each obstacle a box around
    ``GROUP`` consecutive bodies (built per call), then per body a gate (a ball around
-   its capsules) against each obstacle and each other body's gate, then (between links)
-   its groups' gates (a body of many capsules) and its clusters' (a few neighbours
-   each), then the capsules behind a gate that is not clear. Every radius is grown by
+   its capsules) against each obstacle; between links, a box around ``GROUP``
+   consecutive bodies (built per call) against each other group's, then each body's
+   gate against the other's, its groups' gates (a body of many capsules), its clusters'
+   (a few neighbours each) and each sphere's against the other cluster's ball; then the
+   capsules behind a gate that is not clear. Every radius is grown by
    the model's bound ``eps32_m`` of how far float32 can be off: a lane whose every pair
    is clear by more than that is **free** (certainly: in float64 too), a lane with a
    pair closer than its radius by more than that has **hit** (certainly), and a lane in
@@ -44,6 +46,7 @@ from plannerlab.collision.exact import exact_state
 from plannerlab.collision.kinematics import chain_frames, chain_values, place
 from plannerlab.collision.lane_geometry import (
     _box_meets,
+    _boxes_meet,
     _ends,
     _gap2,
     _grade_bounds,
@@ -54,8 +57,10 @@ from plannerlab.collision.lane_geometry import (
     _point_d2,
     _segment_obstacle,
     _segments,
+    _self_boxes,
     _slot3,
 )
+from plannerlab.collision.model import SELF_GROUP
 from plannerlab.collision.simd import (
     LANES,
     bits_mask,
@@ -77,7 +82,8 @@ EVERY_LANE = 0
 ANY_HIT = 1
 _ALL = (1 << LANES) - 1
 #: bodies of ``body_order`` in a group of the scene pass's broadphase (a box around their
-#: gates, built per call, meets each obstacle's world box before the bodies do)
+#: gates, built per call, meets each obstacle's world box before the bodies do; the self
+#: pass's groups are the model's ``SELF_GROUP`` consecutive bodies)
 GROUP = 4
 _F4 = np.float32
 
@@ -115,6 +121,7 @@ class Lanes(NamedTuple):
     edge_rate: np.ndarray  # (L,) the capsules' motion per grid step [m]
     edge_stack: np.ndarray  # (S, 2) int64 stretches still to prove
     edge_marks: np.ndarray  # (3, W) int64 the stretches of one call
+    SB: np.ndarray  # (ng * 6 * W,) the self pass's box around each group of SELF_GROUP bodies
 
 
 @njit(cache=True, nogil=True)
@@ -126,6 +133,7 @@ def lanes(m):
     L = max(m.cap_body.shape[0], 1)
     ncl = max(m.cg_body.shape[0], 1)  # the clusters, then the groups
     n = m.obs_kind.shape[0]
+    ng = (nb + SELF_GROUP - 1) // SELF_GROUP
     R = np.empty((n, 3, 3))
     for o in range(n):
         for a in range(3):
@@ -161,6 +169,7 @@ def lanes(m):
         np.zeros(L),
         np.zeros((4096, 2), dtype=np.int64),
         np.zeros((3, W), dtype=np.int64),
+        np.zeros(ng * 6 * W, dtype=f4),
     )
 
 
@@ -336,16 +345,29 @@ def _scene_pass(m, Z, mode, hu):
 
 
 @njit(cache=True, nogil=True, inline="always")
-def _pairs_in(T, q0, q1, eps, grow, plain, hm):
-    """Capsule pairs ``q0:q1`` graded into the lane masks ``hm`` = (hit, unsure grown,
-    unsure plain), kept as vector masks (the tests of :func:`_grade_d2` and
-    :func:`_grade_bounds`); ``T`` = (X, cpairs, caps32, rate, cap_sphere); ``plain``:
-    every lane's growth is 0 (the grown radius is the plain one)."""
-    X, cpairs, caps, rate, sphere = T
+def _pairs_in(T, q0, q1, cv, eps, grow, plain, hm):
+    """Capsule pairs ``q0:q1`` (of a cluster pair whose second cluster is ``cv``: row of
+    ``cg32``) graded into the lane masks ``hm`` = (hit, unsure grown, unsure plain), kept
+    as vector masks (the tests of :func:`_grade_d2` and :func:`_grade_bounds`); ``T`` =
+    (X, cpairs, caps32, rate, cap_sphere, K, cg32, crate); ``plain``: every lane's growth
+    is 0 (the grown radius is the plain one). The pairs of one sphere ``i`` (a run of
+    ``cpairs``) are tested only if the sphere meets ``cv``'s ball (its gate: a sphere
+    clear of the ball is clear of every capsule in it) in some lane."""
+    X, cpairs, caps, rate, sphere, K, cls, crate = T
     mh, mg, m0 = hm
     zero = splat(0.0)
+    run, skip = -1, False
     for q in range(q0, q1):
         i, j = cpairs[q, 0], cpairs[q, 1]
+        if i != run:  # a sphere's pairs with cv: its gate first
+            run, skip = i, False
+            if sphere[i]:
+                rg = splat(caps[i, 7] + cls[cv, 4]) + eps
+                if not plain:
+                    rg = fma(grow, splat(rate[i] + crate[cv]), rg)
+                skip = not _near(_gap2(X, 6 * i * W, K, 3 * cv * W), rg, _ALL)
+        if skip:
+            continue
         r0 = splat(caps[i, 7] + caps[j, 7])
         h0 = r0 + eps
         if plain:
@@ -370,7 +392,10 @@ def _pairs_in(T, q0, q1, eps, grow, plain, hm):
 
 @inline_kernel
 def _self_pass(m, Z, mode, hu):
-    """Every checked link pair behind its body, group and cluster pairs' gates (hu, stop)."""
+    """Every checked link pair behind the boxes around groups of ``SELF_GROUP``
+    consecutive bodies (built per call: two groups apart in every live lane skip their
+    body pairs, taken group pair by group pair), then its body, group and cluster pairs'
+    gates (hu, stop)."""
     caps, cls, gates = m.caps32, m.cg32, m.gates32  # cg32: the clusters, then the groups
     F, G, K, X, cr = Z.F, Z.G, Z.K, Z.X, Z.crate
     tables = (cls, caps, m.cl_caps, m.cg_body, m.cap_sphere, Z.placed)
@@ -378,42 +403,53 @@ def _self_pass(m, Z, mode, hu):
     plain = mask_bits(grow > splat(0.0)) == 0
     eps = splat(m.eps32_m)
     none = bits_mask(0)
-    pair_tables = (X, m.cpairs, caps, Z.rate, m.cap_sphere)
-    for p in range(m.bpairs.shape[0]):
-        u, v = m.bpairs[p, 0], m.bpairs[p, 1]
-        if u != v:
-            r = fma(grow, splat(Z.brate[u] + Z.brate[v]), splat(gates[u, 4] + gates[v, 4]) + eps)
-            if not _near(_gap2(G, 3 * u * W, G, 3 * v * W), r, _ALL & ~hu[0]):
-                continue
-        hm = (none, none, none)
-        for gp in range(m.bpair_gstart[p], m.bpair_gstart[p + 1]):
-            gu, gv = m.gpairs[gp, 0], m.gpairs[gp, 1]
-            if m.gpairs[gp, 2]:  # a group's centre is placed like a cluster's (placed 1)
-                _place_cluster(F, X, K, gu, tables, 1)
-                _place_cluster(F, X, K, gv, tables, 1)
-                r = fma(grow, splat(cr[gu] + cr[gv]), splat(cls[gu, 4] + cls[gv, 4]) + eps)
-                if not _near(_gap2(K, 3 * gu * W, K, 3 * gv * W), r, _ALL & ~hu[0]):
+    pair_tables = (X, m.cpairs, caps, Z.rate, m.cap_sphere, K, cls, cr)
+    # the broadphase: a box per group of SELF_GROUP consecutive bodies; the body pairs
+    # of two groups whose boxes meet in no live lane are skipped (one branch a group pair)
+    ng = _self_boxes(gates, G, Z.brate, Z.SB, SELF_GROUP, grow, eps)
+    for gh in range(ng * ng):
+        g, h = gh // ng, gh % ng
+        b0, b1 = m.gbpair_start[gh], m.gbpair_start[gh + 1]
+        if b0 == b1:
+            continue
+        meet = _boxes_meet(Z.SB, g, h) & ~hu[0]
+        if meet == 0:
+            continue
+        for kp in range(b0, b1):
+            p = m.bpair_gorder[kp]
+            u, v = m.bpairs[p, 0], m.bpairs[p, 1]
+            if u != v:
+                r = fma(grow, splat(Z.brate[u] + Z.brate[v]), splat(gates[u, 4] + gates[v, 4]))
+                if not _near(_gap2(G, 3 * u * W, G, 3 * v * W), r + eps, meet & ~hu[0]):
                     continue
-            for cp in range(m.gpair_start[gp], m.gpair_start[gp + 1]):
-                cu, cv = m.clpairs[cp, 0], m.clpairs[cp, 1]
-                if cu != cv:
-                    _place_cluster(F, X, K, cu, tables, 1)
-                    _place_cluster(F, X, K, cv, tables, 1)
-                    r = fma(grow, splat(cr[cu] + cr[cv]), splat(cls[cu, 4] + cls[cv, 4]) + eps)
-                    if not _near(_gap2(K, 3 * cu * W, K, 3 * cv * W), r, _ALL & ~hu[0]):
+            hm = (none, none, none)
+            for gp in range(m.bpair_gstart[p], m.bpair_gstart[p + 1]):
+                gu, gv = m.gpairs[gp, 0], m.gpairs[gp, 1]
+                if m.gpairs[gp, 2]:  # a group's centre is placed like a cluster's (placed 1)
+                    _place_cluster(F, X, K, gu, tables, 1)
+                    _place_cluster(F, X, K, gv, tables, 1)
+                    r = fma(grow, splat(cr[gu] + cr[gv]), splat(cls[gu, 4] + cls[gv, 4]) + eps)
+                    if not _near(_gap2(K, 3 * gu * W, K, 3 * gv * W), r, meet & ~hu[0]):
                         continue
-                _place_cluster(F, X, K, cu, tables, 2)
-                _place_cluster(F, X, K, cv, tables, 2)
-                hm = _pairs_in(
-                    pair_tables, m.clpair_start[cp], m.clpair_start[cp + 1], eps, grow, plain, hm
-                )
-        hu = (
-            hu[0] | mask_bits(hm[0]),
-            hu[1] | mask_bits(hm[1]),
-            hu[2] | mask_bits(hm[2]),
-        )
-        if _stop(hu[0], mode):
-            return hu, True
+                for cp in range(m.gpair_start[gp], m.gpair_start[gp + 1]):
+                    cu, cv = m.clpairs[cp, 0], m.clpairs[cp, 1]
+                    if cu != cv:
+                        _place_cluster(F, X, K, cu, tables, 1)
+                        _place_cluster(F, X, K, cv, tables, 1)
+                        r = fma(grow, splat(cr[cu] + cr[cv]), splat(cls[cu, 4] + cls[cv, 4]) + eps)
+                        if not _near(_gap2(K, 3 * cu * W, K, 3 * cv * W), r, meet & ~hu[0]):
+                            continue
+                    _place_cluster(F, X, K, cu, tables, 2)
+                    _place_cluster(F, X, K, cv, tables, 2)
+                    q0, q1 = m.clpair_start[cp], m.clpair_start[cp + 1]
+                    hm = _pairs_in(pair_tables, q0, q1, cv, eps, grow, plain, hm)
+            hu = (
+                hu[0] | mask_bits(hm[0]),
+                hu[1] | mask_bits(hm[1]),
+                hu[2] | mask_bits(hm[2]),
+            )
+            if _stop(hu[0], mode):
+                return hu, True
     return hu, False
 
 
