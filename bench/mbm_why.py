@@ -1,5 +1,5 @@
 """Why MotionBenchMaker problems fail: the facts of each problem's start and goal, and the
-failure classes of a solve log (issue 35, item 3; ``results/mbm_fetch.md``).
+failure classes of a solve log (issue 35, item 3; ``results/mesh_robots.md``, "Fetch").
 
 Per problem of an imported set (``plannerlab import mbm --fetch --robot fetch --out DIR``),
 one JSON line (resumable)::

@@ -252,8 +252,8 @@ def test_the_range_ladder_grows_the_goal_tree_out_of_a_fetch_shelf(tmp_path):
     With one range (``range_levels = 1``, OMPL's RRT-Connect) the goal tree never grows
     beyond its root and 150 000 checks run out; with the ladder of ranges (the default)
     the goal tree grows out of the shelf on the same seeds (issue 35, item 3;
-    ``results/mbm_fetch.md``). On the previous state test both seeds then solved it within
-    the 150 000 checks; on the certified edges they do not (the goal tree reaches 45 and
+    ``bench/mbm_why.py``). On the previous state test both seeds then solved
+    it within the 150 000 checks; on the certified edges they do not (the goal tree reaches 45 and
     82 nodes, the start tree 9 000: issue 32's closing note), so only the growth is
     pinned here, on one run (``restart_cycles = 0``: a restart after the ladder's first
     cycle would start the goal tree again from its root)."""

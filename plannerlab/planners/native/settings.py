@@ -72,7 +72,7 @@ class RRTConnectSettings(NativeSettings):
             from which no long straight motion is free (a grasp deep in a shelf: from the
             median goal state of MotionBenchMaker's Fetch in a bookshelf none of 48
             motions of the default range is free, 8 % of those of a quarter of it;
-            ``results/mbm_fetch.md``). A problem solved within the first ``level_checks``
+            ``bench/mbm_why.py``). A problem solved within the first ``level_checks``
             checks is planned exactly as with one range. 1: one range (OMPL's RRT-Connect).
         level_checks: collision checks spent at each level of the ladder before the next.
         restart_cycles: restarts of a search that has found no path (both trees dropped,
