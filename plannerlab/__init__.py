@@ -40,9 +40,14 @@ def _numba_cache_dir() -> None:
     digest of every source file that holds compiled code (naming numba, ``njit`` or
     ``@kernel``), the cache starts afresh
     whenever any of them changes (``~/.cache/plannerlab/numba/<digest>``; the four most
-    recent folders are kept). A ``NUMBA_CACHE_DIR`` set by the user wins, and nothing is
-    done once numba was imported (its configuration is then read)."""
-    if "NUMBA_CACHE_DIR" in os.environ or "numba" in sys.modules:
+    recent folders are kept). A ``NUMBA_CACHE_DIR`` set by the user wins. numba imported
+    before plannerlab (``from numba import njit`` first, as a notebook or a bench may) has
+    read its configuration already: its ``config.CACHE_DIR`` is set then too (numba reads
+    it when a kernel is decorated, which is after this). Before, the package's digest was
+    skipped then, numba fell back to ``__pycache__`` beside the sources, and after an
+    update a cached caller ran against a changed callee's layout: a segmentation fault of
+    ``bench/state_test_bench.py`` in a checkout updated by a merge."""
+    if "NUMBA_CACHE_DIR" in os.environ:
         return
     import hashlib
     from pathlib import Path
@@ -69,6 +74,9 @@ def _numba_cache_dir() -> None:
     except OSError:
         return  # not writable: numba's default (__pycache__ beside the sources)
     os.environ["NUMBA_CACHE_DIR"] = str(folder)
+    numba = sys.modules.get("numba")
+    if numba is not None:  # imported first: its configuration was read without it
+        numba.core.config.CACHE_DIR = str(folder)
 
 
 _numba_cache_dir()
