@@ -38,9 +38,9 @@ def _numba_cache_dir() -> None:
     a kernel that calls a function of another file (every planner's kernel calls the
     collision core's) would go on running the old callee after an update. Named by a
     digest of every source file that holds compiled code (naming numba, ``njit`` or
-    ``@kernel``), the cache starts afresh
-    whenever any of them changes (``~/.cache/plannerlab/numba/<digest>``; the four most
-    recent folders are kept). A ``NUMBA_CACHE_DIR`` set by the user wins. numba imported
+    ``@kernel``), the cache starts afresh whenever any of them changes
+    (``~/.cache/plannerlab/numba/<digest>``; old folders are removed by
+    :func:`_prune_numba_caches`). A ``NUMBA_CACHE_DIR`` set by the user wins. numba imported
     before plannerlab (``from numba import njit`` first, as a notebook or a bench may) has
     read its configuration already: its ``config.CACHE_DIR`` is set then too (numba reads
     it when a kernel is decorated, which is after this). Before, the package's digest was
@@ -63,20 +63,38 @@ def _numba_cache_dir() -> None:
     try:
         folder.mkdir(parents=True, exist_ok=True)
         (folder / "stamp").touch()
-        old = sorted(
-            (p for p in folder.parent.iterdir() if p.is_dir() and p != folder),
-            key=lambda p: (p / "stamp").stat().st_mtime if (p / "stamp").exists() else 0.0,
-        )
-        import shutil
-
-        for stale in old[:-3]:
-            shutil.rmtree(stale, ignore_errors=True)
+        _prune_numba_caches(folder)
     except OSError:
         return  # not writable: numba's default (__pycache__ beside the sources)
     os.environ["NUMBA_CACHE_DIR"] = str(folder)
     numba = sys.modules.get("numba")
     if numba is not None:  # imported first: its configuration was read without it
         numba.core.config.CACHE_DIR = str(folder)
+
+
+#: a cache folder used (its ``stamp`` touched by an import) within this many seconds is
+#: never removed: another checkout's process may be writing to it
+CACHE_IN_USE_S = 7 * 24 * 3600.0
+
+
+def _prune_numba_caches(folder: Any) -> None:
+    """Remove the cache folders of other code versions beside ``folder``, keeping the three
+    most recently used and every one used within :data:`CACHE_IN_USE_S`. Before, only the
+    four most recent were kept whatever their age: with five checkouts at work at once
+    (worktrees, a CI clone), an import in one removed a folder that another's running
+    process was writing, and numba's cache save failed there (``FileNotFoundError``)."""
+    import shutil
+    import time
+
+    def used(p: Any) -> float:
+        stamp = p / "stamp"
+        return stamp.stat().st_mtime if stamp.exists() else 0.0
+
+    old = sorted((p for p in folder.parent.iterdir() if p.is_dir() and p != folder), key=used)
+    now = time.time()
+    for stale in old[:-3]:
+        if now - used(stale) > CACHE_IN_USE_S:
+            shutil.rmtree(stale, ignore_errors=True)
 
 
 _numba_cache_dir()

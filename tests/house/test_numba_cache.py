@@ -38,3 +38,26 @@ def test_a_cache_dir_set_by_the_user_wins(tmp_path: Path) -> None:
     mine = str(tmp_path / "mine")
     assert _cache_dir("import numba\nimport plannerlab", tmp_path, NUMBA_CACHE_DIR=mine) == mine
     assert _cache_dir("import plannerlab\nimport numba", tmp_path, NUMBA_CACHE_DIR=mine) == mine
+
+
+def test_old_folders_go_but_one_in_use_by_another_checkout_stays(tmp_path: Path) -> None:
+    """Folders of other code versions: beyond the three most recently used, one unused for
+    longer than ``CACHE_IN_USE_S`` is removed; one used recently (another checkout's
+    running process may write to it) stays, however many there are."""
+    import time
+
+    import plannerlab
+
+    base = tmp_path / "plannerlab" / "numba"
+    now = time.time()
+    ages_days = {"recent1": 0.01, "recent2": 1, "recent3": 2, "recent4": 3, "old1": 30, "old2": 60}
+    for name, age in ages_days.items():
+        (base / name).mkdir(parents=True)
+        (base / name / "stamp").touch()
+        os.utime(base / name / "stamp", (now - age * 86400, now - age * 86400))
+    (base / "unstamped").mkdir()
+    mine = base / "mine"
+    mine.mkdir()
+    plannerlab._prune_numba_caches(mine)
+    left = sorted(p.name for p in base.iterdir())
+    assert left == ["mine", "recent1", "recent2", "recent3", "recent4"]
