@@ -393,3 +393,25 @@ def test_a_search_without_a_path_restarts_at_doubling_points_and_still_plans() -
     never = {"level_checks": 64, "restart_cycles": 0}
     r0 = make_planner("native.rrtconnect", never).solve(p, 0, budget, np.random.default_rng(4))
     assert r0.extra["restarts"] == 0
+
+
+@pytest.mark.parametrize("name", ["native.rrtconnect", "native.rrtstar", "native.kpiece"])
+def test_a_planner_warms_only_its_own_algorithms_kernels(name: str, monkeypatch):
+    """Before its clock starts a planner loads its algorithm's kernels, not every native
+    algorithm's (a fresh process on an empty cache would compile RRT* and KPIECE for an
+    RRT-Connect plan otherwise)."""
+    from plannerlab.planners.native import warm
+
+    asked: list[object] = []
+    monkeypatch.setattr(
+        warm, "warm_up", lambda checker=None, algorithm=None: asked.append(algorithm)
+    )
+    make_planner(name, {}).warm_up(None, 0, np.zeros(3))
+    assert asked == [name.split(".")[1]]
+
+
+def test_warming_an_unknown_algorithm_is_refused_by_name():
+    from plannerlab.planners.native.warm import warm_up
+
+    with pytest.raises(ValueError, match="rrtconnect, rrtstar, kpiece, got 'prm'"):
+        warm_up(algorithm="prm")

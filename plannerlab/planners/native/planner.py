@@ -86,10 +86,11 @@ class NativePlanner(LegPlanner):
     settings: NativeSettings
 
     def warm_up(self, problem: Any, leg: int, q_start: Array) -> None:
-        """Load (or compile) the kernels before the leg's clock starts."""
+        """Load (or compile) the kernels of this planner's algorithm before the leg's
+        clock starts."""
         from plannerlab.planners.native.warm import warm_up
 
-        warm_up()
+        warm_up(algorithm=self.algorithm)
 
     def solve(
         self,
