@@ -261,6 +261,7 @@ def write_queries(
             "tip_link": robot.tip_link,
             "joint_names": list(robot.joint_names),
             "continuous": [bool(c) for c in robot.continuous],
+            "root_links": sorted({robot.link_urdf_names[i] for i in robot.fixed_links}),
             "q_start": q0,
             "q_goal": qg,
             "time_limit_s": args.time_limit,
@@ -356,6 +357,73 @@ def referee_path(toml_file: Path, P: np.ndarray, step_rad: float, tmp: Path) -> 
     }
 
 
+def triangles_at(query: dict[str, Any], q: np.ndarray) -> str:
+    """A second opinion at one state (PyBullet collides each link's convex hull): python-fcl
+    on the collision meshes' own triangles (and the URDF's primitives), placed by
+    yourdfpy's kinematics of the peers' URDF, against the scene (a mesh obstacle as its
+    triangles): the pair that intersects, else the smallest distance. Links on the root
+    body are skipped, as the referee skips them."""
+    import fcl
+    import trimesh
+    import yourdfpy
+
+    urdf = Path(query["urdf_relative"])
+    model = yourdfpy.URDF.load(
+        str(urdf), build_scene_graph=True, load_meshes=False, load_collision_meshes=False
+    )
+    model.update_cfg(dict(zip(query["joint_names"], map(float, q), strict=True)))
+
+    def bvh(mesh: Any) -> Any:
+        m = fcl.BVHModel()
+        m.beginModel(len(mesh.vertices), len(mesh.faces))
+        m.addSubModel(np.asarray(mesh.vertices, dtype=float), np.asarray(mesh.faces))
+        m.endModel()
+        return m
+
+    def placed(geom: Any, T: np.ndarray) -> Any:
+        return fcl.CollisionObject(geom, fcl.Transform(T[:3, :3], T[:3, 3]))
+
+    scene = []
+    for o in query["obstacles"]:
+        if o["type"] == "box":
+            g = fcl.Box(*o["size_m"])
+        elif o["type"] == "cylinder":
+            g = fcl.Cylinder(o["radius_m"], o["length_m"])
+        elif o["type"] == "sphere":
+            g = fcl.Sphere(o["radius_m"])
+        else:
+            g = bvh(trimesh.load(o["file"], force="mesh").apply_scale(o["scale"]))
+        scene.append((o["name"], placed(g, np.asarray(o["T_world_obstacle"]))))
+    best, where = np.inf, ""
+    for link in model.robot.links:
+        if link.name in query["root_links"]:
+            continue
+        for col in link.collisions:
+            geo = col.geometry
+            if geo.mesh is not None:
+                mesh = trimesh.load(str(urdf.parent / geo.mesh.filename), force="mesh")
+                if geo.mesh.scale is not None:
+                    mesh.apply_scale(geo.mesh.scale)
+                g = bvh(mesh)
+            elif geo.box is not None:
+                g = fcl.Box(*geo.box.size)
+            elif geo.cylinder is not None:
+                g = fcl.Cylinder(geo.cylinder.radius, geo.cylinder.length)
+            elif geo.sphere is not None:
+                g = fcl.Sphere(geo.sphere.radius)
+            else:
+                continue
+            T_lc = np.eye(4) if col.origin is None else np.asarray(col.origin)
+            a = placed(g, model.get_transform(link.name) @ T_lc)
+            for name, b in scene:
+                if fcl.collide(a, b, fcl.CollisionRequest(), fcl.CollisionResult()):
+                    return f"triangles intersect: {link.name} x {name}"
+                d = fcl.distance(a, b, fcl.DistanceRequest(), fcl.DistanceResult())
+                if d < best:
+                    best, where = d, f"{link.name} x {name}"
+    return f"triangles {best * 1e3:.2f} mm apart ({where})"
+
+
 def path_checks(P: np.ndarray, query: dict[str, Any]) -> tuple[np.ndarray, str]:
     """The path with its continuous joints unwrapped (a peer may cross +-pi), and whether
     it starts at the start and ends at the goal."""
@@ -414,6 +482,9 @@ def one_row(
         row.update(waypoints=len(P), length_rad=round(float(seg.sum()), 3), ends=ends)
         with tempfile.TemporaryDirectory() as tmp:
             row.update(referee_path(toml_file, P, args.referee_step, Path(tmp)))
+        if row["penetrating_states"]:
+            Q = interpolate(P, args.referee_step)
+            row["triangles"] = triangles_at(query, Q[row["worst_state"]])
     return row
 
 
@@ -487,6 +558,7 @@ def report(args: argparse.Namespace) -> None:
         prev = key
         if r["solved"]:
             where = r["referee_where"] if r["penetrating_states"] else ""
+            where += f"; {r['triangles']}" if r.get("triangles") else ""
             cells = [
                 "yes" if r["ends"] == "ends ok" else r["ends"],
                 f"{r['plan_s']:.2f}",
