@@ -12,6 +12,11 @@ of ``plan_qpos``'s 2-pi copies of wide joints nor its TOPP-RA retiming. MPlib's 
 are checked at OMPL's default resolution (1 % of the state space's extent); it has no
 setting for it in this call.
 
+MPlib 0.2.1 refuses an arm with a continuous joint ("Do not support continuous revolute
+joint for constrained planning", raised while the planner is built, whatever the query):
+then the runner loads a copy whose continuous joints are revolute on [-pi, pi] (the range
+plannerlab plans a continuous joint on) and says so in ``notes``.
+
 MPlib prefixes a URDF's mesh paths with the URDF's folder, absolute ones too: the query's
 ``urdf_relative`` names the meshes relative to its own folder.
 """
@@ -19,10 +24,31 @@ MPlib prefixes a URDF's mesh paths with the URDF's folder, absolute ones too: th
 from __future__ import annotations
 
 import time
+import xml.etree.ElementTree as ET
+from pathlib import Path
 from typing import Any
 
 import numpy as np
 from common import main, reorder
+
+
+def continuous_as_revolute(urdf: str) -> tuple[str, list[str]]:
+    """A copy of ``urdf`` (beside it, so its relative mesh paths hold) whose continuous
+    joints are revolute on [-pi, pi]; their names."""
+    root = ET.parse(urdf).getroot()
+    changed = []
+    for j in root.iter("joint"):
+        if j.get("type") == "continuous":
+            changed.append(str(j.get("name")))
+            j.set("type", "revolute")
+            lim = j.find("limit")
+            if lim is None:
+                lim = ET.SubElement(j, "limit", effort="1", velocity="1")
+            lim.set("lower", repr(-np.pi))
+            lim.set("upper", repr(np.pi))
+    out = Path(urdf).with_name(Path(urdf).stem + "_mplib.urdf")
+    out.write_text(ET.tostring(root, encoding="unicode"))
+    return str(out), changed
 
 
 def solve(query: dict[str, Any]) -> dict[str, Any]:
@@ -32,9 +58,18 @@ def solve(query: dict[str, Any]) -> dict[str, Any]:
     notes: list[str] = []
     mplib.set_global_seed(int(query["seed"]))
     t0 = time.perf_counter()
-    planner = mplib.Planner(
-        urdf=query["urdf_relative"], srdf=query["srdf"], move_group=query["tip_link"]
-    )
+    urdf, tip = query["urdf_relative"], query["tip_link"]
+    try:
+        planner = mplib.Planner(urdf=urdf, srdf=query["srdf"], move_group=tip)
+    except RuntimeError as exc:
+        if "continuous" not in str(exc):
+            raise
+        urdf, changed = continuous_as_revolute(urdf)
+        notes.append(
+            f"refused the URDF ({exc}); loaded with the continuous joint(s) "
+            f"{', '.join(changed)} revolute on [-pi, pi]"
+        )
+        planner = mplib.Planner(urdf=urdf, srdf=query["srdf"], move_group=tip)
     names = list(planner.user_joint_names)
     group = [names[i] for i in planner.move_group_joint_indices]
     to_group = reorder(query["joint_names"], group)

@@ -93,6 +93,9 @@ def solve(query: dict[str, Any]) -> dict[str, Any]:
     setup_s = time.perf_counter() - t0
     q0 = np.asarray(query["q_start"], dtype=float)[to_scene]
     qg = np.asarray(query["q_goal"], dtype=float)[to_scene]
+    # Pinocchio holds a continuous joint as (cos, sin): the scene takes the expanded vector
+    q0 = core.expandContinuousJointPositions(scene, "", q0)
+    qg = core.expandContinuousJointPositions(scene, "", qg)
     start_valid = not scene.hasCollisions(q0)
     goal_valid = not scene.hasCollisions(qg)
     if not start_valid:
@@ -116,6 +119,8 @@ def solve(query: dict[str, Any]) -> dict[str, Any]:
             ),
         )
         P = np.asarray(short.shortcut(path).positions, dtype=float)
+        if P.ndim == 2 and P.shape[1] != len(names):  # expanded continuous joints
+            P = np.array([core.collapseContinuousJointPositions(scene, "", p) for p in P])
         solved, status = len(P) >= 2, "solved"
     except Exception as exc:  # roboplan raises when it finds no path in its time
         P, solved, status = np.zeros((0, len(names))), False, f"{type(exc).__name__}: {exc}"
