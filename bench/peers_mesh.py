@@ -543,8 +543,42 @@ def run(args: argparse.Namespace) -> None:
     log(f"end: load average {os.getloadavg()}")
 
 
+def summary(rows: list[dict[str, Any]]) -> None:
+    """Per planner: legs, paths returned, paths the referee refuses, of which the triangles
+    intersect, the median of the paths' smallest distances."""
+    print(
+        "| planner | legs | paths returned | paths penetrating (PyBullet, hulls) "
+        "| of which the triangles intersect | median min distance mm | median planning s |"
+    )
+    print("|" + "---|" * 7)
+    for planner in dict.fromkeys(r["planner"] for r in rows):
+        mine = [r for r in rows if r["planner"] == planner]
+        ok = [r for r in mine if r["solved"]]
+        bad = [r for r in ok if r["penetrating_states"]]
+        tri = [r for r in bad if "intersect" in r.get("triangles", "")]
+        dmin = np.median([r["referee_min_mm"] for r in ok]) if ok else float("nan")
+        tmed = np.median([r["plan_s"] for r in ok]) if ok else float("nan")
+        print(
+            f"| {planner} | {len(mine)} | {len(ok)} | {len(bad)} | {len(tri)} | "
+            f"{dmin:.1f} | {tmed:.2f} |"
+        )
+    print()
+
+
 def report(args: argparse.Namespace) -> None:
     rows = load_rows(args.out / "rows.jsonl")
+    arms = list(dict.fromkeys(r["arm"] for r in rows))
+    legs = list(dict.fromkeys(r["leg"] for r in rows))
+    order = {p: i for i, p in enumerate(PLANNERS)}
+    rows.sort(
+        key=lambda r: (
+            arms.index(r["arm"]),
+            r["problem"],
+            legs.index(r["leg"]),
+            order.get(r["planner"], 9),
+        )
+    )
+    summary(rows)
     print(
         "| arm | problem | leg | planner | solved | planning s | whole call s | path length rad "
         "| states refereed | penetrating | min distance mm | where |"
