@@ -24,14 +24,16 @@ For each arm of ``bench/mesh_arms_bench.py`` (``--arms``) and each of its proble
    scene's boxes and meshes) on every returned path, cut so that no joint moves more than
    ``--referee-step`` (0.005 rad); each cut state is refereed on its own, so the row
    has the number of states that penetrate the scene (distance <= 0) and the smallest
-   distance (100 mm: nothing within the referee's query distance). Robot against the
+   distance (100 mm: nothing within the referee's query distance). PyBullet collides each
+   link's convex hull: at the deepest state of a path it refuses, python-fcl on the meshes'
+   own triangles gives a second opinion (:func:`triangles_at`). Robot against the
    scene only: the referee does not judge self-collision. Each path's ends are compared
    with the query's (1e-6 rad at the start, 1e-3 rad at the goal).
 
 Rows: ``OUT/rows.jsonl`` (rewritten whole and renamed on every row: atomic), one per arm
 x problem x leg x planner; an interrupted run resumes (rows, plans and peers' answers on
 disk are not redone). Progress and the load average on stderr; ``--report`` prints the
-table from the rows.
+tables from the rows (a summary per planner, then every leg).
 
 The query JSON (``OUT/queries/<arm>_<problem>_<leg>.json``)::
 
