@@ -25,7 +25,7 @@ def main() -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--planner", default="native.rrtconnect")
     ap.add_argument("--problem", default="armz_pocket", help="a bundled name or a TOML file")
-    ap.add_argument("--checks", type=int, default=1_000_000, help="the leg's collision-check budget")
+    ap.add_argument("--checks", type=int, default=1_000_000, help="the leg's check budget")
     ap.add_argument("--top", type=int, default=25)
     args = ap.parse_args()
     if "numba" in sys.modules or "plannerlab" in sys.modules:
