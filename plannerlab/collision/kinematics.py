@@ -24,6 +24,7 @@ from __future__ import annotations
 import math
 
 import numpy as np
+from numba import types
 from numba.extending import overload
 
 from plannerlab.collision.simd import (
@@ -86,6 +87,28 @@ def _ov_sincos(x):
     return scalar
 
 
+def turn(V, i, w, slide):
+    """Joint i's value and the sine and cosine of its turn (0 and 1 for a slide): from V
+    (flat, ``w`` lanes a joint) by :func:`sincos`, or, V a float64 table (m, 3), its row
+    as given (value, sine, cosine: computed by the caller, the one-state road's)."""
+    raise NotImplementedError("numba only")
+
+
+@overload(turn)
+def _ov_turn(V, i, w, slide):
+    if isinstance(V, types.Array) and V.ndim == 2:
+        return lambda V, i, w, slide: (V[i, 0], V[i, 1], V[i, 2])
+
+    def flat(V, i, w, slide):
+        v = load(V, i * w)
+        if slide:
+            return v, like(V, 0.0), like(V, 1.0)
+        s, c = sincos(v)
+        return v, s, c
+
+    return flat
+
+
 @kernel
 def chain_values(Q, cpl, V):
     """The chain's joint values V (flat, ``w`` lanes a joint) of the states Q (the same
@@ -111,11 +134,7 @@ def chain_frames(F, V, T0, pre, parent, slide):
     for r in range(12):
         store(F, r * w, like(F, T0[r]))
     for i in range(parent.shape[0]):
-        v = load(V, i * w)
-        if slide[i]:
-            s, c = like(F, 0.0), like(F, 1.0)
-        else:
-            s, c = sincos(v)
+        v, s, c = turn(V, i, w, slide[i])
         fb = 12 * parent[i] * w
         ob = 12 * (i + 1) * w
         p00, p01, p02, p03 = (
@@ -179,4 +198,4 @@ def place(F, b, P, row, col):
     return x, y, z
 
 
-__all__ = ["SINCOS32_ABS_ERR", "chain_frames", "chain_values", "place", "sincos"]
+__all__ = ["SINCOS32_ABS_ERR", "chain_frames", "chain_values", "place", "sincos", "turn"]
