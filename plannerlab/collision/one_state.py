@@ -5,17 +5,19 @@ float32 lanes; asked about one state, it fills seven lanes with copies and pays 
 This road fills the lanes with one state's geometry instead (the tables of
 :mod:`plannerlab.collision.one_lanes`):
 
-1. **Kinematics** of the state in float64 (the one kinematics,
-   :func:`~plannerlab.collision.exact.frames64`), every body's gate centre placed in
-   float64 (and rounded into float32 lanes), a world box around each block of eight
-   bodies' gates.
+1. **Kinematics**: every joint's sine and cosine at once, eight to a float32 vector (the
+   batch road's polynomial, on values wrapped into [-π, π] in float64), then the one
+   kinematics (:func:`~plannerlab.collision.kinematics.chain_frames`) in float64 from
+   them; every body's gate centre placed in float64 (and rounded into float32 lanes), a
+   world box around each block of eight bodies' gates.
 2. **The scene pass**, per obstacle: a block's box against the obstacle's world box
    (scalar), then eight bodies' gates against the obstacle (one vector test), then, for
    a body whose gate meets it, its capsules eight at a time (placed in float32 from the
    body's frame when first needed, one vector per coordinate).
-3. **The self pass**, per checked body pair: the two gates (float64, scalar), then the
-   pair's runs: capsule ``i`` (splat) against up to eight capsules of the other body
-   (one vector load each), a sphere ``i`` first against the other body's gate (scalar).
+3. **The self pass**: a body's gate against eight others' it is paired with (one vector
+   test), then each meeting body pair's runs: capsule ``i`` (splat) against up to eight
+   capsules of the other body (one vector load each), a sphere ``i`` first against the
+   other body's gate (scalar).
 
 Every test grades as the batch road's does, with the same distances
 (:mod:`plannerlab.collision.lane_geometry`) and the model's float32 bound ``eps32_m``:
@@ -26,14 +28,16 @@ end by the float64 test (:func:`~plannerlab.collision.exact.exact_state`: FCL's
 verdicts). The verdicts are therefore exactly the float64 ones, as the batch road's.
 
 **Why ``eps32_m`` still bounds the error.** The model's bound covers float32 frames built
-joint by joint with a polynomial sine (the batch road's). Here the frames are float64,
-rounded once to float32 (each entry off by at most ``u = 2^-24`` of its size), and a
-capsule's end is placed in float32 from them (three fused multiply-adds per coordinate,
-a few ``u`` of the coordinates' size ``P``) from its body-frame point rounded to float32
-(``u S``): far inside ``eps32_m = 2 (ε_fk + 16 u P)`` (``ε_fk ≥ 8 (m + 1) u P``); the
-tests' own roundings are the batch road's. The gate and box tests that skip whole bodies
-are float64 on float64 places (the float64 test's own gates) or float32 grown by
-``eps32_m``: a body is skipped only when it is clear in float64 too.
+joint by joint from the polynomial's sines (the batch road's: ``δ`` per joint, see
+:func:`~plannerlab.collision.model.build_model`). Here the same sines meet float64
+products (smaller errors than float32's), and a capsule's end is placed in float32 from
+the frame rounded once to float32 (three fused multiply-adds per coordinate: a few ``u``
+of the coordinates' size ``P``), its body-frame point rounded to float32: inside
+``eps32_m = 2 (ε_fk + 16 u P)`` with ``ε_fk ≥ 8 (m + 1) u P``; the tests' own roundings
+are the batch road's. ``tests/collision/test_one_state.py`` holds every place within half
+of ``eps32_m`` of float64's, so a gate of two places (a sphere against a body's ball) is
+within ``eps32_m``. Tests that skip whole bodies are float64 on these places or float32
+grown by ``eps32_m``: a body is skipped only when it is clear in float64 too.
 """
 
 from __future__ import annotations
@@ -315,11 +319,12 @@ def _frames(m, Z, T, q):
     chain_frames(Z.e_F, VT, m.T0, m.pre, m.parent, m.slide)
 
 
-@kernel
+@inline_kernel
 def one_valid(m, Z, T, q):
     """Is the one state q (dof,) free (model m, the state test's scratch Z, the opened
     one-state tables T: :func:`~plannerlab.collision.one_lanes.open_one`)? Exactly the
-    float64 verdict (see the module)."""
+    float64 verdict (see the module). Inlined into its callers: out of line, a call
+    would take the model, the scratch and the tables (some hundred arrays) on the stack."""
     _frames(m, Z, T, q)
     _gates(m, Z, T)
     s = _scene(m, Z, T)
@@ -334,13 +339,14 @@ def one_valid(m, Z, T, q):
 
 
 @kernel
-def valid_state(P, T, q):
+def valid_state(P, t32, t64i, t64, q):
     """Is the one state q (dof,) free? ``P``: a checker's packed model
-    (``checker.packed_model``), ``T``: its one-state tables
-    (:func:`~plannerlab.collision.one_lanes.checker_tables`): the compiled entry of the
+    (``checker.packed_model``); ``t32, t64i, t64``: its one-state tables
+    (:func:`~plannerlab.collision.one_lanes.checker_tables`), three arrays, not a tuple
+    (numba types a tuple from Python slowly: ~1 µs a call). The compiled entry of the
     public checker's ``valid(q)``."""
     m, Z = open_packed(P)
-    return one_valid(m, Z, open_one(T), q)
+    return one_valid(m, Z, open_one((t32, t64i, t64)), q)
 
 
 @kernel

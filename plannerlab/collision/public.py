@@ -78,13 +78,18 @@ class Checker:
 
     def valid(self, q: Array) -> Any:
         """One state (dof,) -> bool; states (n, dof) -> (n,) bool array."""
-        Q, one = self._states(q)
+        a = np.asarray(q, dtype=float)
+        if self._one is not None and a.ndim == 1 and a.shape[0] == self.dof:
+            # one state: the one-state road, which also refuses a value that is not finite
+            t32, t64i, t64 = self._one[1]
+            ok = valid_state(self._one[0], t32, t64i, t64, np.ascontiguousarray(a))
+            if ok >= 0:
+                self._checker.checks += 1
+                return bool(ok)
+        Q, one = self._states(a)  # bad input: a clear error
         if not one:
             return self._checker.valid_batch(Q)
-        if self._one is None:
-            return bool(self._checker.is_valid(Q[0]))
-        self._checker.checks += 1
-        return bool(valid_state(self._one[0], self._one[1], Q[0]))
+        return bool(self._checker.is_valid(Q[0]))
 
     def clearance(self, q: Array) -> float:
         """The smallest signed distance [m] between the robot's own geometry (not grown
