@@ -343,10 +343,14 @@ def valid_state(P, t32, t64i, t64, q):
     """Is the one state q (dof,) free? ``P``: a checker's packed model
     (``checker.packed_model``); ``t32, t64i, t64``: its one-state tables
     (:func:`~plannerlab.collision.one_lanes.checker_tables`), three arrays, not a tuple
-    (numba types a tuple from Python slowly: ~1 µs a call). The compiled entry of the
-    public checker's ``valid(q)``."""
+    (numba types a tuple from Python slowly: ~1 µs a call). Returns 1 (free), 0 (not), or
+    -1 when q holds a value that is not finite (nothing tested). The compiled entry of
+    the public checker's ``valid(q)``."""
+    for i in range(q.shape[0]):
+        if not math.isfinite(q[i]):
+            return -1
     m, Z = open_packed(P)
-    return one_valid(m, Z, open_one((t32, t64i, t64)), q)
+    return 1 if one_valid(m, Z, open_one((t32, t64i, t64)), q) else 0
 
 
 @kernel
