@@ -54,6 +54,8 @@ def sincos(x):
 
 @overload(sincos)
 def _ov_sincos(x):
+    if isinstance(x, types.UniTuple):  # (sine, cosine) given: see angle()
+        return lambda x: (x[0], x[1])
     if x == f8:
 
         def vec(x):
@@ -87,26 +89,31 @@ def _ov_sincos(x):
     return scalar
 
 
-def turn(V, i, w, slide):
-    """Joint i's value and the sine and cosine of its turn (0 and 1 for a slide): from V
-    (flat, ``w`` lanes a joint) by :func:`sincos`, or, V a float64 table (m, 3), its row
-    as given (value, sine, cosine: computed by the caller, the one-state road's)."""
+def value(V, i, w):
+    """Joint i's value: ``V[i w]`` (flat, ``w`` lanes a joint) or, V a float64 table (m, 3)
+    of each joint's value, sine and cosine (the one-state road's, computed by the
+    caller), ``V[i, 0]``."""
     raise NotImplementedError("numba only")
 
 
-@overload(turn)
-def _ov_turn(V, i, w, slide):
+def angle(V, i, w):
+    """What :func:`sincos` takes for joint i: its value (flat V), or, V a table (see
+    :func:`value`), its sine and cosine as given."""
+    raise NotImplementedError("numba only")
+
+
+@overload(value)
+def _ov_value(V, i, w):
     if isinstance(V, types.Array) and V.ndim == 2:
-        return lambda V, i, w, slide: (V[i, 0], V[i, 1], V[i, 2])
+        return lambda V, i, w: V[i, 0]
+    return lambda V, i, w: load(V, i * w)
 
-    def flat(V, i, w, slide):
-        v = load(V, i * w)
-        if slide:
-            return v, like(V, 0.0), like(V, 1.0)
-        s, c = sincos(v)
-        return v, s, c
 
-    return flat
+@overload(angle)
+def _ov_angle(V, i, w):
+    if isinstance(V, types.Array) and V.ndim == 2:
+        return lambda V, i, w: (V[i, 1], V[i, 2])
+    return lambda V, i, w: load(V, i * w)
 
 
 @kernel
@@ -134,7 +141,11 @@ def chain_frames(F, V, T0, pre, parent, slide):
     for r in range(12):
         store(F, r * w, like(F, T0[r]))
     for i in range(parent.shape[0]):
-        v, s, c = turn(V, i, w, slide[i])
+        v = value(V, i, w)
+        if slide[i]:
+            s, c = like(F, 0.0), like(F, 1.0)
+        else:
+            s, c = sincos(angle(V, i, w))
         fb = 12 * parent[i] * w
         ob = 12 * (i + 1) * w
         p00, p01, p02, p03 = (
@@ -198,4 +209,4 @@ def place(F, b, P, row, col):
     return x, y, z
 
 
-__all__ = ["SINCOS32_ABS_ERR", "chain_frames", "chain_values", "place", "sincos", "turn"]
+__all__ = ["SINCOS32_ABS_ERR", "chain_frames", "chain_values", "place", "sincos", "value", "angle"]
