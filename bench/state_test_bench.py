@@ -13,10 +13,15 @@ Rows per problem (the least CPU time of ``--repeats`` repetitions, the roads int
   eight states a call in float32 lanes, hits and close calls confirmed in float64);
 * ``lanes, one state a call``: the same test on one state at a time from compiled code
   (``state_test.valid_one``: lane 0 only, as a planner's sample is tested);
+* ``one-state road (compiled)``: the same states one at a time by the one-state road
+  (``one_state.valid_each``: one state's capsules eight to a vector; what the native
+  planners' shim and ``pl.checker(problem).valid(q)`` run);
 * ``float64 alone``: the float64 test of every state with no filter
   (``state_test.exact_batch``: what the lanes save);
-* ``from Python, one state``: ``pl.checker(problem).valid(q)`` per state (the call's
-  overhead included; on ``--python-states`` states);
+* ``from Python, one state``: ``CollisionChecker.is_valid(q)`` per state (the batch road
+  on one state, the call's overhead included; on ``--python-states`` states);
+* ``public valid(q)``: ``pl.checker(problem).valid(q)`` per state (the one-state road and
+  the public call's checks of its input; on ``--python-states`` states);
 * ``python-fcl``: the FCL reference, ``CollisionChecker(backend="fcl").valid_batch`` (on
   ``--fcl-states`` states), the baseline of the ratios.
 
@@ -40,6 +45,9 @@ from numba import njit
 
 from plannerlab.collision.edges import edge_check
 from plannerlab.collision.fcl_checker import CollisionChecker, problem_checker
+from plannerlab.collision.one_lanes import checker_tables
+from plannerlab.collision.one_state import valid_each
+from plannerlab.collision.public import Checker
 from plannerlab.collision.queries import EACH, open_packed, states
 from plannerlab.collision.state_test import exact_batch, set_plain, valid_one
 from plannerlab.problem.catalog import load_problem
@@ -86,6 +94,11 @@ def bench_problem(name: str, n: int, repeats: int, n_py: int, n_fcl: int, n_edge
     assert np.array_equal(out, truth), "lanes, batch: verdicts differ from float64's"
     _one_by_one(P, Q, out)
     assert np.array_equal(out, truth), "lanes, one state: verdicts differ from float64's"
+    T = checker_tables(checker)
+    valid_each(P, T, Q, out)
+    assert np.array_equal(out, truth), "one-state road: verdicts differ from float64's"
+    public = Checker(problem, checker)
+    assert [public.valid(q) for q in Q[:n_py]] == truth[:n_py].tolist()
     fcl = CollisionChecker(robot, problem.scene, backend="fcl", margin_m=problem.safety_margin_m)
     fcl_v = fcl.valid_batch(Q[:n_fcl])
     mismatch = int(np.count_nonzero(fcl_v != truth[:n_fcl]))
@@ -95,8 +108,10 @@ def bench_problem(name: str, n: int, repeats: int, n_py: int, n_fcl: int, n_edge
     roads: dict[str, tuple[Callable[[], Any], int]] = {
         "lanes, batch": (lambda: states(P, Q, out, EACH), n),
         "lanes, one state a call": (lambda: _one_by_one(P, Q, out), n),
+        "one-state road (compiled)": (lambda: valid_each(P, T, Q, out), n),
         "float64 alone": (lambda: exact_batch(checker.model, Q, out), n),
         "from Python, one state": (lambda: [checker.is_valid(q) for q in Q[:n_py]], n_py),
+        "public valid(q)": (lambda: [public.valid(q) for q in Q[:n_py]], n_py),
         "python-fcl": (lambda: fcl.valid_batch(Q[:n_fcl]), n_fcl),
     }
     best = {k: np.inf for k in roads}

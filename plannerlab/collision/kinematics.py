@@ -24,6 +24,7 @@ from __future__ import annotations
 import math
 
 import numpy as np
+from numba import types
 from numba.extending import overload
 
 from plannerlab.collision.simd import (
@@ -53,6 +54,8 @@ def sincos(x):
 
 @overload(sincos)
 def _ov_sincos(x):
+    if isinstance(x, types.UniTuple):  # (sine, cosine) given: see angle()
+        return lambda x: (x[0], x[1])
     if x == f8:
 
         def vec(x):
@@ -86,6 +89,33 @@ def _ov_sincos(x):
     return scalar
 
 
+def value(V, i, w):
+    """Joint i's value: ``V[i w]`` (flat, ``w`` lanes a joint) or, V a float64 table (m, 3)
+    of each joint's value, sine and cosine (the one-state road's, computed by the
+    caller), ``V[i, 0]``."""
+    raise NotImplementedError("numba only")
+
+
+def angle(V, i, w):
+    """What :func:`sincos` takes for joint i: its value (flat V), or, V a table (see
+    :func:`value`), its sine and cosine as given."""
+    raise NotImplementedError("numba only")
+
+
+@overload(value)
+def _ov_value(V, i, w):
+    if isinstance(V, types.Array) and V.ndim == 2:
+        return lambda V, i, w: V[i, 0]
+    return lambda V, i, w: load(V, i * w)
+
+
+@overload(angle)
+def _ov_angle(V, i, w):
+    if isinstance(V, types.Array) and V.ndim == 2:
+        return lambda V, i, w: (V[i, 1], V[i, 2])
+    return lambda V, i, w: load(V, i * w)
+
+
 @kernel
 def chain_values(Q, cpl, V):
     """The chain's joint values V (flat, ``w`` lanes a joint) of the states Q (the same
@@ -111,11 +141,11 @@ def chain_frames(F, V, T0, pre, parent, slide):
     for r in range(12):
         store(F, r * w, like(F, T0[r]))
     for i in range(parent.shape[0]):
-        v = load(V, i * w)
+        v = value(V, i, w)
         if slide[i]:
             s, c = like(F, 0.0), like(F, 1.0)
         else:
-            s, c = sincos(v)
+            s, c = sincos(angle(V, i, w))
         fb = 12 * parent[i] * w
         ob = 12 * (i + 1) * w
         p00, p01, p02, p03 = (
@@ -179,4 +209,4 @@ def place(F, b, P, row, col):
     return x, y, z
 
 
-__all__ = ["SINCOS32_ABS_ERR", "chain_frames", "chain_values", "place", "sincos"]
+__all__ = ["SINCOS32_ABS_ERR", "chain_frames", "chain_values", "place", "sincos", "value", "angle"]

@@ -13,10 +13,12 @@ its safety margin, as VAMP's ``validate`` and MPlib's ``check_for_collision`` gi
     check.lower, check.upper       # the joint bounds [rad or m]
 
 Its answers are every planner's: the compiled state test (a float32 filter in vector
-lanes, confirmed in float64: :mod:`plannerlab.collision.state_test`) with the capsules
-grown by the problem's margin, and certified edges (:mod:`plannerlab.collision.edges`) at
-the problem's re-check resolution (``[checking] joint_step / 4``, and with a margin no
-point moving more than the margin between two checked states).
+lanes, confirmed in float64: :mod:`plannerlab.collision.state_test` for a batch, eight
+states a call; :mod:`plannerlab.collision.one_state` for one state, eight of its capsules
+a vector) with the capsules grown by the problem's margin, and certified edges
+(:mod:`plannerlab.collision.edges`) at the problem's re-check resolution (``[checking]
+joint_step / 4``, and with a margin no point moving more than the margin between two
+checked states).
 """
 
 from __future__ import annotations
@@ -26,6 +28,8 @@ from typing import Any
 import numpy as np
 
 from plannerlab.collision.fcl_checker import CollisionChecker, problem_checker
+from plannerlab.collision.one_lanes import checker_tables
+from plannerlab.collision.one_state import valid_state
 from plannerlab.errors import PlannerlabError
 from plannerlab.robots.base import Array
 
@@ -51,6 +55,10 @@ class Checker:
         self.upper = np.where(robot.continuous, np.pi, robot.upper).astype(float)
         self.margin_m = float(self._checker.margin_m)
         self.joint_step_rad = float(problem.joint_step) / 4.0
+        # the one-state road's inputs (None: no compiled core, the checker answers)
+        self._one: tuple[Any, Any] | None = None
+        if self._checker.backend == "core":
+            self._one = (self._checker.packed_model, checker_tables(self._checker))
 
     @property
     def checks(self) -> int:
@@ -70,10 +78,18 @@ class Checker:
 
     def valid(self, q: Array) -> Any:
         """One state (dof,) -> bool; states (n, dof) -> (n,) bool array."""
-        Q, one = self._states(q)
-        if one:
-            return bool(self._checker.is_valid(Q[0]))
-        return self._checker.valid_batch(Q)
+        a = np.asarray(q, dtype=float)
+        if self._one is not None and a.ndim == 1 and a.shape[0] == self.dof:
+            # one state: the one-state road, which also refuses a value that is not finite
+            t32, t64i, t64 = self._one[1]
+            ok = valid_state(self._one[0], t32, t64i, t64, np.ascontiguousarray(a))
+            if ok >= 0:
+                self._checker.checks += 1
+                return bool(ok)
+        Q, one = self._states(a)  # bad input: a clear error
+        if not one:
+            return self._checker.valid_batch(Q)
+        return bool(self._checker.is_valid(Q[0]))
 
     def clearance(self, q: Array) -> float:
         """The smallest signed distance [m] between the robot's own geometry (not grown

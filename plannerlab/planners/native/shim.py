@@ -6,10 +6,11 @@ check is a change of this file alone.
 
 :func:`bundle` gives the one argument a search's entry takes from Python (the checker's
 packed model, :attr:`~plannerlab.collision.fcl_checker.CollisionChecker.packed_model`);
-the entry opens it once with :func:`open_bundle` and hands the opened bundle (the model
-and the state test's scratch) to the queries below. A state is the state test's
-(:func:`~plannerlab.collision.state_test.valid_one`: float32 lanes, float64
-confirmation); an edge is the re-check's grid (``n`` states ``q_a + (j / n) d``,
+the entry opens it once with :func:`open_bundle` and hands the opened bundle (the model,
+the state test's scratch and the one-state road's tables) to the queries below. A state
+is tested alone by the one-state road (:func:`~plannerlab.collision.one_state.one_valid`:
+one state's capsules eight to a float32 vector, float64 confirmation: the float64
+verdict); an edge is the re-check's grid (``n`` states ``q_a + (j / n) d``,
 ``j = 1 … n``, ``d`` the joint difference the short way round) proved free by certified
 stretches (:func:`~plannerlab.collision.edges.edge_check`), so a path whose edges were all
 found valid here passes the re-check on the same grid.
@@ -22,35 +23,39 @@ from typing import Any
 from numba import njit
 
 from plannerlab.collision.edges import edge_check, edge_count, edge_delta, edge_state
+from plannerlab.collision.one_lanes import checker_tables, open_one
+from plannerlab.collision.one_state import one_valid
 from plannerlab.collision.queries import open_packed
-from plannerlab.collision.state_test import set_plain, valid_one
 
 #: edge statuses: every state asked is valid / one is invalid / the check limit came first
 FREE, BLOCKED, LIMIT = 0, 1, 2
 
 
 def bundle(checker: Any) -> tuple[Any, ...]:
-    """The collision bundle a search's entry takes (the checker's packed model)."""
-    return tuple(checker.packed_model)
+    """The collision bundle a search's entry takes: the checker's packed model and its
+    one-state tables (:func:`~plannerlab.collision.one_lanes.checker_tables`)."""
+    return (tuple(checker.packed_model), checker_tables(checker))
 
 
-def opened(checker: Any) -> tuple[Any, Any]:
-    """The opened bundle, (model, scratch), for calling the queries below from Python
-    (tests and benches; a search opens :func:`bundle`'s inside its entry)."""
+def opened(checker: Any) -> tuple[Any, Any, Any]:
+    """The opened bundle, (model, scratch, one-state tables), for calling the queries
+    below from Python (tests and benches; a search opens :func:`bundle`'s inside its
+    entry)."""
     return open_bundle(bundle(checker))
 
 
 @njit(cache=True, nogil=True, inline="always")
-def open_bundle(P):
-    """The bundle the queries take, (model, scratch), from :func:`bundle`'s."""
-    return open_packed(P)
+def open_bundle(B):
+    """The bundle the queries take, (model, scratch, one-state tables), from
+    :func:`bundle`'s."""
+    m, Z = open_packed(B[0])
+    return m, Z, open_one(B[1])
 
 
 @njit(cache=True, nogil=True)
 def state_valid(ck, q):
-    """Is state q (dof,) free?"""
-    set_plain(ck[1])
-    return valid_one(ck[0], ck[1], q)
+    """Is state q (dof,) free? (The one-state road: the float64 verdict.)"""
+    return one_valid(ck[0], ck[1], ck[2], q)
 
 
 @njit(cache=True, nogil=True)
