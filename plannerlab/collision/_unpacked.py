@@ -125,4 +125,8 @@ def unpack_lanes(f64, f32, i64, b1, head):
         _v2(i64, head, 498),
         _v2(i64, head, 504),
         _v1(f32, head, 510),
+        _v1(i64, head, 516),
+        _v1(i64, head, 522),
+        _v1(i64, head, 528),
+        _v2(f64, head, 534),
     )

@@ -26,12 +26,14 @@ from plannerlab.collision.kinematics import place
 from plannerlab.collision.simd import kernel
 from plannerlab.collision.state_test import (
     ANY_HIT,
+    COHERENT_FROM,
     EVERY_LANE,
     W,
     fill_lanes,
     load_state,
     set_plain,
     test_lanes,
+    valid_coherent,
 )
 
 
@@ -58,11 +60,15 @@ CERTIFIED, IN_ORDER = 0, 1
 def states(P, Q, out, mode):
     """Validity of Q (k, dof), eight states a call (one compiled entry for every state
     query: each entry compiles the state test again into itself). ``EACH``: every verdict
-    into out (k,) bool, returns how many the float64 confirmation decided; ``FIRST``:
+    into out (k,) bool (a batch of ``COHERENT_FROM`` or more tested in the order of
+    :func:`~plannerlab.collision.state_test.coherent_order`), returns how many the
+    float64 confirmation decided; ``FIRST``:
     returns the index of the first invalid state in order, -1 if none (out not written
     past it)."""
     m, Z = _open(P)
     set_plain(Z)
+    if mode == EACH and Q.shape[0] >= COHERENT_FROM:  # in an order where the eight alike
+        return valid_coherent(m, Z, Q, out)
     confirmed = 0
     for s0 in range(0, Q.shape[0], W):
         nn = min(W, Q.shape[0] - s0)

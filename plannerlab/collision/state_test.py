@@ -86,6 +86,14 @@ _ALL = (1 << LANES) - 1
 #: pass's groups are the model's ``SELF_GROUP`` consecutive bodies)
 GROUP = 4
 _F4 = np.float32
+#: a batch of at least this many states is tested in the coherent order (below: as given)
+COHERENT_FROM = 64
+#: states ordered at once (a longer batch: chunk by chunk), and the most bits of the
+#: order's key (its counting sort's cells: about one per eight states)
+CO_CHUNK = 32768
+#: states gathered at once in that order (a multiple of the lanes)
+CO_BLOCK = 256
+_KEY_BITS = 12
 
 
 class Lanes(NamedTuple):
@@ -122,6 +130,10 @@ class Lanes(NamedTuple):
     edge_stack: np.ndarray  # (S, 2) int64 stretches still to prove
     edge_marks: np.ndarray  # (3, W) int64 the stretches of one call
     SB: np.ndarray  # (ng * 6 * W,) the self pass's box around each group of SELF_GROUP bodies
+    co_key: np.ndarray  # (CO_CHUNK,) int64: a batch's states' cells (coherent_order)
+    co_order: np.ndarray  # (CO_CHUNK,) int64: the order they are tested in
+    co_count: np.ndarray  # (2^_KEY_BITS + 1,) int64: the counting sort's cells
+    co_Q: np.ndarray  # (CO_BLOCK, dof) float64: states gathered in that order
 
 
 @njit(cache=True, nogil=True)
@@ -170,6 +182,10 @@ def lanes(m):
         np.zeros((4096, 2), dtype=np.int64),
         np.zeros((3, W), dtype=np.int64),
         np.zeros(ng * 6 * W, dtype=f4),
+        np.zeros(CO_CHUNK, dtype=np.int64),
+        np.zeros(CO_CHUNK, dtype=np.int64),
+        np.zeros((1 << _KEY_BITS) + 1, dtype=np.int64),
+        np.zeros((CO_BLOCK, dof)),
     )
 
 
@@ -491,24 +507,108 @@ def test_lanes(m, Z, mode):
     return _ALL & ~hit & ~unsure_g, hit, confirmed
 
 
+# ------------------------------------------------------------------ coherent lanes
+@kernel
+def coherent_order(Z, Q, s0, s1, lower, upper):
+    """Into ``Z.co_order[:s1 - s0]`` an order of the states ``Q[s0:s1]`` (as indices of Q)
+    in which the eight of a call resemble each other: sorted (a stable counting sort) by
+    their cell of a grid over the joint box ``lower``..``upper``, about one cell per eight
+    states (``log2((s1 - s0) / W)`` bits, at most ``_KEY_BITS``, dealt to the joints of
+    finite range one by one from the first; the cells ordered by the first joint's, then
+    the next's, ...). Fewer bits than such joints (a long chain, or a short batch): cells
+    that do not split some joint hold unlike states, and the order is Q's own.
+
+    A gate that one of eight unlike lanes fails makes all eight test what is behind it; in
+    one cell the lanes' bodies are near each other, and their gates pass or fail together
+    more often. The order decides nothing: each lane's verdict is its own state's (the
+    float32 filter and the float64 confirmation work lane by lane), only the time depends
+    on it. States outside the box (or NaN) fall in its edge cells."""
+    n, dof = s1 - s0, Q.shape[1]
+    key, order, count = Z.co_key, Z.co_order, Z.co_count
+    nu = 0
+    for i in range(dof):
+        span = upper[i] - lower[i]
+        nu += span > 0.0 and span < 1e300
+    total = 0
+    while (W << (total + 1)) <= n and total < _KEY_BITS:
+        total += 1
+    if nu == 0 or total < nu:  # a cell spanning a joint's whole range: nothing alike
+        for s in range(n):
+            order[s] = s0 + s
+        return
+    for s in range(n):
+        key[s] = 0
+    r = 0  # usable joints so far
+    for i in range(dof):  # joint by joint: the key's next digit, the joint's cell
+        span = upper[i] - lower[i]
+        if not (span > 0.0 and span < 1e300):
+            continue
+        have = total // nu + (1 if r < total % nu else 0)
+        r += 1
+        if have == 0:
+            break
+        top, lo, scale = (1 << have) - 1, lower[i], (1 << have) / span
+        for s in range(n):
+            u = (Q[s0 + s, i] - lo) * scale
+            c = min(int(u), top) if u >= 1.0 else 0  # NaN and below the box: cell 0
+            key[s] = (key[s] << have) | c
+    for k in range((1 << total) + 1):
+        count[k] = 0
+    for s in range(n):
+        count[key[s] + 1] += 1
+    for k in range(1 << total):
+        count[k + 1] += count[k]
+    for s in range(n):
+        k = key[s]
+        order[count[k]] = s0 + s
+        count[k] += 1
+
+
+@kernel
+def valid_coherent(m, Z, Q, out):
+    """Validity of states Q (k, dof) -> out (k,) bool, eight a call (Z's growth must be
+    plain), the batch taken in :func:`coherent_order` (``CO_CHUNK`` states at a time;
+    fewer than ``COHERENT_FROM``: as given), the verdicts in Q's order. Returns the
+    number of states the float64 confirmation decided. The states are gathered in their
+    order ``CO_BLOCK`` at a time into ``Z.co_Q`` (a tight loop of loads, many cache misses
+    in flight, rather than one row at a time between tests)."""
+    confirmed = 0
+    order, G = Z.co_order, Z.co_Q
+    dof = Q.shape[1]
+    for c0 in range(0, Q.shape[0], CO_CHUNK):
+        c1 = min(c0 + CO_CHUNK, Q.shape[0])
+        if Q.shape[0] >= COHERENT_FROM:
+            coherent_order(Z, Q, c0, c1, m.lower, m.upper)
+        else:
+            for s in range(c1 - c0):
+                order[s] = c0 + s
+        for b0 in range(0, c1 - c0, CO_BLOCK):
+            b1 = min(b0 + CO_BLOCK, c1 - c0)
+            for s in range(b0, b1):
+                r = order[s]
+                for i in range(dof):
+                    G[s - b0, i] = Q[r, i]
+            for s0 in range(b0, b1, W):
+                nn = min(W, b1 - s0)
+                for j in range(nn):
+                    load_state(Z, j, G[s0 - b0 + j], m.continuous)
+                fill_lanes(Z, nn)
+                free, _, c = test_lanes(m, Z, EVERY_LANE)
+                confirmed += c
+                for j in range(nn):
+                    out[order[s0 + j]] = (free >> j) & 1
+    return confirmed
+
+
 # ------------------------------------------------------------------ entry points
 @njit(cache=True, nogil=True)
 def valid_batch(m, Q, out):
-    """Validity of states Q (k, dof) -> out (k,) bool, eight a call. Returns the number of
-    states the float64 confirmation decided."""
+    """Validity of states Q (k, dof) -> out (k,) bool, eight a call (in the coherent
+    order, :func:`valid_coherent`). Returns the number of states the float64
+    confirmation decided."""
     Z = lanes(m)
     set_plain(Z)
-    confirmed = 0
-    for s0 in range(0, Q.shape[0], W):
-        nn = min(W, Q.shape[0] - s0)
-        for j in range(nn):
-            load_state(Z, j, Q[s0 + j], m.continuous)
-        fill_lanes(Z, nn)
-        free, _, c = test_lanes(m, Z, EVERY_LANE)
-        confirmed += c
-        for j in range(nn):
-            out[s0 + j] = (free >> j) & 1
-    return confirmed
+    return valid_coherent(m, Z, Q, out)
 
 
 @kernel
