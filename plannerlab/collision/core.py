@@ -42,6 +42,7 @@ from plannerlab.collision.geometry import BOX, CYLINDER, SPHERE
 from plannerlab.collision.kernels import (
     PairGeometry,
     all_hits,
+    body_pairs,
     chain_tree,
     min_clearance_kernel,
     pair_distances_kernel,
@@ -179,6 +180,17 @@ class Core:
         lo, hi = scene.aabbs()
         olo = np.ascontiguousarray(lo, dtype=float).reshape(n, 3)
         ohi = np.ascontiguousarray(hi, dtype=float).reshape(n, 3)
+        geo = ChainGeometry(
+            self.radii, self.radii_self, self.moving, allowed, self.kinds, self.Rs, self.cs,
+            self.hs,
+        )  # fmt: skip
+        #: the compiled robot–scene model (:class:`~plannerlab.collision.model.
+        #: CompiledModel`), which compiled consumers take
+        self.model: CompiledModel = build_model(
+            robot, geo, self.margin_m, self.edge_weights, link_rates
+        )
+        cap_body = np.empty(L, dtype=np.int64)  # the model's bodies, in the robot's order
+        cap_body[self.model.perm] = self.model.cap_body
         # the exact distance kernels' arguments (kernels.py: capsule axes and these)
         self._geo = PairGeometry(
             self.radii,
@@ -192,15 +204,7 @@ class Core:
             self.hs,
             olo,
             ohi,
-        )
-        geo = ChainGeometry(
-            self.radii, self.radii_self, self.moving, allowed, self.kinds, self.Rs, self.cs,
-            self.hs,
-        )  # fmt: skip
-        #: the compiled robot–scene model (:class:`~plannerlab.collision.model.
-        #: CompiledModel`), which compiled consumers take
-        self.model: CompiledModel = build_model(
-            robot, geo, self.margin_m, self.edge_weights, link_rates
+            body_pairs(cap_body, allowed),
         )
         self._P = tuple(pack(self.model, lanes(self.model)))
         #: the model and the state test's scratch packed (:mod:`plannerlab.collision.

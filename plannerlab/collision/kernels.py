@@ -41,6 +41,7 @@ class PairGeometry(NamedTuple):
     hs: np.ndarray  # (n, 3)
     olo: np.ndarray  # (n, 3) the obstacles' world boxes
     ohi: np.ndarray
+    bodies: tuple  # :func:`body_pairs`: the capsules by rigid body, the body pairs to test
 
 
 @njit(cache=True, nogil=True)
@@ -143,7 +144,7 @@ def state_hits(seg, geo, buf, first_only, out_pairs):
     consecutive links, traversed against each obstacle and against itself, pruning node
     pairs whose boxes are apart or that hold no checked pair; cost ~ L log L.
     """
-    radii, radii_self, moving, allowed, tree, kinds, Rs, cs, hs, olo, ohi = geo
+    radii, radii_self, moving, allowed, tree, kinds, Rs, cs, hs, olo, ohi, _ = geo
     lo, hi, w, nlo, nhi, stack = buf
     start, end, left, right, prefix = tree
     n_obs = kinds.shape[0]
@@ -267,7 +268,7 @@ def pair_distances_kernel(seg, geo, margin):
     Returns (idx (m, 3) int: link, other, other_is_link; d (m,); t_link (m,);
     t_other (m,); n (m, 3)).
     """
-    radii, radii_self, moving, allowed, tree, kinds, Rs, cs, hs, olo, ohi = geo
+    radii, radii_self, moving, allowed, tree, kinds, Rs, cs, hs, olo, ohi, _ = geo
     L = seg.shape[0]
     n_obs = kinds.shape[0]
     lo = np.empty((L, 3))
@@ -341,6 +342,112 @@ def pair_distances_kernel(seg, geo, margin):
     return idx[:m].copy(), d[:m].copy(), tl[:m].copy(), to[:m].copy(), n[:m].copy()
 
 
+def body_pairs(cap_body: np.ndarray, allowed: np.ndarray) -> tuple[np.ndarray, ...]:
+    """The capsules by rigid body and the body pairs that hold a checked capsule pair, for
+    :func:`min_clearance_kernel`'s gates (built once per robot).
+
+    Args:
+        cap_body: (L,) each capsule's body (the robot's capsule order).
+        allowed: (L, L) bool, upper triangle: the checked pairs.
+
+    Returns ``(order, start, bpairs, checked)``: ``order[start[b]:start[b + 1]]`` are body
+    ``b``'s capsules (ascending), ``bpairs`` (P, 2) the body pairs ``u <= v`` holding a
+    checked pair, ``checked`` (L,) bool the capsules in one.
+    """
+    body = np.asarray(cap_body, dtype=np.int64)
+    nb = int(body.max(initial=-1)) + 1
+    order = np.argsort(body, kind="stable").astype(np.int64)
+    start = np.searchsorted(body[order], np.arange(nb + 1)).astype(np.int64)
+    ii, jj = np.nonzero(np.triu(np.asarray(allowed, dtype=bool), 1))
+    bu, bv = body[ii], body[jj]
+    pairs = np.unique(np.stack([np.minimum(bu, bv), np.maximum(bu, bv)], axis=1), axis=0)
+    checked = np.zeros(len(body), dtype=np.bool_)
+    checked[ii] = True
+    checked[jj] = True
+    return order, start, np.ascontiguousarray(pairs.reshape(-1, 2), dtype=np.int64), checked
+
+
+@njit(cache=True, nogil=True)
+def _body_boxes(lo, hi, bodies, mask, blo, bhi):
+    """Per body, the box around its capsules' boxes (lo, hi) that ``mask`` selects into
+    (blo, bhi); a body with none gets an empty box (lo +inf, hi -inf)."""
+    order, start, _, _ = bodies
+    for b in range(start.shape[0] - 1):
+        for c in range(3):
+            blo[b, c] = np.inf
+            bhi[b, c] = -np.inf
+        for k in range(start[b], start[b + 1]):
+            li = order[k]
+            if not mask[li]:
+                continue
+            for c in range(3):
+                blo[b, c] = min(blo[b, c], lo[li, c])
+                bhi[b, c] = max(bhi[b, c], hi[li, c])
+
+
+@njit(cache=True, nogil=True)
+def _scene_min(seg, geo, boxes, best):
+    """:func:`min_clearance_kernel`'s scene part of one state: ``best`` lowered by every
+    moving capsule's distance to every obstacle, a body's capsules skipped against an
+    obstacle whose box is at least ``best`` from the body's (boxes: capsule lo, hi, body
+    lo, hi, the geometry's scratch w and nv)."""
+    radii, _, moving, _, _, kinds, Rs, cs, hs, olo, ohi, bodies = geo
+    lo, hi, blo, bhi, w, nv = boxes
+    order, start, _, _ = bodies
+    for b in range(start.shape[0] - 1):
+        if blo[b, 0] > bhi[b, 0]:  # no capsule of the body meets the scene
+            continue
+        for oi in range(kinds.shape[0]):
+            g = box_gap(blo, bhi, b, olo, ohi, oi)
+            if g > 0.0 and g >= best:
+                continue
+            for k in range(start[b], start[b + 1]):
+                li = order[k]
+                if not moving[li]:
+                    continue
+                g = box_gap(lo, hi, li, olo, ohi, oi)
+                if g > 0.0 and g >= best:
+                    continue
+                dist, _ = capsule_obstacle(
+                    (kinds, Rs, cs, hs), oi, seg[li, 0], seg[li, 1], radii[li], False, nv, w
+                )
+                if dist < best:
+                    best = dist
+    return best
+
+
+@njit(cache=True, nogil=True)
+def _pair_min(seg, geo, boxes, u, v, best):
+    """:func:`min_clearance_kernel`'s link pairs of body pair (u, v) in one state: ``best``
+    lowered by every checked capsule pair's distance; a capsule of u whose box is at least
+    ``best`` from v's box meets none of v's (boxes: the capsules' and the bodies' boxes with
+    the radii between links)."""
+    _, radii_self, _, allowed, _, _, _, _, _, _, _, bodies = geo
+    lo, hi, blo, bhi = boxes
+    order, start, _, _ = bodies
+    for x in range(start[u], start[u + 1]):
+        i = order[x]
+        if u != v:
+            g = box_gap(lo, hi, i, blo, bhi, v)
+            if g > 0.0 and g >= best:
+                continue
+        y0 = x + 1 if u == v else start[v]
+        for y in range(y0, start[v + 1]):
+            j = order[y]
+            a = min(i, j)
+            c = max(i, j)
+            if not allowed[a, c]:
+                continue
+            g = box_gap(lo, hi, a, lo, hi, c)
+            if g > 0.0 and g >= best:
+                continue
+            d2, _, _ = seg_seg(seg[a, 0], seg[a, 1], seg[c, 0], seg[c, 1])
+            dist = math.sqrt(d2) - radii_self[a] - radii_self[c]
+            if dist < best:
+                best = dist
+    return best
+
+
 @njit(cache=True, nogil=True)
 def min_clearance_kernel(segs, geo, include_self):
     """Smallest signed distance [m] over every checked pair of every state (k, L, 2, 3)
@@ -350,52 +457,42 @@ def min_clearance_kernel(segs, geo, include_self):
     capsule's, grown by its radius, and the obstacle's or the other capsule's) are apart
     by a gap ``g > 0`` is at least ``g`` apart, so once ``g`` is no smaller than the
     smallest distance found so far the pair cannot lower it and is not measured (boxes
-    that touch bound nothing: a penetration may hide inside). ``geo``:
-    :class:`PairGeometry`."""
-    radii, radii_self, moving, allowed, tree, kinds, Rs, cs, hs, olo, ohi = geo
+    that touch bound nothing: a penetration may hide inside). The same gate is taken a
+    level up, per rigid body (``geo.bodies``, :func:`body_pairs`): a box around a body's
+    capsules against an obstacle's, against another body's (the body pairs nearest first,
+    so that the far ones are skipped whole), and a capsule's box against the other body's,
+    so a pair of mesh links of 128 capsules each costs a few box gaps when apart, not
+    128 x 128. ``geo``: :class:`PairGeometry`."""
+    radii, radii_self, moving, allowed, tree, kinds, Rs, cs, hs, olo, ohi, bodies = geo
     L = segs.shape[1]
-    n_obs = kinds.shape[0]
+    order, start, bpairs, checked = bodies
+    nb = start.shape[0] - 1
+    P = bpairs.shape[0]
     lo = np.empty((L, 3))
     hi = np.empty((L, 3))
     lo2 = np.empty((L, 3))
     hi2 = np.empty((L, 3))
+    blo = np.empty((nb, 3))
+    bhi = np.empty((nb, 3))
+    gaps = np.empty(P)
     nv = np.empty(3)
     w = np.zeros(32)
     best = np.inf
     for s in range(segs.shape[0]):
         seg = segs[s]
-        link_boxes(seg, radii, lo, hi)
-        for li in range(L):
-            if not moving[li]:
-                continue
-            for oi in range(n_obs):
-                g = box_gap(lo, hi, li, olo, ohi, oi)
-                if g > 0.0 and g >= best:
-                    continue
-                dist, _ = capsule_obstacle(
-                    (kinds, Rs, cs, hs),
-                    oi,
-                    seg[li, 0],
-                    seg[li, 1],
-                    radii[li],
-                    False,
-                    nv,
-                    w,
-                )
-                if dist < best:
-                    best = dist
-        if not include_self:
+        if kinds.shape[0] > 0:
+            link_boxes(seg, radii, lo, hi)
+            _body_boxes(lo, hi, bodies, moving, blo, bhi)
+            best = _scene_min(seg, geo, (lo, hi, blo, bhi, w, nv), best)
+        if not include_self or P == 0:
             continue
         link_boxes(seg, radii_self, lo2, hi2)
-        for i in range(L):
-            for j in range(i + 1, L):
-                if not allowed[i, j]:
-                    continue
-                g = box_gap(lo2, hi2, i, lo2, hi2, j)
-                if g > 0.0 and g >= best:
-                    continue
-                d2, _, _ = seg_seg(seg[i, 0], seg[i, 1], seg[j, 0], seg[j, 1])
-                dist = math.sqrt(d2) - radii_self[i] - radii_self[j]
-                if dist < best:
-                    best = dist
+        _body_boxes(lo2, hi2, bodies, checked, blo, bhi)
+        for p in range(P):
+            gaps[p] = box_gap(blo, bhi, bpairs[p, 0], blo, bhi, bpairs[p, 1])
+        for p in np.argsort(gaps):
+            g = gaps[p]
+            if g > 0.0 and g >= best:
+                break  # the rest are no nearer
+            best = _pair_min(seg, geo, (lo2, hi2, blo, bhi), bpairs[p, 0], bpairs[p, 1], best)
     return best

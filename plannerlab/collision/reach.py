@@ -11,15 +11,26 @@ robot's collision geometry (every capsule, radius included) moves further than
   radius: ``r_i`` is that sum, whatever the other joints are;
 * a prismatic joint translates them: ``r_i`` is their speed (1 m per m).
 
-This holds for every robot family through the Robot contract only (``link_segments``):
-per joint, which links move, the axis and the speed come from a finite difference of the
-capsule axes, taken at the start of the joint range and at a fixed set of states (its
-own seeded generator; link lengths and gaps of prismatic chains vary with q, so the
-largest seen is used). The sum over joints is the bound a planner's edge resolution in
-metres needs (:class:`~plannerlab.collision.fcl_checker.CollisionChecker` with a margin).
+Two bounds of it are taken and the smaller kept (both hold): the chain sum over the moved
+*capsules* in their index order (:func:`capsule_reach_bounds`), and over the chain's
+rigid *bodies* (:func:`body_reach_bounds`, for a robot that gives its chain,
+``chain_data()``): a body's capsules move together, so a mesh link covered by 128
+capsules adds one body's extent from its joint, not 128 lengths and gaps (the UR10 with
+its finer covers: the capsules' sum is 83-171x the fastest point seen, the bodies' 1.0-1.3x;
+``bench/mesh_reach_bound.py``).
+
+The capsules' bound holds for every robot family through the Robot contract only
+(``link_segments``): per joint, which links move, the axis and the speed come from a
+finite difference of the capsule axes, taken at the start of the joint range and at a
+fixed set of states (its own seeded generator; link lengths and gaps of prismatic chains
+vary with q, so the largest seen is used). The sum over joints is the bound a planner's
+edge resolution in metres needs
+(:class:`~plannerlab.collision.fcl_checker.CollisionChecker` with a margin).
 """
 
 from __future__ import annotations
+
+from typing import Any
 
 import numpy as np
 
@@ -69,6 +80,118 @@ def _motions(robot: Robot) -> tuple[Array, Array, Array, Array]:
     return states, S, V, hi
 
 
+def _chain(robot: Robot) -> tuple[Any, ...] | None:
+    """The robot's serial chain (``chain_data()``, :mod:`plannerlab.collision.chain`'s
+    format) as (parent, pre, axes, prismatic, cap_body, cap_a, cap_b, coupling (n, dof)),
+    or None for a robot that gives none (or one this module cannot read)."""
+    get = getattr(robot, "chain_data", None)
+    if not callable(get):
+        return None
+    data = tuple(get())
+    if len(data) not in (7, 8):
+        return None
+    parent = np.asarray(data[0], dtype=np.int64)
+    n, dof = len(parent), int(robot.dof)
+    coupling = data[7] if len(data) == 8 else None
+    C = np.eye(n) if coupling is None else np.asarray(coupling, dtype=float)
+    if C.shape != (n, dof):
+        return None
+    pre = np.asarray(data[1], dtype=float).reshape(n, 4, 4)
+    axes = np.asarray(data[2], dtype=float).reshape(n, 3)
+    axes = axes / np.linalg.norm(axes, axis=1, keepdims=True)
+    prismatic = np.asarray(data[3], dtype=bool).reshape(n)
+    cap_body = np.asarray(data[4], dtype=np.int64)
+    cap_a = np.asarray(data[5], dtype=float).reshape(-1, 3)
+    cap_b = np.asarray(data[6], dtype=float).reshape(-1, 3)
+    return parent, pre, axes, prismatic, cap_body, cap_a, cap_b, C
+
+
+def _off_axis(p: Array, u: Array) -> Array:
+    """Distances (k,) of points p (k, 3) from the line through the origin along unit u."""
+    return np.linalg.norm(p - np.outer(p @ u, u), axis=-1)
+
+
+def body_reach_bounds(robot: Robot) -> tuple[Array, Array] | None:
+    """Per joint and capsule, an upper bound [m per rad, or m per m] of how fast any point
+    of the capsule moves when the joint moves alone, per rigid body of the robot's chain
+    (``chain_data()``); None for a robot without one.
+
+    A body's capsules move together, so the chain sum runs over bodies, not capsules.
+    Chain joint ``i`` moves body ``i + 1`` and the bodies hung from it. Turning, it moves
+    a point at its distance from the joint's axis (the line through the joint frame's
+    origin, which is body ``i + 1``'s origin): exact for the capsules of body ``i + 1``
+    (their ends' distances from the axis in that body's frame, plus the radius; a
+    capsule's farthest point from a line is at an end), and for a body further out at
+    most its origin's distance (the parent's bound plus the fixed offset of the joint
+    between them, plus the travel of a sliding joint, whatever the joint values) plus the
+    capsule's extent from its body's origin (end point plus radius). Sliding, it moves
+    every point it moves at 1 m per m. A state joint moves chain joint ``i`` by
+    ``coupling[i, j]`` per unit (IRb-6's relative angles; the identity elsewhere): the
+    bound is the sum of the chain joints' bounds times ``|coupling[i, j]|``.
+
+    Returns ``(reach (dof,), W (dof, L))`` as :func:`reach_bounds`' first two (``reach``
+    the largest of ``W``'s row: every point lies on a capsule); inf where a sliding
+    joint's travel is unbounded.
+    """
+    chain = _chain(robot)
+    if chain is None:
+        return None
+    parent, pre, axes, prismatic, cap_body, cap_a, cap_b, C = chain
+    n = len(parent)
+    L = len(cap_body)
+    if np.any(parent > np.arange(n)):  # a body's joint before its parent's: not a chain order
+        return None
+    radii = np.asarray(robot.link_radii_m, dtype=float)
+    if len(radii) != L:
+        return None
+    # each chain joint's travel |v_i| at most (v = C q over the state's bounds)
+    lo = np.asarray(robot.lower, dtype=float)
+    hi = np.asarray(robot.upper, dtype=float)
+    cont = np.asarray(robot.continuous, dtype=bool)
+    q_abs = np.where(cont, np.pi, np.maximum(np.abs(lo), np.abs(hi)))
+    with np.errstate(invalid="ignore"):
+        travel = np.where(C != 0.0, np.abs(C) * q_abs[None, :], 0.0).sum(axis=1)
+    # the offset of each joint's body (i + 1) from its parent body's origin, at most
+    offset = np.linalg.norm(pre[:, :3, 3], axis=1) + np.where(prismatic, travel, 0.0)
+    extent = np.maximum(np.linalg.norm(cap_a, axis=1), np.linalg.norm(cap_b, axis=1)) + radii
+    R = np.zeros((n, L))  # per chain joint
+    for i in range(n):
+        own = i + 1
+        if prismatic[i]:
+            reach_b = {own: 0.0}
+        else:
+            reach_b = {own: -1.0}  # body i + 1 itself: exact, below
+        for k in range(i + 1, n):
+            b = int(parent[k])
+            if b not in reach_b:
+                continue
+            if prismatic[i]:
+                reach_b[k + 1] = 0.0
+            elif b == own:  # the joint's offset in body i + 1's frame: exact off the axis
+                t = pre[k, :3, 3]
+                off = float(_off_axis(t[None], axes[i])[0])
+                if prismatic[k]:
+                    off += travel[k]
+                reach_b[k + 1] = off
+            else:
+                reach_b[k + 1] = reach_b[b] + offset[k]
+        for b, d in reach_b.items():
+            caps = cap_body == b
+            if not caps.any():
+                continue
+            if prismatic[i]:
+                R[i, caps] = 1.0
+            elif b == own:
+                far = np.maximum(_off_axis(cap_a[caps], axes[i]), _off_axis(cap_b[caps], axes[i]))
+                R[i, caps] = far + radii[caps]
+            else:
+                R[i, caps] = d + extent[caps]
+    with np.errstate(invalid="ignore"):
+        W = np.where(C.T[:, :, None] != 0.0, np.abs(C.T)[:, :, None] * R[None], 0.0).sum(axis=1)
+    reach = W.max(axis=1) if L else np.zeros(robot.dof)
+    return reach, W
+
+
 def joint_reach_m(robot: Robot) -> Array:
     """Per joint, an upper bound [m per rad, or m per m] of how fast any point of the
     robot's collision geometry moves when that joint moves alone (see the module): the
@@ -77,9 +200,37 @@ def joint_reach_m(robot: Robot) -> Array:
 
 
 def reach_bounds(robot: Robot) -> tuple[Array, Array, Array]:
+    """Per joint and capsule, an upper bound [m per rad, or m per m] of how fast any point
+    of that capsule moves when the joint moves alone, and per joint whether it moves the
+    links it moves rigidly: the smaller of two bounds of the same speeds
+    (:func:`capsule_reach_bounds`, from the ``Robot`` contract alone, and
+    :func:`body_reach_bounds`, per rigid body of the robot's chain when it gives one), the
+    bodies' alone for a joint that moves its links non-rigidly (the capsules' bound fits
+    one rotation to them all, which holds for a rigid motion only: IRb-6's absolute
+    angles turn two chain joints at once, and its fitted bound fell below the speed seen).
+
+    Returns ``(reach (dof,), W (dof, L), rigid (dof,) bool)`` as
+    :func:`capsule_reach_bounds`.
+    """
+    reach, W, rigid = capsule_reach_bounds(robot)
+    by_body = body_reach_bounds(robot)
+    if by_body is not None:
+        # the capsules' bound takes one rotation for every moved link: it holds for a joint
+        # that moves them rigidly, not for one that turns two chain joints at once (IRb-6's
+        # absolute angles), where the bodies' bound alone holds
+        reach = np.where(rigid, np.minimum(reach, by_body[0]), by_body[0])
+        W = np.where(rigid[:, None], np.minimum(W, by_body[1]), by_body[1])
+    return reach, W, rigid
+
+
+def capsule_reach_bounds(robot: Robot) -> tuple[Array, Array, Array]:
     """Per joint and link, an upper bound [m per rad, or m per m] of how fast any point of
     that link's capsule moves when the joint moves alone, and per joint whether it moves
     the links it moves rigidly (one rotation or translation for all of them).
+
+    From the ``Robot`` contract alone (``link_segments``): a chain sum over the moved
+    capsules in their index order, so a rigid link of many capsules (a mesh's cover) is
+    summed as a chain of that many links (:func:`body_reach_bounds` sums over bodies).
 
     Returns ``(reach (dof,), W (dof, L), rigid (dof,) bool)``: ``reach`` is the whole
     chain's bound of the module (:func:`joint_reach_m`). ``W[i, l]`` is

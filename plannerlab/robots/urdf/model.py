@@ -68,16 +68,18 @@ capsules of one role) a ball per group of at most 16 neighbouring capsules, then
 cluster of four (``collision/model.py``): a pair of links far apart costs one ball test,
 a pair of links near each other opens only the group pairs that meet.
 
-**It is off by default** (``self_cover_max_primitives = 0``), though the state test no
-longer stands in the way: with the group level the finer covers cost 2.5x (UR10) and 4.3x
-(Kinova) the first covers' state test (without it 12.7x and 66x; results/mesh_robots.md).
-What still does: the bundled mesh Panda's end-to-end test (plan, execute, referee) took
-1144 s wall, 280 s of CPU with them on (load ~10), against 9 s without (round 2), and
-the simulator's clearance measure (``SimWorld.link_distances``) builds capsule x capsule
-arrays: 6.3 -> 20.7 ms a state. A robot whose links pass within millimetres of each other
-(the UR10: 4 % of random states free on the first covers, 25.7 % with the finer ones,
-53 % on its meshes) needs them; ask with ``self_cover_max_primitives = 128`` in
-``[robot]``. The first load of a robot computes them (minutes for a large arm; cached).
+**It is on by default** (``self_cover_max_primitives = 128``; ``0`` asks for none: the
+first cover then judges self-collision too). It used to be opt-in for three costs, each
+since cut: the state test (the group level of gates: 2.5x the first covers' on the UR10,
+4.3x on the Kinova), the metric edge bound (``collision/reach.py`` summed a mesh link of
+128 capsules as a chain of 128 links, 83-171x the fastest point seen on the UR10; per rigid
+body now, 1.0-1.3x) and the path clearance measure (``collision/kernels.
+min_clearance_kernel``, a box gap for every capsule pair a state; gated per body pair
+now). A robot whose links pass within millimetres of each other needs them: the UR10 (4 %
+of random states free on the first covers, 25.7 % with the finer ones, 53 % on its
+meshes) had no valid start state on its first covers (results/mesh_robots.md). The first
+load of a robot computes them (minutes for a large arm; cached, or shipped in
+``covers/``).
 
 Only numpy (``yourdfpy`` for parsing, ``trimesh`` for meshes) is used here.
 """
@@ -297,9 +299,8 @@ class UrdfChain:
         cover_max_primitives: the most capsules covering one mesh.
         self_cover_excess_m, self_cover_max_primitives: the second, finer cover of each
             mesh, judging self-collision only (the first one judges the scene): the
-            excess aimed at [m] and the most capsules; 0 primitives (the default): no
-            second cover (the first judges both); 128 is what the module docstring
-            measures.
+            excess aimed at [m] and the most capsules (128, the default; 0: no second
+            cover, the first judges both).
         cover_cache: keep covers on disk; ``cover_cache_dir`` (None:
             ``~/.cache/plannerlab/covers``).
         sim_urdf_path: the robot's real geometry for the simulator: a URDF with the same
@@ -319,7 +320,7 @@ class UrdfChain:
     cover_excess_m: float = 0.01
     cover_max_primitives: int = 32
     self_cover_excess_m: float = 0.004
-    self_cover_max_primitives: int = 0
+    self_cover_max_primitives: int = 128
     cover_cache: bool = True
     cover_cache_dir: Path | None = None
     sim_urdf_path: Path | None = None

@@ -141,11 +141,11 @@ TABLE = RobotTable(
         Key(
             "self_cover_max_primitives",
             "integer",
-            0,
+            128,
             "",
-            "the most capsules of a mesh's finer cover; 0: none (the first cover judges "
-            "self-collision too); 128 for links that pass within millimetres of each other "
-            "(a UR10's wrists; the state test then costs 2.5-4.3x more)",
+            "the most capsules of a mesh's finer cover, which judges self-collision (links "
+            "that pass within millimetres of each other: a UR10's wrists); 0: none (the "
+            "first cover judges self-collision too; the state test costs 2.5-4.3x less)",
             minimum=0,
             maximum=1024,
             why_maximum="every capsule is one more to check",
