@@ -343,8 +343,8 @@ def test_a_seed_planners_settings_are_passed_on() -> None:
 #: (planner, problem, check budget, seed, overrides) -> (status, checks, iterations,
 #: refines); the paths in tests/data/golden_paths.json
 GOLDEN = {
-    ("trajopt.line", "toy", 20_000, 5, ""): ("solved", 490, 17, 0),
-    ("trajopt.line", "toy_joint", 20_000, 5, ""): ("solved", 447, 17, 0),
+    ("trajopt.line", "toy", 20_000, 5, ""): ("solved", 226, 6, 0),
+    ("trajopt.line", "toy_joint", 20_000, 5, ""): ("solved", 184, 5, 0),
     # re-pinned on the certified edges (issue 32): 1 204 checks (its seed's edges); on the
     # Panda (margin 0) the checker now gives its reach (the certificates' bounds), so the
     # waypoints are spaced by it, not by the sphere field's speeds: 30 of them where there
@@ -352,11 +352,11 @@ GOLDEN = {
     # re-pinned for the first pass on coarse waypoints (coarse_factor 4) and the early stop
     # once feasible (feasible_rel_tol 0.3): 12 waypoints (the least) where there were 30,
     # 6 evaluations where there were 21
-    ("trajopt.rrtconnect", "toy", 20_000, 5, ""): ("solved", 389, 6, 0),
+    ("trajopt.rrtconnect", "toy", 20_000, 5, ""): ("solved", 343, 6, 0),
     # re-pinned for the coarse first pass (3 waypoints where there were 5: three
     # refinements, not two, to the same 11) and the re-check that looks at every edge
     # after the first refused one (those checks are charged)
-    ("trajopt.line", "thin_plate", 50_000, 0, "tunnel"): ("solved", 2288, 36, 3),
+    ("trajopt.line", "thin_plate", 50_000, 0, "tunnel"): ("solved", 1849, 36, 3),
     # re-pinned for the coarse first pass and the early stop: 887 checks, 14 evaluations
     ("trajopt.line", "panda_bookshelf", 200_000, 0, ""): ("solved", 887, 14, 0),
 }
