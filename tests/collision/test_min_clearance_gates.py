@@ -1,76 +1,33 @@
 """The path clearance measure's body gates (``kernels.min_clearance_kernel``, issue 35): a
 body pair, or a body and an obstacle, whose boxes are further apart than the smallest
 distance found so far opens no capsule pair. It returns the previous kernel's values (the
-kernel before the gates, kept here verbatim as the reference: a box gap per capsule pair)
+kernel before the gates, kept verbatim as the reference in ``bench/mesh_clearance_cost.py``,
+which times the two: a box gap per capsule pair)
 to 1e-12 m, never looser, on random states of every family and of a mesh robot with its
 finer covers, in and out of collision, with and without the link pairs."""
 
 from __future__ import annotations
 
 import math
+import sys
 from pathlib import Path
 
 import numpy as np
 import pytest
-from conftest import PROBLEMS
-from numba import njit
+from conftest import PROBLEMS, ROOT
 
 from plannerlab.collision.core import Core
-from plannerlab.collision.geometry import capsule_obstacle, seg_seg
-from plannerlab.collision.kernels import box_gap, link_boxes
 from plannerlab.problem.catalog import load_problem
 from plannerlab.problem.load import parse_problem
 from plannerlab.problem.scene import Box, Scene, Sphere
 from plannerlab.robots.base import pose_matrix
 from plannerlab.robots.urdf.model import UrdfChain
 
+sys.path.insert(0, str(ROOT / "bench"))
+from mesh_clearance_cost import previous_min_clearance  # noqa: E402
+
 DATA = Path(__file__).resolve().parents[1] / "data" / "mesh_arm"
 PANDA = PROBLEMS / "urdf" / "panda" / "bookshelf_small_0001.toml"
-
-
-@njit(cache=False)
-def previous_min_clearance(segs, geo, include_self):
-    """``min_clearance_kernel`` before the body gates (every capsule pair's box gap)."""
-    radii, radii_self, moving, allowed, tree, kinds, Rs, cs, hs, olo, ohi, _ = geo
-    L = segs.shape[1]
-    n_obs = kinds.shape[0]
-    lo = np.empty((L, 3))
-    hi = np.empty((L, 3))
-    lo2 = np.empty((L, 3))
-    hi2 = np.empty((L, 3))
-    nv = np.empty(3)
-    w = np.zeros(32)
-    best = np.inf
-    for s in range(segs.shape[0]):
-        seg = segs[s]
-        link_boxes(seg, radii, lo, hi)
-        for li in range(L):
-            if not moving[li]:
-                continue
-            for oi in range(n_obs):
-                g = box_gap(lo, hi, li, olo, ohi, oi)
-                if g > 0.0 and g >= best:
-                    continue
-                dist, _ = capsule_obstacle(
-                    (kinds, Rs, cs, hs), oi, seg[li, 0], seg[li, 1], radii[li], False, nv, w
-                )
-                if dist < best:
-                    best = dist
-        if not include_self:
-            continue
-        link_boxes(seg, radii_self, lo2, hi2)
-        for i in range(L):
-            for j in range(i + 1, L):
-                if not allowed[i, j]:
-                    continue
-                g = box_gap(lo2, hi2, i, lo2, hi2, j)
-                if g > 0.0 and g >= best:
-                    continue
-                d2, _, _ = seg_seg(seg[i, 0], seg[i, 1], seg[j, 0], seg[j, 1])
-                dist = math.sqrt(d2) - radii_self[i] - radii_self[j]
-                if dist < best:
-                    best = dist
-    return best
 
 
 def _scene(robot, rng: np.random.Generator, n: int) -> Scene:
