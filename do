@@ -24,9 +24,15 @@ stamp="$VENV/.installed-$hash${extras:+-test}"
 if [ ! -x "$VENV/bin/python" ] || { [ ! -f "$stamp" ] && [ ! -f "$VENV/.installed-$hash-test" ]; }; then
   echo "setting up $VENV (once; a few minutes on a fresh machine)" >&2
   "$PY" -m venv "$VENV"
-  "$VENV/bin/python" -m pip install --quiet --upgrade pip
+  # pip's scratch space on the venv's own disk, not /tmp (stop 44's CI died with "No space
+  # left on device" in /tmp while pip built the editable wheel; /tmp may be a small tmpfs)
+  export TMPDIR="$PWD/$VENV/.pip-tmp"
+  mkdir -p "$TMPDIR"
+  "$VENV/bin/python" -m pip install --quiet --no-cache-dir --upgrade pip
   # pinned versions (constraints.txt): the goldens of tests/ depend on them
-  "$VENV/bin/python" -m pip install --quiet -c constraints.txt -e ".$extras"
+  "$VENV/bin/python" -m pip install --quiet --no-cache-dir -c constraints.txt -e ".$extras"
+  rm -rf "$TMPDIR"
+  unset TMPDIR
   rm -f "$VENV"/.installed-*
   touch "$stamp"
 fi
