@@ -49,6 +49,7 @@ def main() -> int:
     import plannerlab as pl
     from plannerlab.record.plan import Plan
     from plannerlab.robots.urdf.model import UrdfChain
+
     ex_mod = importlib.import_module("plannerlab.sim.execute")
 
     link_segments_after = UrdfChain.link_segments
