@@ -18,6 +18,8 @@ Prints, one JSON object per part:
   state and for the leg's start, the free-motion fraction (``bench/mbm_why.py``: 48
   seeded straight motions at the default range and its halves, checked on the planner's
   grid);
+- ``valid_share`` (``--valid-share N``): of N seeded uniform states, the share valid, and
+  of (at most 400 of) the invalid ones the share whose colliding pairs touch the scene;
 - ``solve``: per ``--planners``, the leg solved with a check budget and a time limit:
   status, checks, tree sizes (``nodes``), the pool size.
 """
@@ -118,6 +120,7 @@ def main() -> int:
     ap.add_argument("--max-checks", type=int, default=300000)
     ap.add_argument("--time-limit", type=float, default=30.0)
     ap.add_argument("--set", action="append", default=[], help="planner setting key=value")
+    ap.add_argument("--valid-share", type=int, default=0, help="uniform states to judge")
     ap.add_argument("--skip", default="", help="parts to skip: ik,pool")
     args = ap.parse_args()
     from mbm_why import free_fractions
@@ -145,6 +148,29 @@ def main() -> int:
         flush=True,
     )
     skip = set(args.skip.split(","))
+    if args.valid_share:
+        rng = np.random.default_rng(0)
+        Q = rng.uniform(
+            problem.robot.lower, problem.robot.upper, (args.valid_share, problem.robot.dof)
+        )
+        valid = np.array([checker.is_valid(q) for q in Q])
+        scene = {o.name.split("#")[0] for o in problem.scene.obstacles}
+        scene |= {m.name for m in problem.scene.meshes}
+        bad = Q[~valid][:400]
+        touching = sum(
+            any(
+                a.split("#")[0] in scene or b.split("#")[0] in scene
+                for a, b in checker.colliding_pairs(q)
+            )
+            for q in bad
+        )
+        share = {
+            "states": args.valid_share,
+            "valid": round(float(valid.mean()), 4),
+            "invalid_touching_scene": round(touching / max(len(bad), 1), 3),
+            "of_invalid": len(bad),
+        }
+        print(json.dumps({"valid_share": share}), flush=True)
     range0 = 0.2 * space_extent(checker.model)
     if "ik" not in skip:
         facts = ik_facts(problem, checker, args.leg, args.ik, 0, args.ik_free, range0)

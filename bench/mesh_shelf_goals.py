@@ -7,9 +7,10 @@ UR10 shelf; ``results/mesh_robots.md``).
     PYTHONPATH=. nice -n 10 .venv/bin/python bench/mesh_shelf_goals.py PROBLEM.toml \\
         --urdf URDF [--goals 6] [--max-checks 300000] [--seeds 0]
 
+``--joint-goals``: each goal state itself as the goal (a joint goal: one tree root, no IK).
 Per goal state: its tip's distance from the base over the arm's reach ``R`` (the maker's),
 its elbow-free measure (the free-motion fraction at a quarter of the default range,
-``bench/mbm_why.py``), and the leg's status and checks (reach leg only).
+``bench/mbm_why.py``), and the leg's status, checks and tree sizes (reach leg only).
 """
 
 from __future__ import annotations
@@ -35,6 +36,7 @@ def main() -> int:
     ap.add_argument("--goals", type=int, default=6)
     ap.add_argument("--max-checks", type=int, default=300000)
     ap.add_argument("--seeds", default="0")
+    ap.add_argument("--joint-goals", action="store_true", help="each goal state as a joint goal")
     args = ap.parse_args()
     from mbm_why import free_fractions
     from mesh_arms_bench import _toml, scenes
@@ -65,8 +67,11 @@ def main() -> int:
             continue
         found += 1
         goal = dict(doc["goals"][0])
-        goal["p_m"] = P[i].round(5).tolist()
-        goal["n"] = N[i].round(6).tolist()
+        if args.joint_goals:  # the state itself as the goal
+            goal = {"name": goal["name"], "q": Q[i].round(6).tolist(), "joint_tol_rad": 0.001}
+        else:
+            goal["p_m"] = P[i].round(5).tolist()
+            goal["n"] = N[i].round(6).tolist()
         alt = {**doc, "goals": [goal]}
         f = Path(os.environ.get("TMPDIR", "/tmp")) / f"{args.problem.stem}_goal{found}.toml"
         f.write_text(_toml(alt))
@@ -84,7 +89,8 @@ def main() -> int:
                 budget=pl.Budget(max_collision_checks=args.max_checks),
             )
             leg = plan.legs[0]
-            row[f"seed{seed}"] = [leg.status.value, int(leg.collision_checks)]
+            nodes = (leg.extra or {}).get("nodes")
+            row[f"seed{seed}"] = [leg.status.value, int(leg.collision_checks), nodes]
         print(json.dumps(row), flush=True)
     print(json.dumps({"load_end": os.getloadavg()}), flush=True)
     return 0
