@@ -152,6 +152,26 @@ def test_covers_move_with_their_link(covers: Path) -> None:
     assert np.all(d.min(axis=1) <= 1e-9)
 
 
+def test_link_segments_move_every_capsule_by_its_own_body_frame(covers: Path) -> None:
+    """``link_segments`` (one matrix product per body) puts every capsule's end points
+    where its body's frame from ``fk`` puts them, one state and a batch alike."""
+    r = arm(covers)
+    a_b, b_b = r.chain_data()[5:7]
+    body = r.chain_data()[4]
+    assert len(np.unique(body)) >= 3  # several bodies, capsules on each
+    rng = np.random.default_rng(7)
+    Q = rng.uniform(r.lower, r.upper, size=(5, r.dof))
+    batch = r.link_segments(Q)
+    assert batch.shape == (5, len(r.link_radii_m), 2, 3)
+    for k, q in enumerate(Q):
+        F = r.fk(q)[body]  # (L, 4, 4): each capsule's body frame
+        a = np.einsum("lij,lj->li", F[:, :3, :3], a_b) + F[:, :3, 3]
+        b = np.einsum("lij,lj->li", F[:, :3, :3], b_b) + F[:, :3, 3]
+        np.testing.assert_allclose(batch[k, :, 0], a, atol=1e-12)
+        np.testing.assert_allclose(batch[k, :, 1], b, atol=1e-12)
+        np.testing.assert_allclose(r.link_segments(q), batch[k], atol=1e-12)
+
+
 def test_covers_are_cached_by_hash_and_written_atomically(tmp_path: Path) -> None:
     first = arm(tmp_path)
     files = sorted((tmp_path / "covers").iterdir())
