@@ -40,8 +40,8 @@ def _touch_links(reader: TableReader, robot: Any) -> tuple[str, ...]:
             shown = ", ".join(known) if len(known) <= 40 else ", ".join(known[:40]) + ", ..."
             raise reader.fail(
                 "touch_links",
-                f"names of the robot's links with collision geometry; {n!r} is not one."
-                f"{did_you_mean(n, known)} The links: {shown}",
+                f"names of the robot's links with collision geometry; {n!r} is not one;"
+                f"{did_you_mean(n, known)} the robot's links: {shown}",
             )
     return tuple(dict.fromkeys(raw))
 
