@@ -186,3 +186,29 @@ def test_an_edge_through_the_obstacle_with_the_declared_links_only_is_valid(
         pc = checker.check_path(np.array([qa, qc]), float(grasped.joint_step))
         assert not pc.valid
         assert "panda_hand" in {a.split("#")[0] for a, _ in pc.pairs}
+
+
+def test_the_sphere_fields_skip_the_declared_pairs(grasped: Any, undeclared: Any) -> None:
+    """The clearance descent's field (numpy and compiled) and the trajectory optimiser's
+    hinge measure no (declared link, obstacle) pair: the fingers' penetration of the box
+    is there without ``touch_links`` and gone with them."""
+    from plannerlab.planners.clearance.compiled import CompiledField, step_rule
+    from plannerlab.planners.clearance.field import ClearanceField
+    from plannerlab.planners.trajopt.geometry import PathGeometry
+
+    q = np.asarray(Q0)
+    far = 0.05
+    least = {}
+    for label, problem in (("declared", grasped), ("undeclared", undeclared)):
+        core, _ = _checkers(problem)
+        field = ClearanceField(problem.robot, problem.scene, far)
+        d_np = field.distances(q)[0]
+        compiled = CompiledField(field, far, core.model)
+        rule = step_rule(1.0, 1.0, 1.0, False, 0.1, 0.0)
+        d_c = compiled.evaluate(q, problem.goals[0], rule, False).distances_m
+        hinge = PathGeometry(problem.robot, problem.scene, core.model).hinge(q[None], far)[3][0]
+        least[label] = (float(np.min(d_np)), float(np.min(d_c)), float(hinge))
+        # the numpy field and the compiled one: the same pairs (far ones at far_m)
+        assert np.allclose(np.minimum(d_np, far), d_c, atol=1e-9)
+    assert max(least["undeclared"]) < -0.005
+    assert min(least["declared"]) > 0.0
