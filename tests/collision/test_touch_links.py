@@ -212,3 +212,15 @@ def test_the_sphere_fields_skip_the_declared_pairs(grasped: Any, undeclared: Any
         assert np.allclose(np.minimum(d_np, far), d_c, atol=1e-9)
     assert max(least["undeclared"]) < -0.005
     assert min(least["declared"]) > 0.0
+
+
+def test_the_viewers_link_clearance_leaves_the_declared_pairs_out(
+    grasped: Any, undeclared: Any
+) -> None:
+    from plannerlab.run.clearance import link_clearance
+
+    fingers = [i for i, n in enumerate(grasped.robot.link_urdf_names) if n in FINGERS]
+    d, other = link_clearance(undeclared)(np.asarray(Q0))
+    assert np.all(d[fingers] < 0.0) and {other[i] for i in fingers} == {"cup"}
+    d, other = link_clearance(grasped)(np.asarray(Q0))
+    assert np.all(d[fingers] == np.inf) and {other[i] for i in fingers} == {""}
