@@ -167,8 +167,12 @@ def state_hits(seg, geo, buf, first_only, out_pairs):
                 top += 2
                 continue
             li = start[k]
-            if moving[li] and not touch[li, oi] and capsule_obstacle_hit(
-                kinds[oi], Rs[oi], cs[oi], hs[oi], seg[li, 0], seg[li, 1], radii[li], w
+            if (
+                moving[li]
+                and not touch[li, oi]
+                and capsule_obstacle_hit(
+                    kinds[oi], Rs[oi], cs[oi], hs[oi], seg[li, 0], seg[li, 1], radii[li], w
+                )
             ):
                 out_pairs[m, 0] = li
                 out_pairs[m, 1] = oi

@@ -141,7 +141,13 @@ class Mesh:
             Tk = T.copy()
             Tk[:3, 3] = T[:3, :3] @ c + T[:3, 3]
             out.append(
-                Box(f"{self.name}#{k}", Tk, 2.0 * h, cover_of=self.name, touch_links=self.touch_links)
+                Box(
+                    f"{self.name}#{k}",
+                    Tk,
+                    2.0 * h,
+                    cover_of=self.name,
+                    touch_links=self.touch_links,
+                )
             )
         return tuple(out)
 
@@ -207,4 +213,3 @@ def touch_mask(robot: Any, scene: Scene) -> np.ndarray:
             allowed = set(ob.touch_links)
             out[:, o] = [n in allowed for n in links]
     return out
-

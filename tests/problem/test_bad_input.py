@@ -54,11 +54,15 @@ PROBLEM_CASES = {
     ),
     "unknown_table": (TINY_PROBLEM_TOML + "\n[extra_stuff]\na = 1\n", "extra_stuff"),
     "touch_links_not_a_link": (
-        tiny_problem_text("size_m = [0.4, 4.0, 4.0]", 'size_m = [0.4, 4.0, 4.0]\ntouch_links = ["module_9"]'),
+        tiny_problem_text(
+            "size_m = [0.4, 4.0, 4.0]", 'size_m = [0.4, 4.0, 4.0]\ntouch_links = ["module_9"]'
+        ),
         "obstacles[0].touch_links",
     ),
     "touch_links_not_names": (
-        tiny_problem_text("size_m = [0.4, 4.0, 4.0]", 'size_m = [0.4, 4.0, 4.0]\ntouch_links = "module_5"'),
+        tiny_problem_text(
+            "size_m = [0.4, 4.0, 4.0]", 'size_m = [0.4, 4.0, 4.0]\ntouch_links = "module_5"'
+        ),
         "obstacles[0].touch_links",
     ),
     "unknown_problem_key": (
@@ -237,7 +241,8 @@ def test_a_touch_link_that_is_no_link_is_named_with_the_links_it_could_be(capsys
 
 def test_touch_links_naming_the_robots_links_load(tmp_path):
     text = tiny_problem_text(
-        "size_m = [0.4, 4.0, 4.0]", 'size_m = [0.4, 4.0, 4.0]\ntouch_links = ["module_5", "module_4"]'
+        "size_m = [0.4, 4.0, 4.0]",
+        'size_m = [0.4, 4.0, 4.0]\ntouch_links = ["module_5", "module_4"]',
     )
     problem = parse_problem(write_problem(tmp_path, text))
     assert problem.scene.obstacles[0].touch_links == ("module_5", "module_4")
