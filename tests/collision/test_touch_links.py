@@ -224,3 +224,23 @@ def test_the_viewers_link_clearance_leaves_the_declared_pairs_out(
     assert np.all(d[fingers] < 0.0) and {other[i] for i in fingers} == {"cup"}
     d, other = link_clearance(grasped)(np.asarray(Q0))
     assert np.all(d[fingers] == np.inf) and {other[i] for i in fingers} == {""}
+
+
+def test_a_mesh_obstacles_cover_boxes_carry_its_touch_links() -> None:
+    from plannerlab.problem.scene import touch_mask
+
+    cup = {
+        "name": "cup",
+        "type": "mesh",
+        "file": "../meshes/cup.obj",
+        "center_m": [0.307, 0.0, 0.48],
+        "touch_links": FINGERS,
+    }
+    problem = _problem([cup])
+    (mesh,) = problem.scene.meshes
+    assert mesh.touch_links == tuple(FINGERS)
+    boxes = problem.scene.obstacles
+    assert len(boxes) > 1 and all(b.touch_links == tuple(FINGERS) for b in boxes)
+    mask = touch_mask(problem.robot, problem.scene)
+    fingers = np.array([n in FINGERS for n in problem.robot.link_urdf_names])
+    assert np.array_equal(mask, np.repeat(fingers[:, None], len(boxes), axis=1))
