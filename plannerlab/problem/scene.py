@@ -207,6 +207,11 @@ def touch_mask(robot: Any, scene: Scene) -> np.ndarray:
     ``scene.obstacles`` (its link is among the obstacle's ``touch_links``): the pairs
     every collision road skips. All False when no obstacle declares contacts."""
     links = capsule_links(robot)
+    if len(links) != len(robot.link_radii_m):
+        raise ValueError(
+            f"robot {getattr(robot, 'kind', '?')!r} names {len(links)} links for "
+            f"{len(robot.link_radii_m)} capsules: its declared contacts cannot be placed"
+        )
     out = np.zeros((len(links), len(scene.obstacles)), dtype=bool)
     for o, ob in enumerate(scene.obstacles):
         if ob.touch_links:
