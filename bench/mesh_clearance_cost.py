@@ -35,8 +35,9 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 @njit(cache=True)
 def previous_min_clearance(segs, geo, include_self):
-    """``min_clearance_kernel`` before the body gates (every capsule pair's box gap)."""
-    radii, radii_self, moving, allowed, tree, kinds, Rs, cs, hs, olo, ohi, _ = geo
+    """``min_clearance_kernel`` before the body gates (every capsule pair's box gap; it
+    knows no declared contacts, ``geo.touch``: compared on scenes without them)."""
+    radii, radii_self, moving, allowed, tree, kinds, Rs, cs, hs, olo, ohi = geo[:11]
     L = segs.shape[1]
     n_obs = kinds.shape[0]
     lo = np.empty((L, 3))

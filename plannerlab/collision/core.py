@@ -23,7 +23,8 @@ The pairs checked are the checker's: moving capsules against every obstacle (rad
 by the whole margin), and the robot's link pairs except ``excluded_pairs`` and pairs of
 two fixed links (radii grown by half the margin each: a pair keeps one margin); a mesh
 robot's ``self_only_links`` never against the scene and grown by no margin, its
-``scene_only_links`` never against links.
+``scene_only_links`` never against links; an obstacle's declared contacts (its
+``touch_links``' capsules) never against it.
 
 Calls from Python pass the model packed (:mod:`plannerlab.collision.packing`): five
 arrays, so a query's fixed cost is a few microseconds; compiled consumers (the native
@@ -50,7 +51,7 @@ from plannerlab.collision.kernels import (
 from plannerlab.collision.model import ChainGeometry, CompiledModel, build_model, has_chain
 from plannerlab.collision.packing import pack
 from plannerlab.collision.state_test import lanes
-from plannerlab.problem.scene import Box, Cylinder, Scene, Sphere
+from plannerlab.problem.scene import Box, Cylinder, Scene, Sphere, touch_mask
 from plannerlab.robots.base import Array, Robot, joint_difference
 from plannerlab.robots.paths import MAX_EDGE_STATES, edge_steps, edge_too_long, require_joint_step
 
@@ -180,9 +181,12 @@ class Core:
         lo, hi = scene.aabbs()
         olo = np.ascontiguousarray(lo, dtype=float).reshape(n, 3)
         ohi = np.ascontiguousarray(hi, dtype=float).reshape(n, 3)
+        #: (L, n) bool: the declared contacts (capsule, obstacle) never tested (an
+        #: obstacle's ``touch_links``: :func:`~plannerlab.problem.scene.touch_mask`)
+        self.touch = np.ascontiguousarray(touch_mask(robot, scene), dtype=np.bool_)
         geo = ChainGeometry(
             self.radii, self.radii_self, self.moving, allowed, self.kinds, self.Rs, self.cs,
-            self.hs,
+            self.hs, self.touch if self.touch.any() else None,
         )  # fmt: skip
         #: the compiled robot–scene model (:class:`~plannerlab.collision.model.
         #: CompiledModel`), which compiled consumers take
@@ -205,6 +209,7 @@ class Core:
             olo,
             ohi,
             body_pairs(cap_body, allowed),
+            self.touch,
         )
         self._P = tuple(pack(self.model, lanes(self.model)))
         #: the model and the state test's scratch packed (:mod:`plannerlab.collision.

@@ -66,8 +66,9 @@ def frames64(m, Z, q):
 @kernel
 def exact_state(m, Z, q, grow):
     """One state q (dof,) is free with every capsule grown by ``grow · rate`` (float64,
-    the exact tests of ``geometry``: FCL's verdicts); ``Z.rate64``, ``Z.brate64``: the
-    capsules' and bodies' rates."""
+    the exact tests of ``geometry``: FCL's verdicts; an obstacle's declared contacts, the
+    model's ``touch_caps``, never tested); ``Z.rate64``, ``Z.brate64``: the capsules' and
+    bodies' rates."""
     rate, brate = Z.rate64, Z.brate64
     frames64(m, Z, q)
     for b in range(Z.e_placed.shape[0]):
@@ -84,7 +85,10 @@ def exact_state(m, Z, q, grow):
                 continue
             if Z.e_placed[b] == 0:
                 _place64(m, Z, b)
+            touch = m.obs_touch[o]  # -1, or the row of its declared contacts
             for l in range(m.body_caps[b], m.body_caps[b + 1]):
+                if touch >= 0 and m.touch_caps[touch, l]:
+                    continue  # a declared contact: never tested
                 if m.cap_moving[l] and capsule_obstacle_hit(
                     m.obs_kind[o], Z.e_R[o], m.obs_c[o], m.obs_h[o], Z.e_XA[l], Z.e_XB[l],
                     m.r_scene[l] + grow * rate[l], Z.e_w,

@@ -16,7 +16,9 @@ the same meaning:
 :attr:`CollisionChecker.backend` says which one answers; :class:`PathCheck` carries it.
 
 Pairs that are never checked: a fixed link against the scene (the base stands on its
-pedestal by design) and the robot's ``excluded_pairs`` (neighbours that always touch).
+pedestal by design), the robot's ``excluded_pairs`` (neighbours that always touch) and an
+obstacle's declared contacts (the capsules of its ``touch_links`` against it: a grasped
+object and the hand).
 """
 
 from __future__ import annotations
@@ -31,7 +33,7 @@ import numpy as np
 from plannerlab.collision.core import Core, PairDistances
 from plannerlab.collision.core import supports as core_supports
 from plannerlab.collision.reach import joint_reach_m, reach_bounds
-from plannerlab.problem.scene import Box, Cylinder, Mesh, Scene, Sphere
+from plannerlab.problem.scene import Box, Cylinder, Mesh, Scene, Sphere, touch_mask
 from plannerlab.robots.base import Array, Robot, joint_difference
 from plannerlab.robots.paths import densify, edge_counts
 
@@ -178,7 +180,9 @@ class CollisionChecker:
         scene_only = frozenset(getattr(robot, "scene_only_links", ()))
         moving = np.array([i not in robot.fixed_links and i not in self_only for i in range(L)])
         self._against_scene = moving
-        self._scene_mask = moving[:, None] & np.ones((1, len(self._obstacles)), dtype=bool)
+        #: (L, n) the (capsule, obstacle) pairs checked: moving capsules, but an
+        #: obstacle's declared contacts (its ``touch_links``, never checked against it)
+        self._scene_mask = moving[:, None] & ~touch_mask(robot, scene)
         excluded = robot.excluded_pairs
         pairs = [
             (i, j)
@@ -405,10 +409,9 @@ class CollisionChecker:
         self._place(seg)
         best = np.inf
         for li in range(self._n_links):
-            if not self._against_scene[li]:
-                continue
-            for obj in self._obstacles:
-                best = min(best, self._signed_distance(self._links[li], obj))
+            for oi, obj in enumerate(self._obstacles):
+                if self._scene_mask[li, oi]:
+                    best = min(best, self._signed_distance(self._links[li], obj))
         if include_self:
             for i, j in self._self_pairs:
                 best = min(best, self._signed_distance(self._links_self[i], self._links_self[j]))

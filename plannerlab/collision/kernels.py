@@ -42,6 +42,7 @@ class PairGeometry(NamedTuple):
     olo: np.ndarray  # (n, 3) the obstacles' world boxes
     ohi: np.ndarray
     bodies: tuple  # :func:`body_pairs`: the capsules by rigid body, the body pairs to test
+    touch: np.ndarray  # (L, n) bool: declared contacts (capsule, obstacle), never tested
 
 
 @njit(cache=True, nogil=True)
@@ -144,7 +145,7 @@ def state_hits(seg, geo, buf, first_only, out_pairs):
     consecutive links, traversed against each obstacle and against itself, pruning node
     pairs whose boxes are apart or that hold no checked pair; cost ~ L log L.
     """
-    radii, radii_self, moving, allowed, tree, kinds, Rs, cs, hs, olo, ohi, _ = geo
+    radii, radii_self, moving, allowed, tree, kinds, Rs, cs, hs, olo, ohi, _, touch = geo
     lo, hi, w, nlo, nhi, stack = buf
     start, end, left, right, prefix = tree
     n_obs = kinds.shape[0]
@@ -166,8 +167,12 @@ def state_hits(seg, geo, buf, first_only, out_pairs):
                 top += 2
                 continue
             li = start[k]
-            if moving[li] and capsule_obstacle_hit(
-                kinds[oi], Rs[oi], cs[oi], hs[oi], seg[li, 0], seg[li, 1], radii[li], w
+            if (
+                moving[li]
+                and not touch[li, oi]
+                and capsule_obstacle_hit(
+                    kinds[oi], Rs[oi], cs[oi], hs[oi], seg[li, 0], seg[li, 1], radii[li], w
+                )
             ):
                 out_pairs[m, 0] = li
                 out_pairs[m, 1] = oi
@@ -268,7 +273,7 @@ def pair_distances_kernel(seg, geo, margin):
     Returns (idx (m, 3) int: link, other, other_is_link; d (m,); t_link (m,);
     t_other (m,); n (m, 3)).
     """
-    radii, radii_self, moving, allowed, tree, kinds, Rs, cs, hs, olo, ohi, _ = geo
+    radii, radii_self, moving, allowed, tree, kinds, Rs, cs, hs, olo, ohi, _, touch = geo
     L = seg.shape[0]
     n_obs = kinds.shape[0]
     lo = np.empty((L, 3))
@@ -288,7 +293,7 @@ def pair_distances_kernel(seg, geo, margin):
         if not moving[li]:
             continue
         for oi in range(n_obs):
-            if not _overlap(lo, hi, li, olo, ohi, oi, pad):
+            if touch[li, oi] or not _overlap(lo, hi, li, olo, ohi, oi, pad):
                 continue
             dist, t = capsule_obstacle(
                 (kinds, Rs, cs, hs), oi, seg[li, 0], seg[li, 1], radii[li], True, nv, w
@@ -391,7 +396,7 @@ def _scene_min(seg, geo, boxes, best):
     moving capsule's distance to every obstacle, a body's capsules skipped against an
     obstacle whose box is at least ``best`` from the body's (boxes: capsule lo, hi, body
     lo, hi, the geometry's scratch w and nv)."""
-    radii, _, moving, _, _, kinds, Rs, cs, hs, olo, ohi, bodies = geo
+    radii, _, moving, _, _, kinds, Rs, cs, hs, olo, ohi, bodies, touch = geo
     lo, hi, blo, bhi, w, nv = boxes
     order, start, _, _ = bodies
     for b in range(start.shape[0] - 1):
@@ -403,7 +408,7 @@ def _scene_min(seg, geo, boxes, best):
                 continue
             for k in range(start[b], start[b + 1]):
                 li = order[k]
-                if not moving[li]:
+                if not moving[li] or touch[li, oi]:
                     continue
                 g = box_gap(lo, hi, li, olo, ohi, oi)
                 if g > 0.0 and g >= best:
@@ -422,7 +427,7 @@ def _pair_min(seg, geo, boxes, u, v, best):
     lowered by every checked capsule pair's distance; a capsule of u whose box is at least
     ``best`` from v's box meets none of v's (boxes: the capsules' and the bodies' boxes with
     the radii between links)."""
-    _, radii_self, _, allowed, _, _, _, _, _, _, _, bodies = geo
+    _, radii_self, _, allowed, _, _, _, _, _, _, _, bodies, _ = geo
     lo, hi, blo, bhi = boxes
     order, start, _, _ = bodies
     for x in range(start[u], start[u + 1]):
@@ -463,7 +468,7 @@ def min_clearance_kernel(segs, geo, include_self):
     so that the far ones are skipped whole), and a capsule's box against the other body's,
     so a pair of mesh links of 128 capsules each costs a few box gaps when apart, not
     128 x 128. ``geo``: :class:`PairGeometry`."""
-    radii, radii_self, moving, allowed, tree, kinds, Rs, cs, hs, olo, ohi, bodies = geo
+    radii, radii_self, moving, allowed, tree, kinds, Rs, cs, hs, olo, ohi, bodies, _ = geo
     L = segs.shape[1]
     order, start, bpairs, checked = bodies
     nb = start.shape[0] - 1

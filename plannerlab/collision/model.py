@@ -29,7 +29,13 @@ obstacles. Its fields are named; no consumer indexes packed arrays by position.
   side by side test a few group pairs, not every cluster pair.
 * **The scene** (``obs_*``): kind (``geometry.BOX``, ``CYLINDER``, ``SPHERE``), rotation
   (9,), centre, half sizes (a box), radius and half length (a cylinder), radius (a
-  sphere).
+  sphere). **Declared contacts** (an obstacle's ``touch_links``,
+  :func:`~plannerlab.problem.scene.touch_mask`): ``obs_touch[o]`` is -1 for an obstacle
+  every capsule is tested against, else a row of ``touch_caps`` (R, L) whose True
+  capsules (packed order) are never tested against it. Per capsule, not per body: a
+  hand's fingers share its rigid body, and any number of bodies (Arm-Z's hundred) fits.
+  With no contacts declared every road runs the same arithmetic as before (one branch
+  per obstacle or capsule on ``obs_touch``).
 * **Motion bounds**: ``lower``, ``upper``, ``continuous``; ``edge_weights`` (per joint,
   how far [m] the robot's points move per radian or metre, divided by the margin: the
   grid of the checker's ``densify``); ``link_rates`` (dof, L): per joint and packed
@@ -119,6 +125,8 @@ class CompiledModel(NamedTuple):
     obs_h: np.ndarray  # (n, 3)
     obs32: np.ndarray  # (n, 24) float32: centre (0:3), half sizes (3:6), rotation (6:15),
     #   the world box around it: half extents (16:19), padded beyond float32's rounding
+    obs_touch: np.ndarray  # (n,) int64: -1, or the row of touch_caps of its declared contacts
+    touch_caps: np.ndarray  # (R, L) bool: capsules (packed order) never tested against it
     caps32: np.ndarray  # (L, 8) float32: end a (0:3), end b (3:6), r_scene, r_self
     gates32: np.ndarray  # (m + 1, 8) float32: centre (0:3), r_scene, r_self
     cls32: np.ndarray  # (K, 8) float32: centre (0:3), r_scene, r_self
@@ -229,6 +237,25 @@ class ChainGeometry(NamedTuple):
     Rs: np.ndarray  # (n, 3, 3)
     cs: np.ndarray  # (n, 3)
     hs: np.ndarray  # (n, 3)
+    #: (L, n) bool, the robot's capsule order: pairs never tested (declared contacts,
+    #: :func:`~plannerlab.problem.scene.touch_mask`); None: none
+    touch: np.ndarray | None = None
+
+
+def _touch_rows(touch: Any, perm: np.ndarray, n: int) -> tuple[np.ndarray, np.ndarray]:
+    """(obs_touch, touch_caps) of the model (see the module) from an (L, n) mask in the
+    robot's capsule order (None: no declared contacts)."""
+    L = len(perm)
+    obs_touch = np.full(n, -1, dtype=np.int64)
+    rows: list[np.ndarray] = []
+    if touch is not None:
+        t = np.asarray(touch, dtype=bool).reshape(L, n)
+        for o in range(n):
+            if t[:, o].any():
+                obs_touch[o] = len(rows)
+                rows.append(t[perm, o])
+    caps = np.array(rows, dtype=np.bool_).reshape(len(rows), L)
+    return _f(obs_touch, np.int64), _f(caps, np.bool_)
 
 
 def _coupling(coupling: np.ndarray | None, m: int) -> tuple[list[int], list[int], list[float]]:
@@ -509,6 +536,7 @@ def build_model(
     T0 = np.asarray(robot.T_world_base, dtype=float)[:3].reshape(12)
     lower, upper = _f(robot.lower), _f(robot.upper)
     eps = _float32_bound(T0, pre_f, ca, cb, cs, hs, kinds, lower, upper, robot.continuous)
+    obs_touch, touch_caps = _touch_rows(geo.touch, perm, n)
     return CompiledModel(
         parent=_f(parent, np.int64),
         slide=_f(prismatic, np.bool_),
@@ -572,6 +600,8 @@ def build_model(
             ),
             np.float32,
         ),
+        obs_touch=obs_touch,
+        touch_caps=touch_caps,
         caps32=_f(np.column_stack([ca, cb, rad, rads]).reshape(L, 8), np.float32),
         gates32=_f(np.column_stack([gate_c, gate_r, gate_rs, np.zeros((nb, 3))]), np.float32),
         cls32=_f(

@@ -149,10 +149,23 @@ def _box_clear(BB, k, O, o):
     return False
 
 
+@njit(cache=True, nogil=True, inline="always")
+def _touch_bits(m, row, b, k0):
+    """The bits of the eight slots of body b from its capsule k0 whose capsules are
+    declared contacts of the obstacle of ``touch_caps`` row ``row`` (never tested)."""
+    bits = 0
+    l0 = m.body_caps[b] + k0
+    for j in range(min(W, m.body_caps[b + 1] - l0)):
+        if m.touch_caps[row, l0 + j]:
+            bits |= 1 << j
+    return bits
+
+
 @inline_kernel
 def _scene(m, Z, T):
-    """Every moving capsule against every obstacle, behind the bodies' block boxes and
-    gates: :data:`CLEAR`, :data:`UNSURE` or :data:`HIT` (returned at the first)."""
+    """Every moving capsule against every obstacle (but its declared contacts: the
+    model's ``touch_caps``), behind the bodies' block boxes and gates: :data:`CLEAR`,
+    :data:`UNSURE` or :data:`HIT` (returned at the first)."""
     O, kinds = m.obs32, m.obs_kind
     eps = splat(m.eps32_m)
     zero = splat(0.0)
@@ -161,6 +174,7 @@ def _scene(m, Z, T):
     out = CLEAR
     for o in range(kinds.shape[0]):
         kind = kinds[o]
+        touch = m.obs_touch[o]  # -1, or the row of its declared contacts
         for k in range(T.bgated.shape[0]):
             live = T.bgated[k]
             if live == 0 or _box_clear(T.BB, k, O, o):
@@ -181,6 +195,8 @@ def _scene(m, Z, T):
                 _place_body(Z.e_F, b, T)
                 for s in range(T.slot0[b], T.slot0[b + 1], W):
                     move = T.bmove[s // W]
+                    if touch >= 0:
+                        move &= ~_touch_bits(m, touch, b, s - T.slot0[b])
                     if move == 0:
                         continue
                     r0 = load(T.RS, s)

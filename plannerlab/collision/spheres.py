@@ -301,7 +301,9 @@ def tip_jacobians(Bf, ch, p, n, dof):
 @njit(cache=True, nogil=True)
 def pairs(P, r, scene_idx, self_ab, scene, far_m, cull):
     """Every sphere pair, in ``ClearanceField._pairs``' order: distance d (m,), direction
-    n (m, 3). ``scene``: the obstacles (kinds, Rs, cs, pars, bound). A pair at least
+    n (m, 3). ``scene``: the obstacles (kinds, Rs, cs, pars, bound, touch: (n, s) bool,
+    sphere ``scene_idx[ii]``'s link a declared contact of obstacle o: the pair is never
+    measured and gets d = ``far_m``, as a far one). A pair at least
     ``far_m`` apart gets d = ``far_m`` and no direction (the descent asks nothing of it:
     only pairs closer than the margin cost, and only pairs closer than the clearance
     floor are held); an obstacle's pairs are skipped by its bounding sphere (radius
@@ -312,7 +314,7 @@ def pairs(P, r, scene_idx, self_ab, scene, far_m, cull):
     ``self_ab`` = (self_a, self_b), ``cull`` = (lp_of_row, lp_links, ends)."""
     self_a, self_b = self_ab
     lp_of_row, lp_links, ends = cull
-    kinds, Rs, cs, pars, bound = scene
+    kinds, Rs, cs, pars, bound, touch = scene
     n_scene = scene_idx.shape[0]
     n_obs = kinds.shape[0]
     m = n_obs * n_scene + self_a.shape[0]
@@ -327,6 +329,10 @@ def pairs(P, r, scene_idx, self_ab, scene, far_m, cull):
         kind = kinds[o]
         for ii in range(n_scene):
             s = scene_idx[ii]
+            if touch[o, ii]:  # a declared contact: never measured
+                d[row] = far_m
+                row += 1
+                continue
             dx = P[s, 0] - c[0]
             dy = P[s, 1] - c[1]
             dz = P[s, 2] - c[2]

@@ -287,7 +287,8 @@ def _stop(hit, mode):
 
 @inline_kernel
 def _scene_pass(m, Z, mode, hu):
-    """Every moving capsule against every obstacle, behind three gates: a box around a
+    """Every moving capsule against every obstacle (but its declared contacts: the model's
+    ``obs_touch``, ``touch_caps``), behind three gates: a box around a
     group of ``GROUP`` consecutive bodies of ``body_order`` (built per call from the
     kinematics), its bodies' gates, and their clusters' gates. The lane masks ``hu``
     (see :func:`_grade_d2`) updated, and whether the mode's stop came."""
@@ -306,6 +307,7 @@ def _scene_pass(m, Z, mode, hu):
             if not _box_meets(O, o, B, _ALL & ~hu[0]):
                 continue
             kind = kinds[o]
+            touch = m.obs_touch[o]  # -1, or the row of its declared contacts
             for kb in range(k0, k1):
                 b = m.body_order[kb]
                 if gates[b, 3] < 0.0:
@@ -328,6 +330,8 @@ def _scene_pass(m, Z, mode, hu):
                     for l in range(m.cl_caps[c], m.cl_caps[c + 1]):
                         if not m.cap_moving[l]:
                             continue
+                        if touch >= 0 and m.touch_caps[touch, l]:
+                            continue  # a declared contact: never tested
                         r0 = splat(caps[l, 6])
                         r = fma(grow, splat(Z.rate[l]), r0)
                         if m.cap_sphere[l]:

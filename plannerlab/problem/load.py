@@ -13,7 +13,7 @@ File layout (every key is documented in ``docs/problem-format.md``)::
                 parameters
     [start]     q | q_deg | fill | fill_deg
     [[obstacles]] name, type = "box" | "cylinder" | "sphere", center_m, rpy_deg,
-                  size_m | radius_m, length_m
+                  size_m | radius_m, length_m, touch_links
     [[goals]]   name, p_m, n, pos_tol_m, angle_tol_deg     (one per leg, in order), or
                 name, q | q_deg, joint_tol_rad              (a goal state)
     [budget]    max_iterations, max_collision_checks, time_limit_s
@@ -148,7 +148,7 @@ def problem_from_dict(data: Mapping[str, Any], source: str) -> Problem:
     description = meta.string("description", "")
     robot = build_robot(TableReader(source, "robot", top.raw("robot")))
     q_start = read_start(TableReader(source, "start", top.raw("start")), robot)
-    scene = read_scene(top)
+    scene = read_scene(top, robot)
     goals = read_goals(top, robot)
     budget = read_budget(top)
     joint_step = read_joint_step(top)

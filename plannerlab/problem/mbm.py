@@ -7,7 +7,12 @@ given as joint constraints). :func:`problem_toml` turns one pair into the text o
 problem file for a ``type = "urdf"`` robot: the URDF (and SRDF) named by paths relative
 to the written file, the start state, every primitive as an obstacle, the allowed pairs of
 the scene's matrix as ``allowed_collisions``, and the joint goal as a goal state
-(``[[goals]] q``, ``joint_tol_rad`` from the constraints' tolerances).
+(``[[goals]] q``, ``joint_tol_rad`` from the constraints' tolerances). A grasp goal's
+object is a declared contact: an obstacle that the end effector's links (the hand and
+fingers: :func:`end_effector_links`) touch at the goal state, measured on the robot's
+collision model at import (:func:`grasp_contacts`), gets the end effector's links as its
+``touch_links``, with a comment saying which touched it (MoveIt's attached object and its
+touch links).
 
 MoveIt conventions read here: a box's ``dimensions`` are its full edge lengths (x, y, z), a
 cylinder's ``[height, radius]`` along its local z, a sphere's ``[radius]``; orientations are
@@ -396,6 +401,48 @@ def request_states(
 
 
 # ---------------------------------------------------------------------- writing
+def end_effector_links(robot: Any) -> list[str]:
+    """The URDF links of a URDF chain's end effector: those with collision geometry on the
+    last body (moved by the last arm joint) but that joint's own child link (the flange):
+    the hand and its fingers (frozen joints ride on the body)."""
+    last = int(robot.dof)
+    flange = robot._body_links[-1]
+    body = np.asarray(robot._cap_body)
+    names = robot.link_urdf_names
+    return sorted({names[i] for i in np.flatnonzero(body == last)} - {flange})
+
+
+def grasp_contacts(
+    robot: Any, obstacles: Sequence[MbmObstacle], q_goal: Array, margin_m: float
+) -> dict[str, list[str]]:
+    """Per obstacle that the end effector's links (:func:`end_effector_links`) touch at the
+    goal state, measured on the robot's collision model with the file's margin: the links
+    in contact (the grasped object, MoveIt's attached object whose ``touch_links`` are the
+    end effector's)."""
+    from plannerlab.collision.fcl_checker import CollisionChecker
+    from plannerlab.problem.scene import Box, Cylinder, Scene, Sphere
+
+    prims: list[Any] = []
+    for o in obstacles:
+        if o.type == "box":
+            prims.append(Box(o.name, o.T_world, np.asarray(o.size_m, dtype=float)))
+        elif o.type == "cylinder":
+            prims.append(Cylinder(o.name, o.T_world, float(o.size_m[0]), float(o.size_m[1])))
+        else:
+            prims.append(Sphere(o.name, o.T_world, float(o.size_m[0])))
+    ee = set(end_effector_links(robot))
+    if not ee or not prims:
+        return {}
+    checker = CollisionChecker(robot, Scene(tuple(prims)), "fcl", margin_m=float(margin_m))
+    urdf_of = dict(zip(robot.link_names, robot.link_urdf_names, strict=True))
+    names = set(o.name for o in obstacles)
+    out: dict[str, set[str]] = {}
+    for a, b in checker.colliding_pairs(np.asarray(q_goal, dtype=float)):
+        if b in names and urdf_of.get(a) in ee:
+            out.setdefault(b, set()).add(urdf_of[a])
+    return {k: sorted(v) for k, v in out.items()}
+
+
 def _f(x: float) -> str:
     return repr(float(x))
 
@@ -453,6 +500,9 @@ def problem_toml(
                 f"(at most {np.max(np.abs(clipped - q)):.1e} beyond)"
             )
             q[:] = clipped
+    # grasp goals: the objects the hand touches at the goal are declared contacts
+    touched = grasp_contacts(robot, obstacles, q_goal, safety_margin_m)
+    ee = end_effector_links(robot)
     out_dir = Path(out_path).parent
     stem = name or Path(out_path).stem
     lines = [
@@ -492,6 +542,12 @@ def problem_toml(
             lines += [f"radius_m = {_f(o.size_m[0])}", f"length_m = {_f(o.size_m[1])}"]
         else:
             lines.append(f"radius_m = {_f(o.size_m[0])}")
+        if o.name in touched:
+            lines += [
+                f"# grasped at the goal: {', '.join(touched[o.name])} touch it (measured on the",
+                "# robot's collision model at import); the end effector's links may touch it",
+                "touch_links = [" + ", ".join(json.dumps(n) for n in ee) + "]",
+            ]
         lines.append("")
     lines += [
         "[[goals]]",
@@ -515,8 +571,10 @@ __all__ = [
     "VampRobot",
     "allowed_pairs",
     "default_cache",
+    "end_effector_links",
     "fetch_vamp",
     "fetch_vamp_panda",
+    "grasp_contacts",
     "mbm_robot",
     "problem_pairs",
     "problem_toml",

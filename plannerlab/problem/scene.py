@@ -11,11 +11,18 @@ PyBullet use them), and :attr:`Scene.obstacles` holds its conservative cover of 
 (:func:`~plannerlab.robots.urdf.meshes.box_cover`: filled voxels merged into boxes, each
 named ``<mesh>#k`` with ``cover_of = <mesh>``), which every planner and the compiled core
 check exactly, so they see at least the mesh.
+
+**Declared contacts** (``touch_links``, MoveIt's name): an obstacle may name robot links
+allowed to touch it (a grasped object and the hand's links). Every collision road skips
+the pairs (a capsule of such a link, that obstacle): :func:`touch_mask` gives them per
+capsule; other links still collide with the obstacle, and those links with the other
+obstacles. A mesh obstacle's cover boxes carry its ``touch_links``.
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 
@@ -37,6 +44,8 @@ class Box:
     size_m: Array
     #: the mesh obstacle this box is a piece of the cover of ("" for a box of its own)
     cover_of: str = ""
+    #: robot links allowed to touch it (declared contacts, see the module)
+    touch_links: tuple[str, ...] = ()
     kind: str = field(default="box", init=False)
 
     def __post_init__(self) -> None:
@@ -57,6 +66,8 @@ class Cylinder:
     T_world_obstacle: Array
     radius_m: float
     length_m: float
+    #: robot links allowed to touch it (declared contacts, see the module)
+    touch_links: tuple[str, ...] = ()
     kind: str = field(default="cylinder", init=False)
 
     def __post_init__(self) -> None:
@@ -75,6 +86,8 @@ class Sphere:
     name: str
     T_world_obstacle: Array
     radius_m: float
+    #: robot links allowed to touch it (declared contacts, see the module)
+    touch_links: tuple[str, ...] = ()
     kind: str = field(default="sphere", init=False)
 
     def __post_init__(self) -> None:
@@ -99,6 +112,8 @@ class Mesh:
     cover_centres_m: Array
     cover_half_m: Array
     cover_excess_m: float
+    #: robot links allowed to touch it (declared contacts, see the module)
+    touch_links: tuple[str, ...] = ()
     kind: str = field(default="mesh", init=False)
 
     def __post_init__(self) -> None:
@@ -125,7 +140,15 @@ class Mesh:
         for k, (c, h) in enumerate(zip(self.cover_centres_m, self.cover_half_m, strict=True)):
             Tk = T.copy()
             Tk[:3, 3] = T[:3, :3] @ c + T[:3, 3]
-            out.append(Box(f"{self.name}#{k}", Tk, 2.0 * h, cover_of=self.name))
+            out.append(
+                Box(
+                    f"{self.name}#{k}",
+                    Tk,
+                    2.0 * h,
+                    cover_of=self.name,
+                    touch_links=self.touch_links,
+                )
+            )
         return tuple(out)
 
 
@@ -170,3 +193,28 @@ class Scene:
         c = np.array([o.T_world_obstacle[:3, 3] for o in self.obstacles])
         h = np.array([o.half_extents_world() for o in self.obstacles])
         return c - h, c + h
+
+
+def capsule_links(robot: Any) -> tuple[str, ...]:
+    """Per capsule of the robot, the name of the robot link it belongs to: a URDF robot's
+    URDF link (``link_urdf_names``: a mesh link has many capsules), else the capsule's own
+    name (``link_names``). The names ``touch_links`` may use."""
+    return tuple(getattr(robot, "link_urdf_names", None) or robot.link_names)
+
+
+def touch_mask(robot: Any, scene: Scene) -> np.ndarray:
+    """(L, n) bool: capsule ``l`` of the robot may touch obstacle ``o`` of
+    ``scene.obstacles`` (its link is among the obstacle's ``touch_links``): the pairs
+    every collision road skips. All False when no obstacle declares contacts."""
+    links = capsule_links(robot)
+    if len(links) != len(robot.link_radii_m):
+        raise ValueError(
+            f"robot {getattr(robot, 'kind', '?')!r} names {len(links)} links for "
+            f"{len(robot.link_radii_m)} capsules: its declared contacts cannot be placed"
+        )
+    out = np.zeros((len(links), len(scene.obstacles)), dtype=bool)
+    for o, ob in enumerate(scene.obstacles):
+        if ob.touch_links:
+            allowed = set(ob.touch_links)
+            out[:, o] = [n in allowed for n in links]
+    return out

@@ -5,24 +5,54 @@ mesh itself among its meshes)."""
 from __future__ import annotations
 
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
-from plannerlab.errors import ProblemError
+from plannerlab.errors import ProblemError, did_you_mean
 from plannerlab.problem.reader import TableReader
-from plannerlab.problem.scene import OBSTACLE_TYPES, Box, Cylinder, Mesh, Obstacle, Scene, Sphere
+from plannerlab.problem.scene import (
+    OBSTACLE_TYPES,
+    Box,
+    Cylinder,
+    Mesh,
+    Obstacle,
+    Scene,
+    Sphere,
+    capsule_links,
+)
 
 #: the most boxes a mesh obstacle's cover may have (default of ``max_boxes``)
 MESH_MAX_BOXES: int = 64
 
 
-def _mesh(reader: TableReader, name: str, T: np.ndarray) -> Mesh:
+def _touch_links(reader: TableReader, robot: Any) -> tuple[str, ...]:
+    """``touch_links``: names of the robot's links with collision geometry allowed to
+    touch this obstacle (declared contacts; default none)."""
+    raw = reader.raw("touch_links", [])
+    if not isinstance(raw, list) or not all(isinstance(n, str) for n in raw):
+        raise reader.fail("touch_links", f"an array of robot link names (strings), got {raw!r}")
+    if robot is None:
+        return tuple(dict.fromkeys(raw))
+    known = sorted(set(capsule_links(robot)))
+    for n in raw:
+        if n not in known:
+            shown = ", ".join(known) if len(known) <= 40 else ", ".join(known[:40]) + ", ..."
+            raise reader.fail(
+                "touch_links",
+                f"names of the robot's links with collision geometry; {n!r} is not one;"
+                f"{did_you_mean(n, known)} the robot's links: {shown}",
+            )
+    return tuple(dict.fromkeys(raw))
+
+
+def _mesh(reader: TableReader, name: str, T: np.ndarray, touch: tuple[str, ...]) -> Mesh:
     """A ``type = "mesh"`` obstacle: its file (relative to the problem file) read, scaled
     and covered by boxes."""
     from plannerlab.robots.urdf.meshes import MeshError, box_cover, load_mesh
 
     reader.unknown_keys(
-        ("name", "type", "center_m", "rpy_deg", "file", "scale", "max_boxes", "note")
+        ("name", "type", "center_m", "rpy_deg", "file", "scale", "max_boxes", "touch_links", "note")
     )
     file = reader.string("file")
     folder = Path(reader.source).parent if reader.source != "<memory>" else Path.cwd()
@@ -48,43 +78,50 @@ def _mesh(reader: TableReader, name: str, T: np.ndarray) -> Mesh:
         cover = box_cover(V, F, max_boxes, where, str(path))
     except MeshError as exc:
         raise reader.fail("file", f"a mesh plannerlab can read and cover; {exc}") from None
-    return Mesh(name, T, str(path), scale, V, F, cover.centres_m, cover.half_m, cover.max_excess_m)
+    return Mesh(
+        name, T, str(path), scale, V, F, cover.centres_m, cover.half_m, cover.max_excess_m, touch
+    )
 
 
-def _obstacle(reader: TableReader) -> Obstacle | Mesh:
+def _obstacle(reader: TableReader, robot: Any) -> Obstacle | Mesh:
     name = reader.string("name")
     kind = reader.string("type")
     if kind not in OBSTACLE_TYPES:
         raise reader.fail("type", f"one of {', '.join(OBSTACLE_TYPES)}, got {kind!r}")
     T = reader.pose("center_m", "rpy_deg")
+    touch = _touch_links(reader, robot)
+    common = ("name", "type", "center_m", "rpy_deg", "touch_links", "note")
     if kind == "mesh":
-        return _mesh(reader, name, T)
+        return _mesh(reader, name, T, touch)
     if kind == "box":
-        reader.unknown_keys(("name", "type", "center_m", "rpy_deg", "size_m", "note"))
+        reader.unknown_keys((*common, "size_m"))
         size = reader.vector("size_m", 3)
         if np.any(size <= 0):
             raise reader.fail("size_m", f"three positive edge lengths, got {size.tolist()}")
-        return Box(name, T, size)
+        return Box(name, T, size, touch_links=touch)
     if kind == "cylinder":
-        reader.unknown_keys(("name", "type", "center_m", "rpy_deg", "radius_m", "length_m", "note"))
+        reader.unknown_keys((*common, "radius_m", "length_m"))
         return Cylinder(
             name,
             T,
             reader.number("radius_m", positive=True),
             reader.number("length_m", positive=True),
+            touch_links=touch,
         )
-    reader.unknown_keys(("name", "type", "center_m", "rpy_deg", "radius_m", "note"))
-    return Sphere(name, T, reader.number("radius_m", positive=True))
+    reader.unknown_keys((*common, "radius_m"))
+    return Sphere(name, T, reader.number("radius_m", positive=True), touch_links=touch)
 
 
-def read_scene(top: TableReader) -> Scene:
-    """The problem's obstacles (``[[obstacles]]``, none when absent), each name unique."""
+def read_scene(top: TableReader, robot: Any = None) -> Scene:
+    """The problem's obstacles (``[[obstacles]]``, none when absent), each name unique;
+    ``touch_links`` checked against the robot's links when it is given."""
     source = top.source
     raw_obstacles = top.raw("obstacles", [])
     if not isinstance(raw_obstacles, list):
         raise top.fail("obstacles", "an array of tables [[obstacles]]")
     obstacles = [
-        _obstacle(TableReader(source, f"obstacles[{i}]", o)) for i, o in enumerate(raw_obstacles)
+        _obstacle(TableReader(source, f"obstacles[{i}]", o), robot)
+        for i, o in enumerate(raw_obstacles)
     ]
     names = [o.name for o in obstacles]
     for i, n in enumerate(names):

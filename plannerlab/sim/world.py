@@ -23,7 +23,9 @@ Decisions:
 * **Self-collision** is reported (``URDF_USE_SELF_COLLISION``) but switched off, in the
   physics and in :meth:`SimWorld.contacts`, for the robot's ``excluded_pairs`` (modules
   that always overlap) and for its fixed links against the scene (the base stands on its
-  pedestal), the same pairs :mod:`plannerlab.collision.fcl_checker` never checks.
+  pedestal), the same pairs :mod:`plannerlab.collision.fcl_checker` never checks; so are
+  an obstacle's declared contacts (its ``touch_links``: a grasped object and the hand's
+  links, ``setCollisionFilterPair``), in the physics, the contacts and the distances.
   ``..._EXCLUDE_ALL_PARENTS`` is not used: in a serial chain every pair of links is
   ancestor and descendant, so it would switch all self-collision off.
 * **Link names**: PyBullet link indices are mapped to the robot's links by name (the child
@@ -308,12 +310,21 @@ class SimWorld:
         shapes: list[Obstacle | Mesh] = [
             o for o in self.scene.obstacles if not getattr(o, "cover_of", "")
         ]
+        #: per obstacle body, the PyBullet links of its declared contacts (its
+        #: ``touch_links``): no contact is made or counted between them, and no
+        #: distance measured (the pairs the collision checker never checks)
+        self._touch_links: dict[int, frozenset[int]] = {}
         for o in [*shapes, *self.scene.meshes]:
             uid = self._make_obstacle(o)
             self.obstacle_names[uid] = o.name
             for i in robot.fixed_links:
                 a = self._pb_of_robot_link.get(i)
                 if a is not None:
+                    c.setCollisionFilterPair(self.body, uid, a, -1, 0)
+            touch = frozenset(self._pb_link[n] for n in o.touch_links if n in self._pb_link)
+            if touch:
+                self._touch_links[uid] = touch
+                for a in touch:
                     c.setCollisionFilterPair(self.body, uid, a, -1, 0)
 
     def _make_obstacle(self, o: Obstacle | Mesh) -> int:
@@ -574,8 +585,9 @@ class SimWorld:
     ) -> tuple[Array, list[str], Array]:
         """Closest distances of the robot's current state, from PyBullet's closest points
         (``getClosestPoints``) up to ``max_distance_m``: every robot link not in
-        ``robot.fixed_links`` against every obstacle, and every pair of robot links not
-        in ``robot.excluded_pairs`` (the pairs the collision checker checks).
+        ``robot.fixed_links`` against every obstacle (but an obstacle's declared contacts,
+        its ``touch_links``), and every pair of robot links not in
+        ``robot.excluded_pairs`` (the pairs the collision checker checks).
 
         Args:
             max_distance_m: pairs farther than this are not read [m].
@@ -610,9 +622,10 @@ class SimWorld:
         scene = np.where(fixed[first], np.inf, dmax)
         names = [""] * G
         for uid, name in self.obstacle_names.items():
+            touch = self._touch_links.get(uid, frozenset())
             for pt in c.getClosestPoints(self.body, uid, dmax):
                 i = self._robot_link.get(pt[3])
-                if i is None or fixed[i]:
+                if i is None or fixed[i] or pt[3] in touch:
                     continue
                 g, d = int(group[i]), float(pt[8])
                 if d < scene[g]:
@@ -640,7 +653,8 @@ class SimWorld:
 
         Returns:
             one :class:`Contact` per point; self-contacts once, with the lower-indexed
-            robot link as ``link_name``. Excluded pairs never appear.
+            robot link as ``link_name``. Excluded pairs and an obstacle's declared contacts
+            (its ``touch_links``) never appear.
         """
         out: list[Contact] = []
         excluded = self._excluded_pairs
@@ -665,7 +679,7 @@ class SimWorld:
                         p_on_robot = pt[6] if p_on_robot is pt[5] else pt[5]
                 out.append(Contact(name, other, True, depth, as_xyz(p_on_robot)))
             else:
-                if i is not None and i in fixed:
+                if (i is not None and i in fixed) or la in self._touch_links.get(b, ()):
                     continue
                 other = self.obstacle_names.get(b, f"body_{b}")
                 out.append(Contact(name, other, False, depth, as_xyz(p_on_robot)))

@@ -53,6 +53,18 @@ PROBLEM_CASES = {
         "simulaton",
     ),
     "unknown_table": (TINY_PROBLEM_TOML + "\n[extra_stuff]\na = 1\n", "extra_stuff"),
+    "touch_links_not_a_link": (
+        tiny_problem_text(
+            "size_m = [0.4, 4.0, 4.0]", 'size_m = [0.4, 4.0, 4.0]\ntouch_links = ["module_9"]'
+        ),
+        "obstacles[0].touch_links",
+    ),
+    "touch_links_not_names": (
+        tiny_problem_text(
+            "size_m = [0.4, 4.0, 4.0]", 'size_m = [0.4, 4.0, 4.0]\ntouch_links = "module_5"'
+        ),
+        "obstacles[0].touch_links",
+    ),
     "unknown_problem_key": (
         tiny_problem_text('name = "tiny"', 'name = "tiny"\ntitel = "x"'),
         "titel",
@@ -218,6 +230,22 @@ def test_bad_problem_file(capsys, tmp_path, case):
     path = write_problem(tmp_path, text)
     code, _, err = run(capsys, "solve", str(path), "--planner", "gradient")
     assert_clean_error(code, err, str(path), key)
+
+
+def test_a_touch_link_that_is_no_link_is_named_with_the_links_it_could_be(capsys, tmp_path):
+    path = write_problem(tmp_path, PROBLEM_CASES["touch_links_not_a_link"][0])
+    code, _, err = run(capsys, "solve", str(path), "--planner", "gradient")
+    # the tiny Arm-Z has modules 0 to 5: the message says which name is wrong and lists them
+    assert_clean_error(code, err, "'module_9' is not one", "module_0, module_1", "module_5")
+
+
+def test_touch_links_naming_the_robots_links_load(tmp_path):
+    text = tiny_problem_text(
+        "size_m = [0.4, 4.0, 4.0]",
+        'size_m = [0.4, 4.0, 4.0]\ntouch_links = ["module_5", "module_4"]',
+    )
+    problem = parse_problem(write_problem(tmp_path, text))
+    assert problem.scene.obstacles[0].touch_links == ("module_5", "module_4")
 
 
 def test_misspelled_table_suggests_the_right_one(capsys, tmp_path):

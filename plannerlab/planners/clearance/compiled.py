@@ -47,7 +47,7 @@ from plannerlab.collision.spheres import (
     tip_pose,
 )
 from plannerlab.planners.clearance.field import ClearanceField
-from plannerlab.problem.scene import Box, Cylinder, Sphere
+from plannerlab.problem.scene import Box, Cylinder, Sphere, touch_mask
 from plannerlab.robots.base import Array
 
 
@@ -64,7 +64,7 @@ class SphereField(NamedTuple):
     scene_idx: np.ndarray
     self_a: np.ndarray
     self_b: np.ndarray
-    scene: tuple  # (kinds, Rs, cs, pars, bound)
+    scene: tuple  # (kinds, Rs, cs, pars, bound, touch: (n, s) declared contacts)
     A: np.ndarray
     B: np.ndarray
     lp_of_row: np.ndarray
@@ -519,6 +519,11 @@ class CompiledField:
                 bound[i] = pars[i, 0]
             else:  # pragma: no cover - scene types are closed
                 raise TypeError(f"unknown obstacle {o!r}")
+        # the declared contacts (an obstacle's touch_links) per obstacle and scene sphere
+        touch = np.ascontiguousarray(
+            touch_mask(robot, field.scene)[link[scene_idx]].T.reshape(k, len(scene_idx)),
+            dtype=np.bool_,
+        )
         A, B, lp_of_row, lp_links, ends = pair_spheres(scene_idx, k, self_a, self_b, link)
         self.influence_m = float(field.influence_m)
         # fresh (writeable, contiguous) arrays everywhere: numba compiles one version
@@ -530,7 +535,7 @@ class CompiledField:
             scene_idx=scene_idx,
             self_a=self_a,
             self_b=self_b,
-            scene=(kinds, Rs, cs, pars, bound),
+            scene=(kinds, Rs, cs, pars, bound, touch),
             A=A,
             B=B,
             lp_of_row=lp_of_row,

@@ -35,7 +35,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from plannerlab.errors import PlannerlabError
-from plannerlab.problem.scene import Box, Cylinder, Scene, Sphere
+from plannerlab.problem.scene import Box, Cylinder, Scene, Sphere, touch_mask
 from plannerlab.robots.base import Array, Robot
 
 #: the most spheres a field holds (its self pairs grow as the square: 5e5 at most, some
@@ -210,6 +210,8 @@ class ClearanceField:
             self._self_a, self._self_b = a.astype(int), b.astype(int)
         self._n_links = L
         self._analytic = getattr(robot, "kind", "") == "armz"
+        #: (L, n) the declared contacts (an obstacle's touch_links): never measured
+        self._touch = touch_mask(robot, scene)
 
     # ------------------------------------------------------------------ geometry
     def _centres_and_jacobians(self, q: Array) -> tuple[Array, Array]:
@@ -247,7 +249,7 @@ class ClearanceField:
         ds, ns, sa, sb = [], [], [], []
         idx = self._scene_spheres
         ps = p[idx]
-        for o in self.scene.obstacles:
+        for k, o in enumerate(self.scene.obstacles):
             T = o.T_world_obstacle
             R, c = T[:3, :3], T[:3, 3]
             if isinstance(o, Box):
@@ -261,7 +263,8 @@ class ClearanceField:
                 n = diff / np.where(nd > 1e-12, nd, 1.0)[:, None]
             else:  # pragma: no cover - scene types are closed
                 raise TypeError(f"unknown obstacle {o!r}")
-            ds.append(d - self._r[idx])
+            # a declared contact (its link among the obstacle's touch_links): no pair
+            ds.append(np.where(self._touch[self._link[idx], k], np.inf, d - self._r[idx]))
             ns.append(n)
             sa.append(idx)
             sb.append(np.full(len(idx), -1))
