@@ -244,7 +244,7 @@ class Core:
 
     # ------------------------------------------------------------------ geometry
     def _Q(self, Q: Array) -> np.ndarray:
-        Q = np.ascontiguousarray(np.atleast_2d(np.asarray(Q, dtype=float)))
+        Q = queries.kernel_states(np.atleast_2d(np.asarray(Q, dtype=float)))
         if Q.shape[1] != self.robot.dof:
             raise ValueError(f"q must have {self.robot.dof} joints, got shape {Q.shape}")
         return Q
@@ -252,7 +252,7 @@ class Core:
     def _q(self, q: Array) -> np.ndarray:
         """One state as a contiguous float64 (dof,) (no copy when it is one already)."""
         if type(q) is np.ndarray and q.shape == self._one and q.dtype is _F64:
-            return q if q.flags.c_contiguous else np.ascontiguousarray(q)
+            return q if q.flags.c_contiguous and q.flags.writeable else queries.kernel_states(q)
         Q = self._Q(q)
         if len(Q) != 1:
             raise ValueError(f"q must be one state ({self.robot.dof},), got shape {np.shape(q)}")

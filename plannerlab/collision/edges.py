@@ -147,14 +147,25 @@ def edge_check(m, Z, qa, qb, joint_step, limit):
     """Check edge qa -> qb on the grid (see the module). Z: the state test's scratch
     (:func:`~plannerlab.collision.state_test.lanes`). Returns ``(status, checks, n)``:
     FREE, INVALID or LIMIT, the lanes tested, the grid's number of states."""
+    return edge_span(m, Z, (qa, qb), joint_step, (1, -1), limit)
+
+
+@kernel
+def edge_span(m, Z, ends, joint_step, span, limit):
+    """Check grid states ``span[0]`` … ``span[1]`` (``span[1] < 0``: to ``n``) of the edge
+    ``ends`` = (qa, qb), certified as :func:`edge_check` checks the whole grid (the same
+    grid: its ``n`` comes from the whole edge, so a span's verdict is the verdict of those
+    grid states, bit for bit). Returns ``(status, checks, n)`` as :func:`edge_check`."""
+    qa, qb = ends
     d, rate, stack, marks = Z.edge_d, Z.edge_rate, Z.edge_stack, Z.edge_marks
     los, mids, his = marks[0], marks[1], marks[2]
     edge_delta(qa, qb, m.continuous, d)
     n = edge_count(d, joint_step, m.edge_weights)
     step_rates(m, d, n, rate)
     set_rates(m, Z, rate)
-    # the first stretches: [1, n] cut into at most W pieces
-    top = _push_pieces(stack, 0, 1, n, W)
+    first, last = max(span[0], 1), (n if span[1] < 0 else min(span[1], n))
+    # the first stretches: [first, last] cut into at most W pieces
+    top = _push_pieces(stack, 0, first, last, W)
     checks = 0
     while top > 0:
         if checks >= limit:
@@ -232,6 +243,7 @@ __all__ = [
     "edge_count",
     "edge_delta",
     "edge_rake",
+    "edge_span",
     "edge_state",
     "step_rates",
 ]

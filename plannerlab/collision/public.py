@@ -30,6 +30,7 @@ import numpy as np
 from plannerlab.collision.fcl_checker import CollisionChecker, problem_checker
 from plannerlab.collision.one_lanes import checker_tables
 from plannerlab.collision.one_state import valid_state
+from plannerlab.collision.queries import kernel_states
 from plannerlab.errors import PlannerlabError
 from plannerlab.robots.base import Array
 
@@ -74,7 +75,7 @@ class Checker:
             )
         if not np.all(np.isfinite(Q)):
             raise PlannerlabError("states must be finite numbers")
-        return np.ascontiguousarray(Q), one
+        return kernel_states(Q), one
 
     def valid(self, q: Array) -> Any:
         """One state (dof,) -> bool; states (n, dof) -> (n,) bool array."""
@@ -82,7 +83,7 @@ class Checker:
         if self._one is not None and a.ndim == 1 and a.shape[0] == self.dof:
             # one state: the one-state road, which also refuses a value that is not finite
             t32, t64i, t64 = self._one[1]
-            ok = valid_state(self._one[0], t32, t64i, t64, np.ascontiguousarray(a))
+            ok = valid_state(self._one[0], t32, t64i, t64, kernel_states(a))
             if ok >= 0:
                 self._checker.checks += 1
                 return bool(ok)

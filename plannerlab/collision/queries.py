@@ -17,6 +17,7 @@ with the named tuples directly.
 
 from __future__ import annotations
 
+import numpy as np
 from numba import njit
 
 from plannerlab.collision._unpacked import unpack_lanes, unpack_model
@@ -46,6 +47,16 @@ def open_packed(P):
 
 
 _open = open_packed
+
+
+def kernel_states(a: np.ndarray) -> np.ndarray:
+    """``a`` as the compiled queries take states: float64, C-contiguous and *writeable*.
+    numba compiles a kernel once per argument type, and a read-only array (a frozen
+    record's path: :class:`~plannerlab.record.leg.LegResult`) is another type: the state
+    test would be compiled again, inside whatever clock is running (seen: a first leg on a
+    fresh cache 10 s over its time limit). A copy costs far less."""
+    a = np.ascontiguousarray(a, dtype=np.float64)
+    return a if a.flags.writeable else a.copy()
 
 
 #: :func:`states`' modes: every state's verdict; the first invalid state's index

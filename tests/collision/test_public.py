@@ -64,3 +64,31 @@ def test_edge_valid_is_the_grids_verdict(window):
         assert check.edge_valid(a, b) == want
         seen.add(want)
     assert seen == {True, False}
+
+
+def test_read_only_states_reuse_the_compiled_queries(window):
+    """A read-only array (a frozen record's path) is another type to numba: without a
+    writeable copy at the boundary, every compiled query would be compiled again for it,
+    inside the clock of whatever leg met it first."""
+    from plannerlab.collision import one_state, queries
+
+    problem, check = window
+    rng = np.random.default_rng(7)
+    Q = rng.uniform(check.lower, check.upper, (20, check.dof))
+    expected = check.valid(Q)
+    one = [check.valid(q) for q in Q]
+    core = problem_core(problem)
+    core_one = [core.is_valid(q) for q in Q]
+    seen = (len(queries.states.signatures), len(one_state.valid_state.signatures))
+    R = Q.copy()
+    R.setflags(write=False)
+    assert np.array_equal(check.valid(R), expected)
+    assert [check.valid(q) for q in R] == one
+    assert [core.is_valid(q) for q in R] == core_one
+    assert core.first_invalid(R) == core.first_invalid(Q)
+    assert (len(queries.states.signatures), len(one_state.valid_state.signatures)) == seen
+
+
+def problem_core(problem):
+    """The compiled core checker of ``problem`` (what the planners call)."""
+    return CollisionChecker(problem.robot, problem.scene, margin_m=problem.safety_margin_m)

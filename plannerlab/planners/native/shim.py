@@ -22,7 +22,17 @@ from typing import Any
 
 from numba import njit
 
-from plannerlab.collision.edges import edge_check, edge_count, edge_delta, edge_state
+from plannerlab.collision.edges import (
+    INVALID,
+    edge_check,
+    edge_count,
+    edge_delta,
+    edge_span,
+    edge_state,
+)
+from plannerlab.collision.edges import (
+    LIMIT as EDGE_LIMIT,
+)
 from plannerlab.collision.one_lanes import checker_tables, open_one
 from plannerlab.collision.one_state import one_valid
 from plannerlab.collision.queries import open_packed
@@ -81,16 +91,29 @@ def edge_valid(ck, q_a, q_b, joint_step, limit, d, q):
 
 
 @njit(cache=True, nogil=True)
-def _block(ck, q_a, dq, span, n, stride, limit):
+def _block(ck, ends, dq, span, grid, limit):
     """Grid states ``min(i · stride, n)`` for i = lo + 1 … hi (``span`` = (lo, hi)) of the
-    edge from q_a (``dq`` = (d, q): its difference d, n states; q the scratch state),
-    coarse to fine: i = hi first, then the midpoints of ever finer halvings. Returns
-    (status, checks)."""
+    edge ``ends`` = (q_a, q_b) (``dq`` = (d, q): its difference d; ``grid`` = (n, stride,
+    joint_step): its n states, the stride, the grid's joint step; q the scratch state).
+    First the far end alone (a blocked block is most often blocked there: one test);
+    then, every state (``stride`` 1), the rest in certified stretches
+    (:func:`~plannerlab.collision.edges.edge_span`: the grid's verdict on those states, in
+    a few tests where space is free); else each ``stride``-th state alone, coarse to fine:
+    the midpoints of ever finer halvings. Returns (status, checks)."""
     d, q = dq
+    q_a = ends[0]
+    n, stride, joint_step = grid
     lo, hi = span
     L = hi - lo
     if limit < 1:
         return LIMIT, 0
+    if stride == 1:
+        status, k, _ = edge_span(ck[0], ck[1], ends, joint_step, (lo + 1, hi), limit)
+        if status == INVALID:
+            return BLOCKED, k
+        if status == EDGE_LIMIT:
+            return LIMIT, k
+        return FREE, k
     edge_state(q_a, d, min(hi * stride, n), n, q)
     if not state_valid(ck, q):
         return BLOCKED, 1
@@ -132,7 +155,7 @@ def edge_reach(ck, q_a, q_b, joint_step, min_fraction, stride, limit, dq):
     n = edge_count(d, joint_step, ck[0].edge_weights)
     nc = (n + stride - 1) // stride  # the states looked at: min(i · stride, n), i = 1 … nc
     m = min(int(min_fraction * n) // stride + 1, nc)  # the first beyond the fraction
-    status, checks = _block(ck, q_a, dq, (0, m), n, stride, limit)
+    status, checks = _block(ck, (q_a, q_b), dq, (0, m), (n, stride, joint_step), limit)
     if status == LIMIT:
         return LIMIT, 0, n, checks
     if status == BLOCKED:
@@ -140,7 +163,7 @@ def edge_reach(ck, q_a, q_b, joint_step, min_fraction, stride, limit, dq):
     lo = m
     while lo < nc:
         hi = min(2 * lo, nc)
-        status, k = _block(ck, q_a, dq, (lo, hi), n, stride, limit - checks)
+        status, k = _block(ck, (q_a, q_b), dq, (lo, hi), (n, stride, joint_step), limit - checks)
         checks += k
         if status == LIMIT:
             return LIMIT, 0, n, checks

@@ -93,6 +93,7 @@ def _warm_kpiece(checker: Any) -> None:
     KP.kpiece_run(shim.bundle(checker), T, C, proj, goals, prm, counters, rng)
     KP.rehash(C, 1)
     KP.tree_path(T, 0, np.empty((4, dof)))
+    KP.goal_distance(q, goals, checker.model.continuous)  # the start's, from Python
 
 
 def _tiny_checker() -> Any:
