@@ -14,8 +14,9 @@ Three steps, each from the URDF's own structure and geometry (no link names):
 
    * pivot: the centroid of the link's collision hull lies off the joint's axis by more
      than :data:`PIVOT_OFF_AXIS` of the hull's largest distance from the axis (a wrist's or
-     flange's roll joint turns a body centred on its axis: 0.00-0.06 on the UR10, the
-     iiwa, the xArm6 and the Jaco; a jaw swings a lever: 0.2-0.5);
+     flange's roll joint turns a body centred on its axis: 0.00-0.05 on the UR10, the
+     iiwa, the xArm6 and the Jaco; a jaw swings a lever: 0.27-0.33 on the Z1, the
+     SO-100/101 and TALOS);
    * counterpart: along the jaw's direction from the axis (the centroid's, perpendicular
      to the axis, with the jaw at the value off-chain joints are frozen at), the hand's
      geometry reaches out at least :data:`COUNTERPART_REACH` of as far as the jaw's. The
