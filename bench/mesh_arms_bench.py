@@ -4,7 +4,8 @@ refereed on their real meshes (issue 35's targets).
 The arms: UR10, Kinova (Jaco 2, ``kinova.urdf``), SO-101, Panda and Z1 from
 ``example-robot-data`` 6.0.0 and the xArm6 and the KUKA iiwa (``kuka_iiwa/model.urdf``)
 from ``pybullet_data``, each with plannerlab's
-defaults (:func:`plannerlab.run.robot_info.default_tip_link`, the covers' defaults).
+defaults (:func:`plannerlab.robots.urdf.tip.default_tip_link`: the tool centre frame, else
+the hand; the covers' defaults).
 
 The problems are made by one method for every arm, sized to its reach ``R`` (the
 farthest tip of 20 000 seeded random states from the base): no number is tuned to an arm.

@@ -4,7 +4,9 @@ For each plan file: the problem's URDF is loaded in PyBullet *as it ships*
 (``useFixedBase``, ``URDF_USE_SELF_COLLISION``; PyBullet resolves its ``package://``
 paths itself), the scene's obstacles are added as collision shapes (boxes, cylinders,
 spheres; a mesh obstacle from its file, scaled, as a concave triangle mesh), and every
-leg's path is interpolated so that no joint moves more than ``--step`` rad (0.005);
+leg's path is interpolated so that no joint moves more than ``--step`` rad (0.005), a
+continuous joint the short way round (as a plan's edges are meant, ``docs/extending.md``;
+which joints are continuous is read from the URDF's XML);
 ``getClosestPoints(robot, obstacle, 0.0)`` at every state; a negative distance is a
 penetration. Joints off the planned chain stay at 0 (clipped into their limits), as
 plannerlab freezes them. Only this script's own code and PyBullet decide; plannerlab is
@@ -88,6 +90,10 @@ def referee(plan_file: Path, step: float) -> list[tuple[int, int, float, str]]:
     )
     index = {c.getJointInfo(body, j)[1].decode(): j for j in range(c.getNumJoints(body))}
     joints = [index[n] for n in robot.joint_names]
+    # top-level joints only (a <transmission> names joints too, without a type)
+    urdf_root = ET.parse(robot.urdf_path).getroot()
+    kind = {j.get("name"): j.get("type") for j in urdf_root.findall("joint")}
+    continuous = np.array([kind.get(n) == "continuous" for n in robot.joint_names], dtype=bool)
     for j in range(c.getNumJoints(body)):  # joints off the chain: 0 within limits
         info = c.getJointInfo(body, j)
         if j not in joints and info[2] != pybullet.JOINT_FIXED:
@@ -127,8 +133,10 @@ def referee(plan_file: Path, step: float) -> list[tuple[int, int, float, str]]:
             continue
         states = [path[:1]]
         for a, b in zip(path[:-1], path[1:], strict=True):
-            n = max(1, int(np.ceil(np.max(np.abs(b - a)) / step)))
-            states.append(a + (b - a) * (np.arange(1, n + 1)[:, None] / n))
+            d = b - a  # a continuous joint the short way round
+            d = np.where(continuous, (d + np.pi) % (2 * np.pi) - np.pi, d)
+            n = max(1, int(np.ceil(np.max(np.abs(d)) / step)))
+            states.append(a + d * (np.arange(1, n + 1)[:, None] / n))
         Q = np.concatenate(states)
         best, where = QUERY_M, ""
         for q in Q:

@@ -135,7 +135,7 @@ def add_parser(sub: Any) -> None:
         "the load time; writes those pairs as an SRDF ([robot] srdf reads it).",
     )
     p.add_argument("urdf", help="the URDF file")
-    p.add_argument("--tip", help="the tip link (default: the end of the longest joint chain)")
+    p.add_argument("--tip", help="the tip link (default: the tool centre frame, else the hand)")
     p.add_argument("--srdf", help="where to write the SRDF (default: ./<URDF name>.srdf)")
     p.add_argument("--states", type=int, default=1000, help="random states sampled for pairs")
     p.add_argument(

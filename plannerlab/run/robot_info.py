@@ -3,8 +3,10 @@ cover of each collision mesh (primitives, worst excess), the self-collision pair
 computes (:func:`plannerlab.run.srdf.disabled_pairs`) and the SRDF it writes, and how
 long loading took.
 
-The tip link, when not given, is the end of the arm (:func:`default_tip_link`): where the
-chain of movable joints from the root ends or branches (a gripper's fingers).
+The tip link, when not given, is the end of the arm (:func:`default_tip_link`, from
+:mod:`plannerlab.robots.urdf.tip`): the tool centre frame where the URDF names one, else
+the hand where the chain of movable joints ends or branches (a gripper's fingers), never a
+single moving jaw.
 """
 
 from __future__ import annotations
@@ -18,8 +20,8 @@ from typing import Any
 
 import numpy as np
 
-from plannerlab.errors import PlannerlabError
-from plannerlab.robots.urdf.model import MOVABLE, UrdfChain
+from plannerlab.robots.urdf.model import UrdfChain
+from plannerlab.robots.urdf.tip import default_tip_link
 from plannerlab.run.srdf import DisabledPair, disabled_pairs, write_srdf
 
 
@@ -53,47 +55,6 @@ class RobotReport:
     notes: tuple[str, ...]
 
 
-def default_tip_link(urdf: Path) -> str:
-    """The end of the arm: from the URDF's root, down the one child whose subtree holds
-    the most movable joints, stopping where two children each hold movable joints (a
-    gripper's fingers) or none does."""
-    try:
-        root = ET.parse(urdf).getroot()
-    except (OSError, ET.ParseError) as exc:
-        raise PlannerlabError(f"{urdf}: expected a readable URDF (XML): {exc}") from None
-    links = [e.get("name", "") for e in root.findall("link")]
-    if not links:
-        raise PlannerlabError(f"{urdf}: expected a URDF with links; it has none")
-    children: dict[str, list[tuple[str, bool]]] = {n: [] for n in links}
-    has_parent = set()
-    for j in root.findall("joint"):
-        p, c = j.find("parent"), j.find("child")
-        if p is not None and c is not None and p.get("link") in children:
-            children[p.get("link", "")].append((c.get("link", ""), j.get("type") in MOVABLE))
-            has_parent.add(c.get("link", ""))
-    memo: dict[str, int] = {}
-
-    def movable_below(link: str, seen: frozenset[str] = frozenset()) -> int:
-        if link not in memo:
-            memo[link] = sum(
-                int(m) + movable_below(c, seen | {link})
-                for c, m in children.get(link, [])
-                if c not in seen
-            )
-        return memo[link]
-
-    tops = [n for n in links if n not in has_parent]
-    link = max(tops, key=movable_below)
-    if movable_below(link) == 0:
-        raise PlannerlabError(f"{urdf}: expected movable joints; it has none")
-    while True:
-        held = [(c, int(m) + movable_below(c)) for c, m in children.get(link, [])]
-        moving = [h for h in held if h[1] > 0]
-        if len(moving) != 1:
-            return link
-        link = moving[0][0]
-
-
 def robot_report(
     urdf: str | Path,
     tip_link: str | None = None,
@@ -112,7 +73,7 @@ def robot_report(
             which file, link and key).
     """
     path = Path(urdf)
-    tip = tip_link or default_tip_link(path)
+    tip = tip_link or default_tip_link(path, tuple(chain_args.get("mesh_paths", ())))
     with tempfile.TemporaryDirectory() as tmp:
         if chain_args.get("cover_cache") is False:
             # the pairs rebuild the chain: its covers from a cache of this call only
