@@ -26,6 +26,7 @@ from plannerlab.collision.edges import edge_check, edge_count, edge_delta, edge_
 from plannerlab.collision.one_lanes import checker_tables, open_one
 from plannerlab.collision.one_state import one_valid
 from plannerlab.collision.queries import open_packed
+from plannerlab.collision.simd import unliteral
 
 #: edge statuses: every state asked is valid / one is invalid / the check limit came first
 FREE, BLOCKED, LIMIT = 0, 1, 2
@@ -132,7 +133,7 @@ def edge_reach(ck, q_a, q_b, joint_step, min_fraction, stride, limit, dq):
     n = edge_count(d, joint_step, ck[0].edge_weights)
     nc = (n + stride - 1) // stride  # the states looked at: min(i · stride, n), i = 1 … nc
     m = min(int(min_fraction * n) // stride + 1, nc)  # the first beyond the fraction
-    status, checks = _block(ck, q_a, dq, (0, m), n, stride, limit)
+    status, checks = _block(ck, q_a, dq, unliteral((0, m)), n, stride, limit)
     if status == LIMIT:
         return LIMIT, 0, n, checks
     if status == BLOCKED:
