@@ -29,6 +29,7 @@ from numba import njit
 
 from plannerlab.collision.geometry import capsule_obstacle, seg_seg
 from plannerlab.collision.kernels import box_gap, link_boxes
+from plannerlab.collision.simd import unliteral
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
@@ -58,7 +59,14 @@ def previous_min_clearance(segs, geo, include_self):
                 if g > 0.0 and g >= best:
                     continue
                 dist, _ = capsule_obstacle(
-                    (kinds, Rs, cs, hs), oi, seg[li, 0], seg[li, 1], radii[li], False, nv, w
+                    (kinds, Rs, cs, hs),
+                    oi,
+                    seg[li, 0],
+                    seg[li, 1],
+                    radii[li],
+                    unliteral(False),
+                    nv,
+                    w,
                 )
                 if dist < best:
                     best = dist

@@ -312,9 +312,10 @@ class ChainDescent:
         steps, _, _ = kernel(
             np.ascontiguousarray(q_seed, dtype=np.float64).reshape(self.dof),
             self._arrays,
-            IkGoal(
-                np.ascontiguousarray(goal.p_world_m, dtype=np.float64),
-                np.ascontiguousarray(goal.n_world, dtype=np.float64),
+            IkGoal(  # fresh writable copies: a goal's read-only arrays would be another
+                # signature than the warm-up's, compiled again (~2 s on a cold cache)
+                np.array(goal.p_world_m, dtype=np.float64),
+                np.array(goal.n_world, dtype=np.float64),
                 float(goal.pos_tol_m),
                 math.radians(float(goal.angle_tol_deg)),
             ),

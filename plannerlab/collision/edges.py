@@ -40,7 +40,7 @@ import math
 
 import numpy as np
 
-from plannerlab.collision.simd import kernel
+from plannerlab.collision.simd import kernel, unliteral
 from plannerlab.collision.state_test import (
     ANY_HIT,
     W,
@@ -127,7 +127,7 @@ def _load_stretches(m, Z, E, q_ad, stack, top, most):
     los, mids, his = E
     qa, d, n = q_ad
     q = Z.edge_q
-    k = 0
+    k = unliteral(0)
     while k < most and top > 0:
         top -= 1
         lo, hi = stack[top, 0], stack[top, 1]
@@ -147,7 +147,7 @@ def edge_check(m, Z, qa, qb, joint_step, limit):
     """Check edge qa -> qb on the grid (see the module). Z: the state test's scratch
     (:func:`~plannerlab.collision.state_test.lanes`). Returns ``(status, checks, n)``:
     FREE, INVALID or LIMIT, the lanes tested, the grid's number of states."""
-    return edge_span(m, Z, (qa, qb), joint_step, (1, -1), limit)
+    return edge_span(m, Z, (qa, qb), joint_step, unliteral((1, -1)), limit)
 
 
 @kernel
@@ -165,7 +165,7 @@ def edge_span(m, Z, ends, joint_step, span, limit):
     set_rates(m, Z, rate)
     first, last = max(span[0], 1), (n if span[1] < 0 else min(span[1], n))
     # the first stretches: [first, last] cut into at most W pieces
-    top = _push_pieces(stack, 0, first, last, W)
+    top = _push_pieces(stack, unliteral(0), first, last, unliteral(W))
     checks = 0
     while top > 0:
         if checks >= limit:
@@ -175,7 +175,7 @@ def edge_span(m, Z, ends, joint_step, span, limit):
         most = min(W, limit - checks)
         k, top = _load_stretches(m, Z, (los, mids, his), (qa, d, n), stack, top, most)
         fill_lanes(Z, k)
-        free, hit, _ = test_lanes(m, Z, ANY_HIT)
+        free, hit, _ = test_lanes(m, Z, unliteral(ANY_HIT))
         checks += k
         if hit & ((1 << k) - 1):
             return INVALID, checks, n  # a grid state collides
@@ -217,7 +217,7 @@ def edge_rake(m, Z, qa, qb, joint_step, stride, limit):
         if checks >= limit:
             return LIMIT, checks, n, False
         b = min(W, pieces - done, limit - checks)
-        top = 0
+        top = unliteral(0)
         for r in range(b):
             p = pieces - done - b + r
             stack[top, 0] = 1 + (p * n) // pieces
@@ -226,7 +226,7 @@ def edge_rake(m, Z, qa, qb, joint_step, stride, limit):
         done += b
         k, _ = _load_stretches(m, Z, (los, mids, his), (qa, d, n), stack, top, b)
         fill_lanes(Z, k)
-        free, hit, _ = test_lanes(m, Z, ANY_HIT)
+        free, hit, _ = test_lanes(m, Z, unliteral(ANY_HIT))
         checks += k
         if hit & ((1 << k) - 1):
             return INVALID, checks, n, False

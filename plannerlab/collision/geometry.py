@@ -284,9 +284,9 @@ def capsule_obstacle(obstacles, o, a, b, r, want_normal, n_out, w):
         if d2 > 0.0:
             sd = math.sqrt(d2)
         else:
-            sd, t = seg_sd_min(0, p0, p1, h, -np.inf)
+            sd, t = seg_sd_min(kind, p0, p1, h, -np.inf)
     else:
-        sd, t = seg_sd_min(1, p0, p1, h, -np.inf)
+        sd, t = seg_sd_min(kind, p0, p1, h, -np.inf)
     if want_normal:
         x = p0[0] + t * (p1[0] - p0[0])
         y = p0[1] + t * (p1[1] - p0[1])
@@ -354,5 +354,5 @@ def capsule_obstacle_hit(kind, R, c, h, a, b, r, w):
     lim = r + h[0]
     if d2 > lim * lim:
         return False
-    sd, _ = seg_sd_min(1, p0, p1, h, r)
+    sd, _ = seg_sd_min(kind, p0, p1, h, r)
     return sd <= r

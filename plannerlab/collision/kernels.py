@@ -24,6 +24,7 @@ import numpy as np
 from numba import njit
 
 from plannerlab.collision.geometry import capsule_obstacle, capsule_obstacle_hit, seg_seg
+from plannerlab.collision.simd import unliteral
 
 
 class PairGeometry(NamedTuple):
@@ -296,7 +297,7 @@ def pair_distances_kernel(seg, geo, margin):
             if touch[li, oi] or not _overlap(lo, hi, li, olo, ohi, oi, pad):
                 continue
             dist, t = capsule_obstacle(
-                (kinds, Rs, cs, hs), oi, seg[li, 0], seg[li, 1], radii[li], True, nv, w
+                (kinds, Rs, cs, hs), oi, seg[li, 0], seg[li, 1], radii[li], unliteral(True), nv, w
             )
             if dist < margin:
                 idx[m, 0] = li
@@ -414,7 +415,14 @@ def _scene_min(seg, geo, boxes, best):
                 if g > 0.0 and g >= best:
                     continue
                 dist, _ = capsule_obstacle(
-                    (kinds, Rs, cs, hs), oi, seg[li, 0], seg[li, 1], radii[li], False, nv, w
+                    (kinds, Rs, cs, hs),
+                    oi,
+                    seg[li, 0],
+                    seg[li, 1],
+                    radii[li],
+                    unliteral(False),
+                    nv,
+                    w,
                 )
                 if dist < best:
                     best = dist

@@ -24,7 +24,7 @@ from plannerlab.collision._unpacked import unpack_lanes, unpack_model
 from plannerlab.collision.edges import edge_check, edge_count, edge_delta, edge_state
 from plannerlab.collision.exact import frames64
 from plannerlab.collision.kinematics import place
-from plannerlab.collision.simd import kernel
+from plannerlab.collision.simd import kernel, unliteral
 from plannerlab.collision.state_test import (
     ANY_HIT,
     EVERY_LANE,
@@ -111,7 +111,7 @@ def edge(P, qa, qb, joint_step, limits):
             edge_state(qa, d, s0 + j + 1, n, q)
             load_state(Z, j, q, m.continuous)
         fill_lanes(Z, nn)
-        free, _, _ = test_lanes(m, Z, EVERY_LANE)
+        free, _, _ = test_lanes(m, Z, unliteral(EVERY_LANE))
         for j in range(nn):
             if not (free >> j) & 1:
                 return n, s0 + j, 0
@@ -142,7 +142,7 @@ def tip(P, q, body, tip_p, out):
     normal, in the world."""
     m, Z = _open(P)
     frames64(m, Z, q)
-    x, y, z = place(Z.e_F, body, tip_p, 0, 0)
+    x, y, z = place(Z.e_F, body, tip_p, unliteral(0), 0)
     out[0, 0], out[0, 1], out[0, 2] = x, y, z
     F = Z.e_F
     o = 12 * body

@@ -44,6 +44,28 @@ kernel: Any = cast(Any, njit)(cache=True, nogil=True, _nrt=False)
 #: the same, inlined into its caller by numba (the state test's passes: out of line each
 #: call handed over the model and the scratch, some 80 arrays, on the stack)
 inline_kernel: Any = cast(Any, njit)(cache=True, nogil=True, inline="always", _nrt=False)
+
+
+@intrinsic
+def unliteral(typingctx, x):
+    """``x`` as a run-time value: a constant's plain type (int64, bool, a tuple of them)
+    instead of numba's ``Literal[int](1)``. A kernel is compiled once per distinct argument
+    types, and numba types a constant argument as its literal, so a kernel called with
+    ``ANY_HIT`` in one place, ``EVERY_LANE`` in another and a variable in a third is
+    compiled three times (the state test: ~5 s each on a cold cache). Pass constants
+    through this where a kernel is also called with other values; a variable first bound
+    to a constant and then changed in a loop (``top = 0 ... top += 1``) is typed as the
+    literal too for a first, wasted compile, so bind it as ``unliteral(0)``. The value
+    stays a constant in the caller's LLVM code: where LLVM inlines the callee it still
+    folds it."""
+    ty = types.unliteral(x)
+
+    def codegen(context, builder, sig, args):
+        return context.cast(builder, args[0], sig.args[0], sig.return_type)
+
+    return ty(x), codegen
+
+
 _F32 = ir.FloatType()
 _VEC = ir.VectorType(_F32, LANES)
 _MASK = ir.VectorType(ir.IntType(1), LANES)
@@ -513,6 +535,7 @@ select: Any = _select
 __all__ = [
     "LANES",
     "kernel",
+    "unliteral",
     "like",
     "width",
     "bits_mask",

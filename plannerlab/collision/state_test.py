@@ -71,6 +71,7 @@ from plannerlab.collision.simd import (
     mask_bits,
     splat,
     store,
+    unliteral,
     vmax,
 )
 
@@ -321,12 +322,12 @@ def _scene_pass(m, Z, mode, hu):
                 for c in range(m.body_cls[b], m.body_cls[b + 1]):
                     if cls[c, 3] < 0.0:
                         continue
-                    _place_cluster(F, X, K, c, tables, 1)
+                    _place_cluster(F, X, K, c, tables, unliteral(1))
                     kx, ky, kz = _slot3(K, c)
                     rc = fma(grow, splat(Z.crate[c]), splat(cls[c, 3]) + eps)
                     if not _near(_point_d2(kind, O, o, kx, ky, kz), rc, _ALL & ~hu[0]):
                         continue
-                    _place_cluster(F, X, K, c, tables, 2)
+                    _place_cluster(F, X, K, c, tables, unliteral(2))
                     for l in range(m.cl_caps[c], m.cl_caps[c + 1]):
                         if not m.cap_moving[l]:
                             continue
@@ -369,7 +370,7 @@ def _pairs_in(T, q0, q1, cv, eps, grow, plain, hm):
                 rg = splat(caps[i, 7] + cls[cv, 4]) + eps
                 if not plain:
                     rg = fma(grow, splat(rate[i] + crate[cv]), rg)
-                skip = not _near(_gap2(X, 6 * i * W, K, 3 * cv * W), rg, _ALL)
+                skip = not _near(_gap2(X, 6 * i * W, K, 3 * cv * W), rg, unliteral(_ALL))
         if skip:
             continue
         r0 = splat(caps[i, 7] + caps[j, 7])
@@ -430,21 +431,21 @@ def _self_pass(m, Z, mode, hu):
             for gp in range(m.bpair_gstart[p], m.bpair_gstart[p + 1]):
                 gu, gv = m.gpairs[gp, 0], m.gpairs[gp, 1]
                 if m.gpairs[gp, 2]:  # a group's centre is placed like a cluster's (placed 1)
-                    _place_cluster(F, X, K, gu, tables, 1)
-                    _place_cluster(F, X, K, gv, tables, 1)
+                    _place_cluster(F, X, K, gu, tables, unliteral(1))
+                    _place_cluster(F, X, K, gv, tables, unliteral(1))
                     r = fma(grow, splat(cr[gu] + cr[gv]), splat(cls[gu, 4] + cls[gv, 4]) + eps)
                     if not _near(_gap2(K, 3 * gu * W, K, 3 * gv * W), r, meet & ~hu[0]):
                         continue
                 for cp in range(m.gpair_start[gp], m.gpair_start[gp + 1]):
                     cu, cv = m.clpairs[cp, 0], m.clpairs[cp, 1]
                     if cu != cv:
-                        _place_cluster(F, X, K, cu, tables, 1)
-                        _place_cluster(F, X, K, cv, tables, 1)
+                        _place_cluster(F, X, K, cu, tables, unliteral(1))
+                        _place_cluster(F, X, K, cv, tables, unliteral(1))
                         r = fma(grow, splat(cr[cu] + cr[cv]), splat(cls[cu, 4] + cls[cv, 4]) + eps)
                         if not _near(_gap2(K, 3 * cu * W, K, 3 * cv * W), r, meet & ~hu[0]):
                             continue
-                    _place_cluster(F, X, K, cu, tables, 2)
-                    _place_cluster(F, X, K, cv, tables, 2)
+                    _place_cluster(F, X, K, cu, tables, unliteral(2))
+                    _place_cluster(F, X, K, cv, tables, unliteral(2))
                     q0, q1 = m.clpair_start[cp], m.clpair_start[cp + 1]
                     hm = _pairs_in(pair_tables, q0, q1, cv, eps, grow, plain, hm)
             hu = (
@@ -474,7 +475,7 @@ def test_lanes(m, Z, mode):
     for c in range(Z.placed.shape[0]):
         Z.placed[c] = 0
     frames32(m, Z)
-    hu, stop = _scene_pass(m, Z, mode, (0, 0, 0))
+    hu, stop = _scene_pass(m, Z, mode, unliteral((0, 0, 0)))
     if stop:
         return 0, hu[0], 0
     hu, stop = _self_pass(m, Z, mode, hu)
@@ -508,7 +509,7 @@ def valid_batch(m, Q, out):
         for j in range(nn):
             load_state(Z, j, Q[s0 + j], m.continuous)
         fill_lanes(Z, nn)
-        free, _, c = test_lanes(m, Z, EVERY_LANE)
+        free, _, c = test_lanes(m, Z, unliteral(EVERY_LANE))
         confirmed += c
         for j in range(nn):
             out[s0 + j] = (free >> j) & 1
@@ -518,9 +519,9 @@ def valid_batch(m, Q, out):
 @kernel
 def valid_one(m, Z, q):
     """One state q (dof,) is valid (in lane 0; Z's growth must be plain)."""
-    load_state(Z, 0, q, m.continuous)
+    load_state(Z, unliteral(0), q, m.continuous)
     fill_lanes(Z, 1)
-    free, _, _ = test_lanes(m, Z, ANY_HIT)
+    free, _, _ = test_lanes(m, Z, unliteral(ANY_HIT))
     return (free & 1) != 0
 
 

@@ -46,7 +46,7 @@ from plannerlab.collision.edges import (
     edge_delta,
     edge_rake,
 )
-from plannerlab.collision.simd import kernel
+from plannerlab.collision.simd import kernel, unliteral
 from plannerlab.planners.native.kdtree import DEAD, kd_catch_up, kd_insert, kd_nearest
 
 # ---------------------------------------------------------------------- return codes
@@ -318,7 +318,9 @@ def _certify(S, A, B, ab, sizes, joint_step, limit):
         T, c = (A, ab[0]) if t == 0 else (B, ab[1])
         while T.P[c] >= 0:
             if T.F[c] == COARSE:
-                status, k, _ = _tree_edge(S, T, c, t == 1, joint_step, (limit - checks, 1))
+                status, k, _ = _tree_edge(
+                    S, T, c, t == 1, joint_step, (limit - checks, unliteral(1))
+                )
                 checks += k
                 if status == LIMIT:
                     return LIMIT, checks
@@ -444,7 +446,7 @@ def rrtc_run(S, A, B, sizes, O, counters, limits):
             t = 1 - t  # balanced: the tree of at most half the other's nodes grows
         counters[2] = 1 - t
         Tt, To = (A, B) if t == 0 else (B, A)
-        code, c, _ = _grow(S, Tt, sizes[t], t == 1, -1, q_rand, O, hard - counters[1])
+        code, c, _ = _grow(S, Tt, sizes[t], t == 1, unliteral(-1), q_rand, O, hard - counters[1])
         counters[1] += c
         if code == 3:
             return HARD
@@ -455,7 +457,7 @@ def rrtc_run(S, A, B, sizes, O, counters, limits):
         # connect the other tree to q_new: after a step, its nearest node to q_new is the
         # node just added (it lies on the segment from the previous nearest)
         o = 1 - t
-        near = -2  # the nearest node, no dynamic domain for a connection
+        near = unliteral(-2)  # the nearest node, no dynamic domain for a connection
         while True:
             code, c, _ = _grow(S, To, sizes[o], o == 1, near, q_new, O, hard - counters[1])
             counters[1] += c

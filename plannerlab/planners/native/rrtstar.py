@@ -22,7 +22,7 @@ from typing import NamedTuple
 import numpy as np
 
 from plannerlab.collision.edges import FREE, LIMIT, edge_check
-from plannerlab.collision.simd import kernel
+from plannerlab.collision.simd import kernel, unliteral
 from plannerlab.planners.base import PlanResult, Status
 from plannerlab.planners.native import kernels as K
 from plannerlab.planners.native.solve import (
@@ -289,7 +289,7 @@ def rrtstar_run(S, T, X, sizes, O, counters, limits):
         if Q.shape[0] - sizes[0] < 3 or T.goal_nodes.shape[0] - sizes[1] < 2:
             return K.FULL
         if counters[0] == 0:  # the start straight to a goal state
-            status, c = _connect_goal(S, T, X, sizes, 0, O, hard - counters[1])
+            status, c = _connect_goal(S, T, X, sizes, unliteral(0), O, hard - counters[1])
             counters[1] += c
             if status == LIMIT:
                 return K.HARD

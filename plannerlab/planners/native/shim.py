@@ -36,6 +36,7 @@ from plannerlab.collision.edges import (
 from plannerlab.collision.one_lanes import checker_tables, open_one
 from plannerlab.collision.one_state import one_valid
 from plannerlab.collision.queries import open_packed
+from plannerlab.collision.simd import unliteral
 
 #: edge statuses: every state asked is valid / one is invalid / the check limit came first
 FREE, BLOCKED, LIMIT = 0, 1, 2
@@ -155,7 +156,7 @@ def edge_reach(ck, q_a, q_b, joint_step, min_fraction, stride, limit, dq):
     n = edge_count(d, joint_step, ck[0].edge_weights)
     nc = (n + stride - 1) // stride  # the states looked at: min(i · stride, n), i = 1 … nc
     m = min(int(min_fraction * n) // stride + 1, nc)  # the first beyond the fraction
-    status, checks = _block(ck, (q_a, q_b), dq, (0, m), (n, stride, joint_step), limit)
+    status, checks = _block(ck, (q_a, q_b), dq, unliteral((0, m)), (n, stride, joint_step), limit)
     if status == LIMIT:
         return LIMIT, 0, n, checks
     if status == BLOCKED:
