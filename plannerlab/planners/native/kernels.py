@@ -116,8 +116,7 @@ class Options(NamedTuple):
     guide_sigma_rad, range_rad, joint_step), the dynamic domain ``dd`` = (radius,
     min_radius, alpha) (radius 0: none), ``i`` = (max_iterations, need_free, every: the
     coarse check's stride, 1 for every edge in full at once; balance: 1 to grow the
-    smaller tree while it has at most half the other's nodes; connect_on: 1 for the grown
-    tree to connect on towards the other tree, 0 for the other towards it)."""
+    smaller tree while it has at most half the other's nodes)."""
 
     guides: np.ndarray
     f: np.ndarray
@@ -391,48 +390,6 @@ def _added(S, T, sizes, t):
 
 
 @kernel
-def _connect_on(S, AB, sizes, t, new_t, O, counters, limits):
-    """The connection of ``O.i[4]`` (VAMP's RRT-Connect): tree ``t``, just grown to node
-    ``new_t``, goes on from it towards the other tree's nearest node to it, step by step
-    (each at most ``range_rad``), every free step a node of tree ``t``, until it reaches
-    that node (a path: the trees meet in equal states) or a step is not free. A tree in a
-    pocket so grows towards the other tree after each of its extensions, not only by
-    steps towards uniform samples, of which few are free there. Returns -1 to go on with
-    the next iteration, else :func:`rrtc_run`'s code (DONE, CHUNK, HARD)."""
-    A, B = AB
-    soft, hard = limits[0], limits[1]
-    Tt, To = (A, B) if t == 0 else (B, A)
-    o = 1 - t
-    target = _nearest(S, To, sizes[o], Tt.Q[new_t])
-    if target < 0:
-        return -1
-    last = new_t
-    while True:
-        code, c, _ = _grow(S, Tt, sizes[t], t == 1, last, To.Q[target], O, hard - counters[1])
-        counters[1] += c
-        if code == 3:
-            return HARD
-        if code == 0:
-            return -1
-        last = _added(S, Tt, sizes, t)
-        if code == 2:
-            a = last if t == 0 else target
-            b = target if t == 0 else last
-            status, c = _certify(S, A, B, (a, b), sizes, O.f[3], hard - counters[1])
-            counters[1] += c
-            if status == LIMIT:
-                return HARD
-            if status == INVALID:  # a state between the coarse ones collides: search on
-                counters[5] += 1
-                return -1
-            counters[3] = a
-            counters[4] = b
-            return DONE
-        if counters[1] >= soft:  # the connection so far stays (checked nodes)
-            return CHUNK
-
-
-@kernel
 def rrtc_run(S, A, B, sizes, O, counters, limits):
     """RRT-Connect iterations until a path, a limit, or a full tree.
 
@@ -456,8 +413,6 @@ def rrtc_run(S, A, B, sizes, O, counters, limits):
     ``O.i[3]`` (balance, VAMP's default) and one tree has at most half the other's nodes:
     then the smaller one grows (a goal tree in a pocket gets the iterations, not the start
     tree sprawling outside).
-    With ``O.i[4]`` (VAMP's connection) the tree just grown connects on from its new node
-    towards the other tree's nearest node (:func:`_connect_on`) instead.
 
     Limits: ``O.i[0]`` iterations (total), ``limits`` = (soft, hard) total checks: the
     soft one ends this call (:data:`CHUNK`) between two edges (a connection stops where
@@ -497,14 +452,9 @@ def rrtc_run(S, A, B, sizes, O, counters, limits):
             continue
         new_t = _added(S, Tt, sizes, t)
         q_new = Tt.Q[new_t]
-        o = 1 - t
-        if O.i[4] != 0:  # the grown tree goes on from q_new towards the other (VAMP's)
-            code = _connect_on(S, (A, B), sizes, t, new_t, O, counters, limits)
-            if code >= 0:
-                return code
-            continue
         # connect the other tree to q_new: after a step, its nearest node to q_new is the
         # node just added (it lies on the segment from the previous nearest)
+        o = 1 - t
         near = -2  # the nearest node, no dynamic domain for a connection
         while True:
             code, c, _ = _grow(S, To, sizes[o], o == 1, near, q_new, O, hard - counters[1])

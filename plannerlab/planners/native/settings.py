@@ -98,12 +98,6 @@ class RRTConnectSettings(NativeSettings):
             average and 3.8x less CPU, the others 1.6x fewer; the Fetch solves 47 of 54
             valid problems in 10 s of CPU where alternating solved 42; Arm-Z's traps are
             as before and ``armz_deep_e`` is solved on 3 of 5 seeds (0 of 5).
-        connect_on: after a tree grows a node, that same tree connects on from it
-            towards the other tree's nearest node, step by step, every free step a node
-            (VAMP's RRT-Connect, ``rrtc.hh``), instead of the other tree connecting
-            towards the new node (OMPL's). A tree in a pocket then grows towards the
-            other tree after each of its extensions, not only towards uniform samples,
-            of which few are free from inside a pocket.
     """
 
     lazy_every: int = 16
@@ -112,7 +106,6 @@ class RRTConnectSettings(NativeSettings):
     level_checks: int = 16384
     restart_cycles: int = 1
     balance: bool = True
-    connect_on: bool = False
 
 
 @dataclass(frozen=True)

@@ -275,7 +275,6 @@ class NativeSolve:
                     need_free,
                     int(getattr(s, "lazy_every", 1)),
                     int(getattr(s, "balance", False)),
-                    int(getattr(s, "connect_on", False)),
                 ],
                 dtype=np.int64,
             ),

@@ -57,7 +57,7 @@ def warm_up(checker: Any | None = None, algorithm: str | None = None) -> None:
     B = K.Tree(Q.copy(), P0.copy(), F.copy(), radii.copy(), Kd.copy())
     O = K.Options(
         np.zeros((0, dof)), np.array([0.0, 0.1, 1.0, 0.1]), np.zeros(3),
-        np.array([0, 1, 1, 0, 0], dtype=np.int64),
+        np.array([0, 1, 1, 0], dtype=np.int64),
     )  # fmt: skip
     limits = np.zeros(2, dtype=np.int64)
     K.rrtc_entry(P, aux, A, B, np.array([1, 1]), O, np.zeros(6, dtype=np.int64), limits)
