@@ -153,6 +153,7 @@ def run_cpp(geometry: Path, planner: str, seed: int, time_limit: float, motion: 
             "status": "did not stop",
             "solved": False,
             "time_s": time_limit,
+            "cpu_s": time_limit,  # (not measured: a failure counts at the limit)
             "checks": 0,
             "path": None,
         }
