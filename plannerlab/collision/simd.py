@@ -47,7 +47,7 @@ inline_kernel: Any = cast(Any, njit)(cache=True, nogil=True, inline="always", _n
 
 
 @intrinsic
-def unliteral(typingctx, x):
+def _unliteral(typingctx, x):
     """``x`` as a run-time value: a constant's plain type (int64, bool, a tuple of them)
     instead of numba's ``Literal[int](1)``. A kernel is compiled once per distinct argument
     types, and numba types a constant argument as its literal, so a kernel called with
@@ -65,6 +65,9 @@ def unliteral(typingctx, x):
 
     return ty(x), codegen
 
+
+#: (typed Any for mypy, as the other intrinsics: called from kernels with one argument)
+unliteral: Any = _unliteral
 
 _F32 = ir.FloatType()
 _VEC = ir.VectorType(_F32, LANES)

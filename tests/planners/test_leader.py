@@ -228,7 +228,12 @@ def test_leaving_a_two_opening_room_succeeds_on_a_check_budget(two_openings):
     assert log["retract"]["reason"] == "slid 9.31 m back along the body to face 12 in 1710 steps"
     assert log["after_retract"]["status"] == "solved"
     assert r.iterations == 1_999
-    assert r.collision_checks == 190_090
+    # the count within 20 checks of its golden, not to the check: the certified stretches
+    # of this 7-leg path compare distances with growths that tie to the last bit on some
+    # stretches, and LLVM's code for one CPU model rounds them otherwise than for another
+    # (190 090 where the golden was pinned, znver4; 190 094 on znver5, the same search,
+    # iterations and path)
+    assert abs(r.collision_checks - 190_090) <= 20, r.collision_checks
     np.testing.assert_allclose(r.path[0], q_b)
     assert bool(problem.goal(leave).contains(problem.robot, r.path[-1]))
     assert problem_checker(problem).check_path(r.path, problem.joint_step / 4).valid
